@@ -1,0 +1,322 @@
+"""Diagnostics: source spans, severities, the registry of stable codes, the error root.
+
+Every problem aou reports is a :class:`Diagnostic` with a code from :data:`RULES`.
+A code is a stage letter plus three digits:
+
+- ``S`` syntax (the Lark parse),
+- ``V`` validation of statements into the IR,
+- ``M`` the Commitment-Vigilance model (lint's judgement of a valid file),
+- ``C`` compilation (layout, geometry, IK, timing, simulation check),
+- ``R`` reading trajectories (``aouc measure``),
+- ``I`` input/output and usage.
+
+Codes are never reused; a retired code stays in :data:`RULES` as an alias.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass, field
+from typing import Any
+
+__all__ = [
+    "AouError",
+    "Diagnostic",
+    "RULES",
+    "Rule",
+    "Severity",
+    "Span",
+    "diag",
+    "has_errors",
+]
+
+
+class Severity(enum.StrEnum):
+    """How serious a diagnostic is. Only errors (and warnings under ``--strict``) fail."""
+
+    ERROR = "error"
+    WARNING = "warning"
+    NOTE = "note"
+
+
+@dataclass(frozen=True, slots=True)
+class Span:
+    """A region of a source file. Lines and columns are 1-based; ``end_*`` is exclusive."""
+
+    path: str
+    line: int
+    col: int
+    end_line: int
+    end_col: int
+
+    @classmethod
+    def point(cls, path: str, line: int, col: int) -> Span:
+        return cls(path, line, col, line, col + 1)
+
+    @classmethod
+    def whole_file(cls, path: str) -> Span:
+        return cls(path, 1, 1, 1, 1)
+
+    def to(self, other: Span) -> Span:
+        """The span from the start of ``self`` to the end of ``other``."""
+        return Span(self.path, self.line, self.col, other.end_line, other.end_col)
+
+    def __str__(self) -> str:
+        return f"{self.path}:{self.line}:{self.col}"
+
+
+@dataclass(frozen=True, slots=True)
+class Rule:
+    """One diagnostic code: its stable name and the text ``aouc rules`` prints."""
+
+    code: str
+    name: str
+    severity: Severity
+    what: str
+    why: str
+    example: str
+
+
+@dataclass(frozen=True, slots=True)
+class Diagnostic:
+    """One problem found in one place.
+
+    Attributes:
+        code: a code of :data:`RULES`.
+        severity: usually the rule's; lint may raise warnings to errors.
+        message: names the expected and the found value.
+        span: where in the source; for trajectories, the file and (line 0) no position.
+        hint: how to fix it, where one helps.
+        fields: structured data for machine consumers (JSON output).
+    """
+
+    code: str
+    severity: Severity
+    message: str
+    span: Span
+    hint: str | None = None
+    fields: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def rule(self) -> Rule:
+        return RULES[self.code]
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "code": self.code,
+            "name": self.rule.name,
+            "severity": str(self.severity),
+            "message": self.message,
+            "path": self.span.path,
+            "line": self.span.line,
+            "col": self.span.col,
+            "end_line": self.span.end_line,
+            "end_col": self.span.end_col,
+            "hint": self.hint,
+            "fields": self.fields,
+        }
+
+
+class AouError(Exception):
+    """The root of every error aou raises. It carries the diagnostics that explain it."""
+
+    def __init__(self, diagnostics: list[Diagnostic] | Diagnostic):
+        self.diagnostics = [diagnostics] if isinstance(diagnostics, Diagnostic) else diagnostics
+        super().__init__("; ".join(f"{d.span}: {d.code} {d.message}" for d in self.diagnostics))
+
+
+def has_errors(diagnostics: list[Diagnostic]) -> bool:
+    return any(d.severity is Severity.ERROR for d in diagnostics)
+
+
+_E, _W, _N = Severity.ERROR, Severity.WARNING, Severity.NOTE
+
+_RULE_LIST = [
+    # --- S: syntax -------------------------------------------------------------------
+    Rule("S001", "unexpected-token", _E,
+         "A token appears where the grammar does not allow it.",
+         "The file cannot be understood past this point.",
+         "pause 1.67s x5 )"),
+    Rule("S002", "unexpected-end", _E,
+         "The file ends in the middle of a statement or block.",
+         "Usually a `sequence {` without its closing `}`.",
+         "sequence {\n  approach a=0.05"),
+    Rule("S003", "unexpected-character", _E,
+         "A character that no token of the language can start with.",
+         "The lexer cannot continue.",
+         "pause 1.67s @5"),
+    # --- V: validation ---------------------------------------------------------------
+    Rule("V101", "unknown-statement", _E,
+         "A statement starts with a word that is not a keyword of the language.",
+         "Only the settings and primitives of docs/language.md exist; typos are common.",
+         "aproach a=0.05   # did you mean `approach`?"),
+    Rule("V102", "wrong-unit-dimension", _E,
+         "A quantity's unit has the wrong dimension for where it is used.",
+         "A pause lasts a time, a retreat covers a length: `pause 3m` is meaningless.",
+         "pause 3m"),
+    Rule("V103", "missing-unit", _E,
+         "A positional quantity (a length, duration or angle) is written without a unit.",
+         "`retreat 6` could be metres or centimetres; aou refuses to guess.",
+         "retreat 6 a=0.12"),
+    Rule("V104", "unknown-unit", _E,
+         "A quantity has a unit aou does not know.",
+         "Only SI units and a few common multiples are accepted (see docs/language.md).",
+         "start 12in"),
+    Rule("V105", "non-positive-value", _E,
+         "A duration, distance, speed, frequency, acceleration or count that must be "
+         "positive is zero or negative.",
+         "A pause of 0 s or a retreat of -6 cm has no motion to compile.",
+         "pause 0s"),
+    Rule("V106", "effort-out-of-range", _E,
+         "An `effort` component lies outside [-1, 1].",
+         "Laban Effort factors run from the Condensing pole (-1) to the Indulging pole (+1).",
+         "effort W=-2 T=-1 S=-1 F=1"),
+    Rule("V107", "duplicate-primitive", _E,
+         "A primitive kind appears twice in the descriptor form.",
+         "All episodes of one kind are equal in the model; use `xN` for more of them, or a "
+         "`sequence { }` block for episodes that differ.",
+         "pause 1s\npause 2s"),
+    Rule("V108", "mixed-forms", _E,
+         "A file has both a `sequence { }` block and descriptor-form primitives.",
+         "The two forms lay out time differently; a file must choose one.",
+         "pause 1s\nsequence { approach }"),
+    Rule("V109", "unknown-robot", _E,
+         "The `robot` setting names a robot aou has no table for.",
+         "aou needs the robot's end-effector frame, default goal and acceleration limits.",
+         "robot panda2"),
+    Rule("V110", "resource-bound", _E,
+         "The behaviour asks for more than 10 minutes of motion or more than 1000 episodes.",
+         "Such a file is almost always a typo (x10000); compiling it would hang.",
+         "pause 1s x5000"),
+    Rule("V111", "duplicate-setting", _E,
+         "A setting (or the header) appears more than once.",
+         "Each setting has one value; the second would silently win.",
+         "start 0.3m\nstart 0.4m"),
+    Rule("V112", "unknown-key", _E,
+         "A `key=value` argument uses a key the statement does not take.",
+         "Each primitive takes a fixed set of keys (docs/language.md).",
+         "pause 1s a=0.1"),
+    Rule("V113", "bad-arguments", _E,
+         "A statement's arguments do not have the expected shape.",
+         "Each statement takes a fixed list of arguments (docs/language.md).",
+         "retreat a=0.12   # missing the distance"),
+    Rule("V114", "unknown-state", _E,
+         "The header declares a state that is not one of the five canonical states.",
+         "The model has exactly five states: confident curious hesitant fearful inactive.",
+         "behaviour b : brave"),
+    Rule("V115", "header-position", _E,
+         "The `behaviour` header is not the first statement of the file.",
+         "The header names the whole file; it must come before anything else.",
+         "pause 1s\nbehaviour b : hesitant"),
+    Rule("V116", "bad-repeat", _E,
+         "An `xN` repeat count is malformed or given twice.",
+         "`xN` takes a whole number N >= 0.",
+         "pause 1s x2.5"),
+    Rule("V117", "start-inside-standoff", _E,
+         "The start distance is not larger than the standoff distance.",
+         "The reach would begin closer to the goal than it is ever allowed to get.",
+         "start 0.05m\nstandoff 0.10m"),
+    Rule("V118", "sign-in-descriptor-form", _E,
+         "A signed or zero angle is given in the descriptor form.",
+         "Descriptor values are amplitudes; directions belong in a `sequence { }` block.",
+         "gaze horizontal -20deg"),
+    Rule("V119", "retreat-beyond-reach", _E,
+         "The retreats would carry the end-effector further from the goal than the robot "
+         "can be asked to go (start distance plus all retreats exceeds 1 m).",
+         "Retreating past the start is allowed but not without bound.",
+         "retreat 0.5m x4"),
+    Rule("V120", "nothing-to-approach", _E,
+         "An `approach` with a length longer than the way left to the standoff.",
+         "The reach never gets closer to the goal than the standoff.",
+         "start 0.3m\nsequence { approach 0.5m }"),
+    # --- M: the C-V model --------------------------------------------------------------
+    Rule("M201", "state-mismatch", _W,
+         "The state inferred from the behaviour's primitives differs from the declared one.",
+         "People read the motion, not the header: a `hesitant` file that moves confidently "
+         "will be seen as confident.",
+         "behaviour b : hesitant\napproach a=0.1"),
+    Rule("M202", "effort-mismatch", _W,
+         "The `effort` line's (C, V) point lies nearest to another state than the declared one.",
+         "The Effort vector and the declared state contradict each other.",
+         "behaviour b : fearful\neffort W=-1 T=-1 S=-1 F=1"),
+    Rule("M203", "no-perceived-effect", _N,
+         "A descriptor that the study found to have no clear perceived effect on this state.",
+         "Tuning it will probably not change how people read the behaviour (MODEL.md s7).",
+         "behaviour b : fearful\nshiver 6deg"),
+    Rule("M204", "inferred-state", _N,
+         "The state inferred for a file that declares none.",
+         "Without a header aou cannot check intent, so it says what the motion expresses.",
+         "approach a=0.1"),
+    # --- C: compilation --------------------------------------------------------------
+    Rule("C301", "unreachable", _E,
+         "Inverse kinematics found no configuration that reaches a pose of the path.",
+         "The goal, start or an exploration arc lies outside the robot's workspace.",
+         "goal (2.0, 0, 0.3)"),
+    Rule("C302", "joint-limit", _E,
+         "A pose of the path is only reachable with a joint at or beyond its position limit.",
+         "The trajectory would be stopped by the controller, or worse.",
+         "gaze horizontal 170deg"),
+    Rule("C303", "singularity", _E,
+         "The path passes through (or too near) a kinematic singularity.",
+         "Near a singularity small Cartesian motions need huge joint speeds.",
+         "goal (0.0, 0, 1.2)"),
+    Rule("C304", "acceleration-unattainable", _W,
+         "The declared end-effector acceleration cannot be reached within the joint limits; "
+         "the compiled motion peaks lower, and the binding joint is named.",
+         "The measured descriptor will differ from the declared one.",
+         "retreat 0.06m a=50"),
+    Rule("C305", "timing-failed", _E,
+         "TOPP-RA found no feasible time parametrisation of a path segment.",
+         "The limits cannot all be met on this path.",
+         "approach v=1e-9"),
+    Rule("C306", "check-failed", _E,
+         "The compiled trajectory failed a simulation check (limits, collision, target contact).",
+         "A trajectory that fails a check is never written: it is not safe to send to an arm.",
+         "standoff 0.0m"),
+    Rule("C307", "speed-cap-unattainable", _W,
+         "A `v=` speed cap is higher than the motion can reach in the distance available.",
+         "The cap has no effect; the motion peaks lower.",
+         "approach v=5"),
+    # --- R: reading trajectories -------------------------------------------------------
+    Rule("R401", "bad-trajectory", _E,
+         "A trajectory file is not valid: missing keys or columns, non-increasing time, NaN.",
+         "Descriptors cannot be measured from it.",
+         '{"format": "aou-trajectory/1", "t": [0, 0]}'),
+    Rule("R402", "unknown-joint", _E,
+         "A trajectory names a joint that the robot model does not have.",
+         "Forward kinematics needs every column to map onto a joint of the model.",
+         "t,panda_joint9"),
+    Rule("R403", "unequal-episodes", _W,
+         "Episodes of one kind measure different values; the model assumes they are equal.",
+         "The reported descriptor is their mean; per-episode values are in the JSON output.",
+         "two retreats of 4 cm and 8 cm"),
+    # --- I: input/output and usage -----------------------------------------------------
+    Rule("I501", "cannot-read", _E,
+         "An input file or folder cannot be read (missing, a directory, permissions, encoding).",
+         "Nothing can be checked or compiled.",
+         "aouc lint missing.aou"),
+    Rule("I502", "cannot-write", _E,
+         "An output file cannot be written, or would overwrite an input.",
+         "aou writes atomically and never overwrites its inputs.",
+         "aouc compile a.aou -o a.aou"),
+    Rule("I503", "no-inputs", _E,
+         "A folder given on the command line holds no `.aou` files.",
+         "Probably the wrong folder.",
+         "aouc lint empty/"),
+]
+
+RULES: dict[str, Rule] = {r.code: r for r in _RULE_LIST}
+
+
+def diag(
+    code: str,
+    message: str,
+    span: Span,
+    *,
+    hint: str | None = None,
+    severity: Severity | None = None,
+    **fields: Any,
+) -> Diagnostic:
+    """Build a diagnostic of rule ``code``, with the rule's severity unless overridden."""
+    rule = RULES[code]
+    return Diagnostic(code, severity or rule.severity, message, span, hint, dict(fields))

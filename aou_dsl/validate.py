@@ -1,0 +1,593 @@
+"""Stage 2, validate: syntax tree -> :class:`~aou_dsl.ir.Behaviour`, with diagnostics.
+
+The validator reports every problem it can find in one pass (not just the first),
+each with the span of the offending token. It returns ``None`` for the behaviour when
+any error was found.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+from .diagnostics import Diagnostic, Span, diag
+from .ir import (
+    DEFAULTS,
+    Approach,
+    Behaviour,
+    Effort,
+    Gaze,
+    Pause,
+    Primitive,
+    Retreat,
+    Settings,
+    Shiver,
+    State,
+    Tilt,
+)
+from .parse import Colon, KeyVal, Quantity, SequenceBlock, Statement, SyntaxTree, Vector, Word
+from .robots import ROBOTS
+from .units import SI_UNIT, UNITS, Dim, units_for
+
+__all__ = ["MAX_EPISODES", "MAX_MOTION_TIME", "MIN_PAUSE", "estimate_duration", "validate"]
+
+#: Resource bounds: a file asking for more is an error, not a hang.
+MAX_MOTION_TIME = 600.0  # s
+MAX_EPISODES = 1000
+#: Shortest pause [s] that can be told apart from the stop between two episodes.
+MIN_PAUSE = 0.2
+#: Furthest the end-effector may be sent from the goal [m].
+MAX_REACH_DISTANCE = 1.0
+
+PRIMITIVES = ("approach", "pause", "retreat", "gaze", "tilt", "shiver")
+SETTINGS = ("robot", "goal", "from", "start", "standoff", "effort")
+KEYWORDS = ("behaviour", *SETTINGS, *PRIMITIVES, "sequence")
+
+# Keys each primitive takes, with their dimension.
+_KEYS: dict[str, dict[str, Dim]] = {
+    "approach": {"a": Dim.ACCEL, "v": Dim.SPEED},
+    "pause": {},
+    "retreat": {"a": Dim.ACCEL, "v": Dim.SPEED},
+    "gaze": {"v": Dim.ANGULAR_SPEED},
+    "tilt": {"v": Dim.ANGULAR_SPEED},
+    "shiver": {"f": Dim.FREQUENCY},
+}
+
+_REPEAT = re.compile(r"^x(\d+)$")
+
+
+def _did_you_mean(word: str, choices: Iterable[str]) -> str | None:
+    close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
+    return f"did you mean `{close[0]}`?" if close else None
+
+
+@dataclass
+class _Ctx:
+    path: str
+    diags: list[Diagnostic] = field(default_factory=list)
+
+    def error(self, code: str, message: str, span: Span, hint: str | None = None, **f) -> None:
+        self.diags.append(diag(code, message, span, hint=hint, **f))
+
+
+# --- quantities -------------------------------------------------------------------------
+
+
+def _si(ctx: _Ctx, q: Quantity, dim: Dim, *, what: str, unit_required: bool) -> float | None:
+    """The SI value of ``q`` checked against ``dim``; None (and a diagnostic) when wrong."""
+    fits = ", ".join(units_for(dim))
+    if q.unit == "":
+        if unit_required:
+            ctx.error("V103", f"{what} `{q.text}` needs a unit: expected a {dim} ({fits})",
+                      q.span, hint=f"write e.g. `{q.text}{units_for(dim)[0]}`",
+                      expected=str(dim), found=q.text)
+            return None
+        return q.value * UNITS[SI_UNIT[dim]][1]
+    if q.unit not in UNITS:
+        ctx.error("V104", f"unknown unit `{q.unit}` in `{q.text}`: expected a {dim} ({fits})",
+                  q.span, hint=_did_you_mean(q.unit, units_for(dim)), found=q.unit)
+        return None
+    found_dim, factor = UNITS[q.unit]
+    if found_dim is not dim:
+        ctx.error("V102", f"{what} must be a {dim} ({fits}), found a {found_dim} `{q.text}`",
+                  q.span, expected=str(dim), found=str(found_dim))
+        return None
+    return q.value * factor
+
+
+def _positive(ctx: _Ctx, value: float | None, q: Quantity, what: str) -> float | None:
+    if value is not None and not value > 0:
+        ctx.error("V105", f"{what} must be positive, found `{q.text}`", q.span,
+                  found=q.text)
+        return None
+    return value
+
+
+# --- statements -------------------------------------------------------------------------
+
+
+@dataclass
+class _Args:
+    """A statement's arguments sorted by shape."""
+
+    positional: list[Quantity | Word | Vector | Colon] = field(default_factory=list)
+    keys: dict[str, KeyVal] = field(default_factory=dict)
+    count: int | None = None
+    count_span: Span | None = None
+    for_: Quantity | None = None
+
+
+def _split_args(ctx: _Ctx, st: Statement, allowed_keys: dict[str, Dim], repeat: bool) -> _Args:
+    out = _Args()
+    args = list(st.args)
+    i = 0
+    while i < len(args):
+        a = args[i]
+        if isinstance(a, Word) and repeat and _REPEAT.match(a.text):
+            if out.count is not None:
+                ctx.error("V116", f"`{st.keyword}` has two repeat counts", a.span)
+            out.count, out.count_span = int(a.text[1:]), a.span
+        elif isinstance(a, Word) and a.text == "for" and st.keyword == "shiver":
+            nxt = args[i + 1] if i + 1 < len(args) else None
+            if not isinstance(nxt, Quantity):
+                ctx.error("V113", "`for` must be followed by a duration, e.g. `for 1s`",
+                          a.span)
+            else:
+                out.for_ = nxt
+                i += 1
+        elif isinstance(a, KeyVal):
+            if a.key not in allowed_keys:
+                keys = ", ".join(f"{k}=" for k in allowed_keys) or "no keys"
+                ctx.error("V112", f"`{st.keyword}` takes {keys}; found `{a.key}=`", a.span,
+                          hint=_did_you_mean(a.key, allowed_keys), found=a.key)
+            elif a.key in out.keys:
+                ctx.error("V111", f"`{a.key}=` is given twice", a.span)
+            else:
+                out.keys[a.key] = a
+        else:
+            out.positional.append(a)
+        i += 1
+    return out
+
+
+def _key_value(ctx: _Ctx, kv: KeyVal | None, dim: Dim, what: str) -> float | None:
+    if kv is None:
+        return None
+    if not isinstance(kv.value, Quantity):
+        ctx.error("V113", f"`{kv.key}=` takes a {dim}, found `{kv.value.text}`", kv.value.span)
+        return None
+    return _positive(ctx, _si(ctx, kv.value, dim, what=what, unit_required=False),
+                     kv.value, what)
+
+
+def _too_many(ctx: _Ctx, st: Statement, extra: list, usage: str) -> None:
+    for a in extra:
+        text = getattr(a, "text", None) or ":"
+        ctx.error("V113", f"unexpected argument `{text}` to `{st.keyword}`; usage: {usage}",
+                  a.span, found=text)
+
+
+_USAGE = {
+    "approach": "approach [LENGTH] [a=ACC] [v=SPEED]",
+    "pause": "pause DURATION [xN]",
+    "retreat": "retreat LENGTH [a=ACC] [v=SPEED] [xN]",
+    "gaze": "gaze horizontal|vertical ANGLE [v=ANGSPEED] [xN]",
+    "tilt": "tilt ANGLE [v=ANGSPEED] [xN]",
+    "shiver": "shiver ANGLE [f=FREQ] [for DURATION] [xN]",
+}
+
+
+def _primitive(ctx: _Ctx, st: Statement, in_sequence: bool) -> Primitive | None:
+    kind = st.keyword
+    usage = _USAGE[kind]
+    n_before = len(ctx.diags)
+    args = _split_args(ctx, st, _KEYS[kind], repeat=True)
+    pos = args.positional
+    count = 1 if args.count is None else args.count
+    keys = args.keys
+    dim_of = _KEYS[kind]
+
+    def need_quantity(what: str) -> Quantity | None:
+        if not pos or not isinstance(pos[0], Quantity):
+            found = f", found `{pos[0].text}`" if pos and hasattr(pos[0], "text") else ""
+            ctx.error("V113", f"`{kind}` needs {what}{found}; usage: {usage}",
+                      pos[0].span if pos else st.keyword_span)
+            return None
+        return pos.pop(0)
+
+    def signed_ok(q: Quantity, value: float | None, what: str) -> float | None:
+        """In the descriptor form, angles are amplitudes: positive."""
+        if value is not None and not in_sequence and value <= 0:
+            ctx.error("V118", f"{what} in the descriptor form is an amplitude and must be "
+                      f"positive, found `{q.text}`", q.span,
+                      hint="signed angles (directions) belong in a `sequence { }` block")
+            return None
+        return value
+
+    a = _key_value(ctx, keys.get("a"), Dim.ACCEL, "acceleration") if "a" in dim_of else None
+    v = _key_value(ctx, keys.get("v"), dim_of["v"], "speed") if "v" in dim_of else None
+    prim: Primitive | None = None
+    if kind == "approach":
+        length = None
+        if pos and isinstance(pos[0], Quantity):
+            q = pos.pop(0)
+            length = _si(ctx, q, Dim.LENGTH, what="approach length", unit_required=True)
+            if length is not None and not in_sequence:
+                ctx.error("V113", "an approach length is only allowed in a `sequence { }`; "
+                          "in the descriptor form the approach runs from start to standoff",
+                          q.span)
+            elif length == 0:
+                ctx.error("V105", "an approach length must not be zero", q.span)
+        _too_many(ctx, st, pos, usage)
+        if len(ctx.diags) == n_before:
+            prim = Approach(span=st.span, length=length, a=a or DEFAULTS["approach_a"],
+                            v=v or DEFAULTS["speed_cap"], count=count)
+    elif kind == "pause":
+        q = need_quantity("a duration")
+        d = _positive(ctx, _si(ctx, q, Dim.TIME, what="pause duration", unit_required=True),
+                      q, "pause duration") if q else None
+        if d is not None and d < MIN_PAUSE:
+            ctx.error("V105", f"a pause must last at least {MIN_PAUSE}s to be told apart "
+                      f"from the stop between two episodes, found `{q.text}`", q.span)
+        _too_many(ctx, st, pos, usage)
+        if len(ctx.diags) == n_before:
+            prim = Pause(span=st.span, duration=d, count=count)
+    elif kind == "retreat":
+        q = need_quantity("a distance")
+        d = _si(ctx, q, Dim.LENGTH, what="retreat distance", unit_required=True) if q else None
+        if q is not None and not in_sequence:
+            d = _positive(ctx, d, q, "retreat distance")
+        elif q is not None and d == 0:
+            ctx.error("V105", "a retreat distance must not be zero", q.span)
+        _too_many(ctx, st, pos, usage)
+        if len(ctx.diags) == n_before:
+            prim = Retreat(span=st.span, length=d, a=a or DEFAULTS["retreat_a"],
+                           v=v or DEFAULTS["speed_cap"], count=count)
+    elif kind == "gaze":
+        plane = None
+        if pos and isinstance(pos[0], Word) and pos[0].text in ("horizontal", "vertical"):
+            plane = pos.pop(0).text
+        else:
+            w = pos[0] if pos else None
+            found = f", found `{w.text}`" if isinstance(w, Word | Quantity) else ""
+            ctx.error("V113", f"`gaze` needs a plane: `horizontal` or `vertical`{found}",
+                      w.span if w is not None else st.keyword_span,
+                      hint=_did_you_mean(w.text, ("horizontal", "vertical"))
+                      if isinstance(w, Word) else None)
+            if w is not None and isinstance(w, Word):
+                pos.pop(0)
+        q = need_quantity("an angle")
+        ang = _si(ctx, q, Dim.ANGLE, what="gaze angle", unit_required=True) if q else None
+        ang = signed_ok(q, ang, "a gaze angle") if q else None
+        _too_many(ctx, st, pos, usage)
+        if len(ctx.diags) == n_before:
+            prim = Gaze(span=st.span, plane=plane, angle=ang, v=v or DEFAULTS["gaze_v"],
+                        count=count)
+    elif kind == "tilt":
+        q = need_quantity("an angle")
+        ang = _si(ctx, q, Dim.ANGLE, what="tilt angle", unit_required=True) if q else None
+        ang = signed_ok(q, ang, "a tilt angle") if q else None
+        if q is not None and ang == 0:
+            ctx.error("V105", "a tilt angle must not be zero", q.span)
+        _too_many(ctx, st, pos, usage)
+        if len(ctx.diags) == n_before:
+            prim = Tilt(span=st.span, angle=ang, v=v or DEFAULTS["tilt_v"], count=count)
+    elif kind == "shiver":
+        q = need_quantity("an amplitude")
+        amp = _si(ctx, q, Dim.ANGLE, what="shiver amplitude", unit_required=True) if q else None
+        amp = _positive(ctx, amp, q, "shiver amplitude") if q else None
+        f = _key_value(ctx, keys.get("f"), Dim.FREQUENCY, "shiver frequency")
+        dur = None
+        if args.for_ is not None:
+            dur = _positive(ctx, _si(ctx, args.for_, Dim.TIME, what="shiver duration",
+                                     unit_required=True), args.for_, "shiver duration")
+        _too_many(ctx, st, pos, usage)
+        if len(ctx.diags) == n_before:
+            prim = Shiver(span=st.span, amplitude=amp, f=f or DEFAULTS["shiver_f"],
+                          duration=dur or DEFAULTS["shiver_duration"], count=count)
+    return prim
+
+
+def _settings(ctx: _Ctx, stmts: list[Statement]) -> Settings:
+    values: dict = {}
+    spans: dict[str, Span] = {}
+    for st in stmts:
+        key = "start_direction" if st.keyword == "from" else st.keyword
+        if key in spans:
+            ctx.error("V111", f"`{st.keyword}` is set twice (first at {spans[key]})",
+                      st.keyword_span)
+            continue
+        spans[key] = st.span
+        n_before = len(ctx.diags)
+        args = _split_args(ctx, st, {k: Dim.LENGTH for k in "WTSF"} if key == "effort" else {},
+                           repeat=False)
+        pos = args.positional
+        if key == "robot":
+            if len(pos) != 1 or not isinstance(pos[0], Word):
+                ctx.error("V113", "`robot` takes one name, e.g. `robot panda`",
+                          st.keyword_span)
+            elif pos[0].text not in ROBOTS:
+                names = ", ".join(ROBOTS)
+                ctx.error("V109", f"unknown robot `{pos[0].text}`: expected one of {names}",
+                          pos[0].span, hint=_did_you_mean(pos[0].text, ROBOTS),
+                          found=pos[0].text, valid=list(ROBOTS))
+            else:
+                values["robot"] = pos[0].text
+        elif key in ("goal", "start_direction"):
+            if len(pos) != 1 or not isinstance(pos[0], Vector):
+                ctx.error("V113", f"`{st.keyword}` takes a vector, e.g. "
+                          f"`{st.keyword} (0.5, 0, 0.3)`", st.keyword_span)
+                continue
+            vec = []
+            for q in pos[0].items:
+                if key == "goal":
+                    vec.append(_si(ctx, q, Dim.LENGTH, what="a goal coordinate",
+                                   unit_required=False))
+                elif q.unit:
+                    ctx.error("V102", f"`from` is a direction and takes plain numbers, "
+                              f"found `{q.text}`", q.span)
+                else:
+                    vec.append(q.value)
+            if len(ctx.diags) != n_before:
+                continue
+            if key == "start_direction":
+                norm = math.sqrt(sum(c * c for c in vec))
+                if norm == 0:
+                    ctx.error("V105", "`from` must not be the zero vector", pos[0].span)
+                    continue
+                vec = [c / norm for c in vec]
+            values[key] = tuple(vec)
+        elif key in ("start", "standoff"):
+            if len(pos) != 1 or not isinstance(pos[0], Quantity):
+                ctx.error("V113", f"`{key}` takes a distance, e.g. `{key} 0.30m`",
+                          st.keyword_span)
+                continue
+            val = _si(ctx, pos[0], Dim.LENGTH, what=f"the {key} distance", unit_required=True)
+            val = _positive(ctx, val, pos[0], f"the {key} distance")
+            if val is not None:
+                values[key] = val
+        elif key == "effort":
+            comps = {}
+            for k in "WTSF":
+                kv = args.keys.get(k)
+                if kv is None:
+                    ctx.error("V113", f"`effort` needs all of W= T= S= F=; `{k}=` is missing",
+                              st.keyword_span)
+                    continue
+                if not isinstance(kv.value, Quantity) or kv.value.unit:
+                    ctx.error("V113", f"`{k}=` takes a plain number in [-1, 1]", kv.value.span)
+                    continue
+                if not -1.0 <= kv.value.value <= 1.0:
+                    ctx.error("V106", f"effort {k} must lie in [-1, 1], found {kv.value.text}",
+                              kv.value.span, factor=k, found=kv.value.value)
+                    continue
+                comps[k] = kv.value.value
+            for a in pos:
+                ctx.error("V113", "`effort` takes only W= T= S= F=", a.span)
+            if len(comps) == 4 and len(ctx.diags) == n_before:
+                values["effort"] = Effort(span=st.span, **comps)
+    if "start" in values or "standoff" in values:
+        start = values.get("start", DEFAULTS["start"])
+        standoff = values.get("standoff", DEFAULTS["standoff"])
+        if start <= standoff:
+            where = spans.get("start") or spans["standoff"]
+            ctx.error("V117", f"the start distance ({start:g} m) must be larger than the "
+                      f"standoff ({standoff:g} m)", where, start=start, standoff=standoff)
+    return Settings(**values, spans=spans)
+
+
+def _header(ctx: _Ctx, st: Statement) -> tuple[str | None, State | None]:
+    pos = list(st.args)
+    if not pos or not isinstance(pos[0], Word):
+        ctx.error("V113", "`behaviour` takes a name, e.g. `behaviour peek : curious`",
+                  st.keyword_span)
+        return None, None
+    name = pos[0].text
+    state = None
+    rest = pos[1:]
+    if rest:
+        if not isinstance(rest[0], Colon) or len(rest) != 2 or not isinstance(rest[1], Word):
+            ctx.error("V113", "the header is `behaviour NAME : STATE`", rest[0].span)
+            return name, None
+        sw = rest[1]
+        try:
+            state = State(sw.text)
+        except ValueError:
+            ctx.error("V114", f"unknown state `{sw.text}`: expected one of "
+                      f"{', '.join(s.value for s in State)}", sw.span,
+                      hint=_did_you_mean(sw.text, [s.value for s in State]), found=sw.text)
+    return name, state
+
+
+# --- whole file -------------------------------------------------------------------------
+
+
+def _bang_time(d: float, a: float, v: float) -> float:
+    """Rest-to-rest time [s] over ``d`` [m] at peak acceleration ``a`` and speed cap ``v``."""
+    d = abs(d)
+    if d * a < v * v:
+        return 2.0 * math.sqrt(d / a)
+    return d / v + v / a
+
+
+def estimate_duration(b: Behaviour) -> float:
+    """A quick upper-bound-ish estimate [s] of a behaviour's motion time, for the
+    resource bound. The compiler's timeline is exact; this only guards against typos."""
+    s = b.settings
+    total = 0.0
+    reach = s.start - s.standoff
+    retreated = 0.0
+    approach: Approach | None = None
+    for p in b.primitives:
+        n = p.count
+        if isinstance(p, Pause):
+            total += n * p.duration
+        elif isinstance(p, Retreat):
+            total += n * _bang_time(p.length, p.a, p.v)
+            retreated += n * abs(p.length)
+        elif isinstance(p, Gaze):
+            total += n * 2.0 * abs(p.angle) / p.v
+        elif isinstance(p, Tilt):
+            total += n * abs(p.angle) / p.v
+        elif isinstance(p, Shiver):
+            total += n * p.duration
+        elif isinstance(p, Approach):
+            approach = p
+            if p.length is not None:
+                total += n * _bang_time(p.length, p.a, p.v)
+    if approach is not None:
+        total += _bang_time(reach + retreated, approach.a, approach.v)
+    return total
+
+
+def _episode_count(b: Behaviour) -> int:
+    return sum(p.count for p in b.primitives)
+
+
+def _check_whole(ctx: _Ctx, b: Behaviour) -> None:
+    n = _episode_count(b)
+    if n > MAX_EPISODES:
+        big = max(b.primitives, key=lambda p: p.count)
+        ctx.error("V110", f"the behaviour has {n} episodes; at most {MAX_EPISODES} are allowed",
+                  big.span, found=n, limit=MAX_EPISODES)
+        return
+    t = estimate_duration(b)
+    if t > MAX_MOTION_TIME:
+        big = max(b.primitives, key=lambda p: p.count)
+        ctx.error("V110", f"the behaviour asks for about {t:.0f} s of motion; at most "
+                  f"{MAX_MOTION_TIME:.0f} s are allowed", big.span, found=t,
+                  limit=MAX_MOTION_TIME)
+    s = b.settings
+    if b.form == "descriptor":
+        r = b.first("retreat")
+        p = b.first("pause")
+        n_r = r.count if r else 0
+        n_p = p.count if p else 0
+        if n_r and n_p < n_r + 1:
+            ctx.error("V113", f"{n_r} retreat(s) need at least {n_r + 1} pauses (a retreat "
+                      f"starts and ends at a pause, MODEL.md s5), found {n_p}", r.span,
+                      hint=f"add `pause DURATION x{n_r + 1}`")
+        if r and s.start + r.length > MAX_REACH_DISTANCE:
+            ctx.error("V119", f"a retreat of {r.length:g} m from the start ({s.start:g} m) "
+                      f"ends beyond {MAX_REACH_DISTANCE:g} m from the goal", r.span)
+        return
+    # Sequence form: follow the distance to the goal statement by statement.
+    dist = s.start
+    for p in b.primitives:
+        for _ in range(p.count):
+            if isinstance(p, Approach):
+                if p.length is None:
+                    dist = s.standoff
+                elif dist - p.length < s.standoff - 1e-9:
+                    ctx.error("V120", f"this approach of {p.length:g} m would end "
+                              f"{s.standoff - (dist - p.length):.3g} m inside the standoff "
+                              f"({s.standoff:g} m from the goal); {max(dist - s.standoff, 0):.3g}"
+                              f" m are left", p.span)
+                    return
+                else:
+                    dist -= p.length
+            elif isinstance(p, Retreat):
+                if dist + p.length < s.standoff - 1e-9:
+                    ctx.error("V120", "this retreat (negative length) would end inside the "
+                              "standoff", p.span)
+                    return
+                dist += p.length
+                if dist > MAX_REACH_DISTANCE:
+                    ctx.error("V119", f"the end-effector would be {dist:.3g} m from the goal; "
+                              f"at most {MAX_REACH_DISTANCE:g} m", p.span)
+                    return
+
+
+def validate(tree: SyntaxTree) -> tuple[Behaviour | None, list[Diagnostic]]:
+    """Check a syntax tree and build the IR.
+
+    Returns:
+        ``(behaviour, diagnostics)``; ``behaviour`` is None when any error was found.
+    """
+    ctx = _Ctx(tree.path)
+    name: str | None = None
+    state: State | None = None
+    header_span: Span | None = None
+    settings: list[Statement] = []
+    descriptor: list[Primitive] = []
+    sequence: list[Primitive] = []
+    seq_block: SequenceBlock | None = None
+    first_prim_span: Span | None = None
+    seen_kinds: dict[str, Span] = {}
+
+    for i, item in enumerate(tree.items):
+        if isinstance(item, SequenceBlock):
+            if seq_block is not None:
+                ctx.error("V111", f"a file has one `sequence` block; the first is at "
+                          f"{seq_block.span}", item.span)
+                continue
+            seq_block = item
+            for st in item.statements:
+                if st.keyword not in PRIMITIVES:
+                    ctx.error("V101" if st.keyword not in KEYWORDS else "V113",
+                              f"`{st.keyword}` is not a primitive; a sequence holds only "
+                              f"{', '.join(PRIMITIVES)}", st.keyword_span,
+                              hint=_did_you_mean(st.keyword, PRIMITIVES))
+                    continue
+                p = _primitive(ctx, st, in_sequence=True)
+                if p is not None:
+                    sequence.append(p)
+            continue
+        st = item
+        if st.keyword == "behaviour":
+            if header_span is not None:
+                ctx.error("V111", f"the header is given twice (first at {header_span})",
+                          st.keyword_span)
+            elif i != 0:
+                ctx.error("V115", "the `behaviour` header must be the first statement",
+                          st.keyword_span)
+            else:
+                header_span = st.span
+                name, state = _header(ctx, st)
+        elif st.keyword in SETTINGS:
+            settings.append(st)
+        elif st.keyword in PRIMITIVES:
+            first_prim_span = first_prim_span or st.span
+            p = _primitive(ctx, st, in_sequence=False)
+            key = st.keyword
+            if p is not None and p.kind == "gaze":
+                key = f"gaze {p.plane}"
+            if key in seen_kinds:
+                ctx.error("V107", f"`{key}` appears twice in the descriptor form (first at "
+                          f"{seen_kinds[key]})", st.keyword_span,
+                          hint="use `xN` for more episodes, or a `sequence { }` block for "
+                               "episodes that differ")
+                continue
+            seen_kinds[key] = st.span
+            if p is not None:
+                descriptor.append(p)
+        else:
+            ctx.error("V101", f"unknown statement `{st.keyword}`", st.keyword_span,
+                      hint=_did_you_mean(st.keyword, KEYWORDS) or
+                      f"statements are {', '.join(KEYWORDS)}", found=st.keyword)
+
+    if seq_block is not None and first_prim_span is not None:
+        ctx.error("V108", "a file has either a `sequence { }` block or descriptor-form "
+                  "primitives, not both", first_prim_span,
+                  hint=f"the sequence block is at {seq_block.span}")
+    sett = _settings(ctx, settings)
+    if any(d.severity == "error" for d in ctx.diags):
+        return None, ctx.diags
+    stem = tree.path.rsplit("/", 1)[-1].removesuffix(".aou") or "behaviour"
+    lines = 1
+    behaviour = Behaviour(
+        name=name or stem,
+        state=state,
+        form="sequence" if seq_block is not None else "descriptor",
+        settings=sett,
+        primitives=tuple(sequence if seq_block is not None else descriptor),
+        span=Span(tree.path, 1, 1, lines, 1),
+        header_span=header_span,
+    )
+    _check_whole(ctx, behaviour)
+    if any(d.severity == "error" for d in ctx.diags):
+        return None, ctx.diags
+    return behaviour, ctx.diags

@@ -1,0 +1,1 @@
+"""The .aou grammar, shipped as package data (see pyproject.toml)."""
