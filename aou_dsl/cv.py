@@ -35,6 +35,7 @@ __all__ = [
     "Contribution",
     "CVPoint",
     "CVWeights",
+    "DEFAULT_WEIGHTS",
     "INFERENCE",
     "classify",
     "composition_of",
@@ -88,8 +89,11 @@ class CVPoint:
         return {"C": round(self.C, 4), "V": round(self.V, 4), "state": self.state.value}
 
 
+DEFAULT_WEIGHTS = CVWeights()
+
+
 def effort_to_cv(effort: Effort | tuple[float, float, float, float],
-                 weights: CVWeights = CVWeights()) -> CVPoint:
+                 weights: CVWeights = DEFAULT_WEIGHTS) -> CVPoint:
     """Equations 1 and 2 of MODEL.md. ``effort`` is (W, T, S, F), each in [-1, 1]."""
     if isinstance(effort, Effort):
         w, t, s, f = effort.W, effort.T, effort.S, effort.F

@@ -9,7 +9,7 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .cv import CANONICAL, CVPoint, CVWeights, composition_of, effort_to_cv, infer
+from .cv import CANONICAL, DEFAULT_WEIGHTS, CVPoint, CVWeights, composition_of, effort_to_cv, infer
 from .diagnostics import AouError, Diagnostic, Severity, Span, diag, has_errors
 from .ir import Behaviour, State
 from .parse import parse
@@ -107,7 +107,7 @@ def load(text: str, path: str = "<string>") -> tuple[Behaviour | None, list[Diag
 
 
 def lint_source(text: str, path: str = "<string>", *,
-                weights: CVWeights = CVWeights()) -> FileResult:
+                weights: CVWeights = DEFAULT_WEIGHTS) -> FileResult:
     """Lint ``.aou`` source text."""
     behaviour, diags = load(text, path)
     result = FileResult(path, list(diags), source=text)
@@ -130,7 +130,7 @@ def read_source(path: str) -> str:
                             Span.whole_file(path))) from None
 
 
-def lint_file(path: str, *, weights: CVWeights = CVWeights()) -> FileResult:
+def lint_file(path: str, *, weights: CVWeights = DEFAULT_WEIGHTS) -> FileResult:
     try:
         text = read_source(path)
     except AouError as err:
@@ -157,7 +157,7 @@ def collect_files(paths: list[str]) -> tuple[list[str], list[Diagnostic]]:
     return files, problems
 
 
-def lint_paths(paths: list[str], *, weights: CVWeights = CVWeights()
+def lint_paths(paths: list[str], *, weights: CVWeights = DEFAULT_WEIGHTS
                ) -> tuple[list[FileResult], list[Diagnostic]]:
     """Lint files and folders. Returns per-file results and path problems (I5xx)."""
     files, problems = collect_files(paths)
