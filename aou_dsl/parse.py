@@ -10,6 +10,7 @@ from __future__ import annotations
 import functools
 from dataclasses import dataclass
 from importlib import resources
+from pathlib import Path
 
 import lark
 from lark import Lark, Token, Transformer, v_args
@@ -96,8 +97,17 @@ class SyntaxTree:
 
 @functools.cache
 def grammar_text() -> str:
-    """The grammar, read from the installed package (works from a wheel)."""
-    return resources.files("aou_dsl.grammar").joinpath("aou.lark").read_text(encoding="utf-8")
+    """The grammar, read from the installed package (``aou_dsl.grammar`` in the wheel).
+
+    In a source checkout that is imported without installing (``python -m pytest`` from
+    the repository root), the package maps no ``aou_dsl.grammar``; the grammar is then
+    read from the checkout's top-level ``grammar/`` folder, the same file.
+    """
+    try:
+        res = resources.files("aou_dsl.grammar").joinpath("aou.lark")
+    except ModuleNotFoundError:
+        res = Path(__file__).resolve().parent.parent / "grammar" / "aou.lark"
+    return res.read_text(encoding="utf-8")
 
 
 def build_parser(*, strict: bool = False) -> Lark:
