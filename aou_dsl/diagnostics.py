@@ -277,6 +277,16 @@ _RULE_LIST = [
          "A `v=` speed cap is higher than the motion can reach in the distance available.",
          "The cap has no effect; the motion peaks lower.",
          "approach v=5"),
+    Rule("C308", "shiver-too-fast", _E,
+         "A shiver's amplitude and frequency need more speed or acceleration than the "
+         "shivering joint allows; the message gives the highest frequency that fits.",
+         "The controller would stop the arm, or the tremor would be smaller than declared.",
+         "shiver 6deg f=8Hz"),
+    Rule("C309", "tilt-too-fast", _E,
+         "A tilt's angle and velocity need more joint speed or acceleration than the robot "
+         "allows.",
+         "The tilt velocity descriptor fixes the episode's duration; it cannot be slowed.",
+         "tilt 90deg v=500deg/s"),
     # --- R: reading trajectories -------------------------------------------------------
     Rule("R401", "bad-trajectory", _E,
          "A trajectory file is not valid: missing keys or columns, non-increasing time, NaN.",

@@ -50,7 +50,9 @@ DEFAULTS = {
     "speed_cap": 0.25,  # m/s, approach and retreat (ISO/TS 15066 "reduced speed")
     "gaze_v": math.radians(20.0),  # rad/s
     "tilt_v": math.radians(20.0),  # rad/s
-    "shiver_f": 8.0,  # Hz
+    # 6 deg peak to peak at 2.5 Hz needs ~13 rad/s^2 on the shivering joint: within the
+    # Panda's 20 rad/s^2 on joint 7. Faster tremors need smaller amplitudes.
+    "shiver_f": 2.5,  # Hz
     "shiver_duration": 1.0,  # s
 }
 

@@ -81,7 +81,7 @@ ROBOTS: dict[str, RobotSpec] = {
         ),
         goal=(0.45, 0.15, 0.15),
         start_direction=(-0.6, 0.0, 0.8),
-        posture=(0.0, -1.2, 1.6, -1.9, -1.5708, 0.0),
+        posture=(0.3, -1.3, 1.8, -2.1, -1.5708, 0.0),
         joint_accel=(DEFAULT_JOINT_ACCEL,) * 6,
         shiver_joint="wrist_3_joint",
     ),

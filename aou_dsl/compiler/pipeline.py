@@ -1,0 +1,225 @@
+"""The compiler: a validated behaviour -> a sampled joint trajectory, stage by stage.
+
+``compile_behaviour`` runs layout, geometry, IK, timing and sampling and returns a
+:class:`CompileResult` with the trajectory, the timeline, the diagnostics and the time
+each stage took. It never raises for a problem of the input: a behaviour that cannot be
+compiled gives a result with error diagnostics and no trajectory.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..diagnostics import Diagnostic, diag, has_errors
+from ..ir import Behaviour
+from ..kinematics import ArmModel, load_arm
+from .geometry import ReachFrame, reach_frame
+from .ik import IKStatus, solve_path
+from .layout import Episode, Pose, Timeline, layout
+from .timing import JointSegment, PathSegment, TimeLaw, shiver_segment, time_path
+
+__all__ = ["CompileOptions", "CompileResult", "Trajectory", "compile_behaviour"]
+
+#: Waypoint spacing of the IK path: along the line of sight [m], of bearing and roll [rad].
+STEP_LENGTH = 0.005
+STEP_ANGLE = math.radians(1.0)
+MIN_WAYPOINTS = 8
+DEFAULT_RATE = 250.0  # Hz
+
+
+@dataclass(frozen=True)
+class CompileOptions:
+    """Options of ``aouc compile``: sample ``rate`` [Hz], IK ``step_*`` sizes."""
+
+    rate: float = DEFAULT_RATE
+    step_length: float = STEP_LENGTH
+    step_angle: float = STEP_ANGLE
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """A sampled joint trajectory of the arm joints.
+
+    Attributes:
+        t: sample times [s], shape (N,), from 0, strictly increasing.
+        q, qd, qdd: joint positions [rad], velocities, accelerations; shape (N, n).
+        episodes: per episode ``(kind, t_start, t_end)`` [s].
+    """
+
+    robot: str
+    ee_frame: str
+    joint_names: tuple[str, ...]
+    goal: tuple[float, float, float]
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    episodes: tuple[tuple[str, float, float], ...] = ()
+
+    @property
+    def duration(self) -> float:
+        return float(self.t[-1])
+
+
+@dataclass
+class CompileResult:
+    """What the compiler made of one behaviour. ``trajectory`` is None on error."""
+
+    behaviour: Behaviour
+    timeline: Timeline | None = None
+    trajectory: Trajectory | None = None
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+    timings: dict[str, float] = field(default_factory=dict)
+    ik_position_error: float = 0.0
+    ik_rotation_error: float = 0.0
+
+    @property
+    def ok(self) -> bool:
+        return self.trajectory is not None and not has_errors(self.diagnostics)
+
+
+def _waypoints(ep: Episode, frame: ReachFrame, opts: CompileOptions
+               ) -> tuple[np.ndarray, list[tuple[np.ndarray, np.ndarray]]]:
+    """Path coordinate samples (K,) and end-effector targets of a moving episode."""
+    step = opts.step_length if ep.kind in ("approach", "retreat") else opts.step_angle
+    n = max(MIN_WAYPOINTS, math.ceil(ep.path_length / step) + 1)
+    s = np.linspace(0.0, ep.path_length, n)
+    a, b = ep.start, ep.end
+    targets = []
+    for si in s:
+        f = si / ep.path_length
+        pose = Pose(a.d + f * (b.d - a.d), a.h + f * (b.h - a.h), a.v + f * (b.v - a.v),
+                    a.roll + f * (b.roll - a.roll))
+        targets.append(frame.target(pose))
+    return s, targets
+
+
+def _ik_diag(ep: Episode, status: IKStatus, t: float, joint: str | None, b: Behaviour,
+             ) -> Diagnostic:
+    code = {IKStatus.UNREACHABLE: "C301", IKStatus.JOINT_LIMIT: "C302"}.get(status, "C303")
+    where = f" ({joint})" if joint else ""
+    robot = b.settings.robot
+    return diag(code, f"{ep.kind} at t={t:.2f}s: {status.value}{where} on {robot}",
+                ep.span, hint="move the goal (`goal`), the start direction (`from`) or "
+                "shorten the motion", reason=status.name.lower(), time=t, joint=joint)
+
+
+def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions()
+                      ) -> CompileResult:
+    """Compile a validated behaviour into a joint trajectory."""
+    res = CompileResult(b)
+    clock = time.perf_counter()
+
+    def lap(stage: str) -> None:
+        nonlocal clock
+        now = time.perf_counter()
+        res.timings[stage] = res.timings.get(stage, 0.0) + now - clock
+        clock = now
+
+    tl = layout(b)
+    res.timeline = tl
+    lap("layout")
+    arm: ArmModel = load_arm(b.settings.robot)
+    spec = arm.spec
+    frame = reach_frame(b.settings.goal or spec.goal,
+                        b.settings.start_direction or spec.start_direction)
+    lap("model")
+
+    q = None
+    segments: list[PathSegment | JointSegment] = []
+    t_planned = 0.0
+    start_targets = [frame.target(tl.episodes[0].start if tl.episodes else
+                                  Pose(b.settings.start))]
+    first = solve_path(arm, start_targets)
+    if not first.ok:
+        ep0 = tl.episodes[0] if tl.episodes else None
+        span = ep0.span if ep0 else b.span
+        res.diagnostics.append(_ik_diag(ep0 or Episode("pause", span, Pose(0), Pose(0), 0),
+                                        first.failure.status, 0.0, first.failure.joint, b))
+        return res
+    q = first.q[0]
+    worst_p, worst_r = first.worst_position_error, first.worst_rotation_error
+    lap("ik")
+    for ep in tl.episodes:
+        if ep.kind == "pause":
+            segments.append(JointSegment(q, ep.duration))
+        elif ep.kind == "shiver":
+            seg, fail = shiver_segment(arm, q, ep.amplitude, ep.f, ep.duration)
+            if fail is not None:
+                res.diagnostics.append(diag("C308", fail.reason, ep.span, joint=fail.joint,
+                                            max_frequency=fail.wanted))
+                return res
+            segments.append(seg)
+        else:
+            s, targets = _waypoints(ep, frame, options)
+            ik = solve_path(arm, targets, q)
+            lap("ik")
+            if not ik.ok:
+                f = ik.failure
+                t_fail = t_planned + ep.duration * f.index / max(1, len(targets) - 1)
+                res.diagnostics.append(_ik_diag(ep, f.status, t_fail, f.joint, b))
+                return res
+            worst_p = max(worst_p, ik.worst_position_error)
+            worst_r = max(worst_r, ik.worst_rotation_error)
+            if ep.kind == "tilt":
+                seg = PathSegment(s, ik.q, TimeLaw.bang_bang(ep.path_length, ep.duration))
+                _, qd, qdd = seg.sample(np.linspace(0, ep.duration, 200))
+                over = np.maximum(np.abs(qd) / (arm.vmax * spec.velocity_scale),
+                                  np.abs(qdd) / arm.amax).max(axis=0)
+                if over.max() > 1.0:
+                    j = arm.joint_names[int(np.argmax(over))]
+                    res.diagnostics.append(diag(
+                        "C309", f"tilt of {math.degrees(ep.path_length):g} deg in "
+                        f"{ep.duration:.2f}s needs {over.max():.1f}x the limits of {j}",
+                        ep.span, joint=j))
+                    return res
+            else:
+                seg, fail = time_path(arm, s, ik.q, ep.a, ep.vmax)
+                if seg is None:
+                    res.diagnostics.append(diag("C305", f"{ep.kind}: {fail.reason}", ep.span))
+                    return res
+                if fail is not None:
+                    unit = "m/s^2" if ep.kind in ("approach", "retreat") else "rad/s^2"
+                    res.diagnostics.append(diag(
+                        "C304", f"{ep.kind} reaches {fail.achieved:.3g} {unit}, not the "
+                        f"declared {fail.wanted:.3g} {unit}: {fail.joint} is at its limit",
+                        ep.span, joint=fail.joint, achieved=fail.achieved,
+                        declared=fail.wanted))
+            lap("timing")
+            segments.append(seg)
+            q = ik.q[-1]
+        t_planned += segments[-1].duration
+    res.ik_position_error, res.ik_rotation_error = worst_p, worst_r
+    res.trajectory = _sample(arm, b, tl, segments, options.rate)
+    lap("sample")
+    return res
+
+
+def _sample(arm: ArmModel, b: Behaviour, tl: Timeline,
+            segments: list[PathSegment | JointSegment], rate: float) -> Trajectory:
+    """Sample the segments on one clock at ``rate``; the last sample is the end."""
+    bounds = np.concatenate([[0.0], np.cumsum([s.duration for s in segments])])
+    total = float(bounds[-1])
+    n = int(math.floor(total * rate + 1e-9)) + 1
+    t = np.arange(n) / rate
+    if total - t[-1] > 0.25 / rate:
+        t = np.append(t, total)
+    q = np.empty((len(t), arm.n))
+    qd = np.empty_like(q)
+    qdd = np.empty_like(q)
+    idx = np.clip(np.searchsorted(bounds, t, side="right") - 1, 0, max(0, len(segments) - 1))
+    for k, seg in enumerate(segments):
+        m = idx == k
+        if m.any():
+            q[m], qd[m], qdd[m] = seg.sample(t[m] - bounds[k])
+    if not segments:  # an empty behaviour: hold the start pose for one sample
+        raise ValueError("nothing to sample")
+    spec = arm.spec
+    goal = tuple(float(x) for x in (b.settings.goal or spec.goal))
+    episodes = tuple((e.kind, float(bounds[i]), float(bounds[i + 1]))
+                     for i, e in enumerate(tl.episodes))
+    return Trajectory(spec.name, spec.ee_frame, arm.joint_names, goal, t, q, qd, qdd, episodes)

@@ -1,0 +1,238 @@
+"""Stage 6, timing: joint paths -> time laws, under the robot's limits and the declared ones.
+
+Every moving episode is a path ``q(s)`` over its own coordinate ``s`` (metres along the
+line of sight for approach and retreat, radians of bearing for gaze, radians of roll for
+tilt) and starts and ends at rest.
+
+TOPP-RA parametrises approach, retreat and gaze time-optimally under the joint velocity
+limits (URDF, scaled) and joint acceleration limits (:mod:`aou_dsl.robots`). The
+declared end-effector limits enter through a *virtual joint*: ``s`` itself is appended
+to the path as one more coordinate, with velocity limit ``v=`` and acceleration limit
+``a=``. On a straight line the end-effector acceleration is ``s''``, so the time-optimal
+law peaks at exactly the declared acceleration whenever no real joint binds first.
+
+Tilts have a fixed duration (the tilt velocity descriptor is angle / duration); shivers
+are analytic joint oscillations; pauses are exact holds.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..kinematics import ArmModel
+
+__all__ = [
+    "JointSegment",
+    "PathSegment",
+    "TimeLaw",
+    "TimingFailure",
+    "shiver_segment",
+    "time_path",
+]
+
+#: Relative slack when checking a result against a limit.
+LIMIT_SLACK = 1e-3
+
+
+@dataclass(frozen=True)
+class TimeLaw:
+    """``s(t)`` with constant ``s''`` between grid points (TOPP-RA's own output form).
+
+    Attributes:
+        s: grid of the path coordinate, shape (K,), increasing.
+        sd: path speed at the grid points, shape (K,); zero at both ends.
+        t: time at the grid points [s], shape (K,).
+        u: path acceleration on each interval, shape (K - 1,).
+    """
+
+    s: np.ndarray
+    sd: np.ndarray
+    t: np.ndarray
+    u: np.ndarray
+
+    @classmethod
+    def from_speeds(cls, s: np.ndarray, sd: np.ndarray) -> TimeLaw:
+        ds = np.diff(s)
+        mean = sd[:-1] + sd[1:]
+        if np.any(mean <= 0):
+            raise ValueError("path speed is zero on an interval")
+        dt = 2.0 * ds / mean
+        u = (sd[1:] ** 2 - sd[:-1] ** 2) / (2.0 * ds)
+        return cls(s, sd, np.concatenate([[0.0], np.cumsum(dt)]), u)
+
+    @classmethod
+    def bang_bang(cls, length: float, duration: float) -> TimeLaw:
+        """Rest to rest over ``length`` in exactly ``duration``: accelerate, decelerate."""
+        peak = 2.0 * length / duration
+        return cls.from_speeds(np.array([0.0, length / 2, length]), np.array([0.0, peak, 0.0]))
+
+    @property
+    def duration(self) -> float:
+        return float(self.t[-1])
+
+    def __call__(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``s, s', s''`` at local times ``tau`` (clipped to [0, duration])."""
+        tau = np.clip(tau, 0.0, self.duration)
+        i = np.clip(np.searchsorted(self.t, tau, side="right") - 1, 0, len(self.u) - 1)
+        dt = tau - self.t[i]
+        u = self.u[i]
+        sd = self.sd[i] + u * dt
+        s = self.s[i] + self.sd[i] * dt + 0.5 * u * dt * dt
+        return s, sd, u
+
+
+class PathSegment:
+    """A timed joint path: ``q(t) = path(s(t))``, shape (n,) per sample."""
+
+    def __init__(self, s_way: np.ndarray, q_way: np.ndarray, law: TimeLaw):
+        from scipy.interpolate import CubicSpline
+
+        self.spline = CubicSpline(s_way, q_way, axis=0)
+        self.d1 = self.spline.derivative(1)
+        self.d2 = self.spline.derivative(2)
+        self.law = law
+
+    @property
+    def duration(self) -> float:
+        return self.law.duration
+
+    def sample(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Joint positions, velocities, accelerations at local times; each (len(tau), n)."""
+        s, sd, sdd = self.law(tau)
+        qs, qss = self.d1(s), self.d2(s)
+        return self.spline(s), qs * sd[:, None], qss * (sd * sd)[:, None] + qs * sdd[:, None]
+
+
+class JointSegment:
+    """A hold or a shiver: the held configuration plus an analytic offset on one joint."""
+
+    def __init__(self, q_hold: np.ndarray, duration: float, joint: int = 0,
+                 amplitude: float = 0.0, f: float = 0.0):
+        self.q_hold, self._duration = np.asarray(q_hold, dtype=float), duration
+        self.joint, self.amplitude, self.f = joint, amplitude, f
+
+    @property
+    def duration(self) -> float:
+        return self._duration
+
+    def sample(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        n = len(tau)
+        q = np.tile(self.q_hold, (n, 1))
+        qd = np.zeros_like(q)
+        qdd = np.zeros_like(q)
+        if self.amplitude:
+            x, xd, xdd = _shiver_offset(tau, self.amplitude, self.f, self.duration)
+            q[:, self.joint] += x
+            qd[:, self.joint] = xd
+            qdd[:, self.joint] = xdd
+        return q, qd, qdd
+
+
+def _shiver_offset(tau: np.ndarray, amplitude: float, f: float, duration: float
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(A/2) sin(2 pi f t) e(t)``: a sine whose envelope ``e`` rises as sin^2 over the
+    first cycle and falls over the last, so it starts and ends at rest; the middle cycles
+    have the full peak-to-peak amplitude ``A``."""
+    w = 2.0 * math.pi * f
+    ramp = 1.0 / f
+    tau = np.clip(tau, 0.0, duration)
+    edge = np.minimum(tau, duration - tau)  # time from the nearer end
+    sign = np.where(tau <= duration - tau, 1.0, -1.0)  # d(edge)/dt
+    inside = edge < ramp
+    k = math.pi / (2.0 * ramp)
+    e = np.where(inside, np.sin(k * edge) ** 2, 1.0)
+    ed = np.where(inside, k * np.sin(2.0 * k * edge) * sign, 0.0)
+    edd = np.where(inside, 2.0 * k * k * np.cos(2.0 * k * edge), 0.0)
+    a = amplitude / 2.0
+    s, c = np.sin(w * tau), np.cos(w * tau)
+    x = a * s * e
+    xd = a * (w * c * e + s * ed)
+    xdd = a * (-w * w * s * e + 2.0 * w * c * ed + s * edd)
+    return x, xd, xdd
+
+
+@dataclass(frozen=True)
+class TimingFailure:
+    """Why an episode could not be timed as declared; ``joint`` is the binding one."""
+
+    reason: str
+    joint: str | None
+    achieved: float | None = None
+    wanted: float | None = None
+
+
+def _binding_joint(arm: ArmModel, seg: PathSegment, vmax: np.ndarray) -> str | None:
+    """The joint that comes nearest its velocity or acceleration limit on a segment."""
+    tau = np.linspace(0.0, seg.duration, 200)
+    _, qd, qdd = seg.sample(tau)
+    ratio = np.maximum(np.abs(qd) / vmax, np.abs(qdd) / arm.amax).max(axis=0)
+    return arm.joint_names[int(np.argmax(ratio))]
+
+
+def time_path(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vmax: float,
+              *, gridpoints: int = 120) -> tuple[PathSegment | None, TimingFailure | None]:
+    """Time a joint path rest to rest with TOPP-RA.
+
+    Args:
+        arm: the robot (limits).
+        s_way: path coordinate at the waypoints, shape (K,), increasing from 0.
+        q_way: joint waypoints, shape (K, n).
+        a: limit on ``|s''|`` (the declared peak acceleration) [m/s^2 or rad/s^2].
+        vmax: limit on ``|s'|`` (the speed cap) [m/s or rad/s].
+
+    Returns:
+        ``(segment, failure)``: the segment (None if TOPP-RA failed) and, when the
+        declared acceleration could not be reached, a failure naming the binding joint.
+    """
+    import toppra
+    import toppra.algorithm as algo
+    import toppra.constraint as constraint
+
+    logging.getLogger("toppra").setLevel(logging.ERROR)
+    aug = np.column_stack([q_way, s_way])
+    path = toppra.SplineInterpolator(s_way, aug)
+    jv = arm.vmax * arm.spec.velocity_scale
+    vlim = np.column_stack([-np.append(jv, vmax), np.append(jv, vmax)])
+    alim = np.column_stack([-np.append(arm.amax, a), np.append(arm.amax, a)])
+    grid = np.linspace(s_way[0], s_way[-1], gridpoints)
+    inst = algo.TOPPRA([constraint.JointVelocityConstraint(vlim),
+                        constraint.JointAccelerationConstraint(alim)],
+                       path, gridpoints=grid, solver_wrapper="seidel")
+    try:
+        _, sd, _, _ = inst.compute_parameterization(0.0, 0.0, return_data=True)
+    except Exception as exc:  # toppra raises bare exceptions on degenerate input
+        return None, TimingFailure(f"TOPP-RA failed: {exc}", None)
+    if inst.problem_data.return_code != algo.ParameterizationReturnCode.Ok or sd is None:
+        return None, TimingFailure(f"TOPP-RA: {inst.problem_data.return_code}", None)
+    sd = np.asarray(sd, dtype=float)
+    sd[0] = sd[-1] = 0.0
+    seg = PathSegment(s_way, q_way, TimeLaw.from_speeds(grid, sd))
+    peak = float(np.max(np.abs(seg.law.u)))
+    if peak < a * 0.97:
+        return seg, TimingFailure("joint limits bind before the declared acceleration",
+                                  _binding_joint(arm, seg, jv), peak, a)
+    return seg, None
+
+
+def shiver_segment(arm: ArmModel, q_hold: np.ndarray, amplitude: float, f: float,
+                   duration: float) -> tuple[JointSegment, TimingFailure | None]:
+    """An oscillation of the robot's shiver joint about ``q_hold``; checked against that
+    joint's velocity and acceleration limits."""
+    j = arm.joint_names.index(arm.spec.shiver_joint)
+    seg = JointSegment(q_hold, duration, j, amplitude, f)
+    tau = np.linspace(0.0, duration, max(200, int(duration * f * 40)))
+    _, xd, xdd = _shiver_offset(tau, amplitude, f, duration)
+    vlim = arm.vmax[j] * arm.spec.velocity_scale
+    ratio = max(np.max(np.abs(xd)) / vlim, np.max(np.abs(xdd)) / arm.amax[j])
+    if ratio > 1.0 + LIMIT_SLACK:
+        # Both limits scale with f (velocity) and f^2 (acceleration).
+        f_ok = f / max(ratio, math.sqrt(ratio)) if ratio > 0 else f
+        return seg, TimingFailure(
+            f"a {math.degrees(amplitude):g} deg shiver at {f:g} Hz exceeds "
+            f"{arm.spec.shiver_joint}'s limits by {ratio:.1f}x; at most about {f_ok:.2g} Hz",
+            arm.spec.shiver_joint, f, f_ok)
+    return seg, None
