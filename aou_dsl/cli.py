@@ -97,6 +97,159 @@ def _cmd_rules(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+# --- explain ----------------------------------------------------------------------------
+
+
+def _cmd_explain(args: argparse.Namespace) -> int:
+    import math
+
+    from .compiler.layout import layout
+    from .lint import lint_file
+
+    r = lint_file(args.path)
+    if not r.ok or r.behaviour is None:
+        _print_diags(r.diagnostics, "text", {r.path: r.source or ""}, stream=sys.stderr)
+        return EXIT_USAGE if any(d.code.startswith("I") for d in r.diagnostics) else EXIT_ERRORS
+    b = r.behaviour
+    tl = layout(b)
+    declared = f"declared {b.state}" if b.state else "no state declared"
+    print(f"behaviour {b.name} ({declared}; {b.form} form) on {b.settings.robot}")
+    print(f"C-V point: C={r.cv.C:+.2f} V={r.cv.V:+.2f} -> {r.cv.state}; "
+          f"laid out as {tl.state}")
+    print(f"{'#':>3}  {'episode':<9}{'start':>8}{'dur':>8}  what moves")
+    t = 0.0
+    for i, e in enumerate(tl.episodes, 1):
+        if e.kind in ("approach", "retreat"):
+            what = f"distance {e.start.d:.3f} -> {e.end.d:.3f} m (a={e.a:g} m/s^2)"
+        elif e.kind == "gaze":
+            a0, a1 = (e.start.h, e.end.h) if e.plane == "horizontal" else (e.start.v, e.end.v)
+            what = (f"{e.plane} bearing {math.degrees(a0):+.1f} -> {math.degrees(a1):+.1f} deg "
+                    f"at {e.start.d:.3f} m")
+        elif e.kind == "tilt":
+            what = f"roll {math.degrees(e.start.roll):+.1f} -> {math.degrees(e.end.roll):+.1f} deg"
+        elif e.kind == "shiver":
+            what = f"shiver {math.degrees(e.amplitude):g} deg peak to peak at {e.f:g} Hz"
+        else:
+            what = f"hold at {e.start.d:.3f} m"
+        print(f"{i:>3}  {e.kind:<9}{t:>7.2f}s{e.duration:>7.2f}s  {what}  "
+              f"(line {e.span.line})")
+        t += e.duration
+    print(f"planned duration {t:.2f} s (moving episodes at the declared limits; "
+          "`aouc compile` may slow them to the joint limits)")
+    return EXIT_OK
+
+
+# --- compile ----------------------------------------------------------------------------
+
+
+def _output_path(src: str, out: str | None, fmt: str, many: bool) -> str:
+    import os
+
+    stem = os.path.splitext(os.path.basename(src))[0]
+    if out is None:
+        return f"{stem}.{fmt}"
+    if many or out.endswith(os.sep) or os.path.isdir(out):
+        return os.path.join(out, f"{stem}.{fmt}")
+    return out
+
+
+def _cmd_compile(args: argparse.Namespace) -> int:
+    import os
+
+    from .build import build_file
+    from .compiler.output import encode, write_atomic
+    from .diagnostics import AouError, has_errors
+    from .lint import collect_files
+
+    files, problems = collect_files(args.paths)
+    _print_diags(problems, "text", stream=sys.stderr)
+    if problems:
+        return EXIT_USAGE
+    many = len(files) > 1
+    fmt = args.format or (os.path.splitext(args.output)[1].lstrip(".")
+                          if args.output and not many and not os.path.isdir(args.output)
+                          and os.path.splitext(args.output)[1] else "json")
+    if fmt not in ("json", "csv", "npz"):
+        print(f"aouc: unknown output format `{fmt}`: expected json, csv or npz",
+              file=sys.stderr)
+        return EXIT_USAGE
+    if many and args.output and not args.output.endswith(os.sep) \
+            and not os.path.isdir(args.output) and os.path.splitext(args.output)[1]:
+        print(f"aouc: several inputs need -o to be a folder, found `{args.output}`",
+              file=sys.stderr)
+        return EXIT_USAGE
+    if many and args.output:
+        os.makedirs(args.output, exist_ok=True)
+    worst = EXIT_OK
+    for k, src in enumerate(files, 1):
+        res = build_file(src, rate=args.rate, check=not args.no_check)
+        _print_diags(res.diagnostics, "text", {src: res.lint.source or ""}, stream=sys.stderr)
+        dest = _output_path(src, args.output, fmt, many)
+        if not res.ok:
+            io = any(d.code.startswith("I") for d in res.diagnostics)
+            worst = max(worst, EXIT_USAGE if io else EXIT_ERRORS)
+            print(f"[{k}/{len(files)}] {src}: failed, nothing written", file=sys.stderr)
+            continue
+        try:
+            write_atomic(dest, encode(res.document, fmt), inputs=files)
+        except AouError as err:
+            _print_diags(err.diagnostics, "text", stream=sys.stderr)
+            worst = EXIT_USAGE
+            continue
+        tr = res.compiled.trajectory
+        note = "" if not args.no_check else " (checks skipped)"
+        print(f"[{k}/{len(files)}] {src} -> {dest}: {tr.duration:.2f} s of motion, "
+              f"{len(tr.t)} samples, compiled in {res.seconds:.2f} s{note}", file=sys.stderr)
+        if has_errors(res.diagnostics):
+            worst = max(worst, EXIT_ERRORS)
+    return worst
+
+
+# --- measure ----------------------------------------------------------------------------
+
+
+def _parse_goal(text: str | None) -> tuple[float, float, float] | None:
+    if text is None:
+        return None
+    parts = text.strip("()").split(",")
+    if len(parts) != 3:
+        raise ValueError("--goal takes X,Y,Z in metres")
+    return tuple(float(p) for p in parts)  # type: ignore[return-value]
+
+
+def _cmd_measure(args: argparse.Namespace) -> int:
+    from .diagnostics import AouError
+    from .measure.descriptors import measure
+    from .measure.recording import read_recording
+
+    try:
+        goal = _parse_goal(args.goal)
+    except ValueError as exc:
+        print(f"aouc: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    try:
+        rec = read_recording(args.path, robot=args.robot, goal=goal, ee_frame=args.ee_frame)
+        m = measure(rec)
+    except AouError as err:
+        _print_diags(err.diagnostics, "text", stream=sys.stderr)
+        io = any(d.code.startswith("I") for d in err.diagnostics)
+        return EXIT_USAGE if io else EXIT_ERRORS
+    if args.format == "json":
+        print(format_json({"path": args.path, "robot": rec.robot, **m.to_json()}))
+    else:
+        units = {"approach_acceleration": "m/s^2", "pause_count": "", "pause_duration": "s",
+                 "retreat_count": "", "retreat_distance": "m", "retreat_acceleration": "m/s^2",
+                 "horizontal_gaze": "deg", "vertical_gaze": "deg", "tilt_angle": "deg",
+                 "tilt_velocity": "deg/s", "shiver_amplitude": "deg"}
+        print(f"{args.path}: {rec.robot}, {m.duration:.2f} s, {len(m.episodes)} episodes")
+        for k, v in m.descriptors.items():
+            val = "null" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
+            print(f"  {k:<22} {val:>10} {units[k]}")
+        print(f"  C-V: C={m.cv.C:+.2f} V={m.cv.V:+.2f} -> {m.cv.state}")
+        _print_diags(m.diagnostics, "text", stream=sys.stderr)
+    return EXIT_OK
+
+
 # --- the parser -------------------------------------------------------------------------
 
 
@@ -110,6 +263,31 @@ def build_parser() -> argparse.ArgumentParser:
     lint.add_argument("--format", choices=("text", "json", "github"), default="text")
     lint.add_argument("--strict", action="store_true", help="warnings fail too (exit 1)")
     lint.set_defaults(func=_cmd_lint)
+
+    explain = sub.add_parser("explain", help="show the timeline a file compiles to")
+    explain.add_argument("path", metavar="FILE")
+    explain.set_defaults(func=_cmd_explain)
+
+    comp = sub.add_parser("compile", help="compile .aou files into joint trajectories")
+    comp.add_argument("paths", nargs="+", metavar="PATH", help=".aou files or folders")
+    comp.add_argument("-o", "--output", metavar="FILE|DIR",
+                      help="output file, or folder for several inputs (default: STEM.json "
+                           "in the current folder)")
+    comp.add_argument("--format", choices=("json", "csv", "npz"),
+                      help="output format (default: from -o's extension, else json)")
+    comp.add_argument("--rate", type=float, metavar="HZ",
+                      help="sample rate in Hz (default 250)")
+    comp.add_argument("--no-check", action="store_true",
+                      help="skip the safety checks (recorded in the output)")
+    comp.set_defaults(func=_cmd_compile)
+
+    meas = sub.add_parser("measure", help="measure the eleven descriptors of a trajectory")
+    meas.add_argument("path", metavar="FILE", help="a trajectory .json, or a .csv recording")
+    meas.add_argument("--robot", help="robot of a CSV recording (panda, ur5)")
+    meas.add_argument("--ee-frame", help="end-effector frame (default: the robot's)")
+    meas.add_argument("--goal", metavar="X,Y,Z", help="goal position in metres")
+    meas.add_argument("--format", choices=("table", "json"), default="table")
+    meas.set_defaults(func=_cmd_measure)
 
     rules = sub.add_parser("rules", help="list the diagnostic codes, or explain some")
     rules.add_argument("codes", nargs="*", metavar="CODE")

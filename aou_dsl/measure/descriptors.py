@@ -24,25 +24,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..cv import Composition, CVPoint, infer
+from ..declared import DESCRIPTORS
 from ..diagnostics import Diagnostic, Span, diag
 from ..kinematics import ArmModel, load_arm
 from .recording import Recording
 
 __all__ = ["DESCRIPTORS", "MIN_PAUSE", "Measured", "MeasuredEpisode", "measure"]
 
-DESCRIPTORS = (
-    "approach_acceleration",
-    "pause_count",
-    "pause_duration",
-    "retreat_count",
-    "retreat_distance",
-    "retreat_acceleration",
-    "horizontal_gaze",
-    "vertical_gaze",
-    "tilt_angle",
-    "tilt_velocity",
-    "shiver_amplitude",
-)
 
 #: Shortest rest that counts as a pause [s] (the language's shortest pause is 0.2 s).
 MIN_PAUSE = 0.15

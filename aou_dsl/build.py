@@ -1,0 +1,109 @@
+"""``aouc compile`` as a library: one ``.aou`` file -> a checked, measured trajectory document.
+
+The steps: lint (stop on errors), compile, check the joint limits at every sample,
+measure the result with :mod:`aou_dsl.measure` (the declare -> compile -> measure round
+trip, recorded in the output), and build the LANGUAGE.md document. Writing is the
+caller's, so a failed build leaves nothing behind.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+from .diagnostics import Diagnostic, diag, has_errors
+from .lint import FileResult, lint_file
+
+__all__ = ["BuildResult", "build_file", "to_recording"]
+
+
+@dataclass
+class BuildResult:
+    """What ``aouc compile`` made of one file. ``document`` is None when it failed."""
+
+    path: str
+    lint: FileResult
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+    compiled: object | None = None  # CompileResult
+    measured: object | None = None  # Measured
+    checks: list = field(default_factory=list)
+    document: dict | None = None
+    seconds: float = 0.0
+
+    @property
+    def ok(self) -> bool:
+        return self.document is not None and not has_errors(self.diagnostics)
+
+
+def to_recording(trajectory, path: str = "<compiled>"):
+    """A compiled trajectory as a :class:`~aou_dsl.measure.recording.Recording`."""
+    from .measure.recording import Recording
+
+    tr = trajectory
+    return Recording(tr.t, tr.q, tr.joint_names, tr.robot, tr.ee_frame, tr.goal, path)
+
+
+def _rounded(d: dict) -> dict:
+    return {k: (round(v, 6) if isinstance(v, float) else v) for k, v in d.items()}
+
+
+def build_file(path: str, *, rate: float | None = None, check: bool = True) -> BuildResult:
+    """Lint, compile, check and measure one file."""
+    from .check.limits import check_limits
+    from .compiler.output import trajectory_document
+    from .compiler.pipeline import CompileOptions, compile_behaviour
+    from .declared import declared_descriptors
+    from .kinematics import load_arm
+    from .measure.descriptors import measure
+
+    start = time.perf_counter()
+    lint = lint_file(path)
+    res = BuildResult(path, lint, list(lint.diagnostics))
+    if not lint.ok or lint.behaviour is None:
+        return res
+    b = lint.behaviour
+    opts = CompileOptions() if rate is None else CompileOptions(rate=rate)
+    compiled = compile_behaviour(b, opts)
+    res.compiled = compiled
+    res.diagnostics += compiled.diagnostics
+    if not compiled.ok:
+        res.seconds = time.perf_counter() - start
+        return res
+    tr = compiled.trajectory
+    checks_json: dict = {"kinematic": "skipped (--no-check)"}
+    if check:
+        arm = load_arm(tr.robot)
+        res.checks = check_limits(arm, tr.t, tr.q, tr.qd, tr.qdd)
+        checks_json = {"kinematic": [c.to_json() for c in res.checks]}
+        for c in res.checks:
+            if not c.ok:
+                span = _span_at(compiled, c.time)
+                res.diagnostics.append(diag(
+                    "C306", f"{c.name} check failed at t={c.time:.3f}s: {c.joint} reaches "
+                    f"{c.value:.4g}, limit {c.limit:.4g}", span, check=c.name, time=c.time,
+                    joint=c.joint, value=c.value, limit=c.limit))
+        if has_errors(res.diagnostics):
+            res.seconds = time.perf_counter() - start
+            return res
+    m = measure(to_recording(tr, path))
+    res.measured = m
+    res.document = trajectory_document(
+        compiled,
+        measured=_rounded(m.descriptors),
+        declared=_rounded(declared_descriptors(b)),
+        cv=lint.cv.to_json(),
+        checks=checks_json | {"gaze_error_deg": round(m.gaze_error, 6)},
+        rate=opts.rate,
+    )
+    res.seconds = time.perf_counter() - start
+    return res
+
+
+def _span_at(compiled, t: float | None):
+    """The source span of the episode running at time ``t``."""
+    tr, tl = compiled.trajectory, compiled.timeline
+    if t is not None:
+        for (_kind, a, b), ep in zip(tr.episodes, tl.episodes, strict=True):
+            if a <= t <= b:
+                return ep.span
+    return compiled.behaviour.span

@@ -1,0 +1,1 @@
+"""Checks that a trajectory is safe to send to an arm (limits now; PyBullet replay next)."""
