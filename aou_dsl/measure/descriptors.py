@@ -38,6 +38,8 @@ MIN_PAUSE = 0.15
 REST_SPEED = 1e-4
 #: Translation under which an episode has not moved the end-effector [m].
 STILL_TRANSLATION = 2e-3
+#: Smallest roll reported as a tilt [rad] (the tilt tolerance is 0.5 deg).
+MIN_TILT = math.radians(0.5)
 #: Rest instants closer than this are one stop [s].
 STOP_MERGE = 0.08
 
@@ -117,16 +119,16 @@ def _noise(q: np.ndarray) -> float:
     return float(np.median(np.abs(d3)) / 0.6745 / math.sqrt(20.0))
 
 
-def _derivatives(x: np.ndarray, dt: float, window: int) -> tuple[np.ndarray, np.ndarray,
-                                                               np.ndarray]:
-    """Smoothed value, first and second derivative along axis 0."""
+def _derivatives(x: np.ndarray, dt: float, window: int
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Value, first and second derivative along axis 0: central differences when
+    ``window`` <= 2, else a cubic Savitzky-Golay filter of ``window`` samples (odd)."""
     if window <= 2:
         v = np.gradient(x, dt, axis=0)
         return x, v, np.gradient(v, dt, axis=0)
     from scipy.signal import savgol_filter
 
-    w = min(window | 1, (len(x) - 1) | 1 if len(x) % 2 == 0 else len(x))
-    w = max(5, w if w % 2 else w - 1)
+    w = min(window, len(x) if len(x) % 2 else len(x) - 1)
     return (savgol_filter(x, w, 3, axis=0), savgol_filter(x, w, 3, deriv=1, delta=dt, axis=0),
             savgol_filter(x, w, 3, deriv=2, delta=dt, axis=0))
 
@@ -142,34 +144,57 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
 
 
 def _refine(t: np.ndarray, speed: np.ndarray, i: int, direction: int, thr: float) -> float:
-    """The time where the speed reaches zero next to the rest sample ``i``.
+    """Clean data: the time where the speed reaches zero next to the rest sample ``i``.
 
     Motion comes to rest (and leaves it) with a nearly constant acceleration, so the speed
-    is linear in time there: a line through the moving samples beside the rest run
+    is linear in time there: a line through the few moving samples beside the rest run
     (``direction`` -1: before it, +1: after it), while the speed keeps growing away from
-    the rest and stays within a few thresholds (or, for clean data, a few samples), is
-    extrapolated to zero. This undoes the smear of the differentiation filter.
+    the rest, is extrapolated to zero. This undoes the one-sample smear of central
+    differences.
     """
     idx = []
     j = i + direction
-    limit = 6.0 * thr
-    while 0 <= j < len(t) and len(idx) < 40:
+    while 0 <= j < len(t) and len(idx) < 6:
         if idx and speed[j] < speed[idx[-1]]:
             break  # no longer moving away from rest
-        if speed[j] >= limit and len(idx) >= 4:
-            break
         idx.append(j)
         j += direction
     if len(idx) < 3:
         return float(t[i])
-    tt, ss = t[idx], speed[idx]
-    slope, icpt = np.polyfit(tt, ss, 1)
+    slope, icpt = np.polyfit(t[idx], speed[idx], 1)
+    if slope == 0:
+        return float(t[i])
+    lo, hi = sorted((float(t[idx[-1]]), float(t[i])))
+    return float(np.clip(-icpt / slope, lo, hi))
+
+
+def _refine_noisy(t: np.ndarray, qd: np.ndarray, i: int, direction: int, half: int) -> float:
+    """Noisy data: where the motion next to rest sample ``i`` starts or stops.
+
+    The joint moving fastest 0.3 s away is followed back toward the rest: its *signed*
+    filtered velocity is linear in time near a constant-deceleration stop and its noise
+    averages out, unlike the speed (a maximum of absolute values, biased upward). The
+    samples within half a filter window of the rest are skipped (the filter rounds the
+    corner there); a line through the next 0.2 s is extrapolated to zero.
+    """
+    dt = t[1] - t[0]
+    far = i + direction * int(round(0.3 / dt))
+    if not 0 <= far < len(t):
+        return float(t[i])
+    j = int(np.argmax(np.abs(qd[far])))
+    idx = np.arange(i + direction * half, i + direction * (half + int(round(0.2 / dt))),
+                    direction)
+    idx = idx[(idx >= 0) & (idx < len(t))]
+    if len(idx) < 5:
+        return float(t[i])
+    slope, icpt = np.polyfit(t[idx], qd[idx, j], 1)
     if slope == 0:
         return float(t[i])
     t0 = -icpt / slope
-    # Stay within the samples used and the rest sample.
-    lo, hi = sorted((float(t[idx[-1]]), float(t[i])))
-    return float(np.clip(t0, lo, hi))
+    lo, hi = sorted((float(t[i]), float(t[idx[0]])))
+    # The stop lies between the rest sample and the first sample used, give or take the
+    # filter's reach.
+    return float(np.clip(t0, lo - half * dt, hi + half * dt))
 
 
 # --- geometry -------------------------------------------------------------------------------
@@ -216,34 +241,50 @@ def measure(rec: Recording) -> Measured:
     dt = float(t[1] - t[0])
     sigma = _noise(q)
     clean = sigma < 1e-7
-    # Windows: none for clean data; for noisy data wide enough to pull the noise of the
-    # first derivative under 1e-3 rad/s and of the Cartesian acceleration under ~1%.
-    wq = 1 if clean else max(7, int(round(0.12 / dt)))
-    wp = 1 if clean else max(9, int(round(0.30 / dt)))
+    # Clean data: central differences. Noisy data: a cubic Savitzky-Golay filter of
+    # 0.2 s for joint speeds; the rest threshold is 5.5 times the filtered speed's noise
+    # (its gain is the norm of the filter's coefficients).
+    wq = 1 if clean else _odd(0.2 / dt)
     qs, qd, _ = _derivatives(q, dt, wq)
-    pos, rot = arm.fk(qs)
-    _, _, pacc = _derivatives(pos, dt, wp)
+    pos, rot = arm.fk(qs if clean else q)
+    pos_s = pos if clean else _derivatives(pos, dt, wq)[0]
+    pacc = np.gradient(np.gradient(pos, dt, axis=0), dt, axis=0) if clean else None
     goal = np.asarray(rec.goal, float)
-    g = goal - pos
+    g = goal - pos_s
     dist = np.linalg.norm(g, axis=1)
     z_axes = rot[:, :, 2]
-    cosang = np.einsum("ij,ij->i", z_axes, g) / np.maximum(dist, 1e-12)
+    cosang = np.einsum("ij,ij->i", z_axes, goal - pos) / np.maximum(
+        np.linalg.norm(goal - pos, axis=1), 1e-12)
     gaze_error = float(np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0))).max())
 
     speed = np.abs(qd).max(axis=1)
     if clean:
         thr = REST_SPEED
     else:
-        # Velocity noise of the filtered derivative, from the noise of the positions.
-        thr = max(REST_SPEED, 8.0 * sigma * math.sqrt(12.0 / (wq ** 3)) / dt)
+        from scipy.signal import savgol_coeffs
+
+        gain = float(np.linalg.norm(savgol_coeffs(wq, 3, deriv=1, delta=dt)))
+        thr = max(REST_SPEED, 5.5 * sigma * gain)
+    sig = _Signals(t, dt, pos, pos_s, rot, q, dist, g, pacc, sigma, thr)
     rest = speed < thr
+    if not clean:
+        # Close gaps of a few samples in a rest run: a noise spike is not motion.
+        for i0, i1 in _runs(~rest):
+            if i1 - i0 < 3 and i0 > 0 and i1 < len(rest) - 1:
+                rest[i0:i1 + 1] = True
     diags: list[Diagnostic] = []
 
     # --- pauses -----------------------------------------------------------------------
     pauses: list[tuple[float, float, int, int]] = []
     for i0, i1 in _runs(rest):
-        t0 = _refine(t, speed, i0, -1, thr) if i0 > 0 else float(t[i0])
-        t1 = _refine(t, speed, i1, +1, thr) if i1 < len(t) - 1 else t_last
+        if t[i1] - t[i0] < 0.6 * MIN_PAUSE:
+            continue  # an instant of rest (a reversal, the stop between two episodes)
+        if clean:
+            t0 = _refine(t, speed, i0, -1, thr) if i0 > 0 else float(t[i0])
+            t1 = _refine(t, speed, i1, +1, thr) if i1 < len(t) - 1 else t_last
+        else:
+            t0 = _refine_noisy(t, qd, i0, -1, wq // 2) if i0 > 0 else float(t[i0])
+            t1 = _refine_noisy(t, qd, i1, +1, wq // 2) if i1 < len(t) - 1 else t_last
         if t1 - t0 >= MIN_PAUSE:
             pauses.append((t0, t1, i0, i1))
     # A trajectory that starts or ends at rest: that rest is the start/end pose, not a
@@ -261,7 +302,7 @@ def measure(rec: Recording) -> Measured:
             timeline.append(pause_eps[k - 1])
         if b - a < 2:
             continue
-        timeline += _motion_episodes(t, a, b, speed, thr, pos, rot, q, dist, g, pacc)
+        timeline += _motion_episodes(sig, a, b, speed)
     episodes = timeline
 
     # --- descriptors ------------------------------------------------------------------
@@ -342,8 +383,54 @@ def _mean(eps: list[MeasuredEpisode], key: str, diags: list[Diagnostic], path: s
     return m
 
 
-def _motion_episodes(t, a, b, speed, thr, pos, rot, q, dist, g, pacc) -> list[MeasuredEpisode]:
+def _odd(x: float) -> int:
+    n = max(5, int(round(x)))
+    return n if n % 2 else n + 1
+
+
+@dataclass(frozen=True)
+class _Signals:
+    """Per-sample signals shared by the episode functions (arrays of length N)."""
+
+    t: np.ndarray
+    dt: float
+    pos: np.ndarray  # raw end-effector position [m], (N, 3)
+    pos_s: np.ndarray  # smoothed position
+    rot: np.ndarray  # (N, 3, 3)
+    q: np.ndarray  # (N, n)
+    dist: np.ndarray  # goal distance [m]
+    g: np.ndarray  # goal vector, (N, 3)
+    pacc: np.ndarray | None  # clean data: acceleration by central differences
+    sigma: float  # joint noise [rad]
+    thr: float  # rest speed [rad/s]
+
+
+def _peak_acceleration(sig: _Signals, s: int, e: int) -> float:
+    """Peak end-effector acceleration on samples s..e [m/s^2].
+
+    Clean data: the largest central-difference acceleration. Noisy data: a cubic
+    Savitzky-Golay second derivative with a window of 40 % of the episode (at most
+    0.6 s), projected on the episode's direction of travel so that noise across it does
+    not inflate the magnitude.
+    """
+    if sig.pacc is not None:
+        return float(np.linalg.norm(sig.pacc[s:e + 1], axis=1).max())
+    from scipy.signal import savgol_filter
+
+    w = _odd(min(0.6, 0.4 * (sig.t[e] - sig.t[s])) / sig.dt)
+    lo, hi = max(0, s - w), min(len(sig.t), e + w + 1)
+    acc = savgol_filter(sig.pos[lo:hi], w, 3, deriv=2, delta=sig.dt, axis=0)
+    u = sig.pos_s[e] - sig.pos_s[s]
+    u = u / max(np.linalg.norm(u), 1e-12)
+    inner = slice(s - lo + w // 2, e - lo - w // 2 + 1)
+    along = np.abs(acc[inner] @ u)
+    return float(along.max()) if along.size else float(np.abs(acc @ u).max())
+
+
+def _motion_episodes(sig: _Signals, a: int, b: int, speed: np.ndarray
+                     ) -> list[MeasuredEpisode]:
     """Split the motion between samples a..b (inclusive) at rest instants and classify."""
+    t, thr = sig.t, sig.thr
     seg = speed[a:b + 1]
     peak = float(seg.max()) if len(seg) else 0.0
     if peak <= thr:
@@ -364,28 +451,39 @@ def _motion_episodes(t, a, b, speed, thr, pos, rot, q, dist, g, pacc) -> list[Me
     for s, e in zip(edges[:-1], edges[1:], strict=True):
         if e - s < 2:
             continue
-        pieces.append(_classify(t, s, e, pos, rot, q, dist, g, pacc))
-    return _merge_shivers(pieces, q, t)
+        piece = _classify(sig, s, e)
+        if piece is not None:
+            pieces.append(piece)
+    return _merge_shivers(pieces, sig.q, t)
 
 
-def _classify(t, s, e, pos, rot, q, dist, g, pacc) -> MeasuredEpisode:
+def _classify(sig: _Signals, s: int, e: int) -> MeasuredEpisode | None:
+    """What moved between samples s and e; None when nothing moved beyond the noise."""
+    t, pos, rot, q, dist, g = sig.t, sig.pos_s, sig.rot, sig.q, sig.dist, sig.g
     dp = pos[e] - pos[s]
     travel = float(np.linalg.norm(np.diff(pos[s:e + 1], axis=0), axis=1).sum())
+    if sig.pacc is None:
+        # Noisy data: the largest excursion from the start, not the path length (noise
+        # makes every path long); on a straight line it equals the chord.
+        travel = float(np.linalg.norm(pos[s:e + 1] - pos[s], axis=1).max())
     dr = float(dist[e] - dist[s])
-    acc = float(np.linalg.norm(pacc[s:e + 1], axis=1).max())
+    rng = q[s:e + 1].max(axis=0) - q[s:e + 1].min(axis=0)
+    if travel <= STILL_TRANSLATION and rng.max() < 10 * sig.sigma + 1e-6:
+        return None  # jitter
     if travel > STILL_TRANSLATION:
         if abs(dr) >= 0.7 * travel:
             kind = "approach" if dr < 0 else "retreat"
             return MeasuredEpisode(kind, float(t[s]), float(t[e]), {
-                "distance": float(np.linalg.norm(dp)), "peak_acceleration": acc})
+                "distance": float(np.linalg.norm(dp)),
+                "peak_acceleration": _peak_acceleration(sig, s, e)})
         y0, x0 = rot[s][:, 1], rot[s][:, 0]
         dh = abs(_signed_angle(g[s], g[e], y0))
         dv = abs(_signed_angle(g[s], g[e], x0))
         return MeasuredEpisode("gaze", float(t[s]), float(t[e]), {
-            "plane": float(dh >= dv), "swept": math.degrees(max(dh, dv)),
-            "peak_acceleration": acc})
+            "plane": float(dh >= dv), "swept": math.degrees(max(dh, dv))})
     roll = _roll(rot[s], rot[e])
-    rng = q[s:e + 1].max(axis=0) - q[s:e + 1].min(axis=0)
+    if abs(roll) < MIN_TILT:
+        return None  # a roll below what tilt is measured to: jitter
     return MeasuredEpisode("tilt", float(t[s]), float(t[e]), {
         "angle": abs(math.degrees(roll)), "signed": math.degrees(roll),
         "velocity": abs(math.degrees(roll)) / max(float(t[e] - t[s]), 1e-9),
