@@ -52,7 +52,7 @@ def build_file(path: str, *, rate: float | None = None, check: bool = True) -> B
     from .check.limits import check_limits
     from .compiler.output import trajectory_document
     from .compiler.pipeline import CompileOptions, compile_behaviour
-    from .declared import declared_descriptors
+    from .declared import compare_descriptors, declared_descriptors
     from .kinematics import load_arm
     from .measure.descriptors import measure
 
@@ -87,16 +87,33 @@ def build_file(path: str, *, rate: float | None = None, check: bool = True) -> B
             return res
     m = measure(to_recording(tr, path))
     res.measured = m
+    declared = declared_descriptors(b)
+    for name, want, got in compare_descriptors(declared, m.descriptors):
+        res.diagnostics.append(diag(
+            "C310", f"{name}: declared {_fmt(want)}, measured {_fmt(got)} on the compiled "
+            "trajectory", _span_of(b, name), descriptor=name, declared=want, measured=got))
     res.document = trajectory_document(
         compiled,
         measured=_rounded(m.descriptors),
-        declared=_rounded(declared_descriptors(b)),
+        declared=_rounded(declared),
         cv=lint.cv.to_json(),
         checks=checks_json | {"gaze_error_deg": round(m.gaze_error, 6)},
         rate=opts.rate,
     )
     res.seconds = time.perf_counter() - start
     return res
+
+
+def _span_of(b, descriptor: str):
+    """The statement that declares ``descriptor`` (the file when none does)."""
+    kind = descriptor.split("_")[0]
+    plane = kind if kind in ("horizontal", "vertical") else None
+    p = b.first("gaze", plane) if plane else b.first(kind)
+    return p.span if p is not None else b.span
+
+
+def _fmt(v) -> str:
+    return "absent" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
 
 
 def _span_at(compiled, t: float | None):

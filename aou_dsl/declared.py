@@ -12,7 +12,13 @@ import math
 
 from .ir import Behaviour
 
-__all__ = ["DESCRIPTORS", "declared_descriptors"]
+__all__ = [
+    "DESCRIPTORS",
+    "compare_descriptors",
+    "declared_descriptors",
+    "timeline_descriptors",
+    "tolerance",
+]
 
 DESCRIPTORS = (
     "approach_acceleration",
@@ -52,15 +58,21 @@ def _descriptor_form(b: Behaviour) -> dict[str, float | int | None]:
     return d
 
 
-def _sequence_form(b: Behaviour) -> dict[str, float | int | None]:
-    from .compiler.layout import layout
-
-    eps = layout(b).episodes
+def timeline_descriptors(eps) -> dict[str, float | int | None]:
+    """MODEL.md's definitions applied to a laid-out timeline (a sequence of episodes):
+    what a trajectory following it shows."""
     d: dict[str, float | int | None] = dict.fromkeys(DESCRIPTORS)
-    pauses = [e for e in eps if e.kind == "pause"]
+    # Pauses with nothing moving between them are one pause.
+    merged: list = []
+    for e in eps:
+        if e.kind == "pause" and merged and merged[-1][0] == "pause":
+            merged[-1] = ("pause", merged[-1][1] + e.duration)
+        else:
+            merged.append((e.kind, e.duration))
+    pauses = [dur for kind, dur in merged if kind == "pause"]
     d["pause_count"] = len(pauses)
     if pauses:
-        d["pause_duration"] = max(e.duration for e in pauses)
+        d["pause_duration"] = max(pauses)
     approaches = [e for e in eps if e.kind == "approach"]
     if approaches:
         d["approach_acceleration"] = max(e.a for e in approaches)
@@ -87,4 +99,41 @@ def _sequence_form(b: Behaviour) -> dict[str, float | int | None]:
 
 def declared_descriptors(b: Behaviour) -> dict[str, float | int | None]:
     """The eleven descriptors the behaviour declares; None where a primitive is absent."""
-    return _descriptor_form(b) if b.form == "descriptor" else _sequence_form(b)
+    if b.form == "descriptor":
+        return _descriptor_form(b)
+    from .compiler.layout import layout
+
+    return timeline_descriptors(layout(b).episodes)
+
+
+#: How close a measured descriptor must be to the declared one (issue tolerances):
+#: counts exactly; durations 2 % or 20 ms; distances 1 mm; angles 0.5 deg;
+#: accelerations 3 %; angular velocities 2 % or 0.5 deg/s.
+def tolerance(name: str, declared: float) -> float:
+    if name.endswith("_count"):
+        return 0.0
+    if name == "pause_duration":
+        return max(0.02, 0.02 * declared)
+    if name == "retreat_distance":
+        return 1e-3
+    if name.endswith("acceleration"):
+        return 0.03 * declared
+    if name == "tilt_velocity":
+        return max(0.5, 0.02 * declared)
+    return 0.5  # angles [deg]
+
+
+def compare_descriptors(declared: dict, measured: dict
+                        ) -> list[tuple[str, float | int | None, float | int | None]]:
+    """The descriptors whose measured value misses the declared one: (name, declared,
+    measured). A descriptor declared absent must be measured absent, and vice versa."""
+    out = []
+    for name in DESCRIPTORS:
+        want, got = declared.get(name), measured.get(name)
+        if want is None or got is None:
+            if (want is None) != (got is None) and not (name.endswith("_count")):
+                out.append((name, want, got))
+            continue
+        if abs(got - want) > tolerance(name, want) + 1e-12:
+            out.append((name, want, got))
+    return out

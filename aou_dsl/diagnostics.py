@@ -229,6 +229,12 @@ _RULE_LIST = [
          "An `approach` with a length longer than the way left to the standoff.",
          "The reach never gets closer to the goal than the standoff.",
          "start 0.3m\nsequence { approach 0.5m }"),
+    Rule("V121", "unrealisable-descriptors", _E,
+         "The descriptor form declares pauses, retreats or gazes that no layout can show: "
+         "a retreat starts and ends at a pause, a gaze ends at one, and two pauses with "
+         "nothing moving between them read as one.",
+         "The compiled motion would not have the descriptors the file declares.",
+         "pause 1s x3   # and nothing else: three pauses in a row are one pause"),
     # --- M: the C-V model --------------------------------------------------------------
     Rule("M201", "state-mismatch", _W,
          "The state inferred from the behaviour's primitives differs from the declared one.",
@@ -287,6 +293,12 @@ _RULE_LIST = [
          "allows.",
          "The tilt velocity descriptor fixes the episode's duration; it cannot be slowed.",
          "tilt 90deg v=500deg/s"),
+    Rule("C310", "descriptor-mismatch", _W,
+         "A descriptor measured on the compiled trajectory differs from the declared one "
+         "by more than its tolerance (docs/measure.md).",
+         "The motion does not show what the file declares; usually a joint limit slowed it "
+         "(see C304).",
+         "approach a=50   # the joints cannot accelerate the hand that fast"),
     # --- R: reading trajectories -------------------------------------------------------
     Rule("R401", "bad-trajectory", _E,
          "A trajectory file is not valid: missing keys or columns, non-increasing time, NaN.",

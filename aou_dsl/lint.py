@@ -55,7 +55,7 @@ def _model_checks(b: Behaviour, weights: CVWeights) -> tuple[CVPoint, list[Diagn
     out: list[Diagnostic] = []
     point, contributions = infer(composition_of(b))
     inferred = point.state
-    where = b.header_span or b.span
+    where = b.header_span or (b.primitives[0].span if b.primitives else b.span)
     if b.state is None:
         out.append(diag("M204", f"no state declared; the primitives express `{inferred}` "
                         f"(C={point.C:+.2f}, V={point.V:+.2f})", where,
@@ -97,6 +97,37 @@ def _model_checks(b: Behaviour, weights: CVWeights) -> tuple[CVPoint, list[Diagn
     return point, out
 
 
+def _realisable(b: Behaviour) -> list[Diagnostic]:
+    """A descriptor-form file whose layout cannot show what it declares (V121): a gaze is
+    measured at the pause that ends it, a retreat between two pauses, and two pauses
+    with nothing moving between them are one pause."""
+    from .compiler.layout import layout
+    from .declared import declared_descriptors, timeline_descriptors
+
+    if b.form != "descriptor":
+        return []
+    want = declared_descriptors(b)
+    got = timeline_descriptors(layout(b).episodes)
+    out = []
+    for key, kind in (("pause_count", "pause"), ("retreat_count", "retreat")):
+        if want[key] != got[key]:
+            prim = b.first(kind)
+            out.append(diag("V121", f"{want[key]} {kind}s are declared but the layout can "
+                            f"only show {got[key]}", prim.span if prim else b.span,
+                            hint="pauses need motion between them (an approach, a retreat, "
+                            "a gaze...); each retreat and each gaze needs a pause after it",
+                            declared=want[key], realised=got[key]))
+    for plane in ("horizontal", "vertical"):
+        key = f"{plane}_gaze"
+        if want[key] is not None and got[key] is None:
+            g = b.first("gaze", plane)
+            out.append(diag("V121", f"the {plane} gaze is measured at the pause that ends it, "
+                            "and no pause is left for it", g.span,
+                            hint="add a pause per gaze episode (beyond those the retreats "
+                            "need)"))
+    return out
+
+
 def load(text: str, path: str = "<string>") -> tuple[Behaviour | None, list[Diagnostic]]:
     """Parse and validate; the first two stages, without the model's judgement."""
     try:
@@ -112,6 +143,8 @@ def lint_source(text: str, path: str = "<string>", *,
     behaviour, diags = load(text, path)
     result = FileResult(path, list(diags), source=text)
     if behaviour is not None:
+        result.diagnostics.extend(_realisable(behaviour))
+    if behaviour is not None and not has_errors(result.diagnostics):
         point, model_diags = _model_checks(behaviour, weights)
         result.behaviour, result.cv = behaviour, point
         result.diagnostics.extend(model_diags)

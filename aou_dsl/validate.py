@@ -467,7 +467,7 @@ def _check_whole(ctx: _Ctx, b: Behaviour) -> None:
         n_r = r.count if r else 0
         n_p = p.count if p else 0
         if n_r and n_p < n_r + 1:
-            ctx.error("V113", f"{n_r} retreat(s) need at least {n_r + 1} pauses (a retreat "
+            ctx.error("V121", f"{n_r} retreat(s) need at least {n_r + 1} pauses (a retreat "
                       f"starts and ends at a pause, MODEL.md s5), found {n_p}", r.span,
                       hint=f"add `pause DURATION x{n_r + 1}`")
         if r and s.start + r.length > MAX_REACH_DISTANCE:

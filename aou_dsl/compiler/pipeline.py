@@ -178,7 +178,8 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions()
                         ep.span, joint=j))
                     return res
             else:
-                seg, fail = time_path(arm, s, ik.q, ep.a, ep.vmax)
+                seg, fail = time_path(arm, s, ik.q, ep.a, ep.vmax,
+                                      cartesian=ep.kind in ("approach", "retreat"))
                 if seg is None:
                     res.diagnostics.append(diag("C305", f"{ep.kind}: {fail.reason}", ep.span))
                     return res

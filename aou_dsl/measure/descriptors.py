@@ -408,13 +408,17 @@ class _Signals:
 def _peak_acceleration(sig: _Signals, s: int, e: int) -> float:
     """Peak end-effector acceleration on samples s..e [m/s^2].
 
-    Clean data: the largest central-difference acceleration. Noisy data: a cubic
+    Clean data: the largest central-difference acceleration away from the ends. Noisy data: a cubic
     Savitzky-Golay second derivative with a window of 40 % of the episode (at most
     0.6 s), projected on the episode's direction of travel so that noise across it does
     not inflate the magnitude.
     """
     if sig.pacc is not None:
-        return float(np.linalg.norm(sig.pacc[s:e + 1], axis=1).max())
+        # Two central differences reach two samples out: at the ends of an episode they
+        # mix in the neighbouring episode's motion. Bang-bang plateaus reach the ends,
+        # so leaving those samples out loses nothing of the peak.
+        inner = sig.pacc[s + 2:e - 1] if e - s > 6 else sig.pacc[s:e + 1]
+        return float(np.linalg.norm(inner, axis=1).max())
     from scipy.signal import savgol_filter
 
     w = _odd(min(0.6, 0.4 * (sig.t[e] - sig.t[s])) / sig.dt)
