@@ -264,12 +264,13 @@ def shiver_segment(arm: ArmModel, q_hold: np.ndarray, amplitude: float, f: float
     tau = np.linspace(0.0, duration, max(200, int(duration * f * 40)))
     _, xd, xdd = _shiver_offset(tau, amplitude, f, duration)
     vlim = arm.vmax[j] * arm.spec.velocity_scale
-    ratio = max(np.max(np.abs(xd)) / vlim, np.max(np.abs(xdd)) / arm.amax[j])
-    if ratio > 1.0 + LIMIT_SLACK:
-        # Both limits scale with f (velocity) and f^2 (acceleration).
-        f_ok = f / max(ratio, math.sqrt(ratio)) if ratio > 0 else f
+    r_v = float(np.max(np.abs(xd))) / vlim  # scales with f
+    r_a = float(np.max(np.abs(xdd))) / arm.amax[j]  # scales with f^2
+    if max(r_v, r_a) > 1.0 + LIMIT_SLACK:
+        f_ok = f * min(1.0 / max(r_v, 1e-12), 1.0 / math.sqrt(max(r_a, 1e-12)))
+        which = "acceleration" if r_a >= r_v else "velocity"
         return seg, TimingFailure(
-            f"a {math.degrees(amplitude):g} deg shiver at {f:g} Hz exceeds "
-            f"{arm.spec.shiver_joint}'s limits by {ratio:.1f}x; at most about {f_ok:.2g} Hz",
-            arm.spec.shiver_joint, f, f_ok)
+            f"a {math.degrees(amplitude):g} deg shiver at {f:g} Hz needs "
+            f"{max(r_v, r_a):.1f}x {arm.spec.shiver_joint}'s {which} limit; at most about "
+            f"{f_ok:.2g} Hz at this amplitude", arm.spec.shiver_joint, f, f_ok)
     return seg, None
