@@ -18,8 +18,8 @@ from ..kinematics import ArmModel
 
 __all__ = ["IKFailure", "IKResult", "IKStatus", "solve_path"]
 
-POS_TOL = 1e-6  # m
-ROT_TOL = 1e-5  # rad
+POS_TOL = 1e-7  # m
+ROT_TOL = 1e-6  # rad
 MAX_ITER = 60
 DAMPING = 1e-8
 POSTURE_GAIN = 0.2
@@ -83,35 +83,34 @@ class _Solver:
 
     def solve(self, p: np.ndarray, r: np.ndarray, q0: np.ndarray
               ) -> tuple[np.ndarray, float, float, float]:
-        """One target from ``q0``: returns q, position error, rotation error, sigma_min."""
+        """One target from ``q0``: returns q, position error, rotation error, and the
+        smallest singular value of the Jacobian at the solution."""
         pin = self.pin
         target = pin.SE3(r, p)
         q = q0.copy()
         n = len(q)
         fid = self.arm.frame_id
-        sigma = np.inf
-        for _ in range(MAX_ITER):
-            pin.framesForwardKinematics(self.model, self.data, q)
-            dm = self.data.oMf[fid].actInv(target)
+        eye6 = np.eye(6)
+        for it in range(MAX_ITER + 1):
+            # One pass: forward kinematics and every joint's Jacobian; then the frame's
+            # placement and Jacobian from them.
+            pin.computeJointJacobians(self.model, self.data, q)
+            dm = pin.updateFramePlacement(self.model, self.data, fid).actInv(target)
+            jac = pin.getFrameJacobian(self.model, self.data, fid, pin.LOCAL)
             err = pin.log6(dm).vector
-            pe, re = np.linalg.norm(err[:3]), np.linalg.norm(err[3:])
-            if pe < POS_TOL and re < ROT_TOL:
+            pe, re = float(np.linalg.norm(err[:3])), float(np.linalg.norm(err[3:]))
+            if (pe < POS_TOL and re < ROT_TOL) or it == MAX_ITER:
                 break
-            jac = pin.computeFrameJacobian(self.model, self.data, q, fid, pin.LOCAL)
             je = -pin.Jlog6(dm.inverse()) @ jac
-            jj = je @ je.T + DAMPING * np.eye(6)
-            pinv = je.T @ np.linalg.inv(jj)
+            pinv = je.T @ np.linalg.solve(je @ je.T + DAMPING * eye6, eye6)
             dq = -pinv @ err
             dq += (np.eye(n) - pinv @ je) @ (POSTURE_GAIN * (self.posture - q))
             step = np.max(np.abs(dq))
             if step > MAX_ITER_STEP:  # far from the target: Newton steps overshoot
                 dq *= MAX_ITER_STEP / step
             q = np.clip(q + dq, self.lo, self.hi)
-        jac = pin.computeFrameJacobian(self.model, self.data, q, fid, pin.LOCAL)
-        sigma = np.linalg.svd(jac, compute_uv=False)[-1]
-        pin.framesForwardKinematics(self.model, self.data, q)
-        err = pin.log6(self.data.oMf[fid].actInv(target)).vector
-        return q, float(np.linalg.norm(err[:3])), float(np.linalg.norm(err[3:])), float(sigma)
+        sigma = float(np.linalg.svd(jac, compute_uv=False)[-1])
+        return q, pe, re, sigma
 
 
 def _seed(solver: _Solver, p: np.ndarray, r: np.ndarray) -> np.ndarray:

@@ -22,11 +22,17 @@ from .ik import IKStatus, solve_path
 from .layout import Episode, Pose, Timeline, layout
 from .timing import JointSegment, PathSegment, TimeLaw, shiver_segment, time_path
 
-__all__ = ["CompileOptions", "CompileResult", "Trajectory", "compile_behaviour"]
+__all__ = [
+    "CompileOptions",
+    "CompileResult",
+    "Trajectory",
+    "compile_behaviour",
+    "target_path",
+]
 
 #: Waypoint spacing of the IK path: along the line of sight [m], of bearing and roll [rad].
 STEP_LENGTH = 0.005
-STEP_ANGLE = math.radians(1.0)
+STEP_ANGLE = math.radians(0.5)
 MIN_WAYPOINTS = 8
 DEFAULT_RATE = 250.0  # Hz
 
@@ -76,6 +82,9 @@ class CompileResult:
     timings: dict[str, float] = field(default_factory=dict)
     ik_position_error: float = 0.0
     ik_rotation_error: float = 0.0
+    #: Kept for investigation: the reach frame and one timed segment per episode.
+    frame: ReachFrame | None = None
+    segments: list = field(default_factory=list)
 
     @property
     def ok(self) -> bool:
@@ -96,6 +105,20 @@ def _waypoints(ep: Episode, frame: ReachFrame, opts: CompileOptions
                     a.roll + f * (b.roll - a.roll))
         targets.append(frame.target(pose))
     return s, targets
+
+
+_START_CACHE: dict = {}
+
+
+def _start_configuration(arm: ArmModel, frame: ReachFrame, pose: Pose):
+    """IK of the start pose, by continuation from the robot's posture. The same reach
+    always starts the same way, so the result is kept for recompilations."""
+    key = (arm.spec.name, arm.frame_id, frame.goal.tobytes(), frame.R0.tobytes(), pose)
+    if key not in _START_CACHE:
+        if len(_START_CACHE) > 64:
+            _START_CACHE.clear()
+        _START_CACHE[key] = solve_path(arm, [frame.target(pose)])
+    return _START_CACHE[key]
 
 
 def _ik_diag(ep: Episode, status: IKStatus, t: float, joint: str | None, b: Behaviour,
@@ -132,9 +155,8 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions()
     q = None
     segments: list[PathSegment | JointSegment] = []
     t_planned = 0.0
-    start_targets = [frame.target(tl.episodes[0].start if tl.episodes else
-                                  Pose(b.settings.start))]
-    first = solve_path(arm, start_targets)
+    start_pose = tl.episodes[0].start if tl.episodes else Pose(b.settings.start)
+    first = _start_configuration(arm, frame, start_pose)
     if not first.ok:
         ep0 = tl.episodes[0] if tl.episodes else None
         span = ep0.span if ep0 else b.span
@@ -195,9 +217,33 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions()
             q = ik.q[-1]
         t_planned += segments[-1].duration
     res.ik_position_error, res.ik_rotation_error = worst_p, worst_r
+    res.frame, res.segments = frame, segments
     res.trajectory = _sample(arm, b, tl, segments, options.rate)
     lap("sample")
     return res
+
+
+def target_path(res: CompileResult) -> tuple[np.ndarray, np.ndarray]:
+    """The end-effector poses the trajectory is meant to follow, at its sample times:
+    positions (N, 3) and rotations (N, 3, 3). For accuracy studies and benchmarks."""
+    tr, tl = res.trajectory, res.timeline
+    pos = np.empty((len(tr.t), 3))
+    rot = np.empty((len(tr.t), 3, 3))
+    for (_, t0, t1), ep, seg in zip(tr.episodes, tl.episodes, res.segments, strict=True):
+        m = (tr.t >= t0) & (tr.t <= t1)
+        if isinstance(seg, PathSegment):
+            s = seg.law(tr.t[m] - t0)[0]
+            f = s / ep.path_length if ep.path_length else np.zeros_like(s)
+        else:
+            f = np.zeros(int(m.sum()))
+        a, b = ep.start, ep.end
+        out = [res.frame.target(Pose(a.d + x * (b.d - a.d), a.h + x * (b.h - a.h),
+                                     a.v + x * (b.v - a.v), a.roll + x * (b.roll - a.roll)))
+               for x in f]
+        if out:
+            pos[m] = [o[0] for o in out]
+            rot[m] = [o[1] for o in out]
+    return pos, rot
 
 
 def _sample(arm: ArmModel, b: Behaviour, tl: Timeline,

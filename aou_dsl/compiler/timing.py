@@ -17,6 +17,7 @@ are analytic joint oscillations; pauses are exact holds.
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 from dataclasses import dataclass
@@ -86,12 +87,17 @@ class TimeLaw:
 
 
 class PathSegment:
-    """A timed joint path: ``q(t) = path(s(t))``, shape (n,) per sample."""
+    """A timed joint path: ``q(t) = path(s(t))``, shape (n,) per sample.
 
-    def __init__(self, s_way: np.ndarray, q_way: np.ndarray, law: TimeLaw):
+    ``spline`` may have more columns than joints (TOPP-RA's path carries the virtual
+    coordinate last); only the first ``n`` are the joints.
+    """
+
+    def __init__(self, s_way: np.ndarray, q_way: np.ndarray, law: TimeLaw, spline=None):
         from scipy.interpolate import CubicSpline
 
-        self.spline = CubicSpline(s_way, q_way, axis=0)
+        self.n = q_way.shape[1]
+        self.spline = CubicSpline(s_way, q_way, axis=0) if spline is None else spline
         self.d1 = self.spline.derivative(1)
         self.d2 = self.spline.derivative(2)
         self.law = law
@@ -103,8 +109,10 @@ class PathSegment:
     def sample(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Joint positions, velocities, accelerations at local times; each (len(tau), n)."""
         s, sd, sdd = self.law(tau)
-        qs, qss = self.d1(s), self.d2(s)
-        return self.spline(s), qs * sd[:, None], qss * (sd * sd)[:, None] + qs * sdd[:, None]
+        n = self.n
+        qs, qss = self.d1(s)[:, :n], self.d2(s)[:, :n]
+        return (self.spline(s)[:, :n], qs * sd[:, None],
+                qss * (sd * sd)[:, None] + qs * sdd[:, None])
 
 
 class JointSegment:
@@ -165,6 +173,19 @@ class TimingFailure:
     wanted: float | None = None
 
 
+@functools.lru_cache(maxsize=256)
+def _constraints(jv: tuple[float, ...], ja: tuple[float, ...], a: float, vmax: float):
+    """TOPP-RA's joint velocity and acceleration constraints, the virtual joint last.
+    They do not depend on the path, and building one formats its limits as text (slow),
+    so they are made once per set of limits."""
+    import toppra.constraint as constraint
+
+    vlim = np.column_stack([-np.append(jv, vmax), np.append(jv, vmax)])
+    alim = np.column_stack([-np.append(ja, a), np.append(ja, a)])
+    return (constraint.JointVelocityConstraint(vlim),
+            constraint.JointAccelerationConstraint(alim))
+
+
 def _binding_joint(arm: ArmModel, seg: PathSegment, vmax: np.ndarray) -> str | None:
     """The joint that comes nearest its velocity or acceleration limit on a segment."""
     tau = np.linspace(0.0, seg.duration, 200)
@@ -173,7 +194,7 @@ def _binding_joint(arm: ArmModel, seg: PathSegment, vmax: np.ndarray) -> str | N
     return arm.joint_names[int(np.argmax(ratio))]
 
 
-def cartesian_peak(arm: ArmModel, seg: PathSegment, samples: int = 200) -> float:
+def cartesian_peak(arm: ArmModel, seg: PathSegment, samples: int = 100) -> float:
     """Peak translational acceleration of the end-effector on a segment [m/s^2]: the
     classical acceleration ``J q'' + J' q'`` from Pinocchio, at ``samples`` instants."""
     import pinocchio as pin
@@ -227,17 +248,13 @@ def _toppra(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vmax:
             gridpoints: int) -> tuple[PathSegment | None, TimingFailure | None]:
     import toppra
     import toppra.algorithm as algo
-    import toppra.constraint as constraint
 
     logging.getLogger("toppra").setLevel(logging.ERROR)
     aug = np.column_stack([q_way, s_way])
     path = toppra.SplineInterpolator(s_way, aug)
     jv = arm.vmax * arm.spec.velocity_scale
-    vlim = np.column_stack([-np.append(jv, vmax), np.append(jv, vmax)])
-    alim = np.column_stack([-np.append(arm.amax, a), np.append(arm.amax, a)])
     grid = np.linspace(s_way[0], s_way[-1], gridpoints)
-    inst = algo.TOPPRA([constraint.JointVelocityConstraint(vlim),
-                        constraint.JointAccelerationConstraint(alim)],
+    inst = algo.TOPPRA(list(_constraints(tuple(jv), tuple(arm.amax), a, vmax)),
                        path, gridpoints=grid, solver_wrapper="seidel")
     try:
         _, sd, _, _ = inst.compute_parameterization(0.0, 0.0, return_data=True)
@@ -247,7 +264,7 @@ def _toppra(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vmax:
         return None, TimingFailure(f"TOPP-RA: {inst.problem_data.return_code}", None)
     sd = np.asarray(sd, dtype=float)
     sd[0] = sd[-1] = 0.0
-    seg = PathSegment(s_way, q_way, TimeLaw.from_speeds(grid, sd))
+    seg = PathSegment(s_way, q_way, TimeLaw.from_speeds(grid, sd), spline=path.cspl)
     peak = float(np.max(np.abs(seg.law.u)))
     if peak < a * 0.97:
         return seg, TimingFailure("joint limits bind before the declared acceleration",

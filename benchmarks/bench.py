@@ -1,0 +1,154 @@
+"""Benchmarks of aou's speed claims; prints its figures (ratios where machines differ).
+
+    python benchmarks/bench.py            # everything
+    python benchmarks/bench.py compile    # issue 3: compile speed and the by-hand pipeline
+    python benchmarks/bench.py measure    # issue 4: a 60 s trajectory at 1 kHz
+
+compile, per shipped behaviour:
+- cold: a fresh Python process that imports aou and compiles the file (imports, robot
+  model loading and all), as `aouc compile` does once;
+- warm: the median of repeated `compile_behaviour` calls in one process (the case of a
+  robot that recompiles as its uncertainty changes);
+- the real-time factor: trajectory duration / warm compile time;
+- by hand: the same Cartesian path, sampled at the same rate with linear timing, solved
+  with `pybullet.calculateInverseKinematics` per sample, as a user would without aou;
+  speed and accuracy (worst position error against the path, worst gaze error) side by
+  side with aou's.
+"""
+
+from __future__ import annotations
+
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+BEHAVIOURS = ["confident", "curious", "hesitant", "fearful", "inactive"]
+
+
+def _cold(path: Path) -> float:
+    code = ("import time; t = time.perf_counter()\n"
+            "from aou_dsl.lint import lint_file\n"
+            "from aou_dsl.compiler.pipeline import compile_behaviour\n"
+            f"r = compile_behaviour(lint_file({str(path)!r}).behaviour)\n"
+            "assert r.ok\n"
+            "print(time.perf_counter() - t)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    return float(out.stdout.strip().splitlines()[-1])
+
+
+def _errors(arm, q: np.ndarray, pos: np.ndarray, goal: np.ndarray) -> tuple[float, float]:
+    """Worst position error [mm] against ``pos`` and worst gaze error [deg]."""
+    p, r = arm.fk(q)
+    perr = np.linalg.norm(p - pos, axis=1).max() * 1000
+    g = goal - p
+    cos = np.einsum("ij,ij->i", r[:, :, 2], g) / np.linalg.norm(g, axis=1)
+    return float(perr), float(np.degrees(np.arccos(np.clip(cos, -1, 1))).max())
+
+
+def _by_hand(res, arm) -> tuple[float, np.ndarray, np.ndarray]:
+    """The path sampled with linear timing; IK by PyBullet per sample. Returns the time
+    [s] and the joint path, plus the targets it was asked for."""
+    from aou_dsl.check.scene import Scene
+    from aou_dsl.compiler.layout import Pose
+
+    tr, tl, frame = res.trajectory, res.timeline, res.frame
+    targets = []
+    for (_, t0, t1), ep in zip(tr.episodes, tl.episodes, strict=True):
+        n = max(1, int(round((t1 - t0) * (1 / (tr.t[1] - tr.t[0])))))
+        for x in np.arange(n) / n:  # linear timing: constant speed over the episode
+            a, b = ep.start, ep.end
+            targets.append(frame.target(Pose(a.d + x * (b.d - a.d), a.h + x * (b.h - a.h),
+                                             a.v + x * (b.v - a.v),
+                                             a.roll + x * (b.roll - a.roll))))
+    scene = Scene(tr.robot)
+    pb = scene.pb
+    scene.set_arm(tr.q[0])
+    out = np.empty((len(targets), arm.n))
+    start = time.perf_counter()
+    for i, (p, r) in enumerate(targets):
+        quat = _quat(r)
+        sol = pb.calculateInverseKinematics(scene.body, scene.ee_link, p.tolist(), quat,
+                                            maxNumIterations=100, residualThreshold=1e-6,
+                                            physicsClientId=scene.client)
+        q = np.array(sol[:arm.n])
+        scene.set_arm(q)  # warm start the next sample, as a careful user would
+        out[i] = q
+    elapsed = time.perf_counter() - start
+    scene.close()
+    return elapsed, out, np.array([p for p, _ in targets])
+
+
+def _quat(r: np.ndarray) -> list[float]:
+    """Rotation matrix -> PyBullet quaternion (x, y, z, w)."""
+    import pinocchio as pin
+
+    q = pin.Quaternion(r)
+    return [q.x, q.y, q.z, q.w]
+
+
+def bench_compile(repeat: int = 15) -> None:
+    from aou_dsl.compiler.pipeline import compile_behaviour, target_path
+    from aou_dsl.kinematics import load_arm
+    from aou_dsl.lint import lint_file
+
+    print("compile (panda, 250 Hz)")
+    print(f"{'behaviour':<10}{'cold s':>8}{'warm ms':>9}{'motion s':>9}{'RTF':>7}"
+          f"{'by-hand ms':>11}{'speed-up':>9}  {'pos err mm aou/hand':>20}"
+          f"  {'gaze err deg aou/hand':>22}")
+    for name in BEHAVIOURS:
+        path = ROOT / "behaviours" / f"{name}.aou"
+        cold = _cold(path)
+        b = lint_file(str(path)).behaviour
+        compile_behaviour(b)
+        times = []
+        for _ in range(repeat):
+            t = time.perf_counter()
+            res = compile_behaviour(b)
+            times.append(time.perf_counter() - t)
+        warm = statistics.median(times)
+        tr = res.trajectory
+        arm = load_arm(tr.robot)
+        goal = np.asarray(tr.goal)
+        pos, _ = target_path(res)
+        aou_p, aou_g = _errors(arm, tr.q, pos, goal)
+        hand_t, hand_q, hand_pos = _by_hand(res, arm)
+        hand_p, hand_g = _errors(arm, hand_q, hand_pos, goal)
+        print(f"{name:<10}{cold:>8.2f}{warm * 1000:>9.1f}{tr.duration:>9.2f}"
+              f"{tr.duration / warm:>7.0f}{hand_t * 1000:>11.1f}{hand_t / warm:>9.1f}"
+              f"  {aou_p:>9.4f} / {hand_p:<8.4f}  {aou_g:>10.4f} / {hand_g:<9.4f}")
+    print("goals: warm hesitant <= 100 ms; RTF >= 250; >= 10x faster than by hand at equal "
+          "or better accuracy")
+
+
+def bench_measure() -> None:
+    from aou_dsl.build import to_recording
+    from aou_dsl.compiler.pipeline import CompileOptions, compile_behaviour
+    from aou_dsl.lint import load
+    from aou_dsl.measure.descriptors import measure
+
+    text = "approach a=0.05\npause 2s x14\nretreat 0.05m a=0.1 x8\ngaze horizontal 15deg x4\n"
+    b, _ = load(text, "long.aou")
+    res = compile_behaviour(b, CompileOptions(rate=1000.0))
+    rec = to_recording(res.trajectory)
+    measure(rec)  # load the robot model once
+    times = []
+    for _ in range(5):
+        t = time.perf_counter()
+        m = measure(rec)
+        times.append(time.perf_counter() - t)
+    print(f"measure: {res.trajectory.duration:.1f} s of motion at 1 kHz ({len(rec.t)} samples): "
+          f"{statistics.median(times):.3f} s (goal < 1 s); {len(m.episodes)} episodes found")
+
+
+if __name__ == "__main__":
+    what = sys.argv[1:] or ["compile", "measure"]
+    if "compile" in what:
+        bench_compile()
+    if "measure" in what:
+        bench_measure()
