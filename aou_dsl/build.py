@@ -47,13 +47,17 @@ def _rounded(d: dict) -> dict:
     return {k: (round(v, 6) if isinstance(v, float) else v) for k, v in d.items()}
 
 
-def build_file(path: str, *, rate: float | None = None, check: bool = True) -> BuildResult:
-    """Lint, compile, check and measure one file."""
-    from .check.limits import check_limits
+def build_file(path: str, *, rate: float | None = None, check: bool = True,
+               scene=None) -> BuildResult:
+    """Lint, compile, check (kinematic replay in PyBullet) and measure one file.
+
+    ``scene`` is a :class:`~aou_dsl.check.scene.SceneOptions` (target size, table height).
+    """
+    from .check.replay import replay
+    from .check.scene import SceneOptions
     from .compiler.output import trajectory_document
     from .compiler.pipeline import CompileOptions, compile_behaviour
     from .declared import compare_descriptors, declared_descriptors
-    from .kinematics import load_arm
     from .measure.descriptors import measure
 
     start = time.perf_counter()
@@ -72,16 +76,15 @@ def build_file(path: str, *, rate: float | None = None, check: bool = True) -> B
     tr = compiled.trajectory
     checks_json: dict = {"kinematic": "skipped (--no-check)"}
     if check:
-        arm = load_arm(tr.robot)
-        res.checks = check_limits(arm, tr.t, tr.q, tr.qd, tr.qdd)
-        checks_json = {"kinematic": [c.to_json() for c in res.checks]}
-        for c in res.checks:
-            if not c.ok:
-                span = _span_at(compiled, c.time)
-                res.diagnostics.append(diag(
-                    "C306", f"{c.name} check failed at t={c.time:.3f}s: {c.joint} reaches "
-                    f"{c.value:.4g}, limit {c.limit:.4g}", span, check=c.name, time=c.time,
-                    joint=c.joint, value=c.value, limit=c.limit))
+        report = replay(tr.robot, tr.t, tr.q, tr.qd, tr.qdd, tr.goal,
+                        options=scene or SceneOptions())
+        res.checks = report.checks
+        checks_json = {"kinematic": report.to_json()}
+        for c in report.failed():
+            res.diagnostics.append(diag(
+                "C306", f"{c.name} check failed at t={c.time:.3f}s: {_what(c)}",
+                _span_at(compiled, c.time), check=c.name, time=c.time, joint=c.joint,
+                value=c.value, limit=c.limit))
         if has_errors(res.diagnostics):
             res.seconds = time.perf_counter() - start
             return res
@@ -102,6 +105,15 @@ def build_file(path: str, *, rate: float | None = None, check: bool = True) -> B
     )
     res.seconds = time.perf_counter() - start
     return res
+
+
+def _what(c) -> str:
+    """A failed check in words: what reached what."""
+    if c.name in ("joint-position", "joint-velocity", "joint-acceleration", "joint-torque"):
+        return f"{c.joint} reaches {c.value:.4g}, limit {c.limit:.4g}"
+    if c.name == "kinematics-agreement":
+        return c.detail
+    return f"{c.joint}: {c.detail} (distance {c.value:.4g} m)"
 
 
 def _span_of(b, descriptor: str):

@@ -181,8 +181,9 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     if many and args.output:
         os.makedirs(args.output, exist_ok=True)
     worst = EXIT_OK
+    scene = _scene_options(args)
     for k, src in enumerate(files, 1):
-        res = build_file(src, rate=args.rate, check=not args.no_check)
+        res = build_file(src, rate=args.rate, check=not args.no_check, scene=scene)
         _print_diags(res.diagnostics, "text", {src: res.lint.source or ""}, stream=sys.stderr)
         dest = _output_path(src, args.output, fmt, many)
         if not res.ok:
@@ -203,6 +204,90 @@ def _cmd_compile(args: argparse.Namespace) -> int:
         if has_errors(res.diagnostics):
             worst = max(worst, EXIT_ERRORS)
     return worst
+
+
+def _scene_options(args: argparse.Namespace):
+    from .check.scene import SceneOptions
+
+    table = None if args.no_table else args.table_height
+    return SceneOptions(target_size=args.target_size, table_height=table)
+
+
+# --- check ------------------------------------------------------------------------------
+
+
+def _cmd_check(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from .check.replay import replay
+    from .diagnostics import AouError
+
+    path = args.path
+    if path.endswith(".aou"):
+        from .build import build_file
+
+        res = build_file(path, check=False)
+        if not res.ok:
+            _print_diags(res.diagnostics, "text", {path: res.lint.source or ""},
+                         stream=sys.stderr)
+            io = any(d.code.startswith("I") for d in res.diagnostics)
+            return EXIT_USAGE if io else EXIT_ERRORS
+        tr = res.compiled.trajectory
+        robot, t, q, qd, qdd, goal = tr.robot, tr.t, tr.q, tr.qd, tr.qdd, tr.goal
+    else:
+        import json
+
+        from .kinematics import load_arm
+        from .measure.recording import read_recording
+
+        try:
+            rec = read_recording(path)
+            arm = load_arm(rec.robot, rec.ee_frame)
+            cols = [rec.joint_names.index(n) for n in arm.joint_names
+                    if n in rec.joint_names]
+            if len(cols) != arm.n:
+                missing = [n for n in arm.joint_names if n not in rec.joint_names]
+                print(f"{path}: R402 the trajectory lacks joint(s) {', '.join(missing)}",
+                      file=sys.stderr)
+                return EXIT_ERRORS
+            with open(path, encoding="utf-8") as fh:
+                doc = json.load(fh)
+        except AouError as err:
+            _print_diags(err.diagnostics, "text", stream=sys.stderr)
+            return EXIT_USAGE if any(d.code.startswith("I") for d in err.diagnostics) \
+                else EXIT_ERRORS
+        t, q, goal, robot = rec.t, rec.q[:, cols], rec.goal, rec.robot
+        if "qd" in doc and "qdd" in doc:
+            qd = np.asarray(doc["qd"], float)[:, cols]
+            qdd = np.asarray(doc["qdd"], float)[:, cols]
+        else:
+            qd = np.gradient(q, t, axis=0)
+            qdd = np.gradient(qd, t, axis=0)
+    report = replay(robot, t, q, qd, qdd, goal, options=_scene_options(args),
+                    dynamic=not args.no_dynamic)
+    if args.format == "json":
+        print(format_json({"path": path, **report.to_json()}))
+    else:
+        print(f"{path}: {robot}, {t[-1]:.2f} s, {len(t)} samples")
+        for c in report.checks:
+            mark = "pass" if c.ok else "FAIL"
+            where = "" if c.time is None else f" worst at t={c.time:.3f}s"
+            who = f" {c.joint}" if c.joint else ""
+            val = "" if c.value is None else f" value {c.value:.4g}"
+            lim = "" if c.limit is None else f" limit {c.limit:.4g}"
+            print(f"  {mark}  {c.name:<21}{where}{who}{val}{lim}  ({c.detail})")
+        cl = report.clearances
+        print("  clearances: " + ", ".join(
+            f"{k} {'n/a' if v is None else f'{v * 1000:.1f} mm'}" for k, v in cl.items()))
+        ag = report.agreement
+        print(f"  PyBullet vs Pinocchio end-effector: {ag['position_mm']:.2e} mm, "
+              f"{ag['rotation_deg']:.2e} deg")
+        if report.dynamic:
+            d = report.dynamic
+            print(f"  dynamic replay at {d['physics_rate_hz']:.0f} Hz: tracking max "
+                  f"{d['tracking_max_rad']:.2e} rad, RMS {d['tracking_rms_rad']:.2e} rad; "
+                  f"peak torque {d['torque_max_ratio'] * 100:.0f} % of the effort limit")
+    return EXIT_OK if report.ok else EXIT_ERRORS
 
 
 # --- measure ----------------------------------------------------------------------------
@@ -253,6 +338,14 @@ def _cmd_measure(args: argparse.Namespace) -> int:
 # --- the parser -------------------------------------------------------------------------
 
 
+def _scene_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--target-size", type=float, default=0.05, metavar="M",
+                   help="edge of the target cube at the goal, in metres (default 0.05)")
+    p.add_argument("--table-height", type=float, default=0.0, metavar="M",
+                   help="height of the table plane in the base frame (default 0)")
+    p.add_argument("--no-table", action="store_true", help="no table plane")
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="aouc", description="aou: expressive robot-arm motion from .aou files.")
     p.add_argument("--version", action="version", version=f"aouc {__version__}")
@@ -279,7 +372,17 @@ def build_parser() -> argparse.ArgumentParser:
                       help="sample rate in Hz (default 250)")
     comp.add_argument("--no-check", action="store_true",
                       help="skip the safety checks (recorded in the output)")
+    _scene_arguments(comp)
     comp.set_defaults(func=_cmd_compile)
+
+    chk = sub.add_parser("check", help="replay a behaviour or trajectory in PyBullet and "
+                         "report every safety check")
+    chk.add_argument("path", metavar="FILE", help="a .aou file or a trajectory .json")
+    chk.add_argument("--format", choices=("text", "json"), default="text")
+    chk.add_argument("--no-dynamic", action="store_true",
+                     help="kinematic checks only (skip the physics replay)")
+    _scene_arguments(chk)
+    chk.set_defaults(func=_cmd_check)
 
     meas = sub.add_parser("measure", help="measure the eleven descriptors of a trajectory")
     meas.add_argument("path", metavar="FILE", help="a trajectory .json, or a .csv recording")

@@ -53,6 +53,8 @@ class RobotSpec:
     shiver_joint: str
     velocity_scale: float = 0.9
     limit_margin: float = 0.05
+    #: Link pairs allowed to touch beyond adjacent links (meshes that overlap by design).
+    allowed_contacts: tuple[tuple[str, str], ...] = ()
 
 
 ROBOTS: dict[str, RobotSpec] = {
@@ -67,6 +69,10 @@ ROBOTS: dict[str, RobotSpec] = {
         posture=(0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.785398),
         joint_accel=(15.0, 7.5, 10.0, 12.5, 15.0, 20.0, 20.0),
         shiver_joint="panda_joint7",
+        # The hand's mesh overlaps link 7's at the flange (link 8 between them has no
+        # shape), and the two fingers touch when the gripper is closed.
+        allowed_contacts=(("panda_link7", "panda_hand"),
+                          ("panda_leftfinger", "panda_rightfinger")),
     ),
     "ur5": RobotSpec(
         name="ur5",

@@ -6,14 +6,44 @@ client, so several can coexist and none leaks into another.
 
 from __future__ import annotations
 
+import contextlib
 import os
+import sys
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..robots import ROBOTS
 
-__all__ = ["Scene", "SceneOptions", "urdf_path"]
+__all__ = ["Scene", "SceneOptions", "import_pybullet", "urdf_path"]
+
+
+@contextlib.contextmanager
+def _quiet():
+    """Keep PyBullet's C library from printing its banner ("pybullet build time: ...")
+    on standard output or error: it would corrupt ``--format json`` output."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), 1)
+            os.dup2(null.fileno(), 2)
+            yield
+    finally:
+        os.dup2(saved[0], 1)
+        os.dup2(saved[1], 2)
+        for fd in saved:
+            os.close(fd)
+
+
+def import_pybullet():
+    """Import PyBullet quietly (see :func:`_quiet`)."""
+    if "pybullet" not in sys.modules:
+        with _quiet():
+            import pybullet  # noqa: F401
+    return sys.modules["pybullet"]
+
 
 #: The URDF of each robot inside example-robot-data's share folder.
 _URDF = {
@@ -56,10 +86,10 @@ class Scene:
     options: SceneOptions = field(default_factory=SceneOptions)
 
     def __post_init__(self):
-        import pybullet as pb
-
+        pb = import_pybullet()
         self.pb = pb
-        self.client = pb.connect(pb.DIRECT)
+        with _quiet():
+            self.client = pb.connect(pb.DIRECT)
         urdf, search = urdf_path(self.robot)
         pb.setAdditionalSearchPath(search, physicsClientId=self.client)
         flags = pb.URDF_USE_SELF_COLLISION | pb.URDF_USE_SELF_COLLISION_EXCLUDE_PARENT
@@ -92,9 +122,10 @@ class Scene:
                                             physicsClientId=self.client)
 
     def set_arm(self, q: np.ndarray) -> None:
-        """Put the arm joints at ``q`` (kinematically, no physics); fingers open."""
-        for j, v in zip(self.arm, q, strict=True):
-            self.pb.resetJointState(self.body, j, float(v), physicsClientId=self.client)
+        """Put the arm joints at ``q`` (kinematically, no physics), at rest."""
+        self.pb.resetJointStatesMultiDof(self.body, self.arm, [[float(v)] for v in q],
+                                         targetVelocities=[[0.0]] * len(self.arm),
+                                         physicsClientId=self.client)
 
     def ee_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """End-effector position (3,) and rotation (3, 3) as PyBullet computes them."""
