@@ -335,6 +335,181 @@ def _cmd_measure(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+# --- plot, render, variants --------------------------------------------------------------
+
+
+def _media_missing(exc: ImportError) -> int:
+    print(f"aouc: this command needs the media extra ({exc.name} is missing): "
+          "pip install 'aou-dsl[media]'", file=sys.stderr)
+    return EXIT_USAGE
+
+
+def _load_motion(path: str, scene=None):
+    """A file to draw: (recording, episodes or None, title). ``.aou`` files are compiled
+    (without the safety checks: pictures are not sent to a robot)."""
+    from .build import build_file, to_recording
+    from .diagnostics import AouError
+    from .measure.recording import read_recording
+
+    if path.endswith(".aou"):
+        res = build_file(path, check=False)
+        if not res.ok:
+            raise AouError(res.diagnostics)
+        tr = res.compiled.trajectory
+        return to_recording(tr, path), tr.episodes, res.compiled.behaviour.name
+    rec = read_recording(path)
+    episodes = None
+    if path.endswith(".json"):
+        import json
+
+        with open(path, encoding="utf-8") as fh:
+            doc = json.load(fh)
+        if doc.get("episodes"):
+            episodes = tuple((e["kind"], e["t_start"], e["t_end"]) for e in doc["episodes"])
+    import os
+
+    return rec, episodes, os.path.splitext(os.path.basename(path))[0]
+
+
+def _report_error(err) -> int:
+    _print_diags(err.diagnostics, "text", stream=sys.stderr)
+    io = any(d.code.startswith("I") for d in err.diagnostics)
+    return EXIT_USAGE if io else EXIT_ERRORS
+
+
+def _cmd_plot(args: argparse.Namespace) -> int:
+    from .diagnostics import AouError
+
+    try:
+        from .media.plot import cv_figure, profile_data, profile_figure, save
+    except ImportError as exc:
+        return _media_missing(exc)
+    try:
+        if args.cv:
+            from .lint import lint_paths
+
+            results, problems = lint_paths(args.paths)
+            if problems:
+                return _report_error(AouError(problems))
+            bad = [d for r in results if not r.ok for d in r.diagnostics]
+            if bad:
+                return _report_error(AouError(bad))
+            fig = cv_figure([(r.behaviour.name, r.cv) for r in results])
+        else:
+            if len(args.paths) != 1:
+                print("aouc: plot takes one file (or --cv with several)", file=sys.stderr)
+                return EXIT_USAGE
+            rec, episodes, title = _load_motion(args.paths[0])
+            fig = profile_figure(profile_data(rec, episodes, title))
+        save(fig, args.output)
+    except AouError as err:
+        return _report_error(err)
+    print(f"wrote {args.output}", file=sys.stderr)
+    return EXIT_OK
+
+
+def _camera(args: argparse.Namespace):
+    from .media.render import Camera
+
+    target = _parse_goal(args.camera_target) if args.camera_target else None
+    w, h = (int(x) for x in args.size.lower().split("x"))
+    return Camera(distance=args.camera_distance, yaw=args.camera_yaw,
+                  pitch=args.camera_pitch, target=target, width=w, height=h)
+
+
+def _cmd_render(args: argparse.Namespace) -> int:
+    import time
+
+    from .diagnostics import AouError
+
+    try:
+        from .media.render import render_video
+    except ImportError as exc:
+        return _media_missing(exc)
+    paths = args.side_by_side or ([args.path] if args.path else [])
+    if not paths:
+        print("aouc: render takes FILE, or --side-by-side A B", file=sys.stderr)
+        return EXIT_USAGE
+    try:
+        camera = _camera(args)
+        motions = [_load_motion(p)[0] for p in paths]
+        start = time.perf_counter()
+        info = render_video(motions, args.output, fps=args.fps, camera=camera,
+                            scene_options=_scene_options(args))
+    except AouError as err:
+        return _report_error(err)
+    except ImportError as exc:
+        return _media_missing(exc)
+    except ValueError as exc:
+        print(f"aouc: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    print(f"wrote {args.output}: {info['frames']} frames at {info['fps']:g} fps "
+          f"({info['duration']:.2f} s), {info['size'][0]}x{info['size'][1]}, rendered in "
+          f"{time.perf_counter() - start:.1f} s", file=sys.stderr)
+    return EXIT_OK
+
+
+def _cmd_variants(args: argparse.Namespace) -> int:
+    import os
+
+    from .compiler.output import write_atomic
+    from .diagnostics import AouError
+    from .lint import lint_file, lint_source
+    from .media.variants import make_variants
+
+    try:
+        name, values = args.vary.split("=", 1)
+        low, high = (float(v) for v in values.split(","))
+    except ValueError:
+        print("aouc: --vary takes NAME=LOW,HIGH, e.g. pause_duration=1.0,2.5",
+              file=sys.stderr)
+        return EXIT_USAGE
+    base = lint_file(args.path)
+    if not base.ok:
+        _print_diags(base.diagnostics, "text", {args.path: base.source or ""},
+                     stream=sys.stderr)
+        return EXIT_ERRORS
+    try:
+        variants = make_variants(base.behaviour, base.source, name, low, high)
+    except AouError as err:
+        return _report_error(err)
+    stem = os.path.splitext(os.path.basename(args.path))[0]
+    folder = args.output or "."
+    os.makedirs(folder, exist_ok=True)
+    outputs = []
+    for v in variants:
+        out = os.path.join(folder, f"{stem}-{name}-{v.label}.aou")
+        lint = lint_source(v.text, out)
+        if not lint.ok:
+            _print_diags(lint.diagnostics, "text", {out: v.text}, stream=sys.stderr)
+            print(f"aouc: the {v.label} variant ({name}={v.value:g}) is not valid; nothing "
+                  "written", file=sys.stderr)
+            return EXIT_ERRORS
+        outputs.append((out, v))
+    for out, v in outputs:
+        try:
+            write_atomic(out, v.text.encode(), inputs=[args.path])
+        except AouError as err:
+            return _report_error(err)
+        print(f"wrote {out} ({name}={v.value:g})", file=sys.stderr)
+    if args.render:
+        args.side_by_side = [o for o, _ in outputs]
+        args.path = None
+        args.output = args.render
+        return _cmd_render(args)
+    return EXIT_OK
+
+
+def _render_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--fps", type=float, default=30.0, help="frames per second (default 30)")
+    p.add_argument("--size", default="640x480", help="frame size WxH (default 640x480)")
+    p.add_argument("--camera-distance", type=float, default=1.2, metavar="M")
+    p.add_argument("--camera-yaw", type=float, default=30.0, metavar="DEG")
+    p.add_argument("--camera-pitch", type=float, default=-15.0, metavar="DEG")
+    p.add_argument("--camera-target", metavar="X,Y,Z",
+                   help="point looked at (default: halfway from the base to the goal)")
+
+
 # --- the parser -------------------------------------------------------------------------
 
 
@@ -383,6 +558,35 @@ def build_parser() -> argparse.ArgumentParser:
                      help="kinematic checks only (skip the physics replay)")
     _scene_arguments(chk)
     chk.set_defaults(func=_cmd_check)
+
+    plot = sub.add_parser("plot", help="velocity profile of a behaviour or trajectory, or "
+                          "the C-V map of several behaviours (--cv)")
+    plot.add_argument("paths", nargs="+", metavar="FILE")
+    plot.add_argument("-o", "--output", required=True, metavar="X.png|X.svg")
+    plot.add_argument("--cv", action="store_true",
+                      help="plot the C-V plane with each behaviour's inferred point")
+    plot.set_defaults(func=_cmd_plot)
+
+    render = sub.add_parser("render", help="render a video of a behaviour or trajectory")
+    render.add_argument("path", nargs="?", metavar="FILE")
+    render.add_argument("-o", "--output", required=True, metavar="X.mp4|X.gif")
+    render.add_argument("--side-by-side", nargs=2, metavar=("A", "B"),
+                        help="render two behaviours next to each other")
+    _render_arguments(render)
+    _scene_arguments(render)
+    render.set_defaults(func=_cmd_render)
+
+    var = sub.add_parser("variants", help="write a pair of files that differ in one "
+                         "descriptor (the study's Part B stimuli)")
+    var.add_argument("path", metavar="FILE")
+    var.add_argument("--vary", required=True, metavar="NAME=LOW,HIGH",
+                     help="descriptor and its two values, in the descriptor's unit")
+    var.add_argument("-o", "--output", metavar="DIR", help="folder (default: here)")
+    var.add_argument("--render", metavar="X.mp4|X.gif",
+                     help="also render the pair side by side")
+    _render_arguments(var)
+    _scene_arguments(var)
+    var.set_defaults(func=_cmd_variants)
 
     meas = sub.add_parser("measure", help="measure the eleven descriptors of a trajectory")
     meas.add_argument("path", metavar="FILE", help="a trajectory .json, or a .csv recording")

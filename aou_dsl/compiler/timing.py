@@ -18,8 +18,11 @@ are analytic joint oscillations; pauses are exact holds.
 from __future__ import annotations
 
 import functools
+import importlib
 import logging
 import math
+import sys
+import types
 from dataclasses import dataclass
 
 import numpy as np
@@ -173,13 +176,47 @@ class TimingFailure:
     wanted: float | None = None
 
 
+class _LazyModule(types.ModuleType):
+    """Stands in for a module until one of its attributes is used, then imports it."""
+
+    def __getattr__(self, attr: str):
+        return getattr(importlib.import_module(self.__name__), attr)
+
+
+def _import_toppra():
+    """toppra, imported without matplotlib.
+
+    toppra's algorithm module imports ``matplotlib.pyplot`` at its top, for plotting
+    helpers aou never calls; that import costs every compile a fraction of a second. While
+    toppra is imported, lazy stand-ins take matplotlib's place in ``sys.modules``; they
+    are removed right after, so a later ``import matplotlib`` (``aouc plot``) is the real
+    one, and toppra's own reference imports it only if it is ever used.
+    """
+    if "toppra" in sys.modules:
+        return sys.modules["toppra"]
+    stubs: dict[str, types.ModuleType] = {}
+    if "matplotlib" not in sys.modules:
+        stubs["matplotlib"] = _LazyModule("matplotlib")
+        stubs["matplotlib.pyplot"] = _LazyModule("matplotlib.pyplot")
+        stubs["matplotlib"].pyplot = stubs["matplotlib.pyplot"]  # `import a.b as c`
+        sys.modules.update(stubs)
+    try:
+        import toppra
+        import toppra.algorithm  # noqa: F401
+        import toppra.constraint  # noqa: F401
+    finally:
+        for name, stub in stubs.items():
+            if sys.modules.get(name) is stub:
+                del sys.modules[name]
+    return toppra
+
+
 @functools.lru_cache(maxsize=256)
 def _constraints(jv: tuple[float, ...], ja: tuple[float, ...], a: float, vmax: float):
     """TOPP-RA's joint velocity and acceleration constraints, the virtual joint last.
     They do not depend on the path, and building one formats its limits as text (slow),
     so they are made once per set of limits."""
-    import toppra.constraint as constraint
-
+    constraint = _import_toppra().constraint
     vlim = np.column_stack([-np.append(jv, vmax), np.append(jv, vmax)])
     alim = np.column_stack([-np.append(ja, a), np.append(ja, a)])
     return (constraint.JointVelocityConstraint(vlim),
@@ -246,9 +283,8 @@ def time_path(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vma
 
 def _toppra(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vmax: float,
             gridpoints: int) -> tuple[PathSegment | None, TimingFailure | None]:
-    import toppra
-    import toppra.algorithm as algo
-
+    toppra = _import_toppra()
+    algo = toppra.algorithm
     logging.getLogger("toppra").setLevel(logging.ERROR)
     aug = np.column_stack([q_way, s_way])
     path = toppra.SplineInterpolator(s_way, aug)

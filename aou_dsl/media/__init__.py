@@ -1,0 +1,1 @@
+"""Pictures and videos of behaviours: plots, renders, study variant pairs."""

@@ -1,0 +1,161 @@
+"""``aouc plot``: velocity profiles with the episodes shaded, and the C-V map.
+
+matplotlib is imported here only (with the Agg backend: no display needed), so no other
+command pays for it. Figures are built from :class:`ProfileData`, computed once from
+the trajectory, so what is drawn is exactly what was computed (tests check it).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..cv import CANONICAL, CVPoint
+
+__all__ = ["ProfileData", "cv_figure", "profile_data", "profile_figure", "save"]
+
+_COLOURS = {"approach": "#4c9a2a", "retreat": "#c0392b", "pause": "#95a5a6",
+            "gaze": "#2e86c1", "tilt": "#8e44ad", "shiver": "#e67e22"}
+
+
+@dataclass(frozen=True)
+class ProfileData:
+    """What the velocity-profile figure shows.
+
+    Attributes:
+        t: times [s], shape (N,).
+        speed: end-effector speed [m/s], shape (N,).
+        distance: distance to the goal [m], shape (N,).
+        q, qd: joint positions [rad] and velocities [rad/s], shape (N, n).
+        lower, upper, vmax: joint limits, shape (n,).
+        episodes: (kind, t_start, t_end) per episode.
+    """
+
+    title: str
+    joint_names: tuple[str, ...]
+    t: np.ndarray
+    speed: np.ndarray
+    distance: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    vmax: np.ndarray
+    episodes: tuple[tuple[str, float, float], ...]
+
+
+def profile_data(rec, episodes=None, title: str = "") -> ProfileData:
+    """From a :class:`~aou_dsl.measure.recording.Recording`. Without ``episodes`` (a
+    recording), the episodes ``aouc measure`` finds are shaded."""
+    from ..kinematics import load_arm
+
+    arm = load_arm(rec.robot, rec.ee_frame)
+    cols = [rec.joint_names.index(n) for n in arm.joint_names]
+    t = np.asarray(rec.t, float)
+    q = np.asarray(rec.q, float)[:, cols]
+    pos, _ = arm.fk(q)
+    speed = np.linalg.norm(np.gradient(pos, t, axis=0), axis=1)
+    qd = np.gradient(q, t, axis=0)
+    if episodes is None:
+        from ..measure.descriptors import measure
+
+        episodes = tuple((e.kind, e.t_start + t[0], e.t_end + t[0])
+                         for e in measure(rec).episodes)
+    return ProfileData(title, arm.joint_names, t, speed,
+                       np.linalg.norm(np.asarray(rec.goal) - pos, axis=1), q, qd,
+                       arm.lower, arm.upper, arm.vmax, tuple(episodes))
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def profile_figure(d: ProfileData):
+    """Four panels over time: end-effector speed (episodes shaded and labelled, like the
+    paper's velocity profiles), goal distance, joint positions and joint velocities as
+    fractions of their limits."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(4, 1, figsize=(10, 9), sharex=True,
+                             gridspec_kw={"height_ratios": [2, 1, 1.3, 1.3]})
+    ax_v, ax_d, ax_q, ax_qd = axes
+    ax_v.plot(d.t, d.speed, color="black", lw=1.2, label="end-effector speed")
+    top = max(float(d.speed.max()), 1e-3) * 1.25
+    for kind, a, b in d.episodes:
+        for ax in axes:
+            ax.axvspan(a, b, color=_COLOURS.get(kind, "#dddddd"), alpha=0.15, lw=0)
+        ax_v.text((a + b) / 2, top * 0.93, kind, ha="center", va="top", fontsize=7,
+                  rotation=90 if b - a < 0.08 * (d.t[-1] - d.t[0]) else 0)
+    ax_v.set_ylim(0, top)
+    ax_v.set_ylabel("speed [m/s]")
+    ax_v.set_title(d.title or "velocity profile")
+    ax_d.plot(d.t, d.distance, color="#34495e", lw=1.2)
+    ax_d.set_ylabel("goal distance [m]")
+    mid = (d.upper + d.lower) / 2
+    half = (d.upper - d.lower) / 2
+    for j, name in enumerate(d.joint_names):
+        ax_q.plot(d.t, (d.q[:, j] - mid[j]) / half[j], lw=1, label=name)
+        ax_qd.plot(d.t, d.qd[:, j] / d.vmax[j], lw=1, label=name)
+    for ax, label in ((ax_q, "position / range"), (ax_qd, "velocity / limit")):
+        ax.axhline(1, color="red", lw=0.8, ls="--")
+        ax.axhline(-1, color="red", lw=0.8, ls="--")
+        ax.set_ylabel(label)
+        ax.set_ylim(-1.1, 1.1)
+    ax_q.legend(fontsize=6, ncol=4, loc="lower left")
+    ax_qd.set_xlabel("time [s]")
+    fig.tight_layout()
+    return fig
+
+
+def cv_figure(points: list[tuple[str, CVPoint]]):
+    """The C-V plane: the five canonical states, the borders of their regions (nearest
+    state), and each behaviour's inferred point, labelled."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(6.2, 6))
+    # Region borders: the hesitant diamond |C| + |V| = 1, and the axes outside it.
+    ax.plot([1, 0, -1, 0, 1], [0, 1, 0, -1, 0], color="#7f8c8d", lw=1)
+    for x, y in (([1, 1.2], [0, 0]), ([-1, -1.2], [0, 0]), ([0, 0], [1, 1.2]),
+                 ([0, 0], [-1, -1.2])):
+        ax.plot(x, y, color="#7f8c8d", lw=1)
+    for state, (c, v) in CANONICAL.items():
+        ax.scatter([c], [v], s=140, marker="s", color="#bdc3c7", zorder=2)
+        ax.annotate(state.value, (c, v), xytext=(0, -16 if v < 0.5 else 10),
+                    textcoords="offset points", ha="center", fontsize=9, color="#566573")
+    xs = [p.C for _, p in points]
+    ys = [p.V for _, p in points]
+    ax.scatter(xs, ys, s=40, color="#c0392b", zorder=3)
+    for (label, p) in points:
+        ax.annotate(f"{label} ({p.state.value})", (p.C, p.V), xytext=(6, 4),
+                    textcoords="offset points", fontsize=8)
+    ax.set_xlim(-1.25, 1.25)
+    ax.set_ylim(-1.25, 1.25)
+    ax.set_aspect("equal")
+    ax.axhline(0, color="#ecf0f1", lw=0.5, zorder=0)
+    ax.set_xlabel("Commitment C")
+    ax.set_ylabel("Vigilance V")
+    ax.set_title("Commitment-Vigilance plane")
+    fig.tight_layout()
+    return fig
+
+
+def save(fig, path: str) -> None:
+    """Save to a temporary file beside ``path``, then rename (atomic)."""
+    import os
+    import tempfile
+
+    fmt = os.path.splitext(path)[1].lstrip(".").lower() or "png"
+    fd, tmp = tempfile.mkstemp(prefix=".aouc-", suffix=f".{fmt}",
+                               dir=os.path.dirname(os.path.abspath(path)))
+    os.close(fd)
+    try:
+        fig.savefig(tmp, format=fmt, dpi=120, metadata={"Software": None}
+                    if fmt == "png" else None)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
