@@ -152,9 +152,10 @@ def test_variant_errors(tmp_path, vary, code):
 
 
 def test_compile_and_measure_never_import_matplotlib_or_video_libraries(tmp_path):
+    src, out = BEHAVIOURS / "confident.aou", tmp_path / "c.json"
     code = ("import sys\nfrom aou_dsl.cli import main\n"
-            f"main(['compile', r'{BEHAVIOURS / 'confident.aou'}', '-o', r'{tmp_path / 'c.json'}'])\n"
-            f"main(['measure', r'{tmp_path / 'c.json'}'])\n"
+            f"main(['compile', r'{src}', '-o', r'{out}'])\n"
+            f"main(['measure', r'{out}'])\n"
             "print(sorted({'matplotlib', 'imageio', 'PIL'} & set(sys.modules)))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)

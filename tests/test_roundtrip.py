@@ -17,15 +17,16 @@ from .conftest import BEHAVIOURS
 EXPLAINED = {"C301", "C302", "C303", "C304", "C305", "C306", "C308", "C309"}
 
 
-def _round_trip(path) -> tuple[list, set]:
-    # The safety checks have tests of their own (test_check.py); here the question is
-    # only whether the motion has the declared descriptors.
+def _round_trip(path):
+    """Build without the safety checks (test_check.py has theirs): the question here is
+    only whether the motion has the declared descriptors. Returns the build, the
+    mismatches and the codes of the errors and warnings."""
     res = build_file(str(path), check=False)
     codes = {d.code for d in res.diagnostics if d.severity in ("error", "warning")}
     if not res.ok:
-        return [], codes
+        return res, [], codes
     declared = res.document["descriptors"]["declared"]
-    return compare_descriptors(declared, res.measured.descriptors), codes
+    return res, compare_descriptors(declared, res.measured.descriptors), codes
 
 
 @pytest.mark.parametrize("name", ["confident", "curious", "hesitant", "fearful", "inactive"])
@@ -97,7 +98,7 @@ def test_generated_behaviours_measure_as_declared(tmp_path_factory, text):
     assume(lint.ok)
     path = tmp_path_factory.mktemp("gen") / "gen.aou"
     path.write_text(text)
-    mismatches, codes = _round_trip(path)
+    _, mismatches, codes = _round_trip(path)
     assert not mismatches or codes & EXPLAINED, (text, mismatches)
 
 
@@ -133,7 +134,7 @@ def test_generated_sequences_measure_as_declared(tmp_path_factory, text):
     assume(lint_source(text, "seq.aou").ok)
     path = tmp_path_factory.mktemp("seq") / "seq.aou"
     path.write_text(text)
-    mismatches, codes = _round_trip(path)
+    _, mismatches, codes = _round_trip(path)
     assert not mismatches or codes & EXPLAINED, (text, mismatches)
 
 
@@ -142,3 +143,20 @@ def test_gaze_is_locked_at_every_sample():
     res = build_file(str(BEHAVIOURS / "curious.aou"))
     assert res.measured.gaze_error <= 0.5
     assert math.isfinite(res.measured.gaze_error)
+
+
+@pytest.mark.parametrize("name", ["confident", "curious", "hesitant", "fearful", "inactive"])
+def test_shipped_behaviours_on_ur5_compile_or_say_why(tmp_path, name):
+    """On the UR5, each study behaviour compiles with its descriptors, or the compiler
+    names the limit that prevents it (with a conservative 3 rad/s^2 joint acceleration,
+    the fearful shiver and 2 m/s^2 withdrawal do not fit)."""
+    text = (BEHAVIOURS / f"{name}.aou").read_text().replace("robot panda\n", "")
+    path = tmp_path / f"{name}.aou"
+    path.write_text(text + "robot ur5\n")
+    res, mismatches, codes = _round_trip(path)
+    if res.ok:
+        assert not mismatches or codes & EXPLAINED, mismatches
+    else:
+        explained = [d for d in res.diagnostics if d.code in EXPLAINED]
+        assert explained and all(d.span.line > 0 for d in explained)
+        assert any(d.fields.get("joint") for d in explained)

@@ -155,6 +155,7 @@ def save(fig, path: str) -> None:
     try:
         fig.savefig(tmp, format=fmt, dpi=120, metadata={"Software": None}
                     if fmt == "png" else None)
+        os.chmod(tmp, 0o644)  # mkstemp makes files private; outputs are ordinary files
         os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):

@@ -152,6 +152,7 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
             images = [Image.fromarray(f) for f in frames]
             images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:],
                            duration=[10 * d for d in cs], loop=0, optimize=False)
+        os.chmod(tmp, 0o644)  # mkstemp makes files private; outputs are ordinary files
         os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):
