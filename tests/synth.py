@@ -49,7 +49,7 @@ class Synth:
         self.roll = 0.0
         self.poses = []
         self.joint_offsets = []
-        self._add(self._pose(), 1)
+        self._add(self._pose())
 
     def _pose(self) -> tuple[np.ndarray, np.ndarray]:
         y0 = self.R0[:, 1]
@@ -58,7 +58,7 @@ class Synth:
         r = b @ self.R0 @ _rot([0, 0, 1], self.roll)
         return p, r
 
-    def _add(self, pose, n: int, offset: float = 0.0) -> None:
+    def _add(self, pose, offset: float = 0.0) -> None:
         self.poses.append(pose)
         self.joint_offsets.append(offset)
 
@@ -74,35 +74,31 @@ class Synth:
 
     def hold(self, seconds: float) -> Synth:
         for _ in range(int(round(seconds * self.rate))):
-            self._add(self._pose(), 1)
+            self._add(self._pose())
+        return self
+
+    def _move(self, coordinate: str, delta: float, a: float) -> Synth:
+        """Change ``coordinate`` (d, h or roll) by ``delta`` rest to rest, bang-bang with
+        peak acceleration ``a``; everything else stays."""
+        start = getattr(self, coordinate)
+        for s in self._bang(delta, a, self.rate):
+            setattr(self, coordinate, start + math.copysign(s, delta))
+            self._add(self._pose())
+        setattr(self, coordinate, start + delta)
         return self
 
     def line(self, delta: float, a: float) -> Synth:
         """Move along the line of sight: ``delta`` < 0 approaches, > 0 retreats [m]."""
-        d0 = self.d
-        for s in self._bang(delta, a, self.rate):
-            self.d = d0 + math.copysign(s, delta)
-            self._add(self._pose(), 1)
-        self.d = d0 + delta
-        return self
+        return self._move("d", delta, a)
 
     def arc(self, delta: float, alpha: float) -> Synth:
         """Horizontal gaze: turn the bearing by ``delta`` [rad], angular acceleration
         ``alpha``; the distance stays and the gaze stays on the goal."""
-        h0 = self.h
-        for s in self._bang(delta, alpha, self.rate):
-            self.h = h0 + math.copysign(s, delta)
-            self._add(self._pose(), 1)
-        self.h = h0 + delta
-        return self
+        return self._move("h", delta, alpha)
 
     def tilt(self, delta: float, alpha: float) -> Synth:
-        r0 = self.roll
-        for s in self._bang(delta, alpha, self.rate):
-            self.roll = r0 + math.copysign(s, delta)
-            self._add(self._pose(), 1)
-        self.roll = r0 + delta
-        return self
+        """Roll about the forward axis by ``delta`` [rad]."""
+        return self._move("roll", delta, alpha)
 
     def shiver(self, amplitude: float, f: float, cycles: int) -> Synth:
         """The last joint oscillates ``amplitude`` [rad] peak to peak (sin^2 envelope over
@@ -112,7 +108,7 @@ class Synth:
         edge = np.minimum(t, duration - t)
         env = np.where(edge < 1 / f, np.sin(math.pi * f * edge / 2) ** 2, 1.0)
         for x in amplitude / 2 * np.sin(2 * math.pi * f * t) * env:
-            self._add(self._pose(), 1, float(x))
+            self._add(self._pose(), float(x))
         return self
 
     def recording(self, noise: float = 0.0, seed: int = 0) -> Recording:
