@@ -279,10 +279,6 @@ _RULE_LIST = [
          "The compiled trajectory failed a simulation check (limits, collision, target contact).",
          "A trajectory that fails a check is never written: it is not safe to send to an arm.",
          "standoff 0.0m"),
-    Rule("C307", "speed-cap-unattainable", _W,
-         "A `v=` speed cap is higher than the motion can reach in the distance available.",
-         "The cap has no effect; the motion peaks lower.",
-         "approach v=5"),
     Rule("C308", "shiver-too-fast", _E,
          "A shiver's amplitude and frequency need more speed or acceleration than the "
          "shivering joint allows; the message gives the highest frequency that fits.",
