@@ -235,6 +235,15 @@ _RULE_LIST = [
          "nothing moving between them read as one.",
          "The compiled motion would not have the descriptors the file declares.",
          "pause 1s x3   # and nothing else: three pauses in a row are one pause"),
+    Rule("V122", "goal-out-of-range", _E,
+         "The goal lies further than 3 m from the robot's base.",
+         "No arm aou knows reaches that far; such a value is almost always a typo.",
+         "goal (30, 0, 0.3)"),
+    Rule("V123", "below-resolution", _E,
+         "An angle under 1 deg or a retreat under 5 mm: too small to be seen, or measured.",
+         "The descriptors are measured to 0.5 deg and 1 mm; a smaller motion cannot be told "
+         "from a pause, and the compiled motion would not show what the file declares.",
+         "shiver 0.1deg"),
     # --- M: the C-V model --------------------------------------------------------------
     Rule("M201", "state-mismatch", _W,
          "The state inferred from the behaviour's primitives differs from the declared one.",

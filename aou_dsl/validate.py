@@ -41,6 +41,12 @@ MAX_EPISODES = 1000
 MIN_PAUSE = 0.2
 #: Furthest the end-effector may be sent from the goal [m].
 MAX_REACH_DISTANCE = 1.0
+#: Furthest the goal may be from the robot's base [m].
+MAX_GOAL_DISTANCE = 3.0
+#: Smallest angle [rad] and retreat [m] a behaviour may ask for: below, nobody sees it
+#: and it cannot be measured (angles to 0.5 deg, distances to 1 mm).
+MIN_ANGLE = math.radians(1.0)
+MIN_RETREAT = 0.005
 
 PRIMITIVES = ("approach", "pause", "retreat", "gaze", "tilt", "shiver")
 SETTINGS = ("robot", "goal", "from", "start", "standoff", "effort")
@@ -207,6 +213,12 @@ def _primitive(ctx: _Ctx, st: Statement, in_sequence: bool) -> Primitive | None:
             return None
         return value
 
+    def visible(q: Quantity | None, value: float | None, least: float, what: str) -> None:
+        if q is not None and value is not None and 0 < abs(value) < least:
+            shown = f"{math.degrees(least):g} deg" if least < 0.1 else f"{least * 1000:g} mm"
+            ctx.error("V123", f"{what} `{q.text}` is too small to be seen or measured; at "
+                      f"least {shown}", q.span)
+
     a = _key_value(ctx, keys.get("a"), Dim.ACCEL, "acceleration") if "a" in dim_of else None
     v = _key_value(ctx, keys.get("v"), dim_of["v"], "speed") if "v" in dim_of else None
     prim: Primitive | None = None
@@ -242,6 +254,7 @@ def _primitive(ctx: _Ctx, st: Statement, in_sequence: bool) -> Primitive | None:
             d = _positive(ctx, d, q, "retreat distance")
         elif q is not None and d == 0:
             ctx.error("V105", "a retreat distance must not be zero", q.span)
+        visible(q, d, MIN_RETREAT, "a retreat of")
         _too_many(ctx, st, pos, usage)
         if len(ctx.diags) == n_before:
             prim = Retreat(span=st.span, length=d, a=a or DEFAULTS["retreat_a"],
@@ -262,6 +275,8 @@ def _primitive(ctx: _Ctx, st: Statement, in_sequence: bool) -> Primitive | None:
         q = need_quantity("an angle")
         ang = _si(ctx, q, Dim.ANGLE, what="gaze angle", unit_required=True) if q else None
         ang = signed_ok(q, ang, "a gaze angle") if q else None
+        if not in_sequence:  # in a sequence, 0deg looks straight again
+            visible(q, ang, MIN_ANGLE, "a gaze of")
         _too_many(ctx, st, pos, usage)
         if len(ctx.diags) == n_before:
             prim = Gaze(span=st.span, plane=plane, angle=ang, v=v or DEFAULTS["gaze_v"],
@@ -272,6 +287,7 @@ def _primitive(ctx: _Ctx, st: Statement, in_sequence: bool) -> Primitive | None:
         ang = signed_ok(q, ang, "a tilt angle") if q else None
         if q is not None and ang == 0:
             ctx.error("V105", "a tilt angle must not be zero", q.span)
+        visible(q, ang, MIN_ANGLE, "a tilt of")
         _too_many(ctx, st, pos, usage)
         if len(ctx.diags) == n_before:
             prim = Tilt(span=st.span, angle=ang, v=v or DEFAULTS["tilt_v"], count=count)
@@ -279,6 +295,7 @@ def _primitive(ctx: _Ctx, st: Statement, in_sequence: bool) -> Primitive | None:
         q = need_quantity("an amplitude")
         amp = _si(ctx, q, Dim.ANGLE, what="shiver amplitude", unit_required=True) if q else None
         amp = _positive(ctx, amp, q, "shiver amplitude") if q else None
+        visible(q, amp, MIN_ANGLE, "a shiver of")
         f = _key_value(ctx, keys.get("f"), Dim.FREQUENCY, "shiver frequency")
         dur = None
         if args.for_ is not None:
@@ -332,6 +349,11 @@ def _settings(ctx: _Ctx, stmts: list[Statement]) -> Settings:
                 else:
                     vec.append(q.value)
             if len(ctx.diags) != n_before:
+                continue
+            if key == "goal" and math.sqrt(sum(c * c for c in vec)) > MAX_GOAL_DISTANCE:
+                ctx.error("V122", f"the goal is {math.sqrt(sum(c * c for c in vec)):.3g} m "
+                          f"from the robot's base; at most {MAX_GOAL_DISTANCE:g} m",
+                          pos[0].span)
                 continue
             if key == "start_direction":
                 norm = math.sqrt(sum(c * c for c in vec))

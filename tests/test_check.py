@@ -104,8 +104,8 @@ def test_exceeding_an_acceleration_limit_fails_at_the_peak():
     assert abs(fail.value) == pytest.approx(0.06 * w * w, rel=1e-3)
 
 
-@pytest.mark.parametrize("name", ["confident", "curious", "hesitant", "fearful"])
-def test_study_behaviours_pass_and_report_clearances_and_agreement(name, capsys):
+@pytest.mark.parametrize("name", ["confident", "curious", "hesitant", "fearful", "inactive"])
+def test_shipped_behaviours_pass_and_report_clearances_and_agreement(name, capsys):
     assert main(["check", str(BEHAVIOURS / f"{name}.aou"), "--format", "json"]) == EXIT_OK
     report = json.loads(capsys.readouterr().out)
     assert report["ok"]

@@ -160,3 +160,38 @@ def test_shipped_behaviours_on_ur5_compile_or_say_why(tmp_path, name):
         explained = [d for d in res.diagnostics if d.code in EXPLAINED]
         assert explained and all(d.span.line > 0 for d in explained)
         assert any(d.fields.get("joint") for d in explained)
+
+
+#: MODEL.md s6, Table II: the study's four stimuli (None: the primitive is absent).
+TABLE_II = {
+    "confident": dict(approach_acceleration=0.1, pause_count=1, pause_duration=1.67,
+                      retreat_count=0, retreat_distance=None, retreat_acceleration=None,
+                      horizontal_gaze=None, shiver_amplitude=None),
+    "curious": dict(approach_acceleration=0.09, pause_count=3, pause_duration=1.25,
+                    retreat_count=0, retreat_distance=None, retreat_acceleration=None,
+                    horizontal_gaze=20.0, shiver_amplitude=None),
+    "hesitant": dict(approach_acceleration=0.05, pause_count=5, pause_duration=1.67,
+                     retreat_count=3, retreat_distance=0.06, retreat_acceleration=0.12,
+                     horizontal_gaze=None, shiver_amplitude=None),
+    "fearful": dict(approach_acceleration=0.1, pause_count=4, pause_duration=1.25,
+                    retreat_count=1, retreat_distance=0.06, retreat_acceleration=2.0,
+                    horizontal_gaze=None, shiver_amplitude=6.0),
+}
+
+
+@pytest.mark.parametrize("name", list(TABLE_II))
+def test_measuring_the_compiled_stimuli_gives_table_two(name):
+    """The oracle is the paper's table itself, not the files: compile each shipped
+    stimulus and measure it; the values are Table II's."""
+    from aou_dsl.declared import tolerance
+
+    res = build_file(str(BEHAVIOURS / f"{name}.aou"), check=False)
+    measured = res.measured.descriptors
+    for key, want in TABLE_II[name].items():
+        got = measured[key]
+        if want is None or key.endswith("_count"):
+            assert got == want, (key, got, want)
+        else:
+            assert abs(got - want) <= tolerance(key, want), (key, got, want)
+    for key in ("vertical_gaze", "tilt_angle", "tilt_velocity"):
+        assert measured[key] is None

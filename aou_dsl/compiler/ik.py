@@ -109,6 +109,8 @@ class _Solver:
             if step > MAX_ITER_STEP:  # far from the target: Newton steps overshoot
                 dq *= MAX_ITER_STEP / step
             q = np.clip(q + dq, self.lo, self.hi)
+        if not np.all(np.isfinite(jac)):
+            return q, np.inf, np.inf, 0.0  # diverged: the caller reports it unreachable
         sigma = float(np.linalg.svd(jac, compute_uv=False)[-1])
         return q, pe, re, sigma
 
@@ -148,9 +150,14 @@ def solve_path(arm: ArmModel, targets: list[tuple[np.ndarray, np.ndarray]],
     out = np.empty((len(targets), arm.n))
     worst_p = worst_r = 0.0
     for i, (p, r) in enumerate(targets):
+        if not (np.all(np.isfinite(p)) and np.all(np.isfinite(r))):
+            return IKResult(out[:i], worst_p, worst_r,
+                            IKFailure(IKStatus.UNREACHABLE, i, np.inf, np.inf))
         q_new, pe, re, sigma = solver.solve(p, r, q)
         failure = None
-        if pe > 1e-4 or re > 1e-3:
+        if not (np.all(np.isfinite(q_new)) and np.isfinite(pe) and np.isfinite(re)):
+            failure = IKFailure(IKStatus.UNREACHABLE, i, np.inf, np.inf)
+        elif pe > 1e-4 or re > 1e-3:
             at_limit = (q_new <= solver.lo + 1e-9) | (q_new >= solver.hi - 1e-9)
             if at_limit.any():
                 j = arm.joint_names[int(np.argmax(at_limit))]
