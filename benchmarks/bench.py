@@ -8,7 +8,8 @@ compile, per shipped behaviour:
 - cold: a fresh Python process that imports aou and compiles the file (imports, robot
   model loading and all), as `aouc compile` does once;
 - warm: the median of repeated `compile_behaviour` calls in one process (the case of a
-  robot that recompiles as its uncertainty changes);
+  robot that recompiles as its uncertainty changes), garbage collector paused as timeit
+  does;
 - the real-time factor: trajectory duration / warm compile time;
 - by hand: the same Cartesian path, sampled at the same rate with linear timing, solved
   with `pybullet.calculateInverseKinematics` per sample, as a user would without aou;
@@ -18,6 +19,7 @@ compile, per shipped behaviour:
 
 from __future__ import annotations
 
+import gc
 import statistics
 import subprocess
 import sys
@@ -106,11 +108,18 @@ def bench_compile(repeat: int = 15) -> None:
         cold = _cold(path)
         b = lint_file(str(path)).behaviour
         compile_behaviour(b)
+        # As timeit does: collect, then keep the garbage collector out of the timed runs,
+        # so that garbage left by the previous behaviour's by-hand run is not charged here.
+        gc.collect()
+        gc.disable()
         times = []
-        for _ in range(repeat):
-            t = time.perf_counter()
-            res = compile_behaviour(b)
-            times.append(time.perf_counter() - t)
+        try:
+            for _ in range(repeat):
+                t = time.perf_counter()
+                res = compile_behaviour(b)
+                times.append(time.perf_counter() - t)
+        finally:
+            gc.enable()
         warm = statistics.median(times)
         tr = res.trajectory
         arm = load_arm(tr.robot)

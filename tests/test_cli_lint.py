@@ -121,9 +121,10 @@ def test_every_rule_has_kebab_name_and_texts():
 
 
 def test_lint_imports_no_heavy_dependency():
-    """`import aou_dsl` and the lint path stay clear of pinocchio, toppra, pybullet,
+    """`import aou_dsl`, `aouc --help` and the lint path stay clear of pinocchio, toppra, pybullet,
     matplotlib (and numpy): linting a folder in CI has to start fast."""
     code = ("import sys, aou_dsl, aou_dsl.cli as c\n"
+            "try:\n    c.main(['--help'])\nexcept SystemExit:\n    pass\n"
             f"c.main(['lint', r'{BEHAVIOURS}'])\n"
             "heavy = {'pinocchio', 'toppra', 'pybullet', 'matplotlib', 'numpy'}\n"
             "heavy &= set(sys.modules)\n"
