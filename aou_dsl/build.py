@@ -10,9 +10,14 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from .diagnostics import Diagnostic, diag, has_errors
 from .lint import FileResult, lint_file
+
+if TYPE_CHECKING:  # the numerical stages load only when a build runs
+    from .compiler.pipeline import CompileResult, Trajectory
+    from .measure.descriptors import Measured
 
 __all__ = ["BuildResult", "build_file", "to_recording"]
 
@@ -24,8 +29,8 @@ class BuildResult:
     path: str
     lint: FileResult
     diagnostics: list[Diagnostic] = field(default_factory=list)
-    compiled: object | None = None  # CompileResult
-    measured: object | None = None  # Measured
+    compiled: CompileResult | None = None
+    measured: Measured | None = None
     checks: list = field(default_factory=list)
     document: dict | None = None
     seconds: float = 0.0
@@ -33,6 +38,13 @@ class BuildResult:
     @property
     def ok(self) -> bool:
         return self.document is not None and not has_errors(self.diagnostics)
+
+    @property
+    def trajectory(self) -> Trajectory:
+        """The compiled trajectory; a build that failed has none (ValueError)."""
+        if self.compiled is None or self.compiled.trajectory is None:
+            raise ValueError(f"{self.path}: the build failed, there is no trajectory")
+        return self.compiled.trajectory
 
 
 def to_recording(trajectory, path: str = "<compiled>"):
@@ -63,14 +75,14 @@ def build_file(path: str, *, rate: float | None = None, check: bool = True,
     start = time.perf_counter()
     lint = lint_file(path)
     res = BuildResult(path, lint, list(lint.diagnostics))
-    if not lint.ok or lint.behaviour is None:
+    if not lint.ok or lint.behaviour is None or lint.cv is None:
         return res
     b = lint.behaviour
     opts = CompileOptions() if rate is None else CompileOptions(rate=rate)
     compiled = compile_behaviour(b, opts)
     res.compiled = compiled
     res.diagnostics += compiled.diagnostics
-    if not compiled.ok:
+    if not compiled.ok or compiled.trajectory is None:
         res.seconds = time.perf_counter() - start
         return res
     tr = compiled.trajectory

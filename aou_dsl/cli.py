@@ -107,7 +107,7 @@ def _cmd_explain(args: argparse.Namespace) -> int:
     from .lint import lint_file
 
     r = lint_file(args.path)
-    if not r.ok or r.behaviour is None:
+    if not r.ok or r.behaviour is None or r.cv is None:
         _print_diags(r.diagnostics, "text", {r.path: r.source or ""}, stream=sys.stderr)
         return EXIT_USAGE if any(d.code.startswith("I") for d in r.diagnostics) else EXIT_ERRORS
     b = r.behaviour
@@ -186,7 +186,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
         res = build_file(src, rate=args.rate, check=not args.no_check, scene=scene)
         _print_diags(res.diagnostics, "text", {src: res.lint.source or ""}, stream=sys.stderr)
         dest = _output_path(src, args.output, fmt, many)
-        if not res.ok:
+        if not res.ok or res.document is None:
             io = any(d.code.startswith("I") for d in res.diagnostics)
             worst = max(worst, EXIT_USAGE if io else EXIT_ERRORS)
             print(f"[{k}/{len(files)}] {src}: failed, nothing written", file=sys.stderr)
@@ -197,7 +197,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
             _print_diags(err.diagnostics, "text", stream=sys.stderr)
             worst = EXIT_USAGE
             continue
-        tr = res.compiled.trajectory
+        tr = res.trajectory
         note = "" if not args.no_check else " (checks skipped)"
         print(f"[{k}/{len(files)}] {src} -> {dest}: {tr.duration:.2f} s of motion, "
               f"{len(tr.t)} samples, compiled in {res.seconds:.2f} s{note}", file=sys.stderr)
@@ -232,7 +232,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
                          stream=sys.stderr)
             io = any(d.code.startswith("I") for d in res.diagnostics)
             return EXIT_USAGE if io else EXIT_ERRORS
-        tr = res.compiled.trajectory
+        tr = res.trajectory
         robot, t, q, qd, qdd, goal = tr.robot, tr.t, tr.q, tr.qd, tr.qdd, tr.goal
     else:
         import json
@@ -355,8 +355,9 @@ def _load_motion(path: str, scene=None):
         res = build_file(path, check=False)
         if not res.ok:
             raise AouError(res.diagnostics)
-        tr = res.compiled.trajectory
-        return to_recording(tr, path), tr.episodes, res.compiled.behaviour.name
+        tr = res.trajectory
+        name = res.lint.behaviour.name if res.lint.behaviour else path
+        return to_recording(tr, path), tr.episodes, name
     rec = read_recording(path)
     episodes = None
     if path.endswith(".json"):
@@ -394,7 +395,8 @@ def _cmd_plot(args: argparse.Namespace) -> int:
             bad = [d for r in results if not r.ok for d in r.diagnostics]
             if bad:
                 return _report_error(AouError(bad))
-            fig = cv_figure([(r.behaviour.name, r.cv) for r in results])
+            fig = cv_figure([(r.behaviour.name, r.cv) for r in results
+                             if r.behaviour is not None and r.cv is not None])
         else:
             if len(args.paths) != 1:
                 print("aouc: plot takes one file (or --cv with several)", file=sys.stderr)
@@ -465,7 +467,7 @@ def _cmd_variants(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return EXIT_USAGE
     base = lint_file(args.path)
-    if not base.ok:
+    if not base.ok or base.behaviour is None or base.source is None:
         _print_diags(base.diagnostics, "text", {args.path: base.source or ""},
                      stream=sys.stderr)
         return EXIT_ERRORS

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import enum
 import math
-from typing import Annotated, Literal
+from typing import Annotated, Literal, overload
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -169,6 +169,21 @@ class Behaviour(BaseModel):
     primitives: tuple[Primitive, ...]
     span: Span
     header_span: Span | None = None
+
+    @overload
+    def first(self, kind: Literal["approach"], plane: None = None) -> Approach | None: ...
+    @overload
+    def first(self, kind: Literal["pause"], plane: None = None) -> Pause | None: ...
+    @overload
+    def first(self, kind: Literal["retreat"], plane: None = None) -> Retreat | None: ...
+    @overload
+    def first(self, kind: Literal["gaze"], plane: str | None = None) -> Gaze | None: ...
+    @overload
+    def first(self, kind: Literal["tilt"], plane: None = None) -> Tilt | None: ...
+    @overload
+    def first(self, kind: Literal["shiver"], plane: None = None) -> Shiver | None: ...
+    @overload
+    def first(self, kind: str, plane: str | None = None) -> Primitive | None: ...
 
     def first(self, kind: str, plane: str | None = None) -> Primitive | None:
         """The descriptor-form primitive of ``kind`` (and gaze ``plane``), if present."""

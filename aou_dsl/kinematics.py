@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -33,7 +34,7 @@ class ArmModel:
     """
 
     spec: RobotSpec
-    model: object
+    model: Any  # pinocchio.Model (pinocchio ships no type hints)
     frame_id: int
     lower: np.ndarray
     upper: np.ndarray

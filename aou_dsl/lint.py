@@ -122,7 +122,7 @@ def _realisable(b: Behaviour) -> list[Diagnostic]:
         if want[key] is not None and got[key] is None:
             g = b.first("gaze", plane)
             out.append(diag("V121", f"the {plane} gaze is measured at the pause that ends it, "
-                            "and no pause is left for it", g.span,
+                            "and no pause is left for it", g.span if g else b.span,
                             hint="add a pause per gaze episode (beyond those the retreats "
                             "need)"))
     return out

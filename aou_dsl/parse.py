@@ -216,7 +216,8 @@ def _found_text(tok: Token) -> str:
 
 def _syntax_error(path: str, text: str, err: lark.exceptions.UnexpectedInput) -> AouError:
     if isinstance(err, lark.exceptions.UnexpectedCharacters):
-        ch = text[err.pos_in_stream] if err.pos_in_stream < len(text) else "?"
+        at = err.pos_in_stream
+        ch = text[at] if at is not None and at < len(text) else "?"
         span = Span.point(path, err.line, err.column)
         hint = None
         if ch == "{":

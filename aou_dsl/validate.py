@@ -10,8 +10,9 @@ from __future__ import annotations
 import difflib
 import math
 import re
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from typing import Literal
 
 from .diagnostics import Diagnostic, Span, diag
 from .ir import (
@@ -186,126 +187,175 @@ _USAGE = {
 }
 
 
-def _primitive(ctx: _Ctx, st: Statement, in_sequence: bool) -> Primitive | None:
-    kind = st.keyword
-    usage = _USAGE[kind]
-    n_before = len(ctx.diags)
-    args = _split_args(ctx, st, _KEYS[kind], repeat=True)
-    pos = args.positional
-    count = 1 if args.count is None else args.count
-    keys = args.keys
-    dim_of = _KEYS[kind]
+class _Reader:
+    """Reads one primitive statement's arguments, reporting what does not fit."""
 
-    def need_quantity(what: str) -> Quantity | None:
-        if not pos or not isinstance(pos[0], Quantity):
-            found = f", found `{pos[0].text}`" if pos and hasattr(pos[0], "text") else ""
-            ctx.error("V113", f"`{kind}` needs {what}{found}; usage: {usage}",
-                      pos[0].span if pos else st.keyword_span)
+    def __init__(self, ctx: _Ctx, st: Statement, in_sequence: bool):
+        self.ctx, self.st, self.in_sequence = ctx, st, in_sequence
+        self.kind = st.keyword
+        self.n_before = len(ctx.diags)
+        self.args = _split_args(ctx, st, _KEYS[self.kind], repeat=True)
+        self.pos = self.args.positional
+        self.count = 1 if self.args.count is None else self.args.count
+
+    def quantity(self, what: str) -> Quantity | None:
+        """The next positional argument, which must be a quantity."""
+        if not self.pos or not isinstance(self.pos[0], Quantity):
+            first = self.pos[0] if self.pos else None
+            found = f", found `{first.text}`" if isinstance(first, Quantity | Word) else ""
+            self.ctx.error("V113", f"`{self.kind}` needs {what}{found}; usage: "
+                           f"{_USAGE[self.kind]}", first.span if first else self.st.keyword_span)
             return None
-        return pos.pop(0)
+        q = self.pos.pop(0)
+        assert isinstance(q, Quantity)
+        return q
 
-    def signed_ok(q: Quantity, value: float | None, what: str) -> float | None:
+    def optional_quantity(self) -> Quantity | None:
+        if self.pos and isinstance(self.pos[0], Quantity):
+            q = self.pos.pop(0)
+            assert isinstance(q, Quantity)
+            return q
+        return None
+
+    def si(self, q: Quantity | None, dim: Dim, what: str) -> float | None:
+        return None if q is None else _si(self.ctx, q, dim, what=what, unit_required=True)
+
+    def positive(self, q: Quantity | None, value: float | None, what: str) -> float | None:
+        return None if q is None else _positive(self.ctx, value, q, what)
+
+    def key(self, name: str, what: str) -> float | None:
+        dim = _KEYS[self.kind].get(name)
+        if dim is None:
+            return None
+        return _key_value(self.ctx, self.args.keys.get(name), dim, what)
+
+    def amplitude(self, q: Quantity | None, value: float | None, what: str) -> float | None:
         """In the descriptor form, angles are amplitudes: positive."""
-        if value is not None and not in_sequence and value <= 0:
-            ctx.error("V118", f"{what} in the descriptor form is an amplitude and must be "
-                      f"positive, found `{q.text}`", q.span,
-                      hint="signed angles (directions) belong in a `sequence { }` block")
+        if q is not None and value is not None and not self.in_sequence and value <= 0:
+            self.ctx.error("V118", f"{what} in the descriptor form is an amplitude and must "
+                           f"be positive, found `{q.text}`", q.span,
+                           hint="signed angles (directions) belong in a `sequence { }` block")
             return None
         return value
 
-    def visible(q: Quantity | None, value: float | None, least: float, what: str) -> None:
+    def visible(self, q: Quantity | None, value: float | None, least: float,
+                what: str) -> None:
         if q is not None and value is not None and 0 < abs(value) < least:
             shown = f"{math.degrees(least):g} deg" if least < 0.1 else f"{least * 1000:g} mm"
-            ctx.error("V123", f"{what} `{q.text}` is too small to be seen or measured; at "
-                      f"least {shown}", q.span)
+            self.ctx.error("V123", f"{what} `{q.text}` is too small to be seen or measured; "
+                           f"at least {shown}", q.span)
 
-    a = _key_value(ctx, keys.get("a"), Dim.ACCEL, "acceleration") if "a" in dim_of else None
-    v = _key_value(ctx, keys.get("v"), dim_of["v"], "speed") if "v" in dim_of else None
-    prim: Primitive | None = None
-    if kind == "approach":
-        length = None
-        if pos and isinstance(pos[0], Quantity):
-            q = pos.pop(0)
-            length = _si(ctx, q, Dim.LENGTH, what="approach length", unit_required=True)
-            if length is not None and not in_sequence:
-                ctx.error("V113", "an approach length is only allowed in a `sequence { }`; "
-                          "in the descriptor form the approach runs from start to standoff",
-                          q.span)
-            elif length == 0:
-                ctx.error("V105", "an approach length must not be zero", q.span)
-        _too_many(ctx, st, pos, usage)
-        if len(ctx.diags) == n_before:
-            prim = Approach(span=st.span, length=length, a=a or DEFAULTS["approach_a"],
-                            v=v or DEFAULTS["speed_cap"], count=count)
-    elif kind == "pause":
-        q = need_quantity("a duration")
-        d = _positive(ctx, _si(ctx, q, Dim.TIME, what="pause duration", unit_required=True),
-                      q, "pause duration") if q else None
-        if d is not None and d < MIN_PAUSE:
-            ctx.error("V105", f"a pause must last at least {MIN_PAUSE}s to be told apart "
-                      f"from the stop between two episodes, found `{q.text}`", q.span)
-        _too_many(ctx, st, pos, usage)
-        if len(ctx.diags) == n_before:
-            prim = Pause(span=st.span, duration=d, count=count)
-    elif kind == "retreat":
-        q = need_quantity("a distance")
-        d = _si(ctx, q, Dim.LENGTH, what="retreat distance", unit_required=True) if q else None
-        if q is not None and not in_sequence:
-            d = _positive(ctx, d, q, "retreat distance")
-        elif q is not None and d == 0:
-            ctx.error("V105", "a retreat distance must not be zero", q.span)
-        visible(q, d, MIN_RETREAT, "a retreat of")
-        _too_many(ctx, st, pos, usage)
-        if len(ctx.diags) == n_before:
-            prim = Retreat(span=st.span, length=d, a=a or DEFAULTS["retreat_a"],
-                           v=v or DEFAULTS["speed_cap"], count=count)
-    elif kind == "gaze":
-        plane = None
-        if pos and isinstance(pos[0], Word) and pos[0].text in ("horizontal", "vertical"):
-            plane = pos.pop(0).text
-        else:
-            w = pos[0] if pos else None
-            found = f", found `{w.text}`" if isinstance(w, Word | Quantity) else ""
-            ctx.error("V113", f"`gaze` needs a plane: `horizontal` or `vertical`{found}",
-                      w.span if w is not None else st.keyword_span,
-                      hint=_did_you_mean(w.text, ("horizontal", "vertical"))
-                      if isinstance(w, Word) else None)
-            if w is not None and isinstance(w, Word):
-                pos.pop(0)
-        q = need_quantity("an angle")
-        ang = _si(ctx, q, Dim.ANGLE, what="gaze angle", unit_required=True) if q else None
-        ang = signed_ok(q, ang, "a gaze angle") if q else None
-        if not in_sequence:  # in a sequence, 0deg looks straight again
-            visible(q, ang, MIN_ANGLE, "a gaze of")
-        _too_many(ctx, st, pos, usage)
-        if len(ctx.diags) == n_before:
-            prim = Gaze(span=st.span, plane=plane, angle=ang, v=v or DEFAULTS["gaze_v"],
-                        count=count)
-    elif kind == "tilt":
-        q = need_quantity("an angle")
-        ang = _si(ctx, q, Dim.ANGLE, what="tilt angle", unit_required=True) if q else None
-        ang = signed_ok(q, ang, "a tilt angle") if q else None
-        if q is not None and ang == 0:
-            ctx.error("V105", "a tilt angle must not be zero", q.span)
-        visible(q, ang, MIN_ANGLE, "a tilt of")
-        _too_many(ctx, st, pos, usage)
-        if len(ctx.diags) == n_before:
-            prim = Tilt(span=st.span, angle=ang, v=v or DEFAULTS["tilt_v"], count=count)
-    elif kind == "shiver":
-        q = need_quantity("an amplitude")
-        amp = _si(ctx, q, Dim.ANGLE, what="shiver amplitude", unit_required=True) if q else None
-        amp = _positive(ctx, amp, q, "shiver amplitude") if q else None
-        visible(q, amp, MIN_ANGLE, "a shiver of")
-        f = _key_value(ctx, keys.get("f"), Dim.FREQUENCY, "shiver frequency")
-        dur = None
-        if args.for_ is not None:
-            dur = _positive(ctx, _si(ctx, args.for_, Dim.TIME, what="shiver duration",
-                                     unit_required=True), args.for_, "shiver duration")
-        _too_many(ctx, st, pos, usage)
-        if len(ctx.diags) == n_before:
-            prim = Shiver(span=st.span, amplitude=amp, f=f or DEFAULTS["shiver_f"],
-                          duration=dur or DEFAULTS["shiver_duration"], count=count)
-    return prim
+    def done(self) -> bool:
+        """Report arguments left over; True when this statement added no diagnostic."""
+        _too_many(self.ctx, self.st, self.pos, _USAGE[self.kind])
+        return len(self.ctx.diags) == self.n_before
+
+
+def _approach(r: _Reader) -> Approach | None:
+    length = None
+    q = r.optional_quantity()
+    if q is not None:
+        length = r.si(q, Dim.LENGTH, "approach length")
+        if length is not None and not r.in_sequence:
+            r.ctx.error("V113", "an approach length is only allowed in a `sequence { }`; "
+                        "in the descriptor form the approach runs from start to standoff",
+                        q.span)
+        elif length == 0:
+            r.ctx.error("V105", "an approach length must not be zero", q.span)
+    a, v = r.key("a", "acceleration"), r.key("v", "speed")
+    if r.done():
+        return Approach(span=r.st.span, length=length, a=a or DEFAULTS["approach_a"],
+                        v=v or DEFAULTS["speed_cap"], count=r.count)
+    return None
+
+
+def _pause(r: _Reader) -> Pause | None:
+    q = r.quantity("a duration")
+    d = r.positive(q, r.si(q, Dim.TIME, "pause duration"), "pause duration")
+    if q is not None and d is not None and d < MIN_PAUSE:
+        r.ctx.error("V105", f"a pause must last at least {MIN_PAUSE}s to be told apart from "
+                    f"the stop between two episodes, found `{q.text}`", q.span)
+    if r.done() and d is not None:
+        return Pause(span=r.st.span, duration=d, count=r.count)
+    return None
+
+
+def _retreat(r: _Reader) -> Retreat | None:
+    q = r.quantity("a distance")
+    d = r.si(q, Dim.LENGTH, "retreat distance")
+    if q is not None and not r.in_sequence:
+        d = r.positive(q, d, "retreat distance")
+    elif q is not None and d == 0:
+        r.ctx.error("V105", "a retreat distance must not be zero", q.span)
+    r.visible(q, d, MIN_RETREAT, "a retreat of")
+    a, v = r.key("a", "acceleration"), r.key("v", "speed")
+    if r.done() and d is not None:
+        return Retreat(span=r.st.span, length=d, a=a or DEFAULTS["retreat_a"],
+                       v=v or DEFAULTS["speed_cap"], count=r.count)
+    return None
+
+
+def _gaze(r: _Reader) -> Gaze | None:
+    plane: Literal["horizontal", "vertical"] | None = None
+    first = r.pos[0] if r.pos else None
+    if isinstance(first, Word) and first.text in ("horizontal", "vertical"):
+        r.pos.pop(0)
+        plane = "horizontal" if first.text == "horizontal" else "vertical"
+    else:
+        found = f", found `{first.text}`" if isinstance(first, Word | Quantity) else ""
+        r.ctx.error("V113", f"`gaze` needs a plane: `horizontal` or `vertical`{found}",
+                    first.span if first is not None else r.st.keyword_span,
+                    hint=_did_you_mean(first.text, ("horizontal", "vertical"))
+                    if isinstance(first, Word) else None)
+        if isinstance(first, Word):
+            r.pos.pop(0)
+    q = r.quantity("an angle")
+    angle = r.amplitude(q, r.si(q, Dim.ANGLE, "gaze angle"), "a gaze angle")
+    if not r.in_sequence:  # in a sequence, 0deg looks straight again
+        r.visible(q, angle, MIN_ANGLE, "a gaze of")
+    v = r.key("v", "speed")
+    if r.done() and plane is not None and angle is not None:
+        return Gaze(span=r.st.span, plane=plane, angle=angle, v=v or DEFAULTS["gaze_v"],
+                    count=r.count)
+    return None
+
+
+def _tilt(r: _Reader) -> Tilt | None:
+    q = r.quantity("an angle")
+    angle = r.amplitude(q, r.si(q, Dim.ANGLE, "tilt angle"), "a tilt angle")
+    if q is not None and angle == 0:
+        r.ctx.error("V105", "a tilt angle must not be zero", q.span)
+    r.visible(q, angle, MIN_ANGLE, "a tilt of")
+    v = r.key("v", "speed")
+    if r.done() and angle is not None:
+        return Tilt(span=r.st.span, angle=angle, v=v or DEFAULTS["tilt_v"], count=r.count)
+    return None
+
+
+def _shiver(r: _Reader) -> Shiver | None:
+    q = r.quantity("an amplitude")
+    amp = r.positive(q, r.si(q, Dim.ANGLE, "shiver amplitude"), "shiver amplitude")
+    r.visible(q, amp, MIN_ANGLE, "a shiver of")
+    f = r.key("f", "shiver frequency")
+    dur = None
+    if r.args.for_ is not None:
+        dur = r.positive(r.args.for_, r.si(r.args.for_, Dim.TIME, "shiver duration"),
+                         "shiver duration")
+    if r.done() and amp is not None:
+        return Shiver(span=r.st.span, amplitude=amp, f=f or DEFAULTS["shiver_f"],
+                      duration=dur or DEFAULTS["shiver_duration"], count=r.count)
+    return None
+
+
+_BUILDERS: dict[str, Callable[[_Reader], Primitive | None]] = {
+    "approach": _approach, "pause": _pause, "retreat": _retreat, "gaze": _gaze,
+    "tilt": _tilt, "shiver": _shiver,
+}
+
+
+def _primitive(ctx: _Ctx, st: Statement, in_sequence: bool) -> Primitive | None:
+    """A primitive statement as IR, or None (with diagnostics) when it does not fit."""
+    return _BUILDERS[st.keyword](_Reader(ctx, st, in_sequence))
 
 
 def _settings(ctx: _Ctx, stmts: list[Statement]) -> Settings:
@@ -350,18 +400,18 @@ def _settings(ctx: _Ctx, stmts: list[Statement]) -> Settings:
                     vec.append(q.value)
             if len(ctx.diags) != n_before:
                 continue
-            if key == "goal" and math.sqrt(sum(c * c for c in vec)) > MAX_GOAL_DISTANCE:
-                ctx.error("V122", f"the goal is {math.sqrt(sum(c * c for c in vec)):.3g} m "
-                          f"from the robot's base; at most {MAX_GOAL_DISTANCE:g} m",
-                          pos[0].span)
+            comps = [c for c in vec if c is not None]
+            norm = math.sqrt(sum(c * c for c in comps))
+            if key == "goal" and norm > MAX_GOAL_DISTANCE:
+                ctx.error("V122", f"the goal is {norm:.3g} m from the robot's base; at most "
+                          f"{MAX_GOAL_DISTANCE:g} m", pos[0].span)
                 continue
             if key == "start_direction":
-                norm = math.sqrt(sum(c * c for c in vec))
                 if norm == 0:
                     ctx.error("V105", "`from` must not be the zero vector", pos[0].span)
                     continue
-                vec = [c / norm for c in vec]
-            values[key] = tuple(vec)
+                comps = [c / norm for c in comps]
+            values[key] = tuple(comps)
         elif key in ("start", "standoff"):
             if len(pos) != 1 or not isinstance(pos[0], Quantity):
                 ctx.error("V113", f"`{key}` takes a distance, e.g. `{key} 0.30m`",
@@ -372,7 +422,7 @@ def _settings(ctx: _Ctx, stmts: list[Statement]) -> Settings:
             if val is not None:
                 values[key] = val
         elif key == "effort":
-            comps = {}
+            factors: dict[str, float] = {}
             for k in "WTSF":
                 kv = args.keys.get(k)
                 if kv is None:
@@ -386,11 +436,11 @@ def _settings(ctx: _Ctx, stmts: list[Statement]) -> Settings:
                     ctx.error("V106", f"effort {k} must lie in [-1, 1], found {kv.value.text}",
                               kv.value.span, factor=k, found=kv.value.value)
                     continue
-                comps[k] = kv.value.value
+                factors[k] = kv.value.value
             for a in pos:
                 ctx.error("V113", "`effort` takes only W= T= S= F=", a.span)
-            if len(comps) == 4 and len(ctx.diags) == n_before:
-                values["effort"] = Effort(span=st.span, **comps)
+            if len(factors) == 4 and len(ctx.diags) == n_before:
+                values["effort"] = Effort(span=st.span, **factors)
     if "start" in values or "standoff" in values:
         start = values.get("start", DEFAULTS["start"])
         standoff = values.get("standoff", DEFAULTS["standoff"])
@@ -488,7 +538,7 @@ def _check_whole(ctx: _Ctx, b: Behaviour) -> None:
         p = b.first("pause")
         n_r = r.count if r else 0
         n_p = p.count if p else 0
-        if n_r and n_p < n_r + 1:
+        if r is not None and n_r and n_p < n_r + 1:
             ctx.error("V121", f"{n_r} retreat(s) need at least {n_r + 1} pauses (a retreat "
                       f"starts and ends at a pause, MODEL.md s5), found {n_p}", r.span,
                       hint=f"add `pause DURATION x{n_r + 1}`")
@@ -498,28 +548,28 @@ def _check_whole(ctx: _Ctx, b: Behaviour) -> None:
         return
     # Sequence form: follow the distance to the goal statement by statement.
     dist = s.start
-    for p in b.primitives:
-        for _ in range(p.count):
-            if isinstance(p, Approach):
-                if p.length is None:
+    for prim in b.primitives:
+        for _ in range(prim.count):
+            if isinstance(prim, Approach):
+                if prim.length is None:
                     dist = s.standoff
-                elif dist - p.length < s.standoff - 1e-9:
-                    ctx.error("V120", f"this approach of {p.length:g} m would end "
-                              f"{s.standoff - (dist - p.length):.3g} m inside the standoff "
-                              f"({s.standoff:g} m from the goal); {max(dist - s.standoff, 0):.3g}"
-                              f" m are left", p.span)
+                elif dist - prim.length < s.standoff - 1e-9:
+                    ctx.error("V120", f"this approach of {prim.length:g} m would end "
+                              f"{s.standoff - (dist - prim.length):.3g} m inside the standoff "
+                              f"({s.standoff:g} m from the goal); "
+                              f"{max(dist - s.standoff, 0):.3g} m are left", prim.span)
                     return
                 else:
-                    dist -= p.length
-            elif isinstance(p, Retreat):
-                if dist + p.length < s.standoff - 1e-9:
+                    dist -= prim.length
+            elif isinstance(prim, Retreat):
+                if dist + prim.length < s.standoff - 1e-9:
                     ctx.error("V120", "this retreat (negative length) would end inside the "
-                              "standoff", p.span)
+                              "standoff", prim.span)
                     return
-                dist += p.length
+                dist += prim.length
                 if dist > MAX_REACH_DISTANCE:
-                    ctx.error("V119", f"the end-effector would be {dist:.3g} m from the goal; "
-                              f"at most {MAX_REACH_DISTANCE:g} m", p.span)
+                    ctx.error("V119", f"the end-effector would be {dist:.3g} m from the "
+                              f"goal; at most {MAX_REACH_DISTANCE:g} m", prim.span)
                     return
 
 

@@ -101,7 +101,7 @@ def _angle_deg(r1: np.ndarray, r2: np.ndarray) -> float:
 
 
 def replay(robot: str, t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
-           goal: tuple[float, float, float], *, options: SceneOptions | None = None,
+           goal: tuple[float, ...], *, options: SceneOptions | None = None,
            dynamic: bool = False) -> CheckReport:
     """Check a trajectory of the robot's arm joints, shapes (N,) and (N, n).
 
@@ -127,7 +127,7 @@ def replay(robot: str, t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.nda
 _SCENES: dict = {}
 
 
-def _scene(robot: str, goal: tuple[float, float, float], options: SceneOptions) -> Scene:
+def _scene(robot: str, goal: tuple[float, ...], options: SceneOptions) -> Scene:
     """A scene per robot, goal and options, kept: loading the URDF is the slow part.
     Each replay sets the joint states and physics settings it relies on."""
     key = (robot, goal, options)

@@ -82,7 +82,7 @@ class Scene:
     """The robot (and optionally the target and table) in a private PyBullet client."""
 
     robot: str
-    goal: tuple[float, float, float] | None = None
+    goal: tuple[float, ...] | None = None
     options: SceneOptions = field(default_factory=SceneOptions)
 
     def __post_init__(self):

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Literal
+from typing import Any, Literal
 
 from ..cv import composition_of, infer
 from ..diagnostics import Span
@@ -214,7 +214,9 @@ class _Stop:
     """A cluster of non-approach episodes at one place of the reach, as a recipe."""
 
     kind: str
-    items: list[tuple[str, object]]  # ("pause"|"retreat"|"gaze"|"tilt"|"shiver", data)
+    #: ("pause", Pause), ("retreat", Retreat), ("gaze", (Gaze, bearing)),
+    #: ("tilt", (Tilt, delta)), ("shiver", Shiver)
+    items: list[tuple[str, Any]]
 
 
 def _split(n: int, k: int) -> list[int]:
@@ -253,7 +255,8 @@ def _stops(b: Behaviour) -> tuple[list[_Stop], bool]:
         stops.append(_Stop("retreat", items))
     # Tilts join gaze stops (before their pause), else stand alone; alternate +/-.
     gaze_stops = [s for s in stops if s.kind == "gaze"]
-    for i in range(tilt.count if tilt else 0):
+    for i in range(tilt.count if tilt is not None else 0):
+        assert tilt is not None
         delta = tilt.angle if i % 2 == 0 else -tilt.angle
         if gaze_stops:
             gaze_stops[i % len(gaze_stops)].items.append(("tilt", (tilt, delta)))
@@ -316,7 +319,7 @@ def _descriptor(b: Behaviour, state: State) -> list[Episode]:
                 add(_shiver(data, pose))
     if approach is not None and approach.count and pose.d > s.standoff + 1e-12:
         add(_approach_to(approach, pose, s.standoff))
-    if final_pause and not (out and out[-1].kind == "pause"):
+    if final_pause and pause is not None and not (out and out[-1].kind == "pause"):
         add(_pause(pause, pose))
     return out
 

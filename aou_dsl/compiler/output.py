@@ -15,6 +15,7 @@ import json
 import os
 import tempfile
 import zipfile
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -78,7 +79,7 @@ def encode(doc: dict, fmt: str) -> bytes:
     raise ValueError(f"unknown format {fmt!r}")
 
 
-def write_atomic(path: str, data: bytes, *, inputs: list[str] = ()) -> None:
+def write_atomic(path: str, data: bytes, *, inputs: Sequence[str] = ()) -> None:
     """Write ``data`` to ``path`` atomically; never over one of ``inputs``.
 
     Raises:

@@ -59,7 +59,7 @@ class Trajectory:
     robot: str
     ee_frame: str
     joint_names: tuple[str, ...]
-    goal: tuple[float, float, float]
+    goal: tuple[float, ...]
     t: np.ndarray
     q: np.ndarray
     qd: np.ndarray
@@ -152,35 +152,35 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions()
                         b.settings.start_direction or spec.start_direction)
     lap("model")
 
-    q = None
     segments: list[PathSegment | JointSegment] = []
     t_planned = 0.0
     start_pose = tl.episodes[0].start if tl.episodes else Pose(b.settings.start)
     first = _start_configuration(arm, frame, start_pose)
-    if not first.ok:
-        ep0 = tl.episodes[0] if tl.episodes else None
-        span = ep0.span if ep0 else b.span
-        res.diagnostics.append(_ik_diag(ep0 or Episode("pause", span, Pose(0), Pose(0), 0),
-                                        first.failure.status, 0.0, first.failure.joint, b))
+    if first.failure is not None:
+        ep0 = tl.episodes[0] if tl.episodes else Episode("pause", b.span, Pose(0), Pose(0), 0)
+        res.diagnostics.append(_ik_diag(ep0, first.failure.status, 0.0, first.failure.joint,
+                                        b))
         return res
     q = first.q[0]
     worst_p, worst_r = first.worst_position_error, first.worst_rotation_error
     lap("ik")
     for ep in tl.episodes:
+        seg: PathSegment | JointSegment | None
         if ep.kind == "pause":
             segments.append(JointSegment(q, ep.duration))
         elif ep.kind == "shiver":
-            seg, fail = shiver_segment(arm, q, ep.amplitude, ep.f, ep.duration)
-            if fail is not None:
-                res.diagnostics.append(diag("C308", fail.reason, ep.span, joint=fail.joint,
-                                            max_frequency=fail.wanted))
+            seg, shiver_fail = shiver_segment(arm, q, ep.amplitude, ep.f, ep.duration)
+            if shiver_fail is not None:
+                res.diagnostics.append(diag("C308", shiver_fail.reason, ep.span,
+                                            joint=shiver_fail.joint,
+                                            max_frequency=shiver_fail.wanted))
                 return res
             segments.append(seg)
         else:
             s, targets = _waypoints(ep, frame, options)
             ik = solve_path(arm, targets, q)
             lap("ik")
-            if not ik.ok:
+            if ik.failure is not None:
                 f = ik.failure
                 t_fail = t_planned + ep.duration * f.index / max(1, len(targets) - 1)
                 res.diagnostics.append(_ik_diag(ep, f.status, t_fail, f.joint, b))
@@ -203,7 +203,8 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions()
                 seg, fail = time_path(arm, s, ik.q, ep.a, ep.vmax,
                                       cartesian=ep.kind in ("approach", "retreat"))
                 if seg is None:
-                    res.diagnostics.append(diag("C305", f"{ep.kind}: {fail.reason}", ep.span))
+                    reason = fail.reason if fail is not None else "no time law"
+                    res.diagnostics.append(diag("C305", f"{ep.kind}: {reason}", ep.span))
                     return res
                 if fail is not None:
                     unit = "m/s^2" if ep.kind in ("approach", "retreat") else "rad/s^2"
@@ -226,7 +227,9 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions()
 def target_path(res: CompileResult) -> tuple[np.ndarray, np.ndarray]:
     """The end-effector poses the trajectory is meant to follow, at its sample times:
     positions (N, 3) and rotations (N, 3, 3). For accuracy studies and benchmarks."""
-    tr, tl = res.trajectory, res.timeline
+    tr, tl, frame = res.trajectory, res.timeline, res.frame
+    if tr is None or tl is None or frame is None:
+        raise ValueError("the compilation failed: there is no path to follow")
     pos = np.empty((len(tr.t), 3))
     rot = np.empty((len(tr.t), 3, 3))
     for (_, t0, t1), ep, seg in zip(tr.episodes, tl.episodes, res.segments, strict=True):
@@ -237,7 +240,7 @@ def target_path(res: CompileResult) -> tuple[np.ndarray, np.ndarray]:
         else:
             f = np.zeros(int(m.sum()))
         a, b = ep.start, ep.end
-        out = [res.frame.target(Pose(a.d + x * (b.d - a.d), a.h + x * (b.h - a.h),
+        out = [frame.target(Pose(a.d + x * (b.d - a.d), a.h + x * (b.h - a.h),
                                      a.v + x * (b.v - a.v), a.roll + x * (b.roll - a.roll)))
                for x in f]
         if out:

@@ -152,7 +152,7 @@ def _refine(t: np.ndarray, speed: np.ndarray, i: int, direction: int, thr: float
     the rest, is extrapolated to zero. This undoes the one-sample smear of central
     differences.
     """
-    idx = []
+    idx: list[int] = []
     j = i + direction
     while 0 <= j < len(t) and len(idx) < 6:
         if idx and speed[j] < speed[idx[-1]]:
@@ -426,8 +426,7 @@ def _peak_acceleration(sig: _Signals, s: int, e: int) -> float:
     acc = savgol_filter(sig.pos[lo:hi], w, 3, deriv=2, delta=sig.dt, axis=0)
     u = sig.pos_s[e] - sig.pos_s[s]
     u = u / max(np.linalg.norm(u), 1e-12)
-    inner = slice(s - lo + w // 2, e - lo - w // 2 + 1)
-    along = np.abs(acc[inner] @ u)
+    along = np.abs(acc[s - lo + w // 2:e - lo - w // 2 + 1] @ u)
     return float(along.max()) if along.size else float(np.abs(acc @ u).max())
 
 

@@ -38,7 +38,7 @@ class Recording:
     joint_names: tuple[str, ...]
     robot: str
     ee_frame: str | None
-    goal: tuple[float, float, float]
+    goal: tuple[float, ...]
     path: str = "<memory>"
 
 

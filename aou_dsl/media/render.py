@@ -144,7 +144,7 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
                                     quality=8, macro_block_size=8,
                                     ffmpeg_log_level="error") as w:
                 for f in frames:
-                    w.append_data(f)
+                    w.append_data(f)  # type: ignore[attr-defined]
         else:
             from PIL import Image
 
