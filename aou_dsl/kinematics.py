@@ -80,8 +80,9 @@ def load_arm(robot: str, ee_frame: str | None = None) -> ArmModel:
     """Load a robot of :data:`ROBOTS` from example-robot-data, reduced to its arm.
 
     Raises:
-        AouError: C301-like diagnostics are the compiler's; here an unknown robot or
-            frame is an I501 (the input names something this machine does not have).
+        AouError: V109 for a robot aou has no table for, R402 for a frame the model
+            lacks (listing the valid ones), I501 when the model's joints are not the
+            table's.
     """
     import example_robot_data as erd
     import pinocchio as pin
