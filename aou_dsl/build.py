@@ -16,10 +16,13 @@ from .diagnostics import Diagnostic, diag, has_errors
 from .lint import FileResult, lint_file
 
 if TYPE_CHECKING:  # the numerical stages load only when a build runs
+    import numpy as np
+
     from .compiler.pipeline import CompileResult, Trajectory
     from .measure.descriptors import Measured
+    from .measure.recording import Recording
 
-__all__ = ["BuildResult", "build_file", "to_recording"]
+__all__ = ["BuildResult", "Motion", "build_file", "load_motion", "to_recording"]
 
 
 @dataclass
@@ -148,3 +151,61 @@ def _span_at(compiled, t: float | None):
             if a <= t <= b:
                 return ep.span
     return compiled.behaviour.span
+
+
+@dataclass(frozen=True)
+class Motion:
+    """The motion in a file, for the commands that replay or draw it.
+
+    Attributes:
+        recording: times, joint positions, robot, frame and goal.
+        qd, qdd: the file's joint velocities and accelerations in the recording's column
+            order, when it has them (compiled trajectories do), else None.
+        episodes: ``(kind, t_start, t_end)`` from the compiler, else None.
+        title: the behaviour's name, or the file's stem.
+    """
+
+    recording: Recording
+    qd: np.ndarray | None
+    qdd: np.ndarray | None
+    episodes: tuple[tuple[str, float, float], ...] | None
+    title: str
+
+
+def load_motion(path: str, *, robot: str | None = None,
+                goal: tuple[float, float, float] | None = None,
+                ee_frame: str | None = None) -> Motion:
+    """A ``.aou`` file compiled (without the safety checks), or a trajectory file read
+    (a CSV recording needs ``robot``; ``goal`` and ``ee_frame`` override the file's).
+
+    Raises:
+        AouError: the file's diagnostics when it cannot be compiled or read.
+    """
+    import json
+    import os
+
+    import numpy as np
+
+    from .diagnostics import AouError
+    from .measure.recording import read_recording
+
+    if path.endswith(".aou"):
+        res = build_file(path, check=False)
+        if not res.ok:
+            raise AouError(res.diagnostics)
+        tr = res.trajectory
+        title = res.lint.behaviour.name if res.lint.behaviour else path
+        return Motion(to_recording(tr, path), tr.qd, tr.qdd, tr.episodes, title)
+    rec = read_recording(path, robot=robot, goal=goal, ee_frame=ee_frame)
+    qd = qdd = None
+    episodes = None
+    if path.endswith(".json"):
+        with open(path, encoding="utf-8") as fh:
+            doc = json.load(fh)
+        if "qd" in doc and "qdd" in doc:
+            qd, qdd = np.asarray(doc["qd"], float), np.asarray(doc["qdd"], float)
+            if qd.shape != rec.q.shape or qdd.shape != rec.q.shape:
+                qd = qdd = None  # malformed derivatives: recompute them from q
+        if doc.get("episodes"):
+            episodes = tuple((e["kind"], e["t_start"], e["t_end"]) for e in doc["episodes"])
+    return Motion(rec, qd, qdd, episodes, os.path.splitext(os.path.basename(path))[0])

@@ -40,6 +40,11 @@ def _print_diags(diags: list[Diagnostic], fmt: str, sources: dict[str, str] | No
             print(format_text(d, (sources or {}).get(d.span.path)), file=stream)
 
 
+def _exit_for(diags: list[Diagnostic]) -> int:
+    """2 when the input could not be read (I codes), else 1: the file has errors."""
+    return EXIT_USAGE if any(d.code.startswith("I") for d in diags) else EXIT_ERRORS
+
+
 # --- lint -------------------------------------------------------------------------------
 
 
@@ -101,45 +106,30 @@ def _cmd_rules(args: argparse.Namespace) -> int:
 
 
 def _cmd_explain(args: argparse.Namespace) -> int:
-    import math
-
     from .compiler.layout import layout
     from .lint import lint_file
+    from .report import format_timeline
 
     r = lint_file(args.path)
     if not r.ok or r.behaviour is None or r.cv is None:
         _print_diags(r.diagnostics, "text", {r.path: r.source or ""}, stream=sys.stderr)
-        return EXIT_USAGE if any(d.code.startswith("I") for d in r.diagnostics) else EXIT_ERRORS
-    b = r.behaviour
-    tl = layout(b)
-    declared = f"declared {b.state}" if b.state else "no state declared"
-    print(f"behaviour {b.name} ({declared}; {b.form} form) on {b.settings.robot}")
-    print(f"C-V point: C={r.cv.C:+.2f} V={r.cv.V:+.2f} -> {r.cv.state}; "
-          f"laid out as {tl.state}")
-    print(f"{'#':>3}  {'episode':<9}{'start':>8}{'dur':>8}  what moves")
-    t = 0.0
-    for i, e in enumerate(tl.episodes, 1):
-        if e.kind in ("approach", "retreat"):
-            what = f"distance {e.start.d:.3f} -> {e.end.d:.3f} m (a={e.a:g} m/s^2)"
-        elif e.kind == "gaze":
-            a0, a1 = (e.start.h, e.end.h) if e.plane == "horizontal" else (e.start.v, e.end.v)
-            what = (f"{e.plane} bearing {math.degrees(a0):+.1f} -> {math.degrees(a1):+.1f} deg "
-                    f"at {e.start.d:.3f} m")
-        elif e.kind == "tilt":
-            what = f"roll {math.degrees(e.start.roll):+.1f} -> {math.degrees(e.end.roll):+.1f} deg"
-        elif e.kind == "shiver":
-            what = f"shiver {math.degrees(e.amplitude):g} deg peak to peak at {e.f:g} Hz"
-        else:
-            what = f"hold at {e.start.d:.3f} m"
-        print(f"{i:>3}  {e.kind:<9}{t:>7.2f}s{e.duration:>7.2f}s  {what}  "
-              f"(line {e.span.line})")
-        t += e.duration
-    print(f"planned duration {t:.2f} s (moving episodes at the declared limits; "
-          "`aouc compile` may slow them to the joint limits)")
+        return _exit_for(r.diagnostics)
+    print(format_timeline(r.behaviour, r.cv, layout(r.behaviour)))
     return EXIT_OK
 
 
 # --- compile ----------------------------------------------------------------------------
+
+
+def _format_from(output: str | None, many: bool) -> str:
+    """The output format a single ``-o FILE`` implies by its extension; json otherwise."""
+    import os
+
+    if output and not many and not os.path.isdir(output):
+        ext = os.path.splitext(output)[1].lstrip(".")
+        if ext:
+            return ext
+    return "json"
 
 
 def _output_path(src: str, out: str | None, fmt: str, many: bool) -> str:
@@ -166,9 +156,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     if problems:
         return EXIT_USAGE
     many = len(files) > 1
-    fmt = args.format or (os.path.splitext(args.output)[1].lstrip(".")
-                          if args.output and not many and not os.path.isdir(args.output)
-                          and os.path.splitext(args.output)[1] else "json")
+    fmt = args.format or _format_from(args.output, many)
     if fmt not in ("json", "csv", "npz"):
         print(f"aouc: unknown output format `{fmt}`: expected json, csv or npz",
               file=sys.stderr)
@@ -187,8 +175,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
         _print_diags(res.diagnostics, "text", {src: res.lint.source or ""}, stream=sys.stderr)
         dest = _output_path(src, args.output, fmt, many)
         if not res.ok or res.document is None:
-            io = any(d.code.startswith("I") for d in res.diagnostics)
-            worst = max(worst, EXIT_USAGE if io else EXIT_ERRORS)
+            worst = max(worst, _exit_for(res.diagnostics))
             print(f"[{k}/{len(files)}] {src}: failed, nothing written", file=sys.stderr)
             continue
         try:
@@ -217,120 +204,67 @@ def _scene_options(args: argparse.Namespace):
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
-    import numpy as np
-
-    from .check.replay import replay
+    from .build import load_motion
+    from .check.replay import replay_motion
     from .diagnostics import AouError
+    from .report import format_check
 
-    path = args.path
-    if path.endswith(".aou"):
-        from .build import build_file
-
-        res = build_file(path, check=False)
-        if not res.ok:
-            _print_diags(res.diagnostics, "text", {path: res.lint.source or ""},
-                         stream=sys.stderr)
-            io = any(d.code.startswith("I") for d in res.diagnostics)
-            return EXIT_USAGE if io else EXIT_ERRORS
-        tr = res.trajectory
-        robot, t, q, qd, qdd, goal = tr.robot, tr.t, tr.q, tr.qd, tr.qdd, tr.goal
-    else:
-        import json
-
-        from .kinematics import load_arm
-        from .measure.recording import read_recording
-
-        try:
-            rec = read_recording(path)
-            arm = load_arm(rec.robot, rec.ee_frame)
-            cols = [rec.joint_names.index(n) for n in arm.joint_names
-                    if n in rec.joint_names]
-            if len(cols) != arm.n:
-                missing = [n for n in arm.joint_names if n not in rec.joint_names]
-                print(f"{path}: R402 the trajectory lacks joint(s) {', '.join(missing)}",
-                      file=sys.stderr)
-                return EXIT_ERRORS
-            with open(path, encoding="utf-8") as fh:
-                doc = json.load(fh)
-        except AouError as err:
-            _print_diags(err.diagnostics, "text", stream=sys.stderr)
-            return EXIT_USAGE if any(d.code.startswith("I") for d in err.diagnostics) \
-                else EXIT_ERRORS
-        t, q, goal, robot = rec.t, rec.q[:, cols], rec.goal, rec.robot
-        if "qd" in doc and "qdd" in doc:
-            qd = np.asarray(doc["qd"], float)[:, cols]
-            qdd = np.asarray(doc["qdd"], float)[:, cols]
-        else:
-            qd = np.gradient(q, t, axis=0)
-            qdd = np.gradient(qd, t, axis=0)
-    report = replay(robot, t, q, qd, qdd, goal, options=_scene_options(args),
-                    dynamic=not args.no_dynamic)
+    try:
+        motion = load_motion(args.path, **_recording_options(args))
+        report = replay_motion(motion, options=_scene_options(args),
+                               dynamic=not args.no_dynamic)
+    except AouError as err:
+        return _report_error(err)
+    rec = motion.recording
     if args.format == "json":
-        print(format_json({"path": path, **report.to_json()}))
+        print(format_json({"path": args.path, **report.to_json()}))
     else:
-        print(f"{path}: {robot}, {t[-1]:.2f} s, {len(t)} samples")
-        for c in report.checks:
-            mark = "pass" if c.ok else "FAIL"
-            where = "" if c.time is None else f" worst at t={c.time:.3f}s"
-            who = f" {c.joint}" if c.joint else ""
-            val = "" if c.value is None else f" value {c.value:.4g}"
-            lim = "" if c.limit is None else f" limit {c.limit:.4g}"
-            print(f"  {mark}  {c.name:<21}{where}{who}{val}{lim}  ({c.detail})")
-        cl = report.clearances
-        print("  clearances: " + ", ".join(
-            f"{k} {'n/a' if v is None else f'{v * 1000:.1f} mm'}" for k, v in cl.items()))
-        ag = report.agreement
-        print(f"  PyBullet vs Pinocchio end-effector: {ag['position_mm']:.2e} mm, "
-              f"{ag['rotation_deg']:.2e} deg")
-        if report.dynamic:
-            d = report.dynamic
-            print(f"  dynamic replay at {d['physics_rate_hz']:.0f} Hz: tracking max "
-                  f"{d['tracking_max_rad']:.2e} rad, RMS {d['tracking_rms_rad']:.2e} rad; "
-                  f"peak torque {d['torque_max_ratio'] * 100:.0f} % of the effort limit")
+        print(format_check(args.path, rec.robot, rec.t, report))
     return EXIT_OK if report.ok else EXIT_ERRORS
 
 
 # --- measure ----------------------------------------------------------------------------
 
 
-def _parse_goal(text: str | None) -> tuple[float, float, float] | None:
-    if text is None:
-        return None
+def _point(text: str) -> tuple[float, float, float]:
+    """argparse type of X,Y,Z options (metres)."""
     parts = text.strip("()").split(",")
-    if len(parts) != 3:
-        raise ValueError("--goal takes X,Y,Z in metres")
-    return tuple(float(p) for p in parts)  # type: ignore[return-value]
+    try:
+        if len(parts) != 3:
+            raise ValueError
+        x, y, z = (float(p) for p in parts)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected X,Y,Z in metres, found `{text}`") from None
+    return (x, y, z)
+
+
+def _frame_size(text: str) -> tuple[int, int]:
+    """argparse type of --size WxH (pixels)."""
+    try:
+        w, h = (int(x) for x in text.lower().split("x"))
+        if w < 8 or h < 8:
+            raise ValueError
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected WxH in pixels, e.g. 640x480, found "
+                                         f"`{text}`") from None
+    return (w, h)
 
 
 def _cmd_measure(args: argparse.Namespace) -> int:
     from .diagnostics import AouError
     from .measure.descriptors import measure
     from .measure.recording import read_recording
+    from .report import format_measured
 
     try:
-        goal = _parse_goal(args.goal)
-    except ValueError as exc:
-        print(f"aouc: {exc}", file=sys.stderr)
-        return EXIT_USAGE
-    try:
-        rec = read_recording(args.path, robot=args.robot, goal=goal, ee_frame=args.ee_frame)
+        rec = read_recording(args.path, **_recording_options(args))
         m = measure(rec)
     except AouError as err:
-        _print_diags(err.diagnostics, "text", stream=sys.stderr)
-        io = any(d.code.startswith("I") for d in err.diagnostics)
-        return EXIT_USAGE if io else EXIT_ERRORS
+        return _report_error(err)
     if args.format == "json":
         print(format_json({"path": args.path, "robot": rec.robot, **m.to_json()}))
     else:
-        units = {"approach_acceleration": "m/s^2", "pause_count": "", "pause_duration": "s",
-                 "retreat_count": "", "retreat_distance": "m", "retreat_acceleration": "m/s^2",
-                 "horizontal_gaze": "deg", "vertical_gaze": "deg", "tilt_angle": "deg",
-                 "tilt_velocity": "deg/s", "shiver_amplitude": "deg"}
-        print(f"{args.path}: {rec.robot}, {m.duration:.2f} s, {len(m.episodes)} episodes")
-        for k, v in m.descriptors.items():
-            val = "null" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
-            print(f"  {k:<22} {val:>10} {units[k]}")
-        print(f"  C-V: C={m.cv.C:+.2f} V={m.cv.V:+.2f} -> {m.cv.state}")
+        print(format_measured(args.path, rec.robot, m))
         _print_diags(m.diagnostics, "text", stream=sys.stderr)
     return EXIT_OK
 
@@ -344,41 +278,14 @@ def _media_missing(exc: ImportError) -> int:
     return EXIT_USAGE
 
 
-def _load_motion(path: str, scene=None):
-    """A file to draw: (recording, episodes or None, title). ``.aou`` files are compiled
-    (without the safety checks: pictures are not sent to a robot)."""
-    from .build import build_file, to_recording
-    from .diagnostics import AouError
-    from .measure.recording import read_recording
-
-    if path.endswith(".aou"):
-        res = build_file(path, check=False)
-        if not res.ok:
-            raise AouError(res.diagnostics)
-        tr = res.trajectory
-        name = res.lint.behaviour.name if res.lint.behaviour else path
-        return to_recording(tr, path), tr.episodes, name
-    rec = read_recording(path)
-    episodes = None
-    if path.endswith(".json"):
-        import json
-
-        with open(path, encoding="utf-8") as fh:
-            doc = json.load(fh)
-        if doc.get("episodes"):
-            episodes = tuple((e["kind"], e["t_start"], e["t_end"]) for e in doc["episodes"])
-    import os
-
-    return rec, episodes, os.path.splitext(os.path.basename(path))[0]
-
-
 def _report_error(err) -> int:
+    """Print an AouError's diagnostics; the exit code they call for."""
     _print_diags(err.diagnostics, "text", stream=sys.stderr)
-    io = any(d.code.startswith("I") for d in err.diagnostics)
-    return EXIT_USAGE if io else EXIT_ERRORS
+    return _exit_for(err.diagnostics)
 
 
 def _cmd_plot(args: argparse.Namespace) -> int:
+    from .build import load_motion
     from .diagnostics import AouError
 
     try:
@@ -401,8 +308,9 @@ def _cmd_plot(args: argparse.Namespace) -> int:
             if len(args.paths) != 1:
                 print("aouc: plot takes one file (or --cv with several)", file=sys.stderr)
                 return EXIT_USAGE
-            rec, episodes, title = _load_motion(args.paths[0])
-            fig = profile_figure(profile_data(rec, episodes, title))
+            motion = load_motion(args.paths[0], **_recording_options(args))
+            fig = profile_figure(profile_data(motion.recording, motion.episodes,
+                                              motion.title))
         save(fig, args.output)
     except AouError as err:
         return _report_error(err)
@@ -413,15 +321,15 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 def _camera(args: argparse.Namespace):
     from .media.render import Camera
 
-    target = _parse_goal(args.camera_target) if args.camera_target else None
-    w, h = (int(x) for x in args.size.lower().split("x"))
+    w, h = args.size
     return Camera(distance=args.camera_distance, yaw=args.camera_yaw,
-                  pitch=args.camera_pitch, target=target, width=w, height=h)
+                  pitch=args.camera_pitch, target=args.camera_target, width=w, height=h)
 
 
 def _cmd_render(args: argparse.Namespace) -> int:
     import time
 
+    from .build import load_motion
     from .diagnostics import AouError
 
     try:
@@ -434,7 +342,7 @@ def _cmd_render(args: argparse.Namespace) -> int:
         return EXIT_USAGE
     try:
         camera = _camera(args)
-        motions = [_load_motion(p)[0] for p in paths]
+        motions = [load_motion(p, **_recording_options(args)).recording for p in paths]
         start = time.perf_counter()
         info = render_video(motions, args.output, fps=args.fps, camera=camera,
                             scene_options=_scene_options(args))
@@ -470,7 +378,7 @@ def _cmd_variants(args: argparse.Namespace) -> int:
     if not base.ok or base.behaviour is None or base.source is None:
         _print_diags(base.diagnostics, "text", {args.path: base.source or ""},
                      stream=sys.stderr)
-        return EXIT_ERRORS
+        return _exit_for(base.diagnostics)
     try:
         variants = make_variants(base.behaviour, base.source, name, low, high)
     except AouError as err:
@@ -495,6 +403,7 @@ def _cmd_variants(args: argparse.Namespace) -> int:
             return _report_error(err)
         print(f"wrote {out} ({name}={v.value:g})", file=sys.stderr)
     if args.render:
+        args.robot = args.goal = args.ee_frame = None  # the variants are .aou files
         args.side_by_side = [o for o, _ in outputs]
         args.path = None
         args.output = args.render
@@ -504,15 +413,27 @@ def _cmd_variants(args: argparse.Namespace) -> int:
 
 def _render_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--fps", type=float, default=30.0, help="frames per second (default 30)")
-    p.add_argument("--size", default="640x480", help="frame size WxH (default 640x480)")
+    p.add_argument("--size", default=(640, 480), type=_frame_size, metavar="WxH",
+                   help="frame size (default 640x480)")
     p.add_argument("--camera-distance", type=float, default=1.2, metavar="M")
     p.add_argument("--camera-yaw", type=float, default=30.0, metavar="DEG")
     p.add_argument("--camera-pitch", type=float, default=-15.0, metavar="DEG")
-    p.add_argument("--camera-target", metavar="X,Y,Z",
+    p.add_argument("--camera-target", metavar="X,Y,Z", type=_point,
                    help="point looked at (default: halfway from the base to the goal)")
 
 
 # --- the parser -------------------------------------------------------------------------
+
+
+def _recording_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--robot", help="robot of a CSV recording (panda, ur5)")
+    p.add_argument("--ee-frame", help="end-effector frame (default: the robot's)")
+    p.add_argument("--goal", metavar="X,Y,Z", type=_point, help="goal position in metres")
+
+
+def _recording_options(args: argparse.Namespace) -> dict:
+    """``robot``, ``goal``, ``ee_frame`` for reading a recording."""
+    return {"robot": args.robot, "goal": args.goal, "ee_frame": args.ee_frame}
 
 
 def _scene_arguments(p: argparse.ArgumentParser) -> None:
@@ -558,6 +479,7 @@ def build_parser() -> argparse.ArgumentParser:
     chk.add_argument("--format", choices=("text", "json"), default="text")
     chk.add_argument("--no-dynamic", action="store_true",
                      help="kinematic checks only (skip the physics replay)")
+    _recording_arguments(chk)
     _scene_arguments(chk)
     chk.set_defaults(func=_cmd_check)
 
@@ -567,6 +489,7 @@ def build_parser() -> argparse.ArgumentParser:
     plot.add_argument("-o", "--output", required=True, metavar="X.png|X.svg")
     plot.add_argument("--cv", action="store_true",
                       help="plot the C-V plane with each behaviour's inferred point")
+    _recording_arguments(plot)
     plot.set_defaults(func=_cmd_plot)
 
     render = sub.add_parser("render", help="render a video of a behaviour or trajectory")
@@ -575,6 +498,7 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("--side-by-side", nargs=2, metavar=("A", "B"),
                         help="render two behaviours next to each other")
     _render_arguments(render)
+    _recording_arguments(render)
     _scene_arguments(render)
     render.set_defaults(func=_cmd_render)
 
@@ -592,9 +516,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     meas = sub.add_parser("measure", help="measure the eleven descriptors of a trajectory")
     meas.add_argument("path", metavar="FILE", help="a trajectory .json, or a .csv recording")
-    meas.add_argument("--robot", help="robot of a CSV recording (panda, ur5)")
-    meas.add_argument("--ee-frame", help="end-effector frame (default: the robot's)")
-    meas.add_argument("--goal", metavar="X,Y,Z", help="goal position in metres")
+    _recording_arguments(meas)
     meas.add_argument("--format", choices=("table", "json"), default="table")
     meas.set_defaults(func=_cmd_measure)
 

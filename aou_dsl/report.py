@@ -3,10 +3,18 @@
 from __future__ import annotations
 
 import json
+import math
 
 from .diagnostics import Diagnostic
 
-__all__ = ["format_github", "format_json", "format_text"]
+__all__ = [
+    "format_check",
+    "format_github",
+    "format_json",
+    "format_measured",
+    "format_text",
+    "format_timeline",
+]
 
 
 def _source_excerpt(d: Diagnostic, source: str | None) -> list[str]:
@@ -43,3 +51,76 @@ def format_github(d: Diagnostic) -> str:
 
 def format_json(payload: object) -> str:
     return json.dumps(payload, indent=2, sort_keys=False)
+
+
+def format_timeline(behaviour, cv, timeline) -> str:
+    """``aouc explain``: the behaviour, its C-V point, and one line per episode."""
+    b = behaviour
+    declared = f"declared {b.state}" if b.state else "no state declared"
+    lines = [f"behaviour {b.name} ({declared}; {b.form} form) on {b.settings.robot}",
+             f"C-V point: C={cv.C:+.2f} V={cv.V:+.2f} -> {cv.state}; laid out as "
+             f"{timeline.state}",
+             f"{'#':>3}  {'episode':<9}{'start':>8}{'dur':>8}  what moves"]
+    t = 0.0
+    for i, e in enumerate(timeline.episodes, 1):
+        if e.kind in ("approach", "retreat"):
+            what = f"distance {e.start.d:.3f} -> {e.end.d:.3f} m (a={e.a:g} m/s^2)"
+        elif e.kind == "gaze":
+            a0, a1 = (e.start.h, e.end.h) if e.plane == "horizontal" else (e.start.v, e.end.v)
+            what = (f"{e.plane} bearing {math.degrees(a0):+.1f} -> {math.degrees(a1):+.1f} "
+                    f"deg at {e.start.d:.3f} m")
+        elif e.kind == "tilt":
+            what = (f"roll {math.degrees(e.start.roll):+.1f} -> "
+                    f"{math.degrees(e.end.roll):+.1f} deg")
+        elif e.kind == "shiver":
+            what = f"shiver {math.degrees(e.amplitude):g} deg peak to peak at {e.f:g} Hz"
+        else:
+            what = f"hold at {e.start.d:.3f} m"
+        lines.append(f"{i:>3}  {e.kind:<9}{t:>7.2f}s{e.duration:>7.2f}s  {what}  "
+                     f"(line {e.span.line})")
+        t += e.duration
+    lines.append(f"planned duration {t:.2f} s (moving episodes at the declared limits; "
+                 "`aouc compile` may slow them to the joint limits)")
+    return "\n".join(lines)
+
+
+def format_check(path: str, robot: str, t, report) -> str:
+    """``aouc check``: each check, pass or fail, its worst sample; clearances; agreement."""
+    lines = [f"{path}: {robot}, {t[-1] - t[0]:.2f} s, {len(t)} samples"]
+    for c in report.checks:
+        mark = "pass" if c.ok else "FAIL"
+        where = "" if c.time is None else f" worst at t={c.time:.3f}s"
+        who = f" {c.joint}" if c.joint else ""
+        val = "" if c.value is None else f" value {c.value:.4g}"
+        lim = "" if c.limit is None else f" limit {c.limit:.4g}"
+        lines.append(f"  {mark}  {c.name:<21}{where}{who}{val}{lim}  ({c.detail})")
+    lines.append("  clearances: " + ", ".join(
+        f"{k} {'n/a' if v is None else f'{v * 1000:.1f} mm'}"
+        for k, v in report.clearances.items()))
+    ag = report.agreement
+    lines.append(f"  PyBullet vs Pinocchio end-effector: {ag['position_mm']:.2e} mm, "
+                 f"{ag['rotation_deg']:.2e} deg")
+    if report.dynamic:
+        d = report.dynamic
+        lines.append(f"  dynamic replay at {d['physics_rate_hz']:.0f} Hz: tracking max "
+                     f"{d['tracking_max_rad']:.2e} rad, RMS {d['tracking_rms_rad']:.2e} rad; "
+                     f"peak torque {d['torque_max_ratio'] * 100:.0f} % of the effort limit")
+    return "\n".join(lines)
+
+
+#: The unit each descriptor is printed in (MODEL.md s5).
+UNITS = {"approach_acceleration": "m/s^2", "pause_count": "", "pause_duration": "s",
+         "retreat_count": "", "retreat_distance": "m", "retreat_acceleration": "m/s^2",
+         "horizontal_gaze": "deg", "vertical_gaze": "deg", "tilt_angle": "deg",
+         "tilt_velocity": "deg/s", "shiver_amplitude": "deg"}
+
+
+def format_measured(path: str, robot: str, measured) -> str:
+    """``aouc measure``: the eleven descriptors as a table, and the C-V point."""
+    m = measured
+    lines = [f"{path}: {robot}, {m.duration:.2f} s, {len(m.episodes)} episodes"]
+    for k, v in m.descriptors.items():
+        val = "null" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
+        lines.append(f"  {k:<22} {val:>10} {UNITS[k]}".rstrip())
+    lines.append(f"  C-V: C={m.cv.C:+.2f} V={m.cv.V:+.2f} -> {m.cv.state}")
+    return "\n".join(lines)

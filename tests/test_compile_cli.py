@@ -155,3 +155,29 @@ def test_explain_prints_the_timeline(capsys):
     out = capsys.readouterr().out
     assert out.count(" retreat ") == 3 and out.count(" pause ") == 5
     assert "C-V point: C=+0.00" in out
+
+
+@pytest.mark.parametrize("argv", [
+    ["check", "x.json", "--goal", "1,2"],
+    ["measure", "x.json", "--goal", "a,b,c"],
+    ["render", "x.aou", "-o", "x.mp4", "--size", "big"],
+    ["render", "x.aou", "-o", "x.mp4", "--camera-target", "1"],
+    ["compile", "x.aou", "--rate", "fast"],
+])
+def test_bad_option_values_are_usage_errors_not_tracebacks(argv, capsys):
+    with pytest.raises(SystemExit) as info:
+        main(argv)
+    assert info.value.code == EXIT_USAGE
+    assert "aouc: error: argument" in capsys.readouterr().err
+
+
+def test_check_reads_a_csv_recording_with_its_robot(tmp_path, hesitant_json, capsys):
+    doc = json.loads(hesitant_json.read_text())
+    csv = tmp_path / "rec.csv"
+    csv.write_text("t," + ",".join(doc["joint_names"]) + "\n" + "\n".join(
+        ",".join(repr(v) for v in [t, *row]) for t, row in zip(doc["t"], doc["q"],
+                                                               strict=True)))
+    assert main(["check", str(csv), "--no-dynamic"]) == EXIT_USAGE  # which robot?
+    assert "--robot" in capsys.readouterr().err
+    assert main(["check", str(csv), "--robot", "panda", "--no-dynamic"]) == EXIT_OK
+    assert "pass  target-contact" in capsys.readouterr().out

@@ -26,7 +26,7 @@ from ..kinematics import load_arm
 from .limits import Check, check_limits
 from .scene import Scene, SceneOptions
 
-__all__ = ["CheckReport", "replay"]
+__all__ = ["CheckReport", "replay", "replay_motion"]
 
 #: PyBullet and Pinocchio must agree on the end-effector pose within these.
 AGREE_POSITION = 1e-3  # m
@@ -122,6 +122,29 @@ def replay(robot: str, t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.nda
         dyn_check, report.dynamic = _dynamic(scene, arm, t, q, qd)
         report.checks.append(dyn_check)
     return report
+
+
+def replay_motion(motion, *, options: SceneOptions | None = None,
+                  dynamic: bool = False) -> CheckReport:
+    """Check a :class:`~aou_dsl.build.Motion` (a compiled file or a trajectory file).
+    Velocities and accelerations the file lacks are differentiated from the positions."""
+    rec = motion.recording
+    arm = load_arm(rec.robot, rec.ee_frame)
+    missing = [n for n in arm.joint_names if n not in rec.joint_names]
+    if missing:
+        from ..diagnostics import AouError, Span, diag
+
+        raise AouError(diag("R402", f"the trajectory lacks joint(s) {', '.join(missing)} of "
+                            f"robot `{rec.robot}`", Span.whole_file(rec.path),
+                            missing=missing))
+    cols = [rec.joint_names.index(n) for n in arm.joint_names]
+    t, q = rec.t, rec.q[:, cols]
+    if motion.qd is not None and motion.qdd is not None:
+        qd, qdd = motion.qd[:, cols], motion.qdd[:, cols]
+    else:
+        qd = np.gradient(q, t, axis=0)
+        qdd = np.gradient(qd, t, axis=0)
+    return replay(rec.robot, t, q, qd, qdd, rec.goal, options=options, dynamic=dynamic)
 
 
 _SCENES: dict = {}
