@@ -124,6 +124,12 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
     fmt = os.path.splitext(path)[1].lower().lstrip(".")
     if fmt not in ("mp4", "gif"):
         raise ValueError(f"unknown video format `.{fmt}`: expected .mp4 or .gif")
+    # Import the encoder first: a missing one should fail before minutes of rendering.
+    if fmt == "mp4":
+        import imageio.v2 as imageio
+        import imageio_ffmpeg  # noqa: F401  (imageio's ffmpeg plugin needs it)
+    else:
+        from PIL import Image
     opts = scene_options or SceneOptions()
     clips = []
     for i, tr in enumerate(trajs):
@@ -138,16 +144,12 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
     os.close(fd)
     try:
         if fmt == "mp4":
-            import imageio.v2 as imageio
-
             with imageio.get_writer(tmp, format="FFMPEG", fps=fps, codec="libx264",
                                     quality=8, macro_block_size=8,
                                     ffmpeg_log_level="error") as w:
                 for f in frames:
                     w.append_data(f)  # type: ignore[attr-defined]
         else:
-            from PIL import Image
-
             cs = [round((k + 1) * 100 / fps) - round(k * 100 / fps) for k in range(n)]
             images = [Image.fromarray(f) for f in frames]
             images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:],
