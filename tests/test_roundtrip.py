@@ -156,6 +156,9 @@ def test_shipped_behaviours_on_ur5_compile_or_say_why(tmp_path, name):
     res, mismatches, codes = _round_trip(path)
     if res.ok:
         assert not mismatches or codes & EXPLAINED, mismatches
+        # ... and what compiles is safe: the PyBullet checks pass on the UR5 too.
+        checked = build_file(str(path))
+        assert checked.ok, [d.message for d in checked.diagnostics]
     else:
         explained = [d for d in res.diagnostics if d.code in EXPLAINED]
         assert explained and all(d.span.line > 0 for d in explained)

@@ -89,6 +89,18 @@ def _pairs(scene: Scene, allowed: tuple[tuple[str, str], ...]) -> list[tuple[int
     return out
 
 
+def _base_links(scene: Scene) -> set[int]:
+    """The root link and every link welded to it by fixed joints (UR5: ``world`` and
+    ``base_link``): the robot stands on the table through them."""
+    pb, c, body = scene.pb, scene.client, scene.body
+    base = {-1}
+    for j in range(pb.getNumJoints(body, physicsClientId=c)):
+        info = pb.getJointInfo(body, j, physicsClientId=c)
+        if info[2] == pb.JOINT_FIXED and info[16] in base:
+            base.add(j)
+    return base
+
+
 def _link_name(scene: Scene, j: int) -> str:
     if j == -1:
         return scene.pb.getBodyInfo(scene.body, physicsClientId=scene.client)[0].decode()
@@ -168,7 +180,7 @@ def _kinematic(scene: Scene, arm, t: np.ndarray, q: np.ndarray
     pb, c, body = scene.pb, scene.client, scene.body
     pairs = _pairs(scene, arm.spec.allowed_contacts)
     pair_set = {frozenset(p) for p in pairs}
-    base = -1
+    base = _base_links(scene)
     pin_pos, pin_rot = arm.fk(q)
     self_hit = target_hit = table_hit = None
     self_clear = target_clear = table_clear = math.inf
@@ -192,7 +204,7 @@ def _kinematic(scene: Scene, arm, t: np.ndarray, q: np.ndarray
                     target_hit = (i, min(d))
         if scene.table is not None:
             d = [p[8] for p in pb.getClosestPoints(body, scene.table, 1.0, physicsClientId=c)
-                 if p[3] != base]
+                 if p[3] not in base]
             if d:
                 table_clear = min(table_clear, min(d))
                 if table_hit is None and min(d) <= 0.0:
