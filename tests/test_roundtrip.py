@@ -198,3 +198,22 @@ def test_measuring_the_compiled_stimuli_gives_table_two(name):
             assert abs(got - want) <= tolerance(key, want), (key, got, want)
     for key in ("vertical_gaze", "tilt_angle", "tilt_velocity"):
         assert measured[key] is None
+
+
+@pytest.mark.slow
+@settings(max_examples=20, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(descriptor_behaviours())
+def test_generated_behaviours_pass_the_safety_checks(tmp_path_factory, text):
+    """What the compiler makes of a valid file is safe to send: the PyBullet replay
+    (limits, collisions, contact with the object and the table) passes, or the compiler
+    says which limit it could not meet."""
+    from aou_dsl.lint import lint_source
+
+    assume(lint_source(text, "gen.aou").ok)
+    path = tmp_path_factory.mktemp("safe") / "gen.aou"
+    path.write_text(text)
+    res = build_file(str(path))
+    failed = [d for d in res.diagnostics if d.code == "C306"]
+    assert not failed, (text, [d.message for d in failed])
+    assert res.ok or {d.code for d in res.diagnostics} & EXPLAINED
