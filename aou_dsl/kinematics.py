@@ -50,6 +50,16 @@ class ArmModel:
     def n(self) -> int:
         return len(self.spec.arm_joints)
 
+    @property
+    def plan_vmax(self) -> np.ndarray:
+        """Joint velocity limits the compiler plans with [rad/s], shape (n,)."""
+        return self.vmax * self.spec.velocity_scale
+
+    @property
+    def plan_amax(self) -> np.ndarray:
+        """Joint acceleration limits the compiler plans with [rad/s^2], shape (n,)."""
+        return self.amax * self.spec.accel_scale
+
     def data(self):
         return self.model.createData()
 

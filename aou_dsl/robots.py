@@ -10,8 +10,9 @@ the joint acceleration limits here come from the manufacturers' datasheets:
   up to about 40 rad/s^2 (it limits torque, not acceleration). aou uses 3.0 rad/s^2,
   the conservative default :data:`DEFAULT_JOINT_ACCEL` for robots without a datasheet value.
 
-Velocity limits are read from the URDF at compile time and scaled by
-``velocity_scale`` to keep a margin.
+Velocity limits are read from the URDF at compile time; the compiler plans at
+``velocity_scale`` of them and at ``accel_scale`` of the acceleration limits, to keep a
+margin. The safety checks hold the trajectory to the full limits.
 """
 
 from __future__ import annotations
@@ -40,6 +41,9 @@ class RobotSpec:
         shiver_joint: the redundant joint that shivers (rotates about the forward axis
             without moving the end-effector position).
         velocity_scale: fraction of the URDF velocity limit the compiler plans with.
+        accel_scale: fraction of the acceleration limit the compiler plans with. TOPP-RA
+            meets its limits at its grid points; in between, the spline's curvature can
+            add a percent or so, which this margin absorbs (the checks use the full limit).
         limit_margin: distance [rad] kept from every joint position limit.
     """
 
@@ -52,6 +56,7 @@ class RobotSpec:
     joint_accel: tuple[float, ...]
     shiver_joint: str
     velocity_scale: float = 0.9
+    accel_scale: float = 0.95
     limit_margin: float = 0.05
     #: Link pairs allowed to touch beyond adjacent links (meshes that overlap by design).
     allowed_contacts: tuple[tuple[str, str], ...] = ()

@@ -2,7 +2,8 @@
 
 Position limits come from the URDF, velocity limits from the URDF (unscaled: the
 compiler plans at ``velocity_scale`` of them, the check allows the full limit), and
-acceleration limits from :mod:`aou_dsl.robots`. Each check reports its worst sample.
+acceleration limits from :mod:`aou_dsl.robots` (planned at ``accel_scale``, checked in
+full). Each check reports its worst sample.
 """
 
 from __future__ import annotations

@@ -190,8 +190,8 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions()
             if ep.kind == "tilt":
                 seg = PathSegment(s, ik.q, TimeLaw.bang_bang(ep.path_length, ep.duration))
                 _, qd, qdd = seg.sample(np.linspace(0, ep.duration, 200))
-                over = np.maximum(np.abs(qd) / (arm.vmax * spec.velocity_scale),
-                                  np.abs(qdd) / arm.amax).max(axis=0)
+                over = np.maximum(np.abs(qd) / arm.plan_vmax,
+                                  np.abs(qdd) / arm.plan_amax).max(axis=0)
                 if over.max() > 1.0:
                     j = arm.joint_names[int(np.argmax(over))]
                     res.diagnostics.append(diag(

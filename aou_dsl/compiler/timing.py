@@ -227,7 +227,7 @@ def _binding_joint(arm: ArmModel, seg: PathSegment, vmax: np.ndarray) -> str | N
     """The joint that comes nearest its velocity or acceleration limit on a segment."""
     tau = np.linspace(0.0, seg.duration, 200)
     _, qd, qdd = seg.sample(tau)
-    ratio = np.maximum(np.abs(qd) / vmax, np.abs(qdd) / arm.amax).max(axis=0)
+    ratio = np.maximum(np.abs(qd) / vmax, np.abs(qdd) / arm.plan_amax).max(axis=0)
     return arm.joint_names[int(np.argmax(ratio))]
 
 
@@ -271,26 +271,57 @@ def time_path(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vma
         ``(segment, failure)``: the segment (None if TOPP-RA failed) and, when the
         declared acceleration could not be reached, a failure naming the binding joint.
     """
-    seg, fail = _toppra(arm, s_way, q_way, a, vmax, gridpoints)
-    if cartesian and seg is not None and fail is None:
-        peak = cartesian_peak(arm, seg)
-        if peak > a * (1.0 + 2e-3):
-            seg2, fail2 = _toppra(arm, s_way, q_way, a * a / peak, vmax, gridpoints)
-            if seg2 is not None:
-                return seg2, None
+    jv, ja = arm.plan_vmax.copy(), arm.plan_amax.copy()
+    a_virtual = a
+    seg, fail = _toppra(arm, s_way, q_way, a_virtual, vmax, gridpoints, jv, ja)
+    for _ in range(3):
+        if seg is None:
+            break
+        retime = False
+        if cartesian and fail is None:
+            peak = cartesian_peak(arm, seg)
+            if peak > a * (1.0 + 2e-3):
+                a_virtual *= a / peak
+                retime = True
+        # TOPP-RA meets the joint limits at its grid points; between them a sharp bend
+        # of the joint path (the null space turning a joint fast) can overshoot. Check
+        # densely, and lower the limit of a joint that overshoots by its overshoot.
+        rv, ra = _limit_ratios(arm, seg)
+        if rv.max() > 1.0 + LIMIT_SLACK or ra.max() > 1.0 + LIMIT_SLACK:
+            jv = jv / np.maximum(rv, 1.0)
+            ja = ja / np.maximum(ra, 1.0)
+            retime = True
+        if not retime:
+            break
+        seg2, fail2 = _toppra(arm, s_way, q_way, a_virtual, vmax, gridpoints, jv, ja)
+        if seg2 is None:
+            break
+        seg, fail = seg2, (fail2 if not cartesian or fail2 is None or fail is not None
+                           else None)
     return seg, fail
 
 
+def _limit_ratios(arm: ArmModel, seg: PathSegment, samples: int = 1500
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """Per joint, the largest velocity and acceleration over the planned limits on a
+    segment sampled densely (finer than any output rate); shapes (n,)."""
+    tau = np.linspace(0.0, seg.duration, samples)
+    _, qd, qdd = seg.sample(tau)
+    return (np.abs(qd).max(axis=0) / arm.plan_vmax, np.abs(qdd).max(axis=0) / arm.plan_amax)
+
+
 def _toppra(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vmax: float,
-            gridpoints: int) -> tuple[PathSegment | None, TimingFailure | None]:
+            gridpoints: int, jv: np.ndarray, ja: np.ndarray
+            ) -> tuple[PathSegment | None, TimingFailure | None]:
     toppra = _import_toppra()
     algo = toppra.algorithm
     logging.getLogger("toppra").setLevel(logging.ERROR)
     aug = np.column_stack([q_way, s_way])
     path = toppra.SplineInterpolator(s_way, aug)
-    jv = arm.vmax * arm.spec.velocity_scale
-    grid = np.linspace(s_way[0], s_way[-1], gridpoints)
-    inst = algo.TOPPRA(list(_constraints(tuple(jv), tuple(arm.amax), a, vmax)),
+    # A uniform grid plus every waypoint: the spline's second derivative is piecewise
+    # linear, so its extremes sit at the waypoints (knots), which the grid must include.
+    grid = np.union1d(np.linspace(s_way[0], s_way[-1], gridpoints), s_way)
+    inst = algo.TOPPRA(list(_constraints(tuple(jv), tuple(ja), a, vmax)),
                        path, gridpoints=grid, solver_wrapper="seidel")
     try:
         _, sd, _, _ = inst.compute_parameterization(0.0, 0.0, return_data=True)
@@ -304,7 +335,7 @@ def _toppra(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vmax:
     peak = float(np.max(np.abs(seg.law.u)))
     if peak < a * 0.97:
         return seg, TimingFailure("joint limits bind before the declared acceleration",
-                                  _binding_joint(arm, seg, jv), peak, a)
+                                  _binding_joint(arm, seg, arm.plan_vmax), peak, a)
     return seg, None
 
 
@@ -316,9 +347,8 @@ def shiver_segment(arm: ArmModel, q_hold: np.ndarray, amplitude: float, f: float
     seg = JointSegment(q_hold, duration, j, amplitude, f)
     tau = np.linspace(0.0, duration, max(200, int(duration * f * 40)))
     _, xd, xdd = _shiver_offset(tau, amplitude, f, duration)
-    vlim = arm.vmax[j] * arm.spec.velocity_scale
-    r_v = float(np.max(np.abs(xd))) / vlim  # scales with f
-    r_a = float(np.max(np.abs(xdd))) / arm.amax[j]  # scales with f^2
+    r_v = float(np.max(np.abs(xd))) / arm.plan_vmax[j]  # scales with f
+    r_a = float(np.max(np.abs(xdd))) / arm.plan_amax[j]  # scales with f^2
     if max(r_v, r_a) > 1.0 + LIMIT_SLACK:
         f_ok = f * min(1.0 / max(r_v, 1e-12), 1.0 / math.sqrt(max(r_a, 1e-12)))
         which = "acceleration" if r_a >= r_v else "velocity"
