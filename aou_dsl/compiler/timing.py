@@ -249,7 +249,7 @@ def cartesian_peak(arm: ArmModel, seg: PathSegment, samples: int = 100) -> float
 
 
 def time_path(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vmax: float,
-              *, gridpoints: int = 120, cartesian: bool = False
+              *, gridpoints: int = 80, cartesian: bool = False
               ) -> tuple[PathSegment | None, TimingFailure | None]:
     """Time a joint path rest to rest with TOPP-RA.
 
