@@ -33,7 +33,14 @@ from .parse import Colon, KeyVal, Quantity, SequenceBlock, Statement, SyntaxTree
 from .robots import ROBOTS
 from .units import SI_UNIT, UNITS, Dim, units_for
 
-__all__ = ["MAX_EPISODES", "MAX_MOTION_TIME", "MIN_PAUSE", "estimate_duration", "validate"]
+__all__ = [
+    "MAX_EPISODES",
+    "MAX_MOTION_TIME",
+    "MIN_PAUSE",
+    "bang_time",
+    "estimate_duration",
+    "validate",
+]
 
 #: Resource bounds: a file asking for more is an error, not a hang.
 MAX_MOTION_TIME = 600.0  # s
@@ -477,12 +484,15 @@ def _header(ctx: _Ctx, st: Statement) -> tuple[str | None, State | None]:
 # --- whole file -------------------------------------------------------------------------
 
 
-def _bang_time(d: float, a: float, v: float) -> float:
-    """Rest-to-rest time [s] over ``d`` [m] at peak acceleration ``a`` and speed cap ``v``."""
-    d = abs(d)
-    if d * a < v * v:
-        return 2.0 * math.sqrt(d / a)
-    return d / v + v / a
+def bang_time(length: float, a: float, vmax: float) -> float:
+    """Rest-to-rest time [s] over ``length`` at peak acceleration ``a`` and speed cap
+    ``vmax`` (triangular or trapezoidal velocity profile)."""
+    length = abs(length)
+    if length == 0.0:
+        return 0.0
+    if length * a <= vmax * vmax:
+        return 2.0 * math.sqrt(length / a)
+    return length / vmax + vmax / a
 
 
 def estimate_duration(b: Behaviour) -> float:
@@ -498,7 +508,7 @@ def estimate_duration(b: Behaviour) -> float:
         if isinstance(p, Pause):
             total += n * p.duration
         elif isinstance(p, Retreat):
-            total += n * _bang_time(p.length, p.a, p.v)
+            total += n * bang_time(p.length, p.a, p.v)
             retreated += n * abs(p.length)
         elif isinstance(p, Gaze):
             total += n * 2.0 * abs(p.angle) / p.v
@@ -509,9 +519,9 @@ def estimate_duration(b: Behaviour) -> float:
         elif isinstance(p, Approach):
             approach = p
             if p.length is not None:
-                total += n * _bang_time(p.length, p.a, p.v)
+                total += n * bang_time(p.length, p.a, p.v)
     if approach is not None:
-        total += _bang_time(reach + retreated, approach.a, approach.v)
+        total += bang_time(reach + retreated, approach.a, approach.v)
     return total
 
 

@@ -28,6 +28,7 @@ from typing import Any, Literal
 from ..cv import composition_of, infer
 from ..diagnostics import Span
 from ..ir import Approach, Behaviour, Gaze, Pause, Retreat, Shiver, State, Tilt
+from ..validate import bang_time
 
 __all__ = [
     "GAZE_ANGULAR_ACCEL",
@@ -109,17 +110,6 @@ class Timeline:
     @property
     def planned_duration(self) -> float:
         return sum(e.duration for e in self.episodes)
-
-
-def bang_time(length: float, a: float, vmax: float) -> float:
-    """Rest-to-rest time [s] over ``length`` at peak acceleration ``a`` and speed cap
-    ``vmax`` (triangular or trapezoidal velocity profile)."""
-    length = abs(length)
-    if length == 0.0:
-        return 0.0
-    if length * a <= vmax * vmax:
-        return 2.0 * math.sqrt(length / a)
-    return length / vmax + vmax / a
 
 
 # --- episode builders ---------------------------------------------------------------------

@@ -20,7 +20,15 @@ from ..kinematics import ArmModel, load_arm
 from .geometry import ReachFrame, reach_frame
 from .ik import IKStatus, solve_path
 from .layout import Episode, Pose, Timeline, layout
-from .timing import JointSegment, PathSegment, TimeLaw, shiver_segment, time_path
+from .timing import (
+    LIMIT_SLACK,
+    JointSegment,
+    PathSegment,
+    TimeLaw,
+    binding_joint,
+    shiver_segment,
+    time_path,
+)
 
 __all__ = [
     "CompileOptions",
@@ -189,14 +197,11 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions()
             worst_r = max(worst_r, ik.worst_rotation_error)
             if ep.kind == "tilt":
                 seg = PathSegment(s, ik.q, TimeLaw.bang_bang(ep.path_length, ep.duration))
-                _, qd, qdd = seg.sample(np.linspace(0, ep.duration, 200))
-                over = np.maximum(np.abs(qd) / arm.plan_vmax,
-                                  np.abs(qdd) / arm.plan_amax).max(axis=0)
-                if over.max() > 1.0:
-                    j = arm.joint_names[int(np.argmax(over))]
+                j, over = binding_joint(arm, seg)
+                if over > 1.0 + LIMIT_SLACK:
                     res.diagnostics.append(diag(
                         "C309", f"tilt of {math.degrees(ep.path_length):g} deg in "
-                        f"{ep.duration:.2f}s needs {over.max():.1f}x the limits of {j}",
+                        f"{ep.duration:.2f}s needs {over:.1f}x the limits of {j}",
                         ep.span, joint=j))
                     return res
             else:

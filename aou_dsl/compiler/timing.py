@@ -34,6 +34,8 @@ __all__ = [
     "PathSegment",
     "TimeLaw",
     "TimingFailure",
+    "binding_joint",
+    "limit_ratios",
     "shiver_segment",
     "time_path",
 ]
@@ -223,12 +225,13 @@ def _constraints(jv: tuple[float, ...], ja: tuple[float, ...], a: float, vmax: f
             constraint.JointAccelerationConstraint(alim))
 
 
-def _binding_joint(arm: ArmModel, seg: PathSegment, vmax: np.ndarray) -> str | None:
-    """The joint that comes nearest its velocity or acceleration limit on a segment."""
-    tau = np.linspace(0.0, seg.duration, 200)
-    _, qd, qdd = seg.sample(tau)
-    ratio = np.maximum(np.abs(qd) / vmax, np.abs(qdd) / arm.plan_amax).max(axis=0)
-    return arm.joint_names[int(np.argmax(ratio))]
+def binding_joint(arm: ArmModel, seg: PathSegment) -> tuple[str, float]:
+    """The joint that comes nearest (or furthest past) its planned velocity or
+    acceleration limit on a segment, and that ratio."""
+    rv, ra = limit_ratios(arm, seg)
+    ratio = np.maximum(rv, ra)
+    j = int(np.argmax(ratio))
+    return arm.joint_names[j], float(ratio[j])
 
 
 def cartesian_peak(arm: ArmModel, seg: PathSegment, samples: int = 100) -> float:
@@ -286,7 +289,7 @@ def time_path(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vma
         # TOPP-RA meets the joint limits at its grid points; between them a sharp bend
         # of the joint path (the null space turning a joint fast) can overshoot. Check
         # densely, and lower the limit of a joint that overshoots by its overshoot.
-        rv, ra = _limit_ratios(arm, seg)
+        rv, ra = limit_ratios(arm, seg)
         if rv.max() > 1.0 + LIMIT_SLACK or ra.max() > 1.0 + LIMIT_SLACK:
             jv = jv / np.maximum(rv, 1.0)
             ja = ja / np.maximum(ra, 1.0)
@@ -301,7 +304,7 @@ def time_path(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vma
     return seg, fail
 
 
-def _limit_ratios(arm: ArmModel, seg: PathSegment, samples: int = 1500
+def limit_ratios(arm: ArmModel, seg: PathSegment, samples: int = 1500
                   ) -> tuple[np.ndarray, np.ndarray]:
     """Per joint, the largest velocity and acceleration over the planned limits on a
     segment sampled densely (finer than any output rate); shapes (n,)."""
@@ -335,7 +338,7 @@ def _toppra(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vmax:
     peak = float(np.max(np.abs(seg.law.u)))
     if peak < a * 0.97:
         return seg, TimingFailure("joint limits bind before the declared acceleration",
-                                  _binding_joint(arm, seg, arm.plan_vmax), peak, a)
+                                  binding_joint(arm, seg)[0], peak, a)
     return seg, None
 
 
