@@ -1,2 +1,61 @@
-"""aou: a declarative language and compiler for expressive robot-arm motion."""
-__version__ = "0.1.0"
+"""aou: a declarative language and compiler for expressive robot-arm motion.
+
+The public API (see docs/api.md)::
+
+    import aou_dsl
+    result = aou_dsl.linter("behaviours/hesitant.aou")        # diagnostics, C-V point
+    build = aou_dsl.compile("behaviours/hesitant.aou")      # trajectory, descriptors
+    measured = aou_dsl.measuring("recording.csv", robot="panda", goal=(0.55, 0, 0.25))
+
+Importing the package is cheap: the numerical stages (Pinocchio, TOPP-RA, PyBullet)
+load only when a function that needs them runs.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+__version__ = "0.2.0"
+
+__all__ = [
+    "REGISTRY",
+    "AouError",
+    "BuildResult",
+    "CheckReport",
+    "Descriptors",
+    "Diagnostic",
+    "FileResult",
+    "Measured",
+    "Trajectory",
+    "check",
+    "compile",
+    "lint",
+    "lint_paths",
+    "measure",
+    "read_trajectory",
+]
+
+#: name -> module that defines it, imported on first use.
+_LAZY = {
+    "REGISTRY": "descriptors", "Descriptors": "descriptors",
+    "AouError": "diagnostics", "Diagnostic": "diagnostics",
+    "BuildResult": "build", "FileResult": "linter",
+    "CheckReport": "safety.replay", "Measured": "measuring.descriptors",
+    "Trajectory": "trajectory",
+    "check": "api", "compile": "api", "lint": "api", "lint_paths": "api",
+    "measure": "api", "read_trajectory": "api",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'aou_dsl' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted([*globals(), *__all__])

@@ -1,8 +1,9 @@
 """``aouc compile`` as a library: one ``.aou`` file -> a checked, measured trajectory document.
 
-The steps: lint (stop on errors), compile, check the joint limits at every sample,
-measure the result with :mod:`aou_dsl.measure` (the declare -> compile -> measure round
-trip, recorded in the output), and build the LANGUAGE.md document. Writing is the
+The steps: lint (stop on errors), compile the timeline validation laid out, check the
+trajectory in PyBullet (on a clock of at least :data:`CHECK_RATE`, whatever the output
+rate), measure the result with :mod:`aou_dsl.measuring` (the declare -> compile -> measure
+round trip, recorded in the output), and build the trajectory document. Writing is the
 caller's, so a failed build leaves nothing behind.
 """
 
@@ -10,19 +11,22 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
-from .diagnostics import Diagnostic, diag, has_errors
-from .lint import FileResult, lint_file
+from .diagnostics import AouError, Diagnostic, Span, diag, has_errors
+from .linter import FileResult, lint_file, lint_source
 
 if TYPE_CHECKING:  # the numerical stages load only when a build runs
-    import numpy as np
+    from .compiler.pipeline import CompileResult
+    from .descriptors import Descriptors
+    from .measuring.descriptors import Measured
+    from .safety.scene import SceneOptions
+    from .trajectory import Trajectory
 
-    from .compiler.pipeline import CompileResult, Trajectory
-    from .measure.descriptors import Measured
-    from .measure.recording import Recording
+__all__ = ["CHECK_RATE", "BuildResult", "build_file", "build_source", "load_motion"]
 
-__all__ = ["BuildResult", "Motion", "build_file", "load_motion", "to_recording"]
+#: The safety checks look at the motion at least this often [Hz].
+CHECK_RATE = 250.0
 
 
 @dataclass
@@ -33,6 +37,7 @@ class BuildResult:
     lint: FileResult
     diagnostics: list[Diagnostic] = field(default_factory=list)
     compiled: CompileResult | None = None
+    declared: Descriptors | None = None
     measured: Measured | None = None
     checks: list = field(default_factory=list)
     document: dict | None = None
@@ -44,98 +49,120 @@ class BuildResult:
 
     @property
     def trajectory(self) -> Trajectory:
-        """The compiled trajectory; a build that failed has none (ValueError)."""
+        """The compiled trajectory.
+
+        Raises:
+            AouError: the build failed; its diagnostics say why.
+        """
         if self.compiled is None or self.compiled.trajectory is None:
-            raise ValueError(f"{self.path}: the build failed, there is no trajectory")
+            raise AouError(self.diagnostics or diag(
+                "C305", "the build failed: there is no trajectory", Span.whole_file(self.path)))
         return self.compiled.trajectory
 
 
-def to_recording(trajectory, path: str = "<compiled>"):
-    """A compiled trajectory as a :class:`~aou_dsl.measure.recording.Recording`."""
-    from .measure.recording import Recording
+def _with_robot(lint: FileResult, robot: str | None) -> list[Diagnostic]:
+    """Point the behaviour at another robot (``--robot``); V109 for an unknown one."""
+    from .robots import ROBOTS
 
-    tr = trajectory
-    return Recording(tr.t, tr.q, tr.joint_names, tr.robot, tr.ee_frame, tr.goal, path)
+    if robot is None or lint.behaviour is None:
+        return []
+    if robot not in ROBOTS:
+        return [diag("V109", f"unknown robot `{robot}`: expected one of {', '.join(ROBOTS)}",
+                     Span.whole_file(lint.path), found=robot, valid=list(ROBOTS))]
+    b = lint.behaviour
+    lint.behaviour = b.model_copy(update={"settings": b.settings.model_copy(
+        update={"robot": robot})})
+    return []
 
 
-def _rounded(d: dict) -> dict:
-    return {k: (round(v, 6) if isinstance(v, float) else v) for k, v in d.items()}
+def _check(res: BuildResult, scene: SceneOptions | None) -> dict:
+    """The kinematic replay, as C306 diagnostics and the document's ``checks``."""
+    from .compiler.pipeline import sample
+    from .safety.replay import replay
+    from .safety.scene import SceneOptions
+
+    assert res.compiled is not None
+    tr = res.compiled.trajectory
+    assert tr is not None
+    rate = 1.0 / max(float(tr.t[1] - tr.t[0]), 1e-9) if len(tr.t) > 1 else CHECK_RATE
+    dense = tr if rate >= CHECK_RATE - 1e-6 else sample(res.compiled, CHECK_RATE)
+    report = replay(dense, options=scene or SceneOptions())
+    res.checks = report.checks
+    for c in report.failed():
+        res.diagnostics.append(diag(
+            "C306", f"{c.name} check failed at t={c.time:.3f}s: {_what(c)}",
+            _span_at(res.compiled, c.time), check=c.name, time=c.time, joint=c.joint,
+            value=c.value, limit=c.limit))
+    return {"kinematic": report.to_json()}
 
 
-def build_file(path: str, *, rate: float | None = None, check: bool = True,
-               scene=None) -> BuildResult:
-    """Lint, compile, check (kinematic replay in PyBullet) and measure one file.
-
-    ``scene`` is a :class:`~aou_dsl.check.scene.SceneOptions` (target size, table height).
-    """
-    from .check.replay import replay
-    from .check.scene import SceneOptions
+def build_lint(lint: FileResult, *, robot: str | None = None, rate: float | None = None,
+               check: bool = True, scene: SceneOptions | None = None) -> BuildResult:
+    """Compile, check and measure a linted file (see the module's docstring)."""
     from .compiler.output import trajectory_document
     from .compiler.pipeline import CompileOptions, compile_behaviour
-    from .declared import compare_descriptors, declared_descriptors
-    from .measure.descriptors import measure
+    from .declared import declared
+    from .descriptors import compare
+    from .measuring.descriptors import measure
 
     start = time.perf_counter()
-    lint = lint_file(path)
-    res = BuildResult(path, lint, list(lint.diagnostics))
-    if not lint.ok or lint.behaviour is None or lint.cv is None:
+    res = BuildResult(lint.path, lint, list(lint.diagnostics))
+    res.diagnostics += _with_robot(lint, robot)
+    b, tl = lint.behaviour, lint.timeline
+    if has_errors(res.diagnostics) or b is None or tl is None or lint.cv is None:
         return res
-    b = lint.behaviour
     opts = CompileOptions() if rate is None else CompileOptions(rate=rate)
-    compiled = compile_behaviour(b, opts)
-    res.compiled = compiled
+    res.compiled = compiled = compile_behaviour(b, opts, tl)
     res.diagnostics += compiled.diagnostics
-    if not compiled.ok or compiled.trajectory is None:
+    tr = compiled.trajectory
+    if not compiled.ok or tr is None:
         res.seconds = time.perf_counter() - start
         return res
-    tr = compiled.trajectory
-    checks_json: dict = {"kinematic": "skipped (--no-check)"}
+    checks_json: dict[str, Any] = {"kinematic": "skipped (--no-check)"}
     if check:
-        report = replay(tr.robot, tr.t, tr.q, tr.qd, tr.qdd, tr.goal,
-                        options=scene or SceneOptions())
-        res.checks = report.checks
-        checks_json = {"kinematic": report.to_json()}
-        for c in report.failed():
-            res.diagnostics.append(diag(
-                "C306", f"{c.name} check failed at t={c.time:.3f}s: {_what(c)}",
-                _span_at(compiled, c.time), check=c.name, time=c.time, joint=c.joint,
-                value=c.value, limit=c.limit))
+        checks_json = _check(res, scene)
         if has_errors(res.diagnostics):
             res.seconds = time.perf_counter() - start
             return res
-    m = measure(to_recording(tr, path))
-    res.measured = m
-    declared = declared_descriptors(b)
-    for name, want, got in compare_descriptors(declared, m.descriptors):
+    res.measured = m = measure(tr.with_(path=lint.path))
+    res.declared = want = declared(b, tl)
+    for mm in compare(want, m.descriptors):
         res.diagnostics.append(diag(
-            "C310", f"{name}: declared {_fmt(want)}, measured {_fmt(got)} on the compiled "
-            "trajectory", _span_of(b, name), descriptor=name, declared=want, measured=got))
+            "C310", f"{mm.name}: declared {_fmt(mm.declared)}, measured {_fmt(mm.measured)} "
+            "on the compiled trajectory", _span_of(b, mm.name), descriptor=mm.name,
+            declared=mm.declared, measured=mm.measured))
     res.document = trajectory_document(
-        compiled,
-        measured=_rounded(m.descriptors),
-        declared=_rounded(declared),
-        cv=lint.cv.to_json(),
-        checks=checks_json | {"gaze_error_deg": round(m.gaze_error, 6)},
-        rate=opts.rate,
-    )
+        compiled, measured=m.descriptors.to_json(), declared=want.to_json(),
+        cv=lint.cv.to_json(), checks=checks_json | {"gaze_error_deg": round(m.gaze_error, 6)},
+        rate=opts.rate)
     res.seconds = time.perf_counter() - start
     return res
 
 
+def build_source(text: str, path: str = "<string>", **options: Any) -> BuildResult:
+    """:func:`build_lint` of source text; ``options`` as there."""
+    return build_lint(lint_source(text, path), **options)
+
+
+def build_file(path: str, **options: Any) -> BuildResult:
+    """:func:`build_lint` of a file; ``options`` as there."""
+    return build_lint(lint_file(path), **options)
+
+
 def _what(c) -> str:
     """A failed check in words: what reached what."""
-    if c.name in ("joint-position", "joint-velocity", "joint-acceleration", "joint-torque"):
+    if c.name.startswith("joint-"):
         return f"{c.joint} reaches {c.value:.4g}, limit {c.limit:.4g}"
     if c.name == "kinematics-agreement":
         return c.detail
     return f"{c.joint}: {c.detail} (distance {c.value:.4g} m)"
 
 
-def _span_of(b, descriptor: str):
+def _span_of(b, descriptor: str) -> Span:
     """The statement that declares ``descriptor`` (the file when none does)."""
-    kind = descriptor.split("_")[0]
-    plane = kind if kind in ("horizontal", "vertical") else None
-    p = b.first("gaze", plane) if plane else b.first(kind)
+    from .declared import source_of
+
+    p = source_of(b, descriptor)
     return p.span if p is not None else b.span
 
 
@@ -143,7 +170,7 @@ def _fmt(v) -> str:
     return "absent" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
 
 
-def _span_at(compiled, t: float | None):
+def _span_at(compiled, t: float | None) -> Span:
     """The source span of the episode running at time ``t``."""
     tr, tl = compiled.trajectory, compiled.timeline
     if t is not None:
@@ -153,59 +180,20 @@ def _span_at(compiled, t: float | None):
     return compiled.behaviour.span
 
 
-@dataclass(frozen=True)
-class Motion:
-    """The motion in a file, for the commands that replay or draw it.
-
-    Attributes:
-        recording: times, joint positions, robot, frame and goal.
-        qd, qdd: the file's joint velocities and accelerations in the recording's column
-            order, when it has them (compiled trajectories do), else None.
-        episodes: ``(kind, t_start, t_end)`` from the compiler, else None.
-        title: the behaviour's name, or the file's stem.
-    """
-
-    recording: Recording
-    qd: np.ndarray | None
-    qdd: np.ndarray | None
-    episodes: tuple[tuple[str, float, float], ...] | None
-    title: str
-
-
 def load_motion(path: str, *, robot: str | None = None,
                 goal: tuple[float, float, float] | None = None,
-                ee_frame: str | None = None) -> Motion:
+                ee_frame: str | None = None) -> Trajectory:
     """A ``.aou`` file compiled (without the safety checks), or a trajectory file read
     (a CSV recording needs ``robot``; ``goal`` and ``ee_frame`` override the file's).
 
     Raises:
         AouError: the file's diagnostics when it cannot be compiled or read.
     """
-    import json
-    import os
-
-    import numpy as np
-
-    from .diagnostics import AouError
-    from .measure.recording import read_recording
+    from .measuring.recording import read_recording
 
     if path.endswith(".aou"):
-        res = build_file(path, check=False)
+        res = build_file(path, robot=robot, check=False)
         if not res.ok:
             raise AouError(res.diagnostics)
-        tr = res.trajectory
-        title = res.lint.behaviour.name if res.lint.behaviour else path
-        return Motion(to_recording(tr, path), tr.qd, tr.qdd, tr.episodes, title)
-    rec = read_recording(path, robot=robot, goal=goal, ee_frame=ee_frame)
-    qd = qdd = None
-    episodes = None
-    if path.endswith(".json"):
-        with open(path, encoding="utf-8") as fh:
-            doc = json.load(fh)
-        if "qd" in doc and "qdd" in doc:
-            qd, qdd = np.asarray(doc["qd"], float), np.asarray(doc["qdd"], float)
-            if qd.shape != rec.q.shape or qdd.shape != rec.q.shape:
-                qd = qdd = None  # malformed derivatives: recompute them from q
-        if doc.get("episodes"):
-            episodes = tuple((e["kind"], e["t_start"], e["t_end"]) for e in doc["episodes"])
-    return Motion(rec, qd, qdd, episodes, os.path.splitext(os.path.basename(path))[0])
+        return res.trajectory.with_(path=path)
+    return read_recording(path, robot=robot, goal=goal, ee_frame=ee_frame)

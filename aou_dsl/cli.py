@@ -1,70 +1,70 @@
 """``aouc``: the command line. Thin: each command calls the library and formats records.
 
-Exit codes (LANGUAGE.md): 0 no error, 1 the input has errors (or warnings under
-``--strict``), 2 usage or I/O problems. A 2 is never hidden by a flag.
+Exit codes: 0 no error, 1 the input has errors (or warnings under ``--strict``), 2 usage
+or I/O problems, and internal errors (a one-line message; ``--debug`` shows the
+traceback). A 2 is never hidden by a flag.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
-from . import __version__
-from .diagnostics import RULES, Diagnostic, Severity
+from .cli_args import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, build_parser
+from .diagnostics import RULES, AouError, Diagnostic, Severity
 from .report import format_github, format_json, format_text
 
 __all__ = ["EXIT_ERRORS", "EXIT_OK", "EXIT_USAGE", "main"]
 
-EXIT_OK = 0
-EXIT_ERRORS = 1
-EXIT_USAGE = 2
 
-
-class _Parser(argparse.ArgumentParser):
-    """argparse exits 2 on usage errors, as the contract wants; keep its message short."""
-
-    def error(self, message: str) -> None:  # type: ignore[override]
-        self.print_usage(sys.stderr)
-        sys.stderr.write(f"aouc: error: {message}\n")
-        raise SystemExit(EXIT_USAGE)
-
-
-def _print_diags(diags: list[Diagnostic], fmt: str, sources: dict[str, str] | None = None,
-                 stream=None) -> None:
-    stream = stream or sys.stdout
+def _print_diags(diags: list[Diagnostic], fmt: str = "text",
+                 sources: dict[str, str] | None = None, stream=None) -> None:
+    stream = stream or sys.stderr
     for d in diags:
-        if fmt == "github":
-            print(format_github(d), file=stream)
-        else:
-            print(format_text(d, (sources or {}).get(d.span.path)), file=stream)
+        text = format_github(d) if fmt == "github" else format_text(
+            d, (sources or {}).get(d.span.path))
+        print(text, file=stream)
 
 
 def _exit_for(diags: list[Diagnostic]) -> int:
-    """2 when the input could not be read (I codes), else 1: the file has errors."""
+    """2 when the input could not be read or written (I codes), else 1."""
     return EXIT_USAGE if any(d.code.startswith("I") for d in diags) else EXIT_ERRORS
 
 
-# --- lint -------------------------------------------------------------------------------
+def _fail(err: AouError) -> int:
+    _print_diags(err.diagnostics)
+    return _exit_for(err.diagnostics)
+
+
+def _scene_kw(args: argparse.Namespace) -> dict:
+    return {"target_size": args.target_size,
+            "table_height": None if args.no_table else args.table_height}
+
+
+def _read_kw(args: argparse.Namespace) -> dict:
+    return {"robot": args.robot, "goal": args.goal, "ee_frame": args.ee_frame}
+
+
+# --- lint, rules, explain ---------------------------------------------------------------
 
 
 def _cmd_lint(args: argparse.Namespace) -> int:
-    from .lint import lint_paths, severity_counts
+    from .linter import lint_paths, severity_counts
 
     results, problems = lint_paths(args.paths)
     counts = severity_counts(results)
-    io_errors = bool(problems) or any(
-        d.code.startswith("I") for r in results for d in r.diagnostics)
+    io_errors = bool(problems) or any(d.code.startswith("I")
+                                      for r in results for d in r.diagnostics)
     if args.format == "json":
-        print(format_json({
-            "files": [r.to_json() for r in results],
-            "problems": [d.to_json() for d in problems],
-            "summary": {str(k): v for k, v in counts.items()},
-        }))
+        print(format_json({"files": [r.to_json() for r in results],
+                           "problems": [d.to_json() for d in problems],
+                           "summary": {str(k): v for k, v in counts.items()}}))
     else:
-        _print_diags(problems, args.format, stream=sys.stderr)
+        _print_diags(problems, args.format)
         for r in results:
-            _print_diags(r.diagnostics, args.format, {r.path: r.source or ""})
+            _print_diags(r.diagnostics, args.format, {r.path: r.source or ""}, sys.stdout)
         if args.format == "text":
             n = len(results)
             print(f"{n} file{'s' * (n != 1)} checked: {counts[Severity.ERROR]} errors, "
@@ -75,9 +75,6 @@ def _cmd_lint(args: argparse.Namespace) -> int:
     if counts[Severity.ERROR] or (args.strict and counts[Severity.WARNING]):
         return EXIT_ERRORS
     return EXIT_OK
-
-
-# --- rules ------------------------------------------------------------------------------
 
 
 def _cmd_rules(args: argparse.Namespace) -> int:
@@ -102,444 +99,210 @@ def _cmd_rules(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-# --- explain ----------------------------------------------------------------------------
-
-
 def _cmd_explain(args: argparse.Namespace) -> int:
-    from .compiler.layout import layout
-    from .lint import lint_file
+    from .linter import lint_file
     from .report import format_timeline
 
     r = lint_file(args.path)
-    if not r.ok or r.behaviour is None or r.cv is None:
-        _print_diags(r.diagnostics, "text", {r.path: r.source or ""}, stream=sys.stderr)
+    if not r.ok or r.behaviour is None or r.cv is None or r.timeline is None:
+        _print_diags(r.diagnostics, sources={r.path: r.source or ""})
         return _exit_for(r.diagnostics)
-    print(format_timeline(r.behaviour, r.cv, layout(r.behaviour)))
+    print(format_timeline(r.behaviour, r.cv, r.timeline))
     return EXIT_OK
 
 
 # --- compile ----------------------------------------------------------------------------
 
 
-def _format_from(output: str | None, many: bool) -> str:
-    """The output format a single ``-o FILE`` implies by its extension; json otherwise."""
-    import os
-
-    if output and not many and not os.path.isdir(output):
-        ext = os.path.splitext(output)[1].lstrip(".")
-        if ext:
-            return ext
-    return "json"
-
-
-def _output_path(src: str, out: str | None, fmt: str, many: bool) -> str:
-    import os
-
-    stem = os.path.splitext(os.path.basename(src))[0]
-    if out is None:
-        return f"{stem}.{fmt}"
-    if many or out.endswith(os.sep) or os.path.isdir(out):
-        return os.path.join(out, f"{stem}.{fmt}")
-    return out
-
-
 def _cmd_compile(args: argparse.Namespace) -> int:
-    import os
+    from .api import compile as compile_file
+    from .compiler.output import encode, output_paths, write_atomic
+    from .diagnostics import has_errors
+    from .linter import collect_inputs
 
-    from .build import build_file
-    from .compiler.output import encode, write_atomic
-    from .diagnostics import AouError, has_errors
-    from .lint import collect_files
-
-    files, problems = collect_files(args.paths)
-    _print_diags(problems, "text", stream=sys.stderr)
+    inputs, problems = collect_inputs(args.paths)
     if problems:
+        _print_diags(problems)
         return EXIT_USAGE
-    many = len(files) > 1
-    fmt = args.format or _format_from(args.output, many)
-    if fmt not in ("json", "csv", "npz"):
-        print(f"aouc: unknown output format `{fmt}`: expected json, csv or npz",
-              file=sys.stderr)
+    try:
+        dests, fmt = output_paths(inputs, args.output, args.format)
+        for d in {os.path.dirname(d) for d in dests if os.path.dirname(d)}:
+            os.makedirs(d, exist_ok=True)
+    except AouError as err:
+        return _fail(err)
+    except OSError as exc:
+        print(f"aouc: cannot create the output folder: {exc.strerror}", file=sys.stderr)
         return EXIT_USAGE
-    if many and args.output and not args.output.endswith(os.sep) \
-            and not os.path.isdir(args.output) and os.path.splitext(args.output)[1]:
-        print(f"aouc: several inputs need -o to be a folder, found `{args.output}`",
-              file=sys.stderr)
-        return EXIT_USAGE
-    if many and args.output:
-        os.makedirs(args.output, exist_ok=True)
+    sources = [src for src, _ in inputs]
     worst = EXIT_OK
-    scene = _scene_options(args)
-    for k, src in enumerate(files, 1):
-        res = build_file(src, rate=args.rate, check=not args.no_check, scene=scene)
-        _print_diags(res.diagnostics, "text", {src: res.lint.source or ""}, stream=sys.stderr)
-        dest = _output_path(src, args.output, fmt, many)
+    for k, ((src, _), dest) in enumerate(zip(inputs, dests, strict=True), 1):
+        res = compile_file(src, robot=args.robot, rate=args.rate, check=not args.no_check,
+                           **_scene_kw(args))
+        _print_diags(res.diagnostics, sources={src: res.lint.source or ""})
         if not res.ok or res.document is None:
             worst = max(worst, _exit_for(res.diagnostics))
-            print(f"[{k}/{len(files)}] {src}: failed, nothing written", file=sys.stderr)
+            print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)
             continue
         try:
-            write_atomic(dest, encode(res.document, fmt), inputs=files)
+            write_atomic(dest, encode(res.document, fmt), inputs=sources)
         except AouError as err:
-            _print_diags(err.diagnostics, "text", stream=sys.stderr)
-            worst = EXIT_USAGE
+            worst = max(worst, _fail(err))
             continue
         tr = res.trajectory
-        note = "" if not args.no_check else " (checks skipped)"
-        print(f"[{k}/{len(files)}] {src} -> {dest}: {tr.duration:.2f} s of motion, "
+        note = " (checks skipped)" if args.no_check else ""
+        print(f"[{k}/{len(inputs)}] {src} -> {dest}: {tr.duration:.2f} s of motion, "
               f"{len(tr.t)} samples, compiled in {res.seconds:.2f} s{note}", file=sys.stderr)
         if has_errors(res.diagnostics):
             worst = max(worst, EXIT_ERRORS)
     return worst
 
 
-def _scene_options(args: argparse.Namespace):
-    from .check.scene import SceneOptions
-
-    table = None if args.no_table else args.table_height
-    return SceneOptions(target_size=args.target_size, table_height=table)
-
-
-# --- check ------------------------------------------------------------------------------
+# --- check, measure ---------------------------------------------------------------------
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
-    from .build import load_motion
-    from .check.replay import replay_motion
-    from .diagnostics import AouError
+    from .api import check, read_trajectory
     from .report import format_check
 
-    try:
-        motion = load_motion(args.path, **_recording_options(args))
-        report = replay_motion(motion, options=_scene_options(args),
-                               dynamic=not args.no_dynamic)
-    except AouError as err:
-        return _report_error(err)
-    rec = motion.recording
+    tr = read_trajectory(args.path, **_read_kw(args))
+    report = check(tr, dynamic=not args.no_dynamic, **_scene_kw(args))
     if args.format == "json":
         print(format_json({"path": args.path, **report.to_json()}))
     else:
-        print(format_check(args.path, rec.robot, rec.t, report))
+        print(format_check(args.path, tr.robot, tr.t, report))
     return EXIT_OK if report.ok else EXIT_ERRORS
 
 
-# --- measure ----------------------------------------------------------------------------
-
-
-def _point(text: str) -> tuple[float, float, float]:
-    """argparse type of X,Y,Z options (metres)."""
-    parts = text.strip("()").split(",")
-    try:
-        if len(parts) != 3:
-            raise ValueError
-        x, y, z = (float(p) for p in parts)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected X,Y,Z in metres, found `{text}`") from None
-    return (x, y, z)
-
-
-def _frame_size(text: str) -> tuple[int, int]:
-    """argparse type of --size WxH (pixels)."""
-    try:
-        w, h = (int(x) for x in text.lower().split("x"))
-        if w < 8 or h < 8:
-            raise ValueError
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected WxH in pixels, e.g. 640x480, found "
-                                         f"`{text}`") from None
-    return (w, h)
-
-
 def _cmd_measure(args: argparse.Namespace) -> int:
-    from .diagnostics import AouError
-    from .measure.descriptors import measure
-    from .measure.recording import read_recording
+    from .api import measure, read_trajectory
     from .report import format_measured
 
-    try:
-        rec = read_recording(args.path, **_recording_options(args))
-        m = measure(rec)
-    except AouError as err:
-        return _report_error(err)
+    tr = read_trajectory(args.path, **_read_kw(args))
+    m = measure(tr)
     if args.format == "json":
-        print(format_json({"path": args.path, "robot": rec.robot, **m.to_json()}))
+        print(format_json({"path": args.path, "robot": tr.robot, **m.to_json()}))
     else:
-        print(format_measured(args.path, rec.robot, m))
-        _print_diags(m.diagnostics, "text", stream=sys.stderr)
+        print(format_measured(args.path, tr.robot, m))
+        _print_diags(m.diagnostics)
     return EXIT_OK
 
 
 # --- plot, render, variants --------------------------------------------------------------
 
 
-def _media_missing(exc: ImportError) -> int:
-    print(f"aouc: this command needs the media extra ({exc.name} is missing): "
-          "pip install 'aou-dsl[media]'", file=sys.stderr)
-    return EXIT_USAGE
-
-
-def _report_error(err) -> int:
-    """Print an AouError's diagnostics; the exit code they call for."""
-    _print_diags(err.diagnostics, "text", stream=sys.stderr)
-    return _exit_for(err.diagnostics)
-
-
 def _cmd_plot(args: argparse.Namespace) -> int:
-    from .build import load_motion
-    from .diagnostics import AouError
+    from .api import read_trajectory
+    from .linter import lint_paths
+    from .media.plot import cv_figure, profile_data, profile_figure, save
 
-    try:
-        from .media.plot import cv_figure, profile_data, profile_figure, save
-    except ImportError as exc:
-        return _media_missing(exc)
-    try:
-        if args.cv:
-            from .lint import lint_paths
-
-            results, problems = lint_paths(args.paths)
-            if problems:
-                return _report_error(AouError(problems))
-            bad = [d for r in results if not r.ok for d in r.diagnostics]
-            if bad:
-                return _report_error(AouError(bad))
-            fig = cv_figure([(r.behaviour.name, r.cv) for r in results
-                             if r.behaviour is not None and r.cv is not None])
-        else:
-            if len(args.paths) != 1:
-                print("aouc: plot takes one file (or --cv with several)", file=sys.stderr)
-                return EXIT_USAGE
-            motion = load_motion(args.paths[0], **_recording_options(args))
-            fig = profile_figure(profile_data(motion.recording, motion.episodes,
-                                              motion.title))
-        save(fig, args.output)
-    except AouError as err:
-        return _report_error(err)
+    if args.cv:
+        results, problems = lint_paths(args.paths)
+        bad = problems + [d for r in results if not r.ok for d in r.diagnostics]
+        if bad:
+            return _fail(AouError(bad))
+        fig = cv_figure([(r.behaviour.name, r.cv) for r in results
+                         if r.behaviour is not None and r.cv is not None])
+    elif len(args.paths) != 1:
+        print("aouc: plot takes one file (or --cv with several)", file=sys.stderr)
+        return EXIT_USAGE
+    else:
+        tr = read_trajectory(args.paths[0], **_read_kw(args))
+        fig = profile_figure(profile_data(tr))
+    save(fig, args.output)
     print(f"wrote {args.output}", file=sys.stderr)
     return EXIT_OK
 
 
-def _camera(args: argparse.Namespace):
-    from .media.render import Camera
-
-    w, h = args.size
-    return Camera(distance=args.camera_distance, yaw=args.camera_yaw,
-                  pitch=args.camera_pitch, target=args.camera_target, width=w, height=h)
-
-
-def _cmd_render(args: argparse.Namespace) -> int:
+def _render(paths: list[str], output: str, args: argparse.Namespace, read_kw: dict) -> int:
     import time
 
-    from .build import load_motion
-    from .diagnostics import AouError
+    from .api import read_trajectory
+    from .media.render import Camera, check_output, render_video
+    from .safety.scene import SceneOptions
 
-    try:
-        from .media.render import render_video
-    except ImportError as exc:
-        return _media_missing(exc)
-    paths = args.side_by_side or ([args.path] if args.path else [])
-    if not paths:
-        print("aouc: render takes FILE, or --side-by-side A B", file=sys.stderr)
-        return EXIT_USAGE
-    try:
-        camera = _camera(args)
-        motions = [load_motion(p, **_recording_options(args)).recording for p in paths]
-        start = time.perf_counter()
-        info = render_video(motions, args.output, fps=args.fps, camera=camera,
-                            scene_options=_scene_options(args))
-    except AouError as err:
-        return _report_error(err)
-    except ImportError as exc:
-        return _media_missing(exc)
-    except ValueError as exc:
-        print(f"aouc: {exc}", file=sys.stderr)
-        return EXIT_USAGE
-    print(f"wrote {args.output}: {info['frames']} frames at {info['fps']:g} fps "
+    check_output(output)
+    w, h = args.size
+    camera = Camera(distance=args.camera_distance, yaw=args.camera_yaw,
+                    pitch=args.camera_pitch, target=args.camera_target, width=w, height=h)
+    motions = [read_trajectory(p, **read_kw) for p in paths]
+    start = time.perf_counter()
+    info = render_video(motions, output, fps=args.fps, camera=camera,
+                        scene_options=SceneOptions(**_scene_kw(args)))
+    print(f"wrote {output}: {info['frames']} frames at {info['fps']:g} fps "
           f"({info['duration']:.2f} s), {info['size'][0]}x{info['size'][1]}, rendered in "
           f"{time.perf_counter() - start:.1f} s", file=sys.stderr)
     return EXIT_OK
 
 
-def _cmd_variants(args: argparse.Namespace) -> int:
-    import os
-
-    from .compiler.output import write_atomic
-    from .diagnostics import AouError
-    from .lint import lint_file, lint_source
-    from .media.variants import make_variants
-
-    try:
-        name, values = args.vary.split("=", 1)
-        low, high = (float(v) for v in values.split(","))
-    except ValueError:
-        print("aouc: --vary takes NAME=LOW,HIGH, e.g. pause_duration=1.0,2.5",
-              file=sys.stderr)
+def _cmd_render(args: argparse.Namespace) -> int:
+    paths = args.side_by_side or ([args.path] if args.path else [])
+    if not paths:
+        print("aouc: render takes FILE, or --side-by-side A B", file=sys.stderr)
         return EXIT_USAGE
+    return _render(paths, args.output, args, _read_kw(args))
+
+
+def _cmd_variants(args: argparse.Namespace) -> int:
+    from .compiler.output import write_atomic
+    from .linter import lint_file
+    from .media.variants import make_variants, parse_vary
+
+    name, low, high = parse_vary(args.vary)
     base = lint_file(args.path)
     if not base.ok or base.behaviour is None or base.source is None:
-        _print_diags(base.diagnostics, "text", {args.path: base.source or ""},
-                     stream=sys.stderr)
+        _print_diags(base.diagnostics, sources={args.path: base.source or ""})
         return _exit_for(base.diagnostics)
-    try:
-        variants = make_variants(base.behaviour, base.source, name, low, high)
-    except AouError as err:
-        return _report_error(err)
     stem = os.path.splitext(os.path.basename(args.path))[0]
     folder = args.output or "."
+    variants = make_variants(base.behaviour, base.source, name, low, high,
+                             os.path.join(folder, f"{stem}-{name}"))
     os.makedirs(folder, exist_ok=True)
-    outputs = []
     for v in variants:
-        out = os.path.join(folder, f"{stem}-{name}-{v.label}.aou")
-        lint = lint_source(v.text, out)
-        if not lint.ok:
-            _print_diags(lint.diagnostics, "text", {out: v.text}, stream=sys.stderr)
-            print(f"aouc: the {v.label} variant ({name}={v.value:g}) is not valid; nothing "
-                  "written", file=sys.stderr)
-            return EXIT_ERRORS
-        outputs.append((out, v))
-    for out, v in outputs:
-        try:
-            write_atomic(out, v.text.encode(), inputs=[args.path])
-        except AouError as err:
-            return _report_error(err)
-        print(f"wrote {out} ({name}={v.value:g})", file=sys.stderr)
+        write_atomic(v.path, v.text.encode(), inputs=[args.path])
+        print(f"wrote {v.path} ({name}={v.value:g})", file=sys.stderr)
     if args.render:
-        args.robot = args.goal = args.ee_frame = None  # the variants are .aou files
-        args.side_by_side = [o for o, _ in outputs]
-        args.path = None
-        args.output = args.render
-        return _cmd_render(args)
+        return _render([v.path for v in variants], args.render, args, {})
     return EXIT_OK
 
 
-def _render_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--fps", type=float, default=30.0, help="frames per second (default 30)")
-    p.add_argument("--size", default=(640, 480), type=_frame_size, metavar="WxH",
-                   help="frame size (default 640x480)")
-    p.add_argument("--camera-distance", type=float, default=1.2, metavar="M")
-    p.add_argument("--camera-yaw", type=float, default=30.0, metavar="DEG")
-    p.add_argument("--camera-pitch", type=float, default=-15.0, metavar="DEG")
-    p.add_argument("--camera-target", metavar="X,Y,Z", type=_point,
-                   help="point looked at (default: halfway from the base to the goal)")
-
-
-# --- the parser -------------------------------------------------------------------------
-
-
-def _recording_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--robot", help="robot of a CSV recording (panda, ur5)")
-    p.add_argument("--ee-frame", help="end-effector frame (default: the robot's)")
-    p.add_argument("--goal", metavar="X,Y,Z", type=_point, help="goal position in metres")
-
-
-def _recording_options(args: argparse.Namespace) -> dict:
-    """``robot``, ``goal``, ``ee_frame`` for reading a recording."""
-    return {"robot": args.robot, "goal": args.goal, "ee_frame": args.ee_frame}
-
-
-def _scene_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--target-size", type=float, default=0.05, metavar="M",
-                   help="edge of the target cube at the goal, in metres (default 0.05)")
-    p.add_argument("--table-height", type=float, default=0.0, metavar="M",
-                   help="height of the table plane in the base frame (default 0)")
-    p.add_argument("--no-table", action="store_true", help="no table plane")
-
-
-def build_parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="aouc", description="aou: expressive robot-arm motion from .aou files.")
-    p.add_argument("--version", action="version", version=f"aouc {__version__}")
-    sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
-
-    lint = sub.add_parser("lint", help="check .aou files against the language and the C-V model")
-    lint.add_argument("paths", nargs="+", metavar="PATH", help=".aou files or folders")
-    lint.add_argument("--format", choices=("text", "json", "github"), default="text")
-    lint.add_argument("--strict", action="store_true", help="warnings fail too (exit 1)")
-    lint.set_defaults(func=_cmd_lint)
-
-    explain = sub.add_parser("explain", help="show the timeline a file compiles to")
-    explain.add_argument("path", metavar="FILE")
-    explain.set_defaults(func=_cmd_explain)
-
-    comp = sub.add_parser("compile", help="compile .aou files into joint trajectories")
-    comp.add_argument("paths", nargs="+", metavar="PATH", help=".aou files or folders")
-    comp.add_argument("-o", "--output", metavar="FILE|DIR",
-                      help="output file, or folder for several inputs (default: STEM.json "
-                           "in the current folder)")
-    comp.add_argument("--format", choices=("json", "csv", "npz"),
-                      help="output format (default: from -o's extension, else json)")
-    comp.add_argument("--rate", type=float, metavar="HZ",
-                      help="sample rate in Hz (default 250)")
-    comp.add_argument("--no-check", action="store_true",
-                      help="skip the safety checks (recorded in the output)")
-    _scene_arguments(comp)
-    comp.set_defaults(func=_cmd_compile)
-
-    chk = sub.add_parser("check", help="replay a behaviour or trajectory in PyBullet and "
-                         "report every safety check")
-    chk.add_argument("path", metavar="FILE", help="a .aou file or a trajectory .json")
-    chk.add_argument("--format", choices=("text", "json"), default="text")
-    chk.add_argument("--no-dynamic", action="store_true",
-                     help="kinematic checks only (skip the physics replay)")
-    _recording_arguments(chk)
-    _scene_arguments(chk)
-    chk.set_defaults(func=_cmd_check)
-
-    plot = sub.add_parser("plot", help="velocity profile of a behaviour or trajectory, or "
-                          "the C-V map of several behaviours (--cv)")
-    plot.add_argument("paths", nargs="+", metavar="FILE")
-    plot.add_argument("-o", "--output", required=True, metavar="X.png|X.svg")
-    plot.add_argument("--cv", action="store_true",
-                      help="plot the C-V plane with each behaviour's inferred point")
-    _recording_arguments(plot)
-    plot.set_defaults(func=_cmd_plot)
-
-    render = sub.add_parser("render", help="render a video of a behaviour or trajectory")
-    render.add_argument("path", nargs="?", metavar="FILE")
-    render.add_argument("-o", "--output", required=True, metavar="X.mp4|X.gif")
-    render.add_argument("--side-by-side", nargs=2, metavar=("A", "B"),
-                        help="render two behaviours next to each other")
-    _render_arguments(render)
-    _recording_arguments(render)
-    _scene_arguments(render)
-    render.set_defaults(func=_cmd_render)
-
-    var = sub.add_parser("variants", help="write a pair of files that differ in one "
-                         "descriptor (the study's Part B stimuli)")
-    var.add_argument("path", metavar="FILE")
-    var.add_argument("--vary", required=True, metavar="NAME=LOW,HIGH",
-                     help="descriptor and its two values, in the descriptor's unit")
-    var.add_argument("-o", "--output", metavar="DIR", help="folder (default: here)")
-    var.add_argument("--render", metavar="X.mp4|X.gif",
-                     help="also render the pair side by side")
-    _render_arguments(var)
-    _scene_arguments(var)
-    var.set_defaults(func=_cmd_variants)
-
-    meas = sub.add_parser("measure", help="measure the eleven descriptors of a trajectory")
-    meas.add_argument("path", metavar="FILE", help="a trajectory .json, or a .csv recording")
-    _recording_arguments(meas)
-    meas.add_argument("--format", choices=("table", "json"), default="table")
-    meas.set_defaults(func=_cmd_measure)
-
-    rules = sub.add_parser("rules", help="list the diagnostic codes, or explain some")
-    rules.add_argument("codes", nargs="*", metavar="CODE")
-    rules.add_argument("--format", choices=("text", "json"), default="text")
-    rules.set_defaults(func=_cmd_rules)
-    return p
+_COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
+    "lint": _cmd_lint, "rules": _cmd_rules, "explain": _cmd_explain,
+    "compile": _cmd_compile, "check": _cmd_check, "measure": _cmd_measure,
+    "plot": _cmd_plot, "render": _cmd_render, "variants": _cmd_variants,
+}
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
+    parser, _ = build_parser()
     args = parser.parse_args(argv)
-    if not getattr(args, "func", None):
+    if args.command is None:
         parser.print_help(sys.stderr)
         return EXIT_USAGE
     try:
-        return args.func(args)
+        return _COMMANDS[args.command](args)
+    except AouError as err:
+        return _fail(err)
+    except ImportError as exc:
+        if args.command in ("plot", "render", "variants") and exc.name:
+            print(f"aouc: this command needs the media extra ({exc.name} is missing): "
+                  "pip install 'aou-dsl[media]'", file=sys.stderr)
+            return EXIT_USAGE
+        return _internal(exc, args.debug)
     except KeyboardInterrupt:
         print("aouc: interrupted", file=sys.stderr)
         return EXIT_USAGE
     except BrokenPipeError:
         return EXIT_OK
+    except Exception as exc:  # noqa: BLE001 - the last line of defence
+        return _internal(exc, args.debug)
+
+
+def _internal(exc: BaseException, debug: bool) -> int:
+    if debug:
+        raise exc
+    print(f"aouc: internal error: {type(exc).__name__}: {exc} (rerun with --debug for the "
+          "traceback, and please report it)", file=sys.stderr)
+    return EXIT_USAGE
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,23 +1,24 @@
-"""The Commitment-Vigilance model (MODEL.md s1-3) and the inference of (C, V) from motion.
+"""The Commitment-Vigilance model (docs/model.md) and the inference of (C, V) from motion.
 
 Three things live here:
 
 1. :func:`effort_to_cv`: equations 1 and 2, ``C = -c1 W - c2 T``, ``V = v1 S - v2 F``.
 2. :func:`classify`: a point of the plane belongs to the nearest canonical state
    (Euclidean), ties broken in Table I's order.
-3. :func:`infer`: a (C, V) point from a behaviour's *composition*, i.e. from its
-   descriptor values alone, so that ``aouc lint`` (from a file) and ``aouc measure``
-   (from a recorded motion) place motion on the plane the same way. docs/cv-model.md
-   explains the formula; in short, each primitive contributes a saturating evidence
-   term ``1 - exp(-x / x_ref)`` or ``x / (x + x_ref)`` in [0, 1)::
+3. :func:`infer`: a (C, V) point from a behaviour's *composition*: what its episodes
+   do, so that ``aouc lint`` (from a file) and ``aouc measure`` (from a recorded motion)
+   place motion on the plane the same way. docs/cv-model.md explains the formula; in
+   short, each primitive kind feeds evidence channels (its ``evidence`` table), and
+   each channel gives a saturating term ``1 - exp(-x / x_ref)`` or ``x / (x + x_ref)``
+   in [0, 1)::
 
        C = clip(b + k_a D - k_x Rx - k_v Rv)
        V = clip(-1 + k_p P + k_e X + k_s S)
 
-   D approach drive (approach acceleration), Rx retreat extent (count x distance),
-   Rv retreat vigour (retreat acceleration), P stillness (count x pause duration),
-   X exploration (gaze and tilt angle swept), S tremor (shiver amplitude x count).
-   Every term is monotone in its descriptors, so more or longer retreats never raise C,
+   D drive (peak approach acceleration), Rx retreat extent (total distance retreated),
+   Rv retreat vigour (peak retreat acceleration), P stillness (total pause time),
+   X exploration (total gaze and tilt angle), S tremor (total shiver amplitude).
+   Every term is monotone in its evidence, so more or longer retreats never raise C,
    a higher approach acceleration never lowers C, and adding pauses, gaze, tilt or
    shiver never lowers V.
 """
@@ -25,9 +26,10 @@ Three things live here:
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
-from .ir import Behaviour, Effort, State
+from .ir import Effort, State
 
 __all__ = [
     "CANONICAL",
@@ -38,12 +40,12 @@ __all__ = [
     "DEFAULT_WEIGHTS",
     "INFERENCE",
     "classify",
-    "composition_of",
+    "composition",
     "effort_to_cv",
     "infer",
 ]
 
-#: MODEL.md Table I: state -> (W, T, S, F), in the table's order.
+#: Table I of the model: state -> (W, T, S, F), in the table's order.
 CANONICAL_EFFORT: dict[State, tuple[float, float, float, float]] = {
     State.CONFIDENT: (-1, -1, -1, +1),
     State.CURIOUS: (-1, -1, +1, -1),
@@ -52,7 +54,7 @@ CANONICAL_EFFORT: dict[State, tuple[float, float, float, float]] = {
     State.INACTIVE: (+1, +1, -1, +1),
 }
 
-#: MODEL.md Table I: state -> canonical (C, V).
+#: Table I of the model: state -> canonical (C, V).
 CANONICAL: dict[State, tuple[float, float]] = {
     State.CONFIDENT: (1.0, -1.0),
     State.CURIOUS: (1.0, 1.0),
@@ -94,7 +96,7 @@ DEFAULT_WEIGHTS = CVWeights()
 
 def effort_to_cv(effort: Effort | tuple[float, float, float, float],
                  weights: CVWeights = DEFAULT_WEIGHTS) -> CVPoint:
-    """Equations 1 and 2 of MODEL.md. ``effort`` is (W, T, S, F), each in [-1, 1]."""
+    """Equations 1 and 2 of the model. ``effort`` is (W, T, S, F), each in [-1, 1]."""
     if isinstance(effort, Effort):
         w, t, s, f = effort.W, effort.T, effort.S, effort.F
     else:
@@ -117,33 +119,35 @@ def classify(c: float, v: float) -> State:
 
 @dataclass(frozen=True, slots=True)
 class Composition:
-    """The descriptors that drive the inference; zero/None for absent primitives.
+    """The evidence a behaviour's episodes give, per channel (zero when absent).
 
-    Units: accelerations [m/s^2], distances [m], durations [s], angles [deg].
+    Attributes:
+        drive: peak approach acceleration [m/s^2].
+        extent: total distance retreated [m].
+        vigour: peak retreat acceleration [m/s^2].
+        stillness: total pause time [s].
+        exploration: total angle of gazes (from the initial line of sight) and tilts [deg].
+        tremor: total shiver amplitude [deg].
     """
 
-    approach_acceleration: float | None = None
-    pause_count: int = 0
-    pause_duration: float = 0.0
-    retreat_count: int = 0
-    retreat_distance: float = 0.0
-    retreat_acceleration: float = 0.0
-    gaze_swept: float = 0.0  # total |angle| of gaze episodes, both planes [deg]
-    tilt_swept: float = 0.0  # total |angle| of tilt episodes [deg]
-    shiver_amplitude: float = 0.0
-    shiver_count: int = 0
+    drive: float = 0.0
+    extent: float = 0.0
+    vigour: float = 0.0
+    stillness: float = 0.0
+    exploration: float = 0.0
+    tremor: float = 0.0
 
 
 @dataclass(frozen=True, slots=True)
 class InferenceParams:
     """Reference scales and gains of the inference (docs/cv-model.md). Chosen so the five
-    study behaviours land in their own states with margin; see tests/test_cv.py."""
+    study behaviours land in their own states with margin (the tests check it)."""
 
-    a_ref: float = 0.05  # m/s^2: approach drive is 1/2 at this acceleration
+    a_ref: float = 0.05  # m/s^2: drive is 1/2 at this acceleration
     d_ref: float = 0.10  # m: retreat extent 1 - 1/e at this total distance
     ar_ref: float = 0.5  # m/s^2: retreat vigour is 1/2 at this acceleration
     p_ref: float = 5.0  # s: stillness 1 - 1/e at this total pause time
-    e_ref: float = 30.0  # deg: exploration 1 - 1/e at this total angle swept
+    e_ref: float = 30.0  # deg: exploration 1 - 1/e at this total angle
     s_ref: float = 5.0  # deg: tremor 1 - 1/e at this total shiver amplitude
     bias: float = -0.8
     k_drive: float = 2.7
@@ -159,7 +163,7 @@ INFERENCE = InferenceParams()
 
 @dataclass(frozen=True, slots=True)
 class Contribution:
-    """How much one primitive moves the point: ``dC``, ``dV`` before clipping."""
+    """How much one evidence channel moves the point: ``dC``, ``dV`` before clipping."""
 
     primitive: str
     dC: float
@@ -177,66 +181,34 @@ def _ratio(x: float, ref: float) -> float:
 
 def infer(comp: Composition, params: InferenceParams = INFERENCE
           ) -> tuple[CVPoint, list[Contribution]]:
-    """The (C, V) point a composition expresses, and each primitive's pull on it."""
+    """The (C, V) point a composition expresses, and each channel's pull on it."""
     p = params
-    contrib: list[Contribution] = []
-    if comp.approach_acceleration:
-        contrib.append(Contribution(
-            "approach", p.k_drive * _ratio(comp.approach_acceleration, p.a_ref), 0.0))
-    if comp.retreat_count:
-        extent = _sat(comp.retreat_count * comp.retreat_distance, p.d_ref)
-        vigour = _ratio(comp.retreat_acceleration, p.ar_ref)
-        contrib.append(Contribution("retreat", -p.k_extent * extent - p.k_vigour * vigour, 0.0))
-    if comp.pause_count:
-        contrib.append(Contribution(
-            "pause", 0.0, p.k_still * _sat(comp.pause_count * comp.pause_duration, p.p_ref)))
-    if comp.gaze_swept or comp.tilt_swept:
-        contrib.append(Contribution(
-            "gaze/tilt", 0.0, p.k_explore * _sat(comp.gaze_swept + comp.tilt_swept, p.e_ref)))
-    if comp.shiver_count:
-        contrib.append(Contribution(
-            "shiver", 0.0,
-            p.k_tremor * _sat(comp.shiver_count * comp.shiver_amplitude, p.s_ref)))
+    terms = (
+        ("approach", comp.drive, p.k_drive * _ratio(comp.drive, p.a_ref), 0.0),
+        ("retreat extent", comp.extent, -p.k_extent * _sat(comp.extent, p.d_ref), 0.0),
+        ("retreat vigour", comp.vigour, -p.k_vigour * _ratio(comp.vigour, p.ar_ref), 0.0),
+        ("pause", comp.stillness, 0.0, p.k_still * _sat(comp.stillness, p.p_ref)),
+        ("gaze/tilt", comp.exploration, 0.0, p.k_explore * _sat(comp.exploration, p.e_ref)),
+        ("shiver", comp.tremor, 0.0, p.k_tremor * _sat(comp.tremor, p.s_ref)),
+    )
+    contrib = [Contribution(name, dc, dv) for name, x, dc, dv in terms if x > 0]
     c = p.bias + sum(x.dC for x in contrib)
     v = -1.0 + sum(x.dV for x in contrib)
     return CVPoint(max(-1.0, min(1.0, c)), max(-1.0, min(1.0, v))), contrib
 
 
-def composition_of(b: Behaviour) -> Composition:
-    """The composition a behaviour declares (descriptor or sequence form).
+def composition(episodes: Iterable) -> Composition:
+    """The evidence of a list of :class:`~aou_dsl.descriptors.EpisodeValues` (declared or
+    measured): each kind's ``evidence`` table says which value feeds which channel and
+    whether its episodes add up or the largest counts. An episode is read by what it
+    does: a negative approach is a retreat."""
+    from .primitives import KINDS
 
-    In a sequence, counts add up, and durations, distances and accelerations are the
-    largest of their kind (the model assumes equal episodes; lint is not the place to
-    average them).
-    """
-    kw: dict = {"pause_count": 0, "retreat_count": 0, "shiver_count": 0}
-    acc = None
-    pause_d = retreat_d = retreat_a = gaze = tilt = shiver = 0.0
-    for prim in b.primitives:
-        n = prim.count
-        if prim.kind == "approach":
-            acc = max(acc or 0.0, prim.a)
-        elif prim.kind == "pause":
-            kw["pause_count"] += n
-            pause_d = max(pause_d, prim.duration)
-        elif prim.kind == "retreat":
-            kw["retreat_count"] += n
-            retreat_d = max(retreat_d, abs(prim.length))
-            retreat_a = max(retreat_a, prim.a)
-        elif prim.kind == "gaze":
-            gaze += n * abs(math.degrees(prim.angle))
-        elif prim.kind == "tilt":
-            tilt += n * abs(math.degrees(prim.angle))
-        elif prim.kind == "shiver":
-            kw["shiver_count"] += n
-            shiver = max(shiver, math.degrees(prim.amplitude))
-    return Composition(
-        approach_acceleration=acc,
-        pause_duration=pause_d,
-        retreat_distance=retreat_d,
-        retreat_acceleration=retreat_a,
-        gaze_swept=gaze,
-        tilt_swept=tilt,
-        shiver_amplitude=shiver,
-        **kw,
-    )
+    amounts: dict[str, float] = {}
+    for e in episodes:
+        kind = KINDS.get(e.kind)
+        for channel, (key, how) in (kind.evidence.items() if kind else ()):
+            x = float(e.values.get(key, 0.0))
+            old = amounts.get(channel, 0.0)
+            amounts[channel] = old + x if how == "sum" else max(old, x)
+    return Composition(**amounts)

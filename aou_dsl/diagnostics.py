@@ -244,6 +244,11 @@ _RULE_LIST = [
          "The descriptors are measured to 0.5 deg and 1 mm; a smaller motion cannot be told "
          "from a pause, and the compiled motion would not show what the file declares.",
          "shiver 0.1deg"),
+    Rule("V124", "nothing-to-move", _E,
+         "The behaviour has no episode: no primitive, only `x0` counts, or a sequence "
+         "whose moves all vanish.",
+         "There is no motion to compile and nothing to measure.",
+         "behaviour b : inactive\nrobot panda"),
     # --- M: the C-V model --------------------------------------------------------------
     Rule("M201", "state-mismatch", _W,
          "The state inferred from the behaviour's primitives differs from the declared one.",

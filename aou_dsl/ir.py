@@ -1,5 +1,7 @@
 """The intermediate representation: a validated behaviour, in SI units, every node spanned.
 
+The primitive nodes live with their kinds in :mod:`aou_dsl.primitives`.
+
 All models are frozen pydantic v2 models that reject unknown fields. Angles are in
 radians, angular speeds in rad/s. Values a file leaves out are filled from
 :data:`DEFAULTS` by the validator, so later stages never guess.
@@ -9,26 +11,13 @@ from __future__ import annotations
 
 import enum
 import math
-from typing import Annotated, Literal, overload
+from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
 from .diagnostics import Span
 
-__all__ = [
-    "DEFAULTS",
-    "Approach",
-    "Behaviour",
-    "Effort",
-    "Gaze",
-    "Pause",
-    "Primitive",
-    "Retreat",
-    "Settings",
-    "Shiver",
-    "State",
-    "Tilt",
-]
+__all__ = ["DEFAULTS", "Behaviour", "Effort", "Node", "Settings", "State"]
 
 
 class State(enum.StrEnum):
@@ -57,84 +46,18 @@ DEFAULTS = {
 }
 
 
-class _Node(BaseModel):
+class Node(BaseModel):
+    """An IR node: frozen, unknown fields rejected, spanned. Primitive nodes (one per kind,
+    in :mod:`aou_dsl.primitives`) add ``kind`` and ``count``."""
+
     model_config = ConfigDict(frozen=True, extra="forbid")
 
     span: Span
-
-
-class Approach(_Node):
-    """Translation toward the goal along the line of sight.
-
-    ``length`` [m] is None for "the rest of the way to the standoff"; it may be negative in
-    a sequence (moving away). ``a`` [m/s^2] is the peak acceleration, ``v`` [m/s] the cap.
-    """
-
-    kind: Literal["approach"] = "approach"
-    length: float | None = None
-    a: float
-    v: float
+    kind: str = ""
     count: int = 1
 
 
-class Pause(_Node):
-    """A hold: every joint velocity zero for ``duration`` [s]."""
-
-    kind: Literal["pause"] = "pause"
-    duration: float
-    count: int = 1
-
-
-class Retreat(_Node):
-    """Translation away from the goal by ``length`` [m] with peak acceleration ``a``."""
-
-    kind: Literal["retreat"] = "retreat"
-    length: float
-    a: float
-    v: float
-    count: int = 1
-
-
-class Gaze(_Node):
-    """An arc about the goal in the horizontal or vertical plane.
-
-    ``angle`` [rad] is the bearing of the goal vector from its start direction at the end
-    of the episode (signed in a sequence; the amplitude in the descriptor form).
-    """
-
-    kind: Literal["gaze"] = "gaze"
-    plane: Literal["horizontal", "vertical"]
-    angle: float
-    v: float
-    count: int = 1
-
-
-class Tilt(_Node):
-    """A roll of ``angle`` [rad] about the forward axis at angular speed ``v`` [rad/s]."""
-
-    kind: Literal["tilt"] = "tilt"
-    angle: float
-    v: float
-    count: int = 1
-
-
-class Shiver(_Node):
-    """Oscillation of the redundant joint: ``amplitude`` [rad] peak to peak, at ``f`` [Hz]
-    for ``duration`` [s]."""
-
-    kind: Literal["shiver"] = "shiver"
-    amplitude: float
-    f: float
-    duration: float
-    count: int = 1
-
-
-Primitive = Annotated[
-    Approach | Pause | Retreat | Gaze | Tilt | Shiver, Field(discriminator="kind")
-]
-
-
-class Effort(_Node):
+class Effort(Node):
     """The Laban Effort vector of MODEL.md s1, each factor in [-1, 1]."""
 
     W: float = Field(ge=-1.0, le=1.0)
@@ -166,27 +89,13 @@ class Behaviour(BaseModel):
     state: State | None
     form: Literal["descriptor", "sequence"]
     settings: Settings
-    primitives: tuple[Primitive, ...]
+    primitives: tuple[Node, ...]
     span: Span
     header_span: Span | None = None
 
-    @overload
-    def first(self, kind: Literal["approach"], plane: None = None) -> Approach | None: ...
-    @overload
-    def first(self, kind: Literal["pause"], plane: None = None) -> Pause | None: ...
-    @overload
-    def first(self, kind: Literal["retreat"], plane: None = None) -> Retreat | None: ...
-    @overload
-    def first(self, kind: Literal["gaze"], plane: str | None = None) -> Gaze | None: ...
-    @overload
-    def first(self, kind: Literal["tilt"], plane: None = None) -> Tilt | None: ...
-    @overload
-    def first(self, kind: Literal["shiver"], plane: None = None) -> Shiver | None: ...
-    @overload
-    def first(self, kind: str, plane: str | None = None) -> Primitive | None: ...
-
-    def first(self, kind: str, plane: str | None = None) -> Primitive | None:
-        """The descriptor-form primitive of ``kind`` (and gaze ``plane``), if present."""
+    def first(self, kind: str, plane: str | None = None) -> Any:
+        """The descriptor-form node of ``kind`` (and gaze ``plane``), if present. Typed
+        ``Any``: the node class is the kind's (:mod:`aou_dsl.primitives`)."""
         for p in self.primitives:
             if p.kind == kind and (plane is None or getattr(p, "plane", None) == plane):
                 return p

@@ -108,19 +108,14 @@ def format_check(path: str, robot: str, t, report) -> str:
     return "\n".join(lines)
 
 
-#: The unit each descriptor is printed in (MODEL.md s5).
-UNITS = {"approach_acceleration": "m/s^2", "pause_count": "", "pause_duration": "s",
-         "retreat_count": "", "retreat_distance": "m", "retreat_acceleration": "m/s^2",
-         "horizontal_gaze": "deg", "vertical_gaze": "deg", "tilt_angle": "deg",
-         "tilt_velocity": "deg/s", "shiver_amplitude": "deg"}
-
-
 def format_measured(path: str, robot: str, measured) -> str:
     """``aouc measure``: the eleven descriptors as a table, and the C-V point."""
     m = measured
     lines = [f"{path}: {robot}, {m.duration:.2f} s, {len(m.episodes)} episodes"]
+    from .descriptors import REGISTRY
+
     for k, v in m.descriptors.items():
         val = "null" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
-        lines.append(f"  {k:<22} {val:>10} {UNITS[k]}".rstrip())
+        lines.append(f"  {k:<22} {val:>10} {REGISTRY[k].unit}".rstrip())
     lines.append(f"  C-V: C={m.cv.C:+.2f} V={m.cv.V:+.2f} -> {m.cv.state}")
     return "\n".join(lines)

@@ -11,7 +11,7 @@ import numpy as np
 import pinocchio as pin
 
 from aou_dsl.kinematics import load_arm
-from aou_dsl.measure.recording import Recording
+from aou_dsl.trajectory import Trajectory
 
 RATE = 250.0
 
@@ -117,7 +117,7 @@ class Synth:
         if noise:
             q = q + np.random.default_rng(seed).normal(0.0, noise, q.shape)
         t = np.arange(len(q)) / self.rate
-        return Recording(t, q, self.arm.joint_names, self.robot, None, tuple(self.goal))
+        return Trajectory(t, q, self.arm.joint_names, self.robot, None, tuple(self.goal))
 
     def _ik(self) -> np.ndarray:
         model, data, fid = self.arm.model, self.arm.model.createData(), self.arm.frame_id

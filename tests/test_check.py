@@ -6,8 +6,9 @@ import json
 import numpy as np
 import pytest
 
-from aou_dsl.check.replay import replay
-from aou_dsl.check.scene import Scene
+from aou_dsl.safety.replay import replay
+from aou_dsl.trajectory import Trajectory
+from aou_dsl.safety.scene import Scene
 from aou_dsl.cli import EXIT_ERRORS, EXIT_OK, main
 from aou_dsl.kinematics import load_arm
 
@@ -39,8 +40,9 @@ def _hold_then(q_after: np.ndarray, n_before: int = 250, n_after: int = 50) -> n
 
 def _failed(doc: dict) -> list:
     t = np.array(doc["t"])
-    report = replay("panda", t, np.array(doc["q"]), np.array(doc["qd"]),
-                    np.array(doc["qdd"]), GOAL)
+    tr = Trajectory(t, np.array(doc["q"]), tuple(doc["joint_names"]), "panda", None, GOAL,
+                    np.array(doc["qd"]), np.array(doc["qdd"]))
+    report = replay(tr)
     return [c for c in report.checks if not c.ok]
 
 

@@ -58,7 +58,7 @@ def test_mismatch_warning_names_inferred_point_and_pulling_primitives(capsys, tm
 
 
 def test_effort_line_contradicting_declared_state_warns(tmp_path):
-    from aou_dsl.lint import lint_file
+    from aou_dsl.linter import lint_file
 
     f = tmp_path / "e.aou"
     f.write_text("behaviour e : fearful\neffort W=-1 T=-1 S=-1 F=1\n"

@@ -12,12 +12,12 @@ from aou_dsl.cv import (
     Composition,
     CVWeights,
     classify,
-    composition_of,
+    composition,
     effort_to_cv,
     infer,
 )
 from aou_dsl.ir import State
-from aou_dsl.lint import lint_file
+from aou_dsl.linter import lint_file
 
 from .conftest import BEHAVIOURS
 
@@ -58,20 +58,16 @@ def test_a_file_without_primitives_is_inactive():
     assert point.state is State.INACTIVE and contrib == []
 
 
-# --- monotonicity (issue 2, 4b) ------------------------------------------------------
+# --- monotonicity ---------------------------------------------------------------------
 
 compositions = st.builds(
     Composition,
-    approach_acceleration=st.one_of(st.none(), st.floats(0.001, 5.0)),
-    pause_count=st.integers(0, 20),
-    pause_duration=st.floats(0.2, 10.0),
-    retreat_count=st.integers(0, 10),
-    retreat_distance=st.floats(0.001, 0.3),
-    retreat_acceleration=st.floats(0.001, 5.0),
-    gaze_swept=st.floats(0.0, 360.0),
-    tilt_swept=st.floats(0.0, 360.0),
-    shiver_amplitude=st.floats(0.1, 30.0),
-    shiver_count=st.integers(0, 5),
+    drive=st.floats(0.0, 5.0),
+    extent=st.floats(0.0, 3.0),
+    vigour=st.floats(0.0, 5.0),
+    stillness=st.floats(0.0, 100.0),
+    exploration=st.floats(0.0, 720.0),
+    tremor=st.floats(0.0, 150.0),
 )
 
 
@@ -80,46 +76,57 @@ def _with(c: Composition, **kw) -> Composition:
 
 
 @settings(max_examples=300)
-@given(compositions, st.integers(1, 5), st.floats(0.0, 0.2))
-def test_more_or_longer_retreats_never_raise_commitment(c, extra, longer):
+@given(compositions, st.floats(0.0, 1.0), st.floats(0.0, 5.0))
+def test_more_or_longer_or_faster_retreats_never_raise_commitment(c, farther, faster):
     base, _ = infer(c)
-    more, _ = infer(_with(c, retreat_count=c.retreat_count + extra))
-    farther, _ = infer(_with(c, retreat_distance=c.retreat_distance + longer))
+    more, _ = infer(_with(c, extent=c.extent + farther))
+    vigorous, _ = infer(_with(c, vigour=c.vigour + faster))
     assert more.C <= base.C + 1e-12
-    assert farther.C <= base.C + 1e-12
+    assert vigorous.C <= base.C + 1e-12
 
 
 @settings(max_examples=300)
 @given(compositions, st.floats(0.0, 5.0))
 def test_higher_approach_acceleration_never_lowers_commitment(c, more):
     base, _ = infer(c)
-    a = (c.approach_acceleration or 0.0) + more
-    faster, _ = infer(_with(c, approach_acceleration=a or None))
+    faster, _ = infer(_with(c, drive=c.drive + more))
     assert faster.C >= base.C - 1e-12
 
 
 @settings(max_examples=300)
-@given(compositions, st.integers(1, 5), st.floats(0.0, 90.0), st.floats(0.0, 90.0),
-       st.integers(1, 3))
-def test_adding_vigilance_primitives_never_lowers_vigilance(c, pauses, gaze, tilt, shivers):
+@given(compositions, st.floats(0.0, 20.0), st.floats(0.0, 90.0), st.floats(0.0, 30.0))
+def test_adding_vigilance_primitives_never_lowers_vigilance(c, pauses, explore, tremor):
     base, _ = infer(c)
-    for kw in ({"pause_count": c.pause_count + pauses},
-               {"gaze_swept": c.gaze_swept + gaze},
-               {"tilt_swept": c.tilt_swept + tilt},
-               {"shiver_count": c.shiver_count + shivers}):
+    for kw in ({"stillness": c.stillness + pauses},
+               {"exploration": c.exploration + explore},
+               {"tremor": c.tremor + tremor}):
         more, _ = infer(_with(c, **kw))
         assert more.V >= base.V - 1e-12, kw
 
 
-def test_composition_of_a_sequence_adds_counts():
-    from aou_dsl.lint import load
+def test_composition_of_a_sequence_reads_what_the_episodes_do():
+    """Pause time and retreat distance add up; gazes count their angle from the line of
+    sight; a negative approach moves away from the goal and counts as a retreat."""
+    from aou_dsl.layout import episode_values
+    from aou_dsl.linter import load_validated
 
-    b, _ = load("sequence {\n pause 1s x2\n retreat 2cm\n pause 1.5s\n retreat 3cm\n"
-                " pause 1s\n gaze horizontal 20deg\n gaze horizontal -20deg\n}")
-    comp = composition_of(b)
-    assert comp.pause_count == 4 and comp.pause_duration == 1.5
-    assert comp.retreat_count == 2 and comp.retreat_distance == pytest.approx(0.03)
-    assert comp.gaze_swept == pytest.approx(40.0)
+    v = load_validated("sequence {\n pause 1s x2\n retreat 2cm\n pause 1.5s\n retreat 3cm\n"
+                       " pause 1s\n gaze horizontal 20deg\n gaze horizontal -20deg\n"
+                       " approach -1cm\n}")
+    comp = composition(episode_values(v.timeline.episodes))
+    assert comp.stillness == pytest.approx(4.5)
+    assert comp.extent == pytest.approx(0.06)
+    assert comp.exploration == pytest.approx(40.0)
+
+
+def test_a_negative_approach_is_not_confident():
+    """`sequence { approach -0.8m }` moves away from the goal: it cannot read as
+    confident (the model classifies motion by what it does)."""
+    from aou_dsl.linter import lint_source
+
+    r = lint_source("start 0.15m\nsequence { approach -0.5m }")
+    assert r.ok and r.cv is not None
+    assert r.cv.state is not State.CONFIDENT and r.cv.C < 0
 
 
 def test_docs_table_matches_the_code():

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from aou_dsl.diagnostics import Severity
-from aou_dsl.lint import lint_file
+from aou_dsl.linter import lint_file
 
 from .conftest import BEHAVIOURS, INVALID, VALID
 

@@ -3,9 +3,10 @@ than the standoff, and realises the declared counts."""
 
 import pytest
 
-from aou_dsl.compiler.layout import layout
-from aou_dsl.declared import declared_descriptors, timeline_descriptors
-from aou_dsl.lint import load
+from aou_dsl.declared import declared, written
+from aou_dsl.descriptors import compare, derive
+from aou_dsl.layout import episode_values, layout
+from aou_dsl.linter import load
 
 from .conftest import BEHAVIOURS
 
@@ -20,7 +21,8 @@ def _timeline(text: str):
 def test_shipped_layouts_realise_their_descriptors(name):
     b, _ = _timeline((BEHAVIOURS / f"{name}.aou").read_text())
     tl = layout(b)
-    want, got = declared_descriptors(b), timeline_descriptors(tl.episodes)
+    want, got = written(b), derive(episode_values(tl.episodes))
+    assert declared(b, tl) == want
     for key in ("pause_count", "retreat_count"):
         assert want[key] == got[key]
     assert layout(b) == tl  # deterministic

@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 from aou_dsl.diagnostics import AouError
-from aou_dsl.measure.descriptors import measure
-from aou_dsl.measure.recording import Recording, read_csv, read_json
+from aou_dsl.measuring.descriptors import measure
+from aou_dsl.measuring.recording import read_csv, read_json
+from aou_dsl.trajectory import Trajectory as Recording
 
 from .synth import Synth
 

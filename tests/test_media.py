@@ -9,10 +9,10 @@ import sys
 import numpy as np
 import pytest
 
-from aou_dsl.build import build_file, to_recording
+from aou_dsl.build import build_file
 from aou_dsl.cli import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, main
 from aou_dsl.kinematics import load_arm
-from aou_dsl.lint import lint_file
+from aou_dsl.linter import lint_file
 
 from .conftest import BEHAVIOURS
 
@@ -26,7 +26,7 @@ def confident():
 def test_profile_plot_draws_the_trajectory(confident):
     from aou_dsl.media.plot import profile_data, profile_figure
 
-    d = profile_data(to_recording(confident), confident.episodes, "confident")
+    d = profile_data(confident)
     fig = profile_figure(d)
     ax_v, ax_d, ax_q, ax_qd = fig.axes
     assert np.array_equal(ax_v.lines[0].get_xdata(), confident.t)

@@ -9,7 +9,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from aou_dsl.build import build_file
-from aou_dsl.declared import compare_descriptors
+from aou_dsl.descriptors import compare as compare_descriptors
 
 from .conftest import BEHAVIOURS
 
@@ -92,7 +92,7 @@ def descriptor_behaviours(draw) -> str:
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(descriptor_behaviours())
 def test_generated_behaviours_measure_as_declared(tmp_path_factory, text):
-    from aou_dsl.lint import lint_source
+    from aou_dsl.linter import lint_source
 
     lint = lint_source(text, "gen.aou")
     assume(lint.ok)
@@ -129,7 +129,7 @@ def sequence_behaviours(draw) -> str:
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(sequence_behaviours())
 def test_generated_sequences_measure_as_declared(tmp_path_factory, text):
-    from aou_dsl.lint import lint_source
+    from aou_dsl.linter import lint_source
 
     assume(lint_source(text, "seq.aou").ok)
     path = tmp_path_factory.mktemp("seq") / "seq.aou"
@@ -186,7 +186,7 @@ TABLE_II = {
 def test_measuring_the_compiled_stimuli_gives_table_two(name):
     """The oracle is the paper's table itself, not the files: compile each shipped
     stimulus and measure it; the values are Table II's."""
-    from aou_dsl.declared import tolerance
+    from aou_dsl.descriptors import REGISTRY
 
     res = build_file(str(BEHAVIOURS / f"{name}.aou"), check=False)
     measured = res.measured.descriptors
@@ -195,7 +195,7 @@ def test_measuring_the_compiled_stimuli_gives_table_two(name):
         if want is None or key.endswith("_count"):
             assert got == want, (key, got, want)
         else:
-            assert abs(got - want) <= tolerance(key, want), (key, got, want)
+            assert abs(got - want) <= REGISTRY[key].tolerance(want), (key, got, want)
     for key in ("vertical_gaze", "tilt_angle", "tilt_velocity"):
         assert measured[key] is None
 
@@ -208,7 +208,7 @@ def test_generated_behaviours_pass_the_safety_checks(tmp_path_factory, text):
     """What the compiler makes of a valid file is safe to send: the PyBullet replay
     (limits, collisions, contact with the object and the table) passes, or the compiler
     says which limit it could not meet."""
-    from aou_dsl.lint import lint_source
+    from aou_dsl.linter import lint_source
 
     assume(lint_source(text, "gen.aou").ok)
     path = tmp_path_factory.mktemp("safe") / "gen.aou"

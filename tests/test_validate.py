@@ -6,7 +6,7 @@ import pytest
 from pydantic import ValidationError
 
 from aou_dsl.ir import DEFAULTS, State
-from aou_dsl.lint import load
+from aou_dsl.linter import load
 
 from .conftest import VALID
 
@@ -40,7 +40,7 @@ def test_header_optional_name_is_stem():
 
 
 def test_defaults_are_filled():
-    b = _ok("approach; retreat 5cm; pause 1s x2; gaze vertical 10deg; shiver 3deg")
+    b = _ok("approach; retreat 5cm; pause 1s x3; gaze vertical 10deg; shiver 3deg")
     ap, re_, pa, gz, sh = b.primitives
     assert ap.a == DEFAULTS["approach_a"] and ap.v == DEFAULTS["speed_cap"] and ap.length is None
     assert re_.a == DEFAULTS["retreat_a"]

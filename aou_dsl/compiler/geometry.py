@@ -8,20 +8,24 @@ The start frame ``R0 = [x0, y0, z0]`` (MODEL.md s4):
   horizontal gaze looks left and right; if ``z0`` is vertical, the world x axis is used;
 - ``x0 = y0 x z0``.
 
-A pose ``(d, h, v, roll)`` puts the end-effector at ``goal + d B u`` with ``u = -z0``
-and ``B = Rot(x0, v) Rot(y0, h)``, oriented ``B R0 Rz(roll)``: its z axis points at the
-goal whatever the pose, so the line of sight is zero by construction.
+A pose ``(d, h, v, roll)`` gives the goal vector ``g`` the plane angles of the model:
+projected into the horizontal plane (normal ``y0``) it is ``h`` from the initial line of
+sight, projected into the vertical plane (normal ``x0``) it is ``v``, so in the start
+frame ``g ~ (tan h, -tan v, 1)``. The end-effector sits at ``goal - d g/|g|``, oriented
+``B R0 Rz(roll)`` where ``B = Rot(x0, b) Rot(y0, a)`` turns ``z0`` onto ``g``: its z axis
+points at the goal whatever the pose, so the line of sight is zero by construction.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from .layout import Pose
+from ..timeline import Pose
 
-__all__ = ["ReachFrame", "axis_angle", "reach_frame"]
+__all__ = ["ReachFrame", "axis_angle", "reach_frame", "rotation_angles"]
 
 
 def axis_angle(axis: np.ndarray, angle: float) -> np.ndarray:
@@ -46,10 +50,24 @@ class ReachFrame:
     def target(self, pose: Pose) -> tuple[np.ndarray, np.ndarray]:
         """Position (3,) and rotation (3, 3) of the end-effector at ``pose``."""
         x0, y0, z0 = self.R0.T
-        b = axis_angle(x0, pose.v) @ axis_angle(y0, pose.h)
+        a, c = rotation_angles(pose.h, pose.v)
+        b = axis_angle(x0, c) @ axis_angle(y0, a)
         p = self.goal + pose.d * (b @ -z0)
         r = b @ self.R0 @ axis_angle(np.array([0.0, 0.0, 1.0]), pose.roll)
         return p, r
+
+
+def rotation_angles(h: float, v: float) -> tuple[float, float]:
+    """The rotations ``(a, b)`` about ``y0`` then ``x0`` [rad] whose goal vector has the
+    plane angles ``h`` (horizontal) and ``v`` (vertical), each within +-90 deg.
+
+    ``Rot(x0, b) Rot(y0, a)`` takes the line of sight to ``(sin a, -cos a sin b,
+    cos a cos b)`` in the start frame; it must be parallel to ``(tan h, -tan v, 1)``.
+    """
+    gx, gy, gz = math.tan(h), -math.tan(v), 1.0
+    n = math.sqrt(gx * gx + gy * gy + gz * gz)
+    a = math.asin(gx / n)
+    return a, math.atan2(-gy, gz)
 
 
 def reach_frame(goal: tuple[float, float, float], start_direction: tuple[float, float, float]

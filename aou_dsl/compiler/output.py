@@ -1,11 +1,12 @@
-"""Stage 8, output: the trajectory file (LANGUAGE.md), written atomically and deterministically.
+"""Stage 8, output: the trajectory file, written atomically and deterministically.
 
 Three formats: ``json`` (``aou-trajectory/1``), ``csv`` (``t`` then one column per joint)
 and ``npz`` (numpy arrays plus the JSON header). Floats are written with Python's
 shortest round-trip representation (up to 17 significant digits). Nothing that varies
 between runs (times, paths, dates) is written, so the same input and versions give the
 same bytes. A file is written to a temporary name beside the target and renamed over it
-only when complete: on any error no output appears and an existing file is untouched.
+only when complete (:func:`aou_dsl.files.write_atomic`): on any error no output appears
+and an existing file is untouched.
 """
 
 from __future__ import annotations
@@ -13,23 +14,23 @@ from __future__ import annotations
 import io
 import json
 import os
-import tempfile
 import zipfile
-from collections.abc import Sequence
 
 import numpy as np
 
 from .. import __version__
 from ..diagnostics import AouError, Span, diag
+from ..files import write_atomic
 
-__all__ = ["FORMATS", "trajectory_document", "write_atomic", "encode"]
+__all__ = ["FORMATS", "encode", "output_paths", "trajectory_document", "write_atomic"]
 
 FORMATS = ("json", "csv", "npz")
 
 
 def trajectory_document(result, *, measured: dict, declared: dict, cv: dict,
                         checks: dict | None = None, rate: float) -> dict:
-    """The JSON document of LANGUAGE.md for a :class:`~.pipeline.CompileResult`."""
+    """The trajectory document (``aou-trajectory/1``) of a
+    :class:`~.pipeline.CompileResult`."""
     tr = result.trajectory
     b = result.behaviour
     return {
@@ -76,33 +77,49 @@ def encode(doc: dict, fmt: str) -> bytes:
             zf.writestr(zipfile.ZipInfo("header.json", (1980, 1, 1, 0, 0, 0)),
                         json.dumps(header, indent=1))
         return buf.getvalue()
-    raise ValueError(f"unknown format {fmt!r}")
+    raise AouError(diag("I502", f"unknown output format `{fmt}`: expected one of "
+                        f"{', '.join(FORMATS)}", Span.whole_file("<output>")))
 
 
-def write_atomic(path: str, data: bytes, *, inputs: Sequence[str] = ()) -> None:
-    """Write ``data`` to ``path`` atomically; never over one of ``inputs``.
+def output_paths(inputs: list[tuple[str, str | None]], output: str | None, fmt: str | None
+                 ) -> tuple[list[str], str]:
+    """Where each input's trajectory goes, and the format.
+
+    One input: ``-o FILE`` (its extension sets the format unless ``fmt`` does), ``-o DIR``
+    or the current folder. Several inputs: ``-o`` is a folder (default: the current one);
+    files found in a folder keep their path below it, so ``x/same.aou`` and
+    ``y/same.aou`` never land on one output.
 
     Raises:
-        AouError: I502 when the file cannot be written or would overwrite an input.
+        AouError: I502 for an unknown format, ``-o FILE`` with several inputs, or two
+            inputs that would write the same output.
     """
-    where = Span.whole_file(path)
-    target = os.path.realpath(path)
-    if any(os.path.exists(i) and os.path.realpath(i) == target for i in inputs):
-        raise AouError(diag("I502", f"refusing to overwrite the input `{path}`", where,
-                            hint="choose another output with -o"))
-    folder = os.path.dirname(target) or "."
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=".aouc-", suffix=".tmp", dir=folder)
-    except OSError as exc:
-        raise AouError(diag("I502", f"cannot write `{path}`: {exc.strerror}", where)) from None
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, target)
-    except OSError as exc:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise AouError(diag("I502", f"cannot write `{path}`: {exc.strerror}", where)) from None
+    many = len(inputs) > 1 or any(root is not None for _, root in inputs)
+    is_dir = output is not None and (output.endswith(os.sep) or os.path.isdir(output))
+    if fmt is None:
+        ext = os.path.splitext(output or "")[1].lstrip(".")
+        fmt = ext if output and not many and not is_dir and ext else "json"
+    if fmt not in FORMATS:
+        raise AouError(diag("I502", f"unknown output format `{fmt}`: expected one of "
+                            f"{', '.join(FORMATS)}", Span.whole_file(output or fmt)))
+    if many and output and not is_dir and os.path.splitext(output)[1]:
+        raise AouError(diag("I502", f"several inputs need -o to be a folder, found "
+                            f"`{output}`", Span.whole_file(output)))
+    folder = output if (many or is_dir) else None
+    dests = []
+    for src, root in inputs:
+        rel = os.path.relpath(src, root) if root is not None else os.path.basename(src)
+        name = os.path.splitext(rel)[0] + f".{fmt}"
+        if folder is not None:
+            dests.append(os.path.join(folder, name))
+        else:
+            dests.append(output or name)
+    seen: dict[str, str] = {}
+    for (src, _), dest in zip(inputs, dests, strict=True):
+        key = os.path.realpath(dest)
+        if key in seen:
+            raise AouError(diag("I502", f"`{seen[key]}` and `{src}` would both be written to "
+                                f"`{dest}`", Span.whole_file(src),
+                                hint="compile them into different folders with -o"))
+        seen[key] = src
+    return dests, fmt

@@ -14,12 +14,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..diagnostics import Diagnostic, diag, has_errors
+from ..diagnostics import AouError, Diagnostic, diag, has_errors
 from ..ir import Behaviour
 from ..kinematics import ArmModel, load_arm
+from ..layout import layout
+from ..primitives import KINDS
+from ..timeline import Episode, Pose, Timeline
+from ..trajectory import Trajectory
 from .geometry import ReachFrame, reach_frame
 from .ik import IKStatus, solve_path
-from .layout import Episode, Pose, Timeline, layout
 from .timing import (
     LIMIT_SLACK,
     JointSegment,
@@ -33,8 +36,8 @@ from .timing import (
 __all__ = [
     "CompileOptions",
     "CompileResult",
-    "Trajectory",
     "compile_behaviour",
+    "sample",
     "target_path",
 ]
 
@@ -52,31 +55,6 @@ class CompileOptions:
     rate: float = DEFAULT_RATE
     step_length: float = STEP_LENGTH
     step_angle: float = STEP_ANGLE
-
-
-@dataclass(frozen=True)
-class Trajectory:
-    """A sampled joint trajectory of the arm joints.
-
-    Attributes:
-        t: sample times [s], shape (N,), from 0, strictly increasing.
-        q, qd, qdd: joint positions [rad], velocities, accelerations; shape (N, n).
-        episodes: per episode ``(kind, t_start, t_end)`` [s].
-    """
-
-    robot: str
-    ee_frame: str
-    joint_names: tuple[str, ...]
-    goal: tuple[float, ...]
-    t: np.ndarray
-    q: np.ndarray
-    qd: np.ndarray
-    qdd: np.ndarray
-    episodes: tuple[tuple[str, float, float], ...] = ()
-
-    @property
-    def duration(self) -> float:
-        return float(self.t[-1])
 
 
 @dataclass
@@ -102,16 +80,14 @@ class CompileResult:
 def _waypoints(ep: Episode, frame: ReachFrame, opts: CompileOptions
                ) -> tuple[np.ndarray, list[tuple[np.ndarray, np.ndarray]]]:
     """Path coordinate samples (K,) and end-effector targets of a moving episode."""
-    step = opts.step_length if ep.kind in ("approach", "retreat") else opts.step_angle
+    step = opts.step_length if KINDS[ep.kind].translation else opts.step_angle
     n = max(MIN_WAYPOINTS, math.ceil(ep.path_length / step) + 1)
     s = np.linspace(0.0, ep.path_length, n)
     a, b = ep.start, ep.end
     targets = []
     for si in s:
         f = si / ep.path_length
-        pose = Pose(a.d + f * (b.d - a.d), a.h + f * (b.h - a.h), a.v + f * (b.v - a.v),
-                    a.roll + f * (b.roll - a.roll))
-        targets.append(frame.target(pose))
+        targets.append(frame.target(a.lerp(b, f)))
     return s, targets
 
 
@@ -139,9 +115,13 @@ def _ik_diag(ep: Episode, status: IKStatus, t: float, joint: str | None, b: Beha
                 "shorten the motion", reason=status.name.lower(), time=t, joint=joint)
 
 
-def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions()
-                      ) -> CompileResult:
-    """Compile a validated behaviour into a joint trajectory."""
+def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
+                      timeline: Timeline | None = None) -> CompileResult:
+    """Compile a validated behaviour into a joint trajectory.
+
+    ``timeline`` is the behaviour's layout when the caller has it (validation makes
+    it); otherwise it is laid out here.
+    """
     res = CompileResult(b)
     clock = time.perf_counter()
 
@@ -151,7 +131,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions()
         res.timings[stage] = res.timings.get(stage, 0.0) + now - clock
         clock = now
 
-    tl = layout(b)
+    tl = timeline if timeline is not None else layout(b)
     res.timeline = tl
     lap("layout")
     arm: ArmModel = load_arm(b.settings.robot)
@@ -174,9 +154,10 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions()
     lap("ik")
     for ep in tl.episodes:
         seg: PathSegment | JointSegment | None
-        if ep.kind == "pause":
+        timing = KINDS[ep.kind].timing
+        if timing == "hold":
             segments.append(JointSegment(q, ep.duration))
-        elif ep.kind == "shiver":
+        elif timing == "oscillation":
             seg, shiver_fail = shiver_segment(arm, q, ep.amplitude, ep.f, ep.duration)
             if shiver_fail is not None:
                 res.diagnostics.append(diag("C308", shiver_fail.reason, ep.span,
@@ -195,7 +176,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions()
                 return res
             worst_p = max(worst_p, ik.worst_position_error)
             worst_r = max(worst_r, ik.worst_rotation_error)
-            if ep.kind == "tilt":
+            if timing == "fixed":
                 seg = PathSegment(s, ik.q, TimeLaw.bang_bang(ep.path_length, ep.duration))
                 j, over = binding_joint(arm, seg)
                 if over > 1.0 + LIMIT_SLACK:
@@ -206,13 +187,13 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions()
                     return res
             else:
                 seg, fail = time_path(arm, s, ik.q, ep.a, ep.vmax,
-                                      cartesian=ep.kind in ("approach", "retreat"))
+                                      cartesian=KINDS[ep.kind].translation)
                 if seg is None:
                     reason = fail.reason if fail is not None else "no time law"
                     res.diagnostics.append(diag("C305", f"{ep.kind}: {reason}", ep.span))
                     return res
                 if fail is not None:
-                    unit = "m/s^2" if ep.kind in ("approach", "retreat") else "rad/s^2"
+                    unit = "m/s^2" if KINDS[ep.kind].translation else "rad/s^2"
                     res.diagnostics.append(diag(
                         "C304", f"{ep.kind} reaches {fail.achieved:.3g} {unit}, not the "
                         f"declared {fail.wanted:.3g} {unit}: {fail.joint} is at its limit",
@@ -234,7 +215,8 @@ def target_path(res: CompileResult) -> tuple[np.ndarray, np.ndarray]:
     positions (N, 3) and rotations (N, 3, 3). For accuracy studies and benchmarks."""
     tr, tl, frame = res.trajectory, res.timeline, res.frame
     if tr is None or tl is None or frame is None:
-        raise ValueError("the compilation failed: there is no path to follow")
+        raise AouError(diag("C305", "the compilation failed: there is no path to follow",
+                            res.behaviour.span))
     pos = np.empty((len(tr.t), 3))
     rot = np.empty((len(tr.t), 3, 3))
     for (_, t0, t1), ep, seg in zip(tr.episodes, tl.episodes, res.segments, strict=True):
@@ -245,36 +227,53 @@ def target_path(res: CompileResult) -> tuple[np.ndarray, np.ndarray]:
         else:
             f = np.zeros(int(m.sum()))
         a, b = ep.start, ep.end
-        out = [frame.target(Pose(a.d + x * (b.d - a.d), a.h + x * (b.h - a.h),
-                                     a.v + x * (b.v - a.v), a.roll + x * (b.roll - a.roll)))
-               for x in f]
+        out = [frame.target(a.lerp(b, x)) for x in f]
         if out:
             pos[m] = [o[0] for o in out]
             rot[m] = [o[1] for o in out]
     return pos, rot
 
 
+def sample(res: CompileResult, rate: float) -> Trajectory:
+    """The compiled motion sampled at ``rate`` [Hz] (the checks use a dense clock
+    whatever the output rate)."""
+    if res.trajectory is None or res.timeline is None:
+        raise AouError(diag("C305", "the compilation failed: there is nothing to sample",
+                            res.behaviour.span))
+    arm = load_arm(res.behaviour.settings.robot)
+    return _sample(arm, res.behaviour, res.timeline, res.segments, rate)
+
+
+def _clock(total: float, rate: float) -> np.ndarray:
+    """Sample times at ``rate`` from 0, ending exactly at ``total`` (the motion's true
+    end, at rest): a last tick closer than half a period to the end is moved onto it."""
+    n = int(math.floor(total * rate + 1e-9)) + 1
+    t = np.arange(n) / rate
+    if total - t[-1] > 0.5 / rate:
+        return np.append(t, total)
+    if len(t) > 1:
+        t[-1] = total
+    return t
+
+
 def _sample(arm: ArmModel, b: Behaviour, tl: Timeline,
             segments: list[PathSegment | JointSegment], rate: float) -> Trajectory:
     """Sample the segments on one clock at ``rate``; the last sample is the end."""
+    if not segments:
+        raise AouError(diag("V124", "the behaviour has nothing to move or hold", b.span))
     bounds = np.concatenate([[0.0], np.cumsum([s.duration for s in segments])])
-    total = float(bounds[-1])
-    n = int(math.floor(total * rate + 1e-9)) + 1
-    t = np.arange(n) / rate
-    if total - t[-1] > 0.25 / rate:
-        t = np.append(t, total)
+    t = _clock(float(bounds[-1]), rate)
     q = np.empty((len(t), arm.n))
     qd = np.empty_like(q)
     qdd = np.empty_like(q)
-    idx = np.clip(np.searchsorted(bounds, t, side="right") - 1, 0, max(0, len(segments) - 1))
+    idx = np.clip(np.searchsorted(bounds, t, side="right") - 1, 0, len(segments) - 1)
     for k, seg in enumerate(segments):
         m = idx == k
         if m.any():
             q[m], qd[m], qdd[m] = seg.sample(t[m] - bounds[k])
-    if not segments:  # an empty behaviour: hold the start pose for one sample
-        raise ValueError("nothing to sample")
     spec = arm.spec
     goal = tuple(float(x) for x in (b.settings.goal or spec.goal))
     episodes = tuple((e.kind, float(bounds[i]), float(bounds[i + 1]))
                      for i, e in enumerate(tl.episodes))
-    return Trajectory(spec.name, spec.ee_frame, arm.joint_names, goal, t, q, qd, qdd, episodes)
+    return Trajectory(t, q, arm.joint_names, spec.name, spec.ee_frame, goal, qd, qdd,
+                      episodes, title=b.name)

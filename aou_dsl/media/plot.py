@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..cv import CANONICAL, CVPoint
+from ..trajectory import Trajectory
 
 __all__ = ["ProfileData", "cv_figure", "profile_data", "profile_figure", "save"]
 
@@ -45,9 +46,9 @@ class ProfileData:
     episodes: tuple[tuple[str, float, float], ...]
 
 
-def profile_data(rec, episodes=None, title: str = "") -> ProfileData:
-    """From a :class:`~aou_dsl.measure.recording.Recording`. Without ``episodes`` (a
-    recording), the episodes ``aouc measure`` finds are shaded."""
+def profile_data(rec: Trajectory) -> ProfileData:
+    """From a trajectory: its compiler episodes are shaded, or, for a recording, the
+    episodes ``aouc measure`` finds."""
     from ..kinematics import load_arm
 
     arm = load_arm(rec.robot, rec.ee_frame)
@@ -57,12 +58,13 @@ def profile_data(rec, episodes=None, title: str = "") -> ProfileData:
     pos, _ = arm.fk(q)
     speed = np.linalg.norm(np.gradient(pos, t, axis=0), axis=1)
     qd = np.gradient(q, t, axis=0)
-    if episodes is None:
-        from ..measure.descriptors import measure
+    episodes = rec.episodes
+    if not episodes:
+        from ..measuring.descriptors import measure
 
         episodes = tuple((e.kind, e.t_start + t[0], e.t_end + t[0])
                          for e in measure(rec).episodes)
-    return ProfileData(title, arm.joint_names, t, speed,
+    return ProfileData(rec.title, arm.joint_names, t, speed,
                        np.linalg.norm(np.asarray(rec.goal) - pos, axis=1), q, qd,
                        arm.lower, arm.upper, arm.vmax, tuple(episodes))
 
@@ -144,19 +146,14 @@ def cv_figure(points: list[tuple[str, CVPoint]]):
 
 
 def save(fig, path: str) -> None:
-    """Save to a temporary file beside ``path``, then rename (atomic)."""
-    import os
-    import tempfile
+    """Save atomically (a temporary file beside ``path``, then renamed).
 
-    fmt = os.path.splitext(path)[1].lstrip(".").lower() or "png"
-    fd, tmp = tempfile.mkstemp(prefix=".aouc-", suffix=f".{fmt}",
-                               dir=os.path.dirname(os.path.abspath(path)))
-    os.close(fd)
-    try:
+    Raises:
+        AouError: I502 when the folder is missing or the extension unknown.
+    """
+    from ..files import atomic, check_output
+
+    fmt = check_output(path, ("png", "svg", "pdf"))
+    with atomic(path) as tmp:
         fig.savefig(tmp, format=fmt, dpi=120, metadata={"Software": None}
                     if fmt == "png" else None)
-        os.chmod(tmp, 0o644)  # mkstemp makes files private; outputs are ordinary files
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)

@@ -10,12 +10,13 @@ display.
 from __future__ import annotations
 
 import math
-import os
 import sys
-import tempfile
 from dataclasses import dataclass
 
 import numpy as np
+
+from ..files import atomic
+from ..files import check_output as _check_output
 
 __all__ = ["Camera", "frame_times", "render_video"]
 
@@ -42,9 +43,11 @@ def frame_times(duration: float, fps: float) -> np.ndarray:
 
 
 def _frames(traj, camera: Camera, fps: float, scene_options, progress) -> list[np.ndarray]:
-    from ..check.scene import Scene
+    from ..robots import ROBOTS
+    from ..safety.scene import Scene
 
-    t, q = np.asarray(traj.t, float), np.asarray(traj.q, float)
+    t = np.asarray(traj.t, float)
+    q = np.asarray(traj.q, float)[:, traj.columns(ROBOTS[traj.robot].arm_joints)]
     goal = tuple(traj.goal)
     scene = Scene(traj.robot, goal, scene_options)
     pb, c = scene.pb, scene.client
@@ -119,11 +122,9 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
     Returns:
         ``{"frames": N, "fps": fps, "duration": seconds, "size": [w, h]}``.
     """
-    from ..check.scene import SceneOptions
+    from ..safety.scene import SceneOptions
 
-    fmt = os.path.splitext(path)[1].lower().lstrip(".")
-    if fmt not in ("mp4", "gif"):
-        raise ValueError(f"unknown video format `.{fmt}`: expected .mp4 or .gif")
+    fmt = check_output(path)
     # Import the encoder first: a missing one should fail before minutes of rendering.
     if fmt == "mp4":
         import imageio.v2 as imageio
@@ -139,10 +140,7 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
     n = max(len(c) for c in clips)
     frames = [np.concatenate([c[min(k, len(c) - 1)] for c in clips], axis=1)
               for k in range(n)]
-    fd, tmp = tempfile.mkstemp(prefix=".aouc-", suffix=f".{fmt}",
-                               dir=os.path.dirname(os.path.abspath(path)))
-    os.close(fd)
-    try:
+    with atomic(path) as tmp:
         if fmt == "mp4":
             with imageio.get_writer(tmp, format="FFMPEG", fps=fps, codec="libx264",
                                     quality=8, macro_block_size=8,
@@ -154,10 +152,10 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
             images = [Image.fromarray(f) for f in frames]
             images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:],
                            duration=[10 * d for d in cs], loop=0, optimize=False)
-        os.chmod(tmp, 0o644)  # mkstemp makes files private; outputs are ordinary files
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
     h, w = frames[0].shape[:2]
     return {"frames": n, "fps": fps, "duration": n / fps, "size": [w, h]}
+
+
+def check_output(path: str) -> str:
+    """Check a video path before rendering: .mp4 or .gif, in a folder that exists."""
+    return _check_output(path, ("mp4", "gif"))

@@ -22,11 +22,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..diagnostics import AouError, Span, diag
 from ..kinematics import load_arm
+from ..trajectory import Trajectory
 from .limits import Check, check_limits
 from .scene import Scene, SceneOptions
 
-__all__ = ["CheckReport", "replay", "replay_motion"]
+__all__ = ["CheckReport", "replay"]
 
 #: PyBullet and Pinocchio must agree on the end-effector pose within these.
 AGREE_POSITION = 1e-3  # m
@@ -112,57 +114,49 @@ def _angle_deg(r1: np.ndarray, r2: np.ndarray) -> float:
     return math.degrees(math.acos(max(-1.0, min(1.0, c))))
 
 
-def replay(robot: str, t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
-           goal: tuple[float, ...], *, options: SceneOptions | None = None,
+def replay(tr: Trajectory, *, options: SceneOptions | None = None,
            dynamic: bool = False) -> CheckReport:
-    """Check a trajectory of the robot's arm joints, shapes (N,) and (N, n).
+    """Check a trajectory (compiled or read from a file).
+
+    Velocities and accelerations the trajectory lacks are differentiated from its
+    positions; columns of joints the arm does not move are ignored.
 
     Args:
-        robot: a robot of :data:`aou_dsl.robots.ROBOTS`.
-        t, q, qd, qdd: times [s] and joint positions, velocities, accelerations.
-        goal: where the target cube stands [m].
+        tr: the trajectory; its goal is where the target cube stands.
         options: the scene (target size, table height).
         dynamic: also replay with physics (slower).
+
+    Raises:
+        AouError: R402 when the trajectory lacks a joint of the robot.
     """
-    arm = load_arm(robot)
+    arm = load_arm(tr.robot, tr.ee_frame)
+    missing = [n for n in arm.joint_names if n not in tr.joint_names]
+    if missing:
+        raise AouError(diag("R402", f"the trajectory lacks joint(s) {', '.join(missing)} of "
+                            f"robot `{tr.robot}`", Span.whole_file(tr.path), missing=missing))
+    cols = tr.columns(arm.joint_names)
+    t, q = tr.t, tr.q[:, cols]
+    if tr.qd is not None and tr.qdd is not None:
+        qd, qdd = tr.qd[:, cols], tr.qdd[:, cols]
+    else:
+        qd = np.gradient(q, t, axis=0)
+        qdd = np.gradient(qd, t, axis=0)
     checks = check_limits(arm, t, q, qd, qdd)
-    scene = _scene(robot, tuple(float(x) for x in goal), options or SceneOptions())
+    goal = tuple(float(x) for x in tr.goal) if tr.goal is not None else None
+    scene = _scene(tr.robot, goal, options or SceneOptions())
     kin_checks, clear, agree = _kinematic(scene, arm, t, q)
     checks += kin_checks
-    report = CheckReport(robot, checks, clear, agree)
+    report = CheckReport(tr.robot, checks, clear, agree)
     if dynamic:
         dyn_check, report.dynamic = _dynamic(scene, arm, t, q, qd)
         report.checks.append(dyn_check)
     return report
 
 
-def replay_motion(motion, *, options: SceneOptions | None = None,
-                  dynamic: bool = False) -> CheckReport:
-    """Check a :class:`~aou_dsl.build.Motion` (a compiled file or a trajectory file).
-    Velocities and accelerations the file lacks are differentiated from the positions."""
-    rec = motion.recording
-    arm = load_arm(rec.robot, rec.ee_frame)
-    missing = [n for n in arm.joint_names if n not in rec.joint_names]
-    if missing:
-        from ..diagnostics import AouError, Span, diag
-
-        raise AouError(diag("R402", f"the trajectory lacks joint(s) {', '.join(missing)} of "
-                            f"robot `{rec.robot}`", Span.whole_file(rec.path),
-                            missing=missing))
-    cols = [rec.joint_names.index(n) for n in arm.joint_names]
-    t, q = rec.t, rec.q[:, cols]
-    if motion.qd is not None and motion.qdd is not None:
-        qd, qdd = motion.qd[:, cols], motion.qdd[:, cols]
-    else:
-        qd = np.gradient(q, t, axis=0)
-        qdd = np.gradient(qd, t, axis=0)
-    return replay(rec.robot, t, q, qd, qdd, rec.goal, options=options, dynamic=dynamic)
-
-
 _SCENES: dict = {}
 
 
-def _scene(robot: str, goal: tuple[float, ...], options: SceneOptions) -> Scene:
+def _scene(robot: str, goal: tuple[float, ...] | None, options: SceneOptions) -> Scene:
     """A scene per robot, goal and options, kept: loading the URDF is the slow part.
     Each replay sets the joint states and physics settings it relies on."""
     key = (robot, goal, options)

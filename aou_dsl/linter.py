@@ -9,21 +9,17 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .cv import CANONICAL, DEFAULT_WEIGHTS, CVPoint, CVWeights, composition_of, effort_to_cv, infer
+from .cv import CANONICAL, DEFAULT_WEIGHTS, CVPoint, CVWeights, composition, effort_to_cv, infer
+from .descriptors import REGISTRY
 from .diagnostics import AouError, Diagnostic, Severity, Span, diag, has_errors
-from .ir import Behaviour, State
+from .ir import Behaviour
+from .layout import episode_values, nominal_values
 from .parse import parse
-from .validate import validate
+from .timeline import Timeline
+from .validate import Validated, validate_tree
 
-__all__ = ["FileResult", "collect_files", "lint_file", "lint_paths", "lint_source", "load"]
-
-#: MODEL.md s7: descriptors with no clear perceived effect, per state, and the statement
-#: (primitive kind) that sets each.
-NO_EFFECT: dict[State, tuple[tuple[str, str], ...]] = {
-    State.CURIOUS: (("pause_duration", "pause"), ("tilt_velocity", "tilt")),
-    State.HESITANT: (("tilt_angle", "tilt"), ("retreat_acceleration", "retreat")),
-    State.FEARFUL: (("shiver_amplitude", "shiver"), ("retreat_acceleration", "retreat")),
-}
+__all__ = ["FileResult", "collect_files", "collect_inputs", "lint_file", "lint_paths",
+           "lint_source", "load", "read_source", "severity_counts"]
 
 
 @dataclass
@@ -35,6 +31,7 @@ class FileResult:
     behaviour: Behaviour | None = None
     cv: CVPoint | None = None
     source: str | None = None
+    timeline: Timeline | None = None
 
     @property
     def ok(self) -> bool:
@@ -51,9 +48,18 @@ class FileResult:
         }
 
 
-def _model_checks(b: Behaviour, weights: CVWeights) -> tuple[CVPoint, list[Diagnostic]]:
+def behaviour_cv(b: Behaviour, timeline: Timeline | None) -> tuple[CVPoint, list]:
+    """The C-V point a behaviour expresses, from what its episodes do (a sequence's
+    negative approach is a retreat), and each evidence channel's pull."""
+    values = episode_values(timeline.episodes) if b.form == "sequence" and timeline \
+        else nominal_values(b)
+    return infer(composition(values))
+
+
+def _model_checks(b: Behaviour, timeline: Timeline | None, weights: CVWeights
+                  ) -> tuple[CVPoint, list[Diagnostic]]:
     out: list[Diagnostic] = []
-    point, contributions = infer(composition_of(b))
+    point, contributions = behaviour_cv(b, timeline)
     inferred = point.state
     where = b.header_span or (b.primitives[0].span if b.primitives else b.span)
     if b.state is None:
@@ -86,67 +92,40 @@ def _model_checks(b: Behaviour, weights: CVWeights) -> tuple[CVPoint, list[Diagn
                 C=ep.C, V=ep.V,
             ))
     state = b.state or inferred
-    for descriptor, kind in NO_EFFECT.get(state, ()):
-        for p in b.primitives:
-            if p.kind == kind:
-                out.append(diag(
-                    "M203", f"the study found no clear perceived effect of {descriptor} on "
-                    f"how {state} a motion looks (MODEL.md s7)", p.span,
-                    descriptor=descriptor, state=state.value))
-                break
+    kinds = {p.kind for p in b.primitives if p.count}
+    for name, d in REGISTRY.items():
+        if state in d.no_effect and d.kind in kinds:
+            p = next(p for p in b.primitives if p.kind == d.kind)
+            out.append(diag("M203", f"the study found no clear perceived effect of {name} on "
+                            f"how {state} a motion looks", p.span, descriptor=name,
+                            state=state.value))
     return point, out
 
 
-def _realisable(b: Behaviour) -> list[Diagnostic]:
-    """A descriptor-form file whose layout cannot show what it declares (V121): a gaze is
-    measured at the pause that ends it, a retreat between two pauses, and two pauses
-    with nothing moving between them are one pause."""
-    from .compiler.layout import layout
-    from .declared import declared_descriptors, timeline_descriptors
-
-    if b.form != "descriptor":
-        return []
-    want = declared_descriptors(b)
-    got = timeline_descriptors(layout(b).episodes)
-    out = []
-    for key, kind in (("pause_count", "pause"), ("retreat_count", "retreat")):
-        if want[key] != got[key]:
-            prim = b.first(kind)
-            out.append(diag("V121", f"{want[key]} {kind}s are declared but the layout can "
-                            f"only show {got[key]}", prim.span if prim else b.span,
-                            hint="pauses need motion between them (an approach, a retreat, "
-                            "a gaze...); each retreat and each gaze needs a pause after it",
-                            declared=want[key], realised=got[key]))
-    for plane in ("horizontal", "vertical"):
-        key = f"{plane}_gaze"
-        if want[key] is not None and got[key] is None:
-            g = b.first("gaze", plane)
-            out.append(diag("V121", f"the {plane} gaze is measured at the pause that ends it, "
-                            "and no pause is left for it", g.span if g else b.span,
-                            hint="add a pause per gaze episode (beyond those the retreats "
-                            "need)"))
-    return out
-
-
-def load(text: str, path: str = "<string>") -> tuple[Behaviour | None, list[Diagnostic]]:
-    """Parse and validate; the first two stages, without the model's judgement."""
+def load_validated(text: str, path: str = "<string>") -> Validated:
+    """Parse and validate: the front end, without the model's judgement."""
     try:
         tree = parse(text, path)
     except AouError as err:
-        return None, err.diagnostics
-    return validate(tree)
+        return Validated(None, None, err.diagnostics)
+    return validate_tree(tree)
+
+
+def load(text: str, path: str = "<string>") -> tuple[Behaviour | None, list[Diagnostic]]:
+    """Parse and validate; the behaviour (None on errors) and the diagnostics."""
+    v = load_validated(text, path)
+    return v.behaviour, v.diagnostics
 
 
 def lint_source(text: str, path: str = "<string>", *,
                 weights: CVWeights = DEFAULT_WEIGHTS) -> FileResult:
     """Lint ``.aou`` source text."""
-    behaviour, diags = load(text, path)
-    result = FileResult(path, list(diags), source=text)
-    if behaviour is not None:
-        result.diagnostics.extend(_realisable(behaviour))
-    if behaviour is not None and not has_errors(result.diagnostics):
-        point, model_diags = _model_checks(behaviour, weights)
-        result.behaviour, result.cv = behaviour, point
+    v = load_validated(text, path)
+    result = FileResult(path, list(v.diagnostics), source=text)
+    b = v.behaviour
+    if b is not None and not has_errors(result.diagnostics):
+        point, model_diags = _model_checks(b, v.timeline, weights)
+        result.behaviour, result.cv, result.timeline = b, point, v.timeline
         result.diagnostics.extend(model_diags)
     result.diagnostics.sort(key=lambda d: (d.span.line, d.span.col, d.code))
     return result
@@ -171,9 +150,10 @@ def lint_file(path: str, *, weights: CVWeights = DEFAULT_WEIGHTS) -> FileResult:
     return lint_source(text, path, weights=weights)
 
 
-def collect_files(paths: list[str]) -> tuple[list[str], list[Diagnostic]]:
-    """Expand folders recursively into their ``.aou`` files, sorted; report bad paths."""
-    files: list[str] = []
+def collect_inputs(paths: list[str]) -> tuple[list[tuple[str, str | None]], list[Diagnostic]]:
+    """Expand folders recursively into their ``.aou`` files, sorted; report bad paths.
+    Each file comes with the folder it was found in (None when named directly)."""
+    files: list[tuple[str, str | None]] = []
     problems: list[Diagnostic] = []
     for p in paths:
         if os.path.isdir(p):
@@ -181,13 +161,19 @@ def collect_files(paths: list[str]) -> tuple[list[str], list[Diagnostic]]:
             if not found:
                 problems.append(diag("I503", f"no `.aou` files in folder `{p}`",
                                      Span.whole_file(p)))
-            files.extend(found)
+            files.extend((f, p) for f in found)
         elif os.path.exists(p):
-            files.append(p)
+            files.append((p, None))
         else:
             problems.append(diag("I501", f"cannot read `{p}`: no such file or folder",
                                  Span.whole_file(p)))
     return files, problems
+
+
+def collect_files(paths: list[str]) -> tuple[list[str], list[Diagnostic]]:
+    """:func:`collect_inputs` without the folders."""
+    files, problems = collect_inputs(paths)
+    return [f for f, _ in files], problems
 
 
 def lint_paths(paths: list[str], *, weights: CVWeights = DEFAULT_WEIGHTS

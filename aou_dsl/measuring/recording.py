@@ -1,8 +1,10 @@
-"""Reading joint trajectories for ``aouc measure``: aou's JSON or a CSV recording.
+"""Reading joint trajectories: aou's JSON or a CSV recording, as a
+:class:`~aou_dsl.trajectory.Trajectory`.
 
-A :class:`Recording` holds only what MODEL.md s5 needs: times, joint positions by joint
-name, the robot, its end-effector frame and the goal. Nothing of the compiler's
-timeline or declared values is read, so recordings of real arms measure the same way.
+What measuring needs is times, joint positions by joint name, the robot, its
+end-effector frame and the goal. The compiler's timeline and declared values are read
+only for plots and replays, never for measuring, so recordings of real arms measure
+the same way as compiled trajectories.
 """
 
 from __future__ import annotations
@@ -10,36 +12,14 @@ from __future__ import annotations
 import csv
 import json
 import math
-from dataclasses import dataclass
+import os
 
 import numpy as np
 
 from ..diagnostics import AouError, Span, diag
+from ..trajectory import Trajectory
 
-__all__ = ["Recording", "read_csv", "read_json", "read_recording"]
-
-
-@dataclass(frozen=True)
-class Recording:
-    """A joint trajectory to measure.
-
-    Attributes:
-        t: sample times [s], shape (N,), strictly increasing.
-        q: joint positions [rad or m], shape (N, J), one column per ``joint_names``.
-        joint_names: the columns' joint names (may include joints aou does not use).
-        robot: example-robot-data name.
-        ee_frame: end-effector frame, or None for the robot's default.
-        goal: goal position in the base frame [m], shape (3,).
-        path: where it was read from (for diagnostics).
-    """
-
-    t: np.ndarray
-    q: np.ndarray
-    joint_names: tuple[str, ...]
-    robot: str
-    ee_frame: str | None
-    goal: tuple[float, ...]
-    path: str = "<memory>"
+__all__ = ["read_csv", "read_json", "read_recording"]
 
 
 def _bad(path: str, message: str, hint: str | None = None, **fields) -> AouError:
@@ -70,8 +50,23 @@ def _check_arrays(path: str, t: np.ndarray, q: np.ndarray, names: tuple[str, ...
         raise _bad(path, "a joint name appears twice among the columns")
 
 
-def read_json(path: str, text: str) -> Recording:
-    """An ``aou-trajectory/1`` document (LANGUAGE.md)."""
+def _optional(doc: dict, q: np.ndarray) -> dict:
+    """The velocities, accelerations and episodes a compiled file carries, when sound."""
+    out: dict = {}
+    try:
+        qd = np.asarray(doc.get("qd", []), dtype=float)
+        qdd = np.asarray(doc.get("qdd", []), dtype=float)
+        if qd.shape == q.shape and qdd.shape == q.shape:
+            out["qd"], out["qdd"] = qd, qdd
+        out["episodes"] = tuple((str(e["kind"]), float(e["t_start"]), float(e["t_end"]))
+                                for e in doc.get("episodes") or ())
+    except (TypeError, ValueError, KeyError):
+        return {}  # malformed extras: measure from q alone
+    return out
+
+
+def read_json(path: str, text: str) -> Trajectory:
+    """An ``aou-trajectory/1`` document."""
     try:
         doc = json.loads(text)
     except json.JSONDecodeError as exc:
@@ -95,11 +90,13 @@ def read_json(path: str, text: str) -> Recording:
     if len(goal) != 3:
         raise _bad(path, "`goal.position` must have 3 coordinates")
     _check_arrays(path, t, q, names)
-    return Recording(t, q, names, str(doc["robot"]), doc.get("ee_frame"), goal, path)
+    title = str(doc.get("behaviour") or os.path.splitext(os.path.basename(path))[0])
+    return Trajectory(t, q, names, str(doc["robot"]), doc.get("ee_frame"), goal,
+                      path=path, title=title, **_optional(doc, q))
 
 
 def read_csv(path: str, text: str, robot: str, goal: tuple[float, float, float] | None,
-             ee_frame: str | None) -> Recording:
+             ee_frame: str | None) -> Trajectory:
     """A CSV with a header row: ``t`` then one column per joint name."""
     rows = list(csv.reader(text.splitlines()))
     rows = [r for r in rows if r and not r[0].startswith("#")]
@@ -129,12 +126,14 @@ def read_csv(path: str, text: str, robot: str, goal: tuple[float, float, float] 
         goal = spec.goal
     names = tuple(header[1:])
     _check_arrays(path, values[:, 0], values[:, 1:], names)
-    return Recording(values[:, 0], values[:, 1:], names, robot, ee_frame, tuple(goal), path)
+    title = os.path.splitext(os.path.basename(path))[0]
+    return Trajectory(values[:, 0], values[:, 1:], names, robot, ee_frame, tuple(goal),
+                      path=path, title=title)
 
 
 def read_recording(path: str, *, robot: str | None = None,
                    goal: tuple[float, float, float] | None = None,
-                   ee_frame: str | None = None) -> Recording:
+                   ee_frame: str | None = None) -> Trajectory:
     """Read a ``.json`` trajectory or a ``.csv`` recording (which needs ``robot``)."""
     try:
         with open(path, encoding="utf-8") as fh:
@@ -150,6 +149,6 @@ def read_recording(path: str, *, robot: str | None = None,
         return read_csv(path, text, robot, goal, ee_frame)
     rec = read_json(path, text)
     if goal is not None or ee_frame is not None or robot is not None:
-        rec = Recording(rec.t, rec.q, rec.joint_names, robot or rec.robot,
-                        ee_frame or rec.ee_frame, tuple(goal) if goal else rec.goal, path)
+        rec = rec.with_(robot=robot or rec.robot, ee_frame=ee_frame or rec.ee_frame,
+                        goal=tuple(goal) if goal else rec.goal)
     return rec

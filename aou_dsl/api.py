@@ -1,0 +1,109 @@
+"""The Python API: lint, compile, check and measure, each returning records.
+
+Everything ``aouc`` does goes through these functions; the command line only parses
+arguments, calls them, prints and maps exit codes. A problem of the input is never an
+exception from ``lint`` or ``compile``: it is a diagnostic in the result. ``check`` and
+``measure`` raise :class:`~aou_dsl.diagnostics.AouError` (with its diagnostics) when
+their input cannot be read.
+
+Example::
+
+    import aou_dsl
+
+    build = aou_dsl.compile("behaviours/hesitant.aou")
+    if build.ok:
+        print(build.measured.descriptors["pause_count"])   # 5
+        trajectory = build.trajectory                       # t, q, qd, qdd, joint_names
+"""
+
+from __future__ import annotations
+
+import os
+from typing import TYPE_CHECKING, Any
+
+from .build import BuildResult, build_file, build_source
+from .linter import FileResult, lint_file, lint_paths, lint_source
+
+if TYPE_CHECKING:
+    from .measuring.descriptors import Measured
+    from .safety.replay import CheckReport
+    from .trajectory import Trajectory
+
+__all__ = ["check", "compile", "lint", "lint_paths", "measure", "read_trajectory"]
+
+Source = str | os.PathLike
+
+
+def lint(path: Source | None = None, *, source: str | None = None) -> FileResult:
+    """Lint a ``.aou`` file (``path``) or source text (``source``; ``path`` then only
+    names it in diagnostics)."""
+    if source is not None:
+        return lint_source(source, os.fspath(path) if path is not None else "<string>")
+    if path is None:
+        raise TypeError("lint() needs a path or source=")
+    return lint_file(os.fspath(path))
+
+
+def compile(path: Source | None = None, *, source: str | None = None,  # noqa: A001
+            robot: str | None = None, rate: float | None = None, check: bool = True,
+            target_size: float = 0.05, table_height: float | None = 0.0) -> BuildResult:
+    """Lint, compile, check and measure one behaviour.
+
+    Args:
+        path: a ``.aou`` file; or ``source`` text.
+        robot: overrides the file's ``robot`` line.
+        rate: output sample rate [Hz] (default 250).
+        check: run the safety replay (a trajectory that fails it has no document).
+        target_size, table_height: the scene the checks use [m] (None: no table).
+
+    Returns:
+        A :class:`~aou_dsl.build.BuildResult`: ``ok``, ``diagnostics``, ``trajectory``,
+        ``declared`` and ``measured`` descriptors, the output ``document``.
+    """
+    from .safety.scene import SceneOptions
+
+    scene = SceneOptions(target_size=target_size, table_height=table_height)
+    options: dict[str, Any] = {"robot": robot, "rate": rate, "check": check, "scene": scene}
+    if source is not None:
+        return build_source(source, os.fspath(path) if path is not None else "<string>",
+                            **options)
+    if path is None:
+        raise TypeError("compile() needs a path or source=")
+    return build_file(os.fspath(path), **options)
+
+
+def read_trajectory(path: Source, *, robot: str | None = None,
+                    goal: tuple[float, float, float] | None = None,
+                    ee_frame: str | None = None) -> Trajectory:
+    """A trajectory from a file: aou's JSON, or a CSV recording (which needs ``robot``);
+    a ``.aou`` file is compiled. ``goal`` and ``ee_frame`` override the file's."""
+    from .build import load_motion
+
+    return load_motion(os.fspath(path), robot=robot, goal=goal, ee_frame=ee_frame)
+
+
+def _trajectory(what: Trajectory | Source, **options: Any) -> Trajectory:
+    from .trajectory import Trajectory
+
+    return what if isinstance(what, Trajectory) else read_trajectory(what, **options)
+
+
+def measure(what: Trajectory | Source, **options: Any) -> Measured:
+    """The eleven descriptors of a trajectory (or of a file, read with
+    :func:`read_trajectory`'s ``options``), its episodes and its C-V point."""
+    from .measuring.descriptors import measure as measure_trajectory
+
+    return measure_trajectory(_trajectory(what, **options))
+
+
+def check(what: Trajectory | Source, *, dynamic: bool = True, target_size: float = 0.05,
+          table_height: float | None = 0.0, **options: Any) -> CheckReport:
+    """The safety replay of a trajectory (or a file) in PyBullet: limits, collisions,
+    contacts, kinematics agreement and, with ``dynamic``, torques under physics."""
+    from .safety.replay import replay
+    from .safety.scene import SceneOptions
+
+    scene = SceneOptions(target_size=target_size, table_height=table_height)
+    return replay(_trajectory(what, **options), options=scene, dynamic=dynamic)
+
+

@@ -1,0 +1,284 @@
+"""The eleven expressive descriptors: one table, and one way to derive them from episodes.
+
+Everything else in aou reads :data:`REGISTRY`: the declared side (a file's values, or the
+timeline the layout makes of it), the measured side (``aouc measure``), reports, study
+variants, the C-V inference and synthesis. A descriptor is defined by the episodes it is
+read from and how their values aggregate (docs/model.md, "Descriptors"):
+
+- counts are the number of qualifying episodes;
+- durations, distances, tilt angles and velocities are the median over episodes;
+- peaks (accelerations, shiver amplitude) are the maximum;
+- a gaze is the largest angle from the initial line of sight reached at the pause that
+  ends a gaze episode (a look that comes back is still the look).
+
+Which episodes qualify is decided once, by :func:`qualify`: two pauses with nothing
+moving between them are one pause, a retreat counts when it starts and ends at a pause,
+a gaze when a pause ends it. The declared timeline and the measured motion go through
+the same two functions, so they can only disagree when the motion does.
+
+Pure Python: no numerical imports.
+"""
+
+from __future__ import annotations
+
+import enum
+import statistics
+from collections.abc import Iterable, Iterator, Mapping
+from dataclasses import dataclass, field, replace
+
+from .ir import State
+
+__all__ = [
+    "REGISTRY",
+    "Aggregate",
+    "Descriptor",
+    "Descriptors",
+    "EpisodeValues",
+    "Mismatch",
+    "compare",
+    "derive",
+    "qualify",
+]
+
+
+class Aggregate(enum.StrEnum):
+    """How the values of several episodes make one descriptor."""
+
+    COUNT = "count"
+    MEDIAN = "median"
+    MAX = "max"
+
+
+@dataclass(frozen=True, slots=True)
+class Descriptor:
+    """One row of the table.
+
+    Attributes:
+        name: the name used in files, output and the API.
+        unit: the unit values are given in (``""`` for counts).
+        kind: the primitive kind whose episodes it is read from.
+        key: the episode value it aggregates (unused for counts).
+        aggregate: how episodes combine.
+        field: the field of the kind's IR node that sets it in the descriptor form, and
+            ``scale``, the factor from the descriptor's unit to the IR's (degrees to
+            radians); ``count`` for counts.
+        rel_tol, abs_tol: a measured value matches a declared ``x`` within
+            ``max(abs_tol, rel_tol * |x|)``.
+        stronger: Part B of the study: states perceived more strongly as the value rises
+            (+1) or falls (-1).
+        no_effect: states on which the study found no clear perceived effect.
+    """
+
+    name: str
+    unit: str
+    kind: str
+    key: str
+    aggregate: Aggregate
+    field: str
+    scale: float = 1.0
+    rel_tol: float = 0.0
+    abs_tol: float = 0.0
+    stronger: Mapping[State, int] = field(default_factory=dict)
+    no_effect: tuple[State, ...] = ()
+
+    @property
+    def is_count(self) -> bool:
+        return self.aggregate is Aggregate.COUNT
+
+    def tolerance(self, declared: float) -> float:
+        """How far a measured value may be from ``declared`` and still match it."""
+        return max(self.abs_tol, self.rel_tol * abs(declared))
+
+    def matches(self, declared: float | None, measured: float | None) -> bool:
+        if declared is None or measured is None:
+            return declared is None and measured is None
+        return abs(measured - declared) <= self.tolerance(declared) + 1e-12
+
+
+_DEG = 0.017453292519943295  # radians per degree
+_C, _Cu, _H, _F = State.CONFIDENT, State.CURIOUS, State.HESITANT, State.FEARFUL
+_COUNT, _MEDIAN, _MAX = Aggregate.COUNT, Aggregate.MEDIAN, Aggregate.MAX
+
+#: The eleven descriptors, in the order they are reported. Tolerances: counts exactly,
+#: durations 2 % or 20 ms, distances 1 mm, angles 0.5 deg, accelerations 3 %, angular
+#: velocities 2 % or 0.5 deg/s.
+REGISTRY: dict[str, Descriptor] = {d.name: d for d in (
+    Descriptor("approach_acceleration", "m/s^2", "approach", "peak_acceleration", _MAX, "a",
+               rel_tol=0.03, stronger={_C: +1, _Cu: +1, _H: -1, _F: -1}),
+    Descriptor("pause_count", "", "pause", "", _COUNT, "count", stronger={_F: +1}),
+    Descriptor("pause_duration", "s", "pause", "duration", _MEDIAN, "duration",
+               rel_tol=0.02, abs_tol=0.02, stronger={_C: -1, _H: +1, _F: +1},
+               no_effect=(_Cu,)),
+    Descriptor("retreat_count", "", "retreat", "", _COUNT, "count",
+               stronger={_H: +1, _F: +1}),
+    Descriptor("retreat_distance", "m", "retreat", "distance", _MEDIAN, "length",
+               abs_tol=1e-3, stronger={_H: +1}),
+    Descriptor("retreat_acceleration", "m/s^2", "retreat", "peak_acceleration", _MAX, "a",
+               rel_tol=0.03, no_effect=(_H, _F)),
+    Descriptor("horizontal_gaze", "deg", "gaze", "horizontal", _MAX, "angle", _DEG,
+               abs_tol=0.5, stronger={_Cu: +1}),
+    Descriptor("vertical_gaze", "deg", "gaze", "vertical", _MAX, "angle", _DEG,
+               abs_tol=0.5, stronger={_Cu: +1}),
+    Descriptor("tilt_angle", "deg", "tilt", "angle", _MEDIAN, "angle", _DEG, abs_tol=0.5,
+               stronger={_Cu: +1}, no_effect=(_H,)),
+    Descriptor("tilt_velocity", "deg/s", "tilt", "velocity", _MEDIAN, "v", _DEG,
+               rel_tol=0.02, abs_tol=0.5, no_effect=(_Cu,)),
+    Descriptor("shiver_amplitude", "deg", "shiver", "amplitude", _MAX, "amplitude", _DEG,
+               abs_tol=0.5, no_effect=(_F,)),
+)}
+
+
+class Descriptors(Mapping[str, float | int | None]):
+    """The eleven values of one behaviour or trajectory, frozen; ``None`` for an absent
+    primitive. A mapping from name to value, in :data:`REGISTRY`'s order."""
+
+    __slots__ = ("_values",)
+
+    def __init__(self, values: Mapping[str, float | int | None] | None = None, **kw):
+        given = dict(values or {}, **kw)
+        unknown = set(given) - set(REGISTRY)
+        if unknown:
+            raise KeyError(f"unknown descriptor(s): {', '.join(sorted(unknown))}")
+        self._values = tuple(given.get(name) for name in REGISTRY)
+
+    def __getitem__(self, name: str) -> float | int | None:
+        return self._values[list(REGISTRY).index(name)]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(REGISTRY)
+
+    def __len__(self) -> int:
+        return len(REGISTRY)
+
+    def __hash__(self) -> int:
+        return hash(self._values)
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, Descriptors):
+            return self._values == other._values
+        return isinstance(other, Mapping) and dict(self) == dict(other)
+
+    def __repr__(self) -> str:
+        shown = ", ".join(f"{k}={v!r}" for k, v in self.items() if v is not None)
+        return f"Descriptors({shown})"
+
+    def to_json(self, digits: int = 6) -> dict[str, float | int | None]:
+        return {k: (round(v, digits) if isinstance(v, float) else v) for k, v in self.items()}
+
+
+@dataclass(frozen=True, slots=True)
+class EpisodeValues:
+    """One episode as the descriptors see it: its kind, when it ran, and its values.
+
+    ``values`` keys are the :attr:`Descriptor.key` of the kind's descriptors (e.g. a
+    retreat's ``distance`` [m] and ``peak_acceleration`` [m/s^2], a gaze's
+    ``horizontal`` and ``vertical`` angle from the initial line of sight [deg] at its
+    end, only for the planes it moved in). ``counts`` is set by :func:`qualify`.
+    """
+
+    kind: str
+    t_start: float = 0.0
+    t_end: float = 0.0
+    values: Mapping[str, float] = field(default_factory=dict)
+    counts: bool = True
+
+    @property
+    def duration(self) -> float:
+        return self.t_end - self.t_start
+
+    def to_json(self) -> dict:
+        return {"kind": self.kind, "t_start": round(self.t_start, 4),
+                "t_end": round(self.t_end, 4), "counts": self.counts,
+                **{k: round(v, 6) for k, v in self.values.items()}}
+
+
+#: Kinds that must sit between two pauses (before and after) to count, and kinds that
+#: must be followed by one.
+_BETWEEN_PAUSES = frozenset({"retreat"})
+_ENDS_AT_PAUSE = frozenset({"gaze"})
+
+
+def qualify(episodes: Iterable[EpisodeValues]) -> list[EpisodeValues]:
+    """The episodes as the definitions read them: touching pauses merged into one (their
+    durations added), and every episode marked whether it counts."""
+    merged: list[EpisodeValues] = []
+    for e in episodes:
+        last = merged[-1] if merged else None
+        if e.kind == "pause" and last is not None and last.kind == "pause":
+            duration = last.values.get("duration", 0.0) + e.values.get("duration", 0.0)
+            merged[-1] = replace(last, t_end=e.t_end, values={"duration": duration})
+        else:
+            merged.append(e)
+    out = []
+    for i, e in enumerate(merged):
+        before = i > 0 and merged[i - 1].kind == "pause"
+        after = i + 1 < len(merged) and merged[i + 1].kind == "pause"
+        if e.kind in _BETWEEN_PAUSES:
+            e = replace(e, counts=before and after)
+        elif e.kind in _ENDS_AT_PAUSE:
+            e = replace(e, counts=after)
+        out.append(e)
+    return out
+
+
+def _aggregate(d: Descriptor, episodes: list[EpisodeValues]) -> float | int | None:
+    mine = [e for e in episodes if e.kind == d.kind and e.counts]
+    if d.is_count:
+        return len(mine)
+    values = [e.values[d.key] for e in mine if d.key in e.values]
+    if not values:
+        return None
+    if d.aggregate is Aggregate.MAX:
+        return max(values)
+    return float(statistics.median(values))
+
+
+def derive(episodes: Iterable[EpisodeValues]) -> Descriptors:
+    """The eleven descriptors of a list of episodes, in time order: declared (a laid-out
+    timeline) and measured (episodes found in a trajectory) alike."""
+    eps = qualify(episodes)
+    return Descriptors({name: _aggregate(d, eps) for name, d in REGISTRY.items()})
+
+
+def spread(episodes: Iterable[EpisodeValues]) -> dict[str, list[float]]:
+    """Per non-count descriptor, the values of the episodes it aggregates (for reports
+    of unequal episodes)."""
+    eps = qualify(episodes)
+    out: dict[str, list[float]] = {}
+    for name, d in REGISTRY.items():
+        if not d.is_count:
+            vals = [e.values[d.key] for e in eps
+                    if e.kind == d.kind and e.counts and d.key in e.values]
+            if vals:
+                out[name] = vals
+    return out
+
+
+@dataclass(frozen=True, slots=True)
+class Mismatch:
+    """A descriptor whose measured value misses the declared one."""
+
+    name: str
+    declared: float | int | None
+    measured: float | int | None
+
+
+def compare(declared: Mapping[str, float | int | None],
+            measured: Mapping[str, float | int | None]) -> list[Mismatch]:
+    """The descriptors whose measured value misses the declared one by more than its
+    tolerance. Absent must be measured absent, and present present; a count of zero and
+    an absent count are the same."""
+    out = []
+    for name, d in REGISTRY.items():
+        want, got = declared.get(name), measured.get(name)
+        if d.is_count:
+            want, got = want or 0, got or 0
+        if not d.matches(want, got):
+            out.append(Mismatch(name, want, got))
+    return out
+
+
+def for_kind(kind: str, plane: str | None = None) -> list[Descriptor]:
+    """The descriptors a primitive kind sets (a gaze: those of its plane)."""
+    return [d for d in REGISTRY.values()
+            if d.kind == kind and (plane is None or d.key in (plane, "") or d.kind != "gaze")]

@@ -1,0 +1,232 @@
+"""Layout: a behaviour -> a timeline of episodes (pure Python, no heavy imports).
+
+A sequence is laid out as written. The descriptor form is laid out in three steps
+(docs/compiler.md has the rules with a table per state):
+
+1. *Stops*: the episodes that are not approaches, grouped. Gaze episodes alternate
+   +angle, -angle (horizontal first, then vertical), tilts join gaze stops (before the
+   gaze) and shivers retreat stops; retreats form clusters (``R R`` when pauses are
+   scarce), and pauses left over after the end's hold become stops of their own. The
+   stops are ordered by the state's composition.
+2. *Motion*: an approach piece leads to each stop and a last one to the standoff; each
+   wins back the last withdrawal and makes an equal share of the net progress, so the
+   reach never gets closer than the standoff and ends there.
+3. *Pauses* go into the gaps between motion episodes: first those the definitions need
+   (after every gaze, before and after every retreat), then the pause stops, the hold at
+   the end, then any gap left, the start last. Two pauses never touch: they would read
+   as one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from .cv import composition, infer
+from .descriptors import EpisodeValues
+from .ir import Behaviour, State
+from .primitives import KINDS, Approach
+from .primitives.approach import translation
+from .timeline import Episode, Pose, Timeline
+
+__all__ = ["STOP_ORDER", "episode_values", "layout", "nominal_values"]
+
+#: Which kinds of stop come first along the reach, by state (the composition of each
+#: state: docs/model.md).
+STOP_ORDER: dict[State, tuple[str, ...]] = {
+    State.CONFIDENT: ("pause", "gaze", "tilt", "retreat", "shiver"),
+    State.CURIOUS: ("gaze", "tilt", "pause", "retreat", "shiver"),
+    State.HESITANT: ("retreat", "pause", "shiver", "gaze", "tilt"),
+    State.FEARFUL: ("retreat", "shiver", "pause", "gaze", "tilt"),
+    State.INACTIVE: ("pause", "shiver", "tilt", "gaze", "retreat"),
+}
+
+
+# --- the sequence form ----------------------------------------------------------------------
+
+
+def _sequence(b: Behaviour) -> list[Episode]:
+    s = b.settings
+    pose = Pose(s.start)
+    out: list[Episode] = []
+    for p in b.primitives:
+        for _ in range(p.count):
+            ep = _sequence_episode(p, pose, s.standoff)
+            if ep.moving and ep.path_length == 0.0 and ep.kind != "shiver":
+                continue  # nothing moves (e.g. an approach already at the standoff)
+            out.append(ep)
+            pose = ep.end
+    return out
+
+
+def _sequence_episode(p: Any, pose: Pose, standoff: float) -> Episode:
+    if isinstance(p, Approach):
+        d = standoff if p.length is None else pose.d - p.length
+        return translation(p, p.span, pose, d)
+    kind: Any = KINDS[p.kind]
+    if p.kind == "gaze":
+        return kind.episode(p, pose, p.angle)
+    if p.kind == "tilt":
+        return kind.episode(p, pose, p.angle)
+    return kind.episode(p, pose)
+
+
+# --- the descriptor form --------------------------------------------------------------------
+
+
+@dataclass
+class _Stop:
+    """A group of non-approach episodes at one place of the reach.
+
+    ``items`` are ``(node, arg)``: ``arg`` is a gaze's plane angle or a tilt's roll
+    [rad], else None.
+    """
+
+    kind: str
+    items: list[tuple[Any, float | None]] = field(default_factory=list)
+
+
+def _split(n: int, k: int) -> list[int]:
+    """``n`` split into ``k`` near-equal parts, larger first."""
+    return [n // k + (1 if i < n % k else 0) for i in range(k)]
+
+
+def _count(node: Any) -> int:
+    return node.count if node is not None else 0
+
+
+def _gazes(b: Behaviour) -> list[tuple[Any, float]]:
+    out = []
+    for plane in ("horizontal", "vertical"):
+        g = b.first("gaze", plane)
+        out += [(g, g.angle if i % 2 == 0 else -g.angle) for i in range(_count(g))]
+    return out
+
+
+@dataclass
+class _Plan:
+    stops: list[_Stop]
+    pause_stops: int
+    end_hold: bool
+
+
+def _plan(b: Behaviour, has_approach: bool) -> _Plan:
+    """The stops, and how the pauses left after the required ones are used."""
+    n_p, n_r = _count(b.first("pause")), _count(b.first("retreat"))
+    retreat, tilt, shiver = b.first("retreat"), b.first("tilt"), b.first("shiver")
+    gazes = _gazes(b)
+    need_r = n_r + 1 if n_r else 0
+    spare = n_p - need_r - min(len(gazes), max(0, n_p - need_r))
+    clusters = 1 + min(n_r - 1, max(0, spare)) if n_r else 0
+    spare -= max(0, clusters - 1)
+    stops = [_Stop("gaze", [(g, angle)]) for g, angle in gazes]
+    gaze_stops = list(stops)
+    for size in _split(n_r, clusters) if clusters else []:
+        stops.append(_Stop("retreat", [(retreat, None)] * size))
+    for i in range(_count(tilt)):
+        delta = tilt.angle if i % 2 == 0 else -tilt.angle
+        if gaze_stops:
+            gaze_stops[i % len(gaze_stops)].items.insert(0, (tilt, delta))
+        else:
+            stops.append(_Stop("tilt", [(tilt, delta)]))
+    retreat_stops = [s for s in stops if s.kind == "retreat"]
+    for i in range(_count(shiver)):
+        if retreat_stops:
+            retreat_stops[i % len(retreat_stops)].items.append((shiver, None))
+        else:
+            stops.append(_Stop("shiver", [(shiver, None)]))
+    end_hold = spare > 0
+    pause_stops = max(0, spare - 1) if has_approach else 0
+    stops += [_Stop("pause") for _ in range(pause_stops)]
+    return _Plan(stops, pause_stops, end_hold)
+
+
+def _motion(b: Behaviour, approach: Any, stops: list[_Stop]
+            ) -> tuple[list[Episode], set[int], list[int]]:
+    """The motion episodes in order; the gaps that need a pause (gap ``i`` is before
+    episode ``i``); the gaps where a pause stop sits."""
+    s = b.settings
+    k, net = len(stops), s.start - s.standoff
+    pose, out = Pose(s.start), []
+    required: set[int] = set()
+    stop_gaps: list[int] = []
+    for j, stop in enumerate(stops):
+        target = s.standoff + net * (k - j) / (k + 1)
+        if approach is not None and pose.d > target + 1e-12:
+            out.append(translation(approach, approach.span, pose, target))
+            pose = out[-1].end
+        if stop.kind == "pause":
+            stop_gaps.append(len(out))
+        for node, arg in stop.items:
+            kind: Any = KINDS[node.kind]
+            ep = kind.episode(node, pose) if arg is None else kind.episode(node, pose, arg)
+            if ep.kind == "retreat":
+                required.add(len(out))
+            out.append(ep)
+            pose = ep.end
+            if ep.kind in ("retreat", "gaze"):
+                required.add(len(out))
+    if approach is not None and pose.d > s.standoff + 1e-12:
+        out.append(translation(approach, approach.span, pose, s.standoff))
+    return out, required, stop_gaps
+
+
+def _descriptor(b: Behaviour, state: State) -> list[Episode]:
+    approach = b.first("approach")
+    approach = approach if _count(approach) else None
+    pause = b.first("pause")
+    plan = _plan(b, approach is not None)
+    order = STOP_ORDER[state]
+    plan.stops.sort(key=lambda st: order.index(st.kind))  # stable: keeps alternation
+    motion, required, stop_gaps = _motion(b, approach, plan.stops)
+    n = len(motion)
+    wanted = sorted(required) + stop_gaps + ([n] if plan.end_hold else [])
+    wanted += [g for g in range(n, -1, -1)]  # any gap left, from the end to the start
+    gaps: list[int] = []
+    for g in wanted:
+        if len(gaps) == _count(pause):
+            break
+        if g not in gaps:
+            gaps.append(g)
+    out: list[Episode] = []
+    for i in range(n + 1):
+        if i in gaps and pause is not None:
+            at = motion[i].start if i < n else (motion[-1].end if motion else
+                                                Pose(b.settings.start))
+            out.append(KINDS["pause"].episode(pause, at))  # type: ignore[attr-defined]
+        if i < n:
+            out.append(motion[i])
+    return out
+
+
+# --- values for the descriptors and the C-V inference ------------------------------------
+
+
+def nominal_values(b: Behaviour) -> list[EpisodeValues]:
+    """A descriptor-form file's episodes as written, before any layout: ``count`` copies of
+    each statement's values (for the C-V inference, which needs no order)."""
+    return [EpisodeValues(p.kind, values=KINDS[p.kind].values(p))
+            for p in b.primitives for _ in range(p.count)]
+
+
+def episode_values(episodes: tuple[Episode, ...] | list[Episode]) -> list[EpisodeValues]:
+    """A timeline's episodes as the descriptors see them, on the planned clock."""
+    out, t = [], 0.0
+    for e in episodes:
+        out.append(EpisodeValues(e.kind, t, t + e.duration, KINDS[e.kind].episode_values(e)))
+        t += e.duration
+    return out
+
+
+def layout(b: Behaviour) -> Timeline:
+    """Lay a behaviour out in time. Deterministic: the same IR gives the same timeline.
+
+    A file without a declared state is laid out as the state its primitives express.
+    """
+    if b.form == "sequence":
+        episodes = _sequence(b)
+        state = b.state or infer(composition(episode_values(episodes)))[0].state
+    else:
+        state = b.state or infer(composition(nominal_values(b)))[0].state
+        episodes = _descriptor(b, state)
+    return Timeline(b.name, state, b.state, tuple(episodes))

@@ -1,0 +1,100 @@
+"""Checks of a whole behaviour: resource bounds, how far it goes, and whether its layout
+can show what it declares."""
+
+from __future__ import annotations
+
+from ..declared import source_of, written
+from ..descriptors import compare, derive
+from ..ir import Behaviour
+from ..layout import episode_values, layout
+from ..timeline import Timeline
+from .reader import Ctx
+
+__all__ = ["MAX_EPISODES", "MAX_MOTION_TIME", "MAX_REACH_DISTANCE", "check_whole"]
+
+#: Resource bounds: a file asking for more is an error, not a hang.
+MAX_MOTION_TIME = 600.0  # s
+MAX_EPISODES = 1000
+#: Furthest the end-effector may be sent from the goal [m].
+MAX_REACH_DISTANCE = 1.0
+
+
+def _episodes(ctx: Ctx, b: Behaviour) -> bool:
+    n = sum(p.count for p in b.primitives)
+    if n > MAX_EPISODES:
+        big = max(b.primitives, key=lambda p: p.count)
+        ctx.error("V110", f"the behaviour has {n} episodes; at most {MAX_EPISODES} are allowed",
+                  big.span, found=n, limit=MAX_EPISODES)
+        return False
+    return True
+
+
+def _time(ctx: Ctx, b: Behaviour, tl: Timeline) -> bool:
+    t = tl.planned_duration
+    if t > MAX_MOTION_TIME:
+        big = max(tl.episodes, key=lambda e: e.duration)
+        ctx.error("V110", f"the behaviour asks for about {t:.0f} s of motion; at most "
+                  f"{MAX_MOTION_TIME:.0f} s are allowed", big.span, found=t,
+                  limit=MAX_MOTION_TIME)
+        return False
+    return True
+
+
+def _standoff(ctx: Ctx, b: Behaviour) -> bool:
+    """A sequence's moves toward the goal stop at the standoff (V120)."""
+    s = b.settings
+    dist = s.start
+    for p in b.primitives:
+        if p.kind not in ("approach", "retreat"):
+            continue
+        for _ in range(p.count):
+            if p.kind == "approach" and p.length is None:
+                dist = s.standoff
+                continue
+            new = dist - p.length if p.kind == "approach" else dist + p.length
+            if new < s.standoff - 1e-9:
+                left = max(dist - s.standoff, 0.0)
+                ctx.error("V120", f"this {p.kind} would end {s.standoff - new:.3g} m inside "
+                          f"the standoff ({s.standoff:g} m from the goal); {left:.3g} m are "
+                          "left", p.span, left=left)
+                return False
+            dist = new
+    return True
+
+
+def _reach(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
+    far = max((e.end for e in tl.episodes), key=lambda p: p.d, default=None)
+    worst = max(tl.episodes, key=lambda e: e.end.d, default=None)
+    if far is not None and worst is not None and far.d > MAX_REACH_DISTANCE + 1e-9:
+        ctx.error("V119", f"the end-effector would be {far.d:.3g} m from the goal; at most "
+                  f"{MAX_REACH_DISTANCE:g} m", worst.span, distance=far.d)
+
+
+def _realisable(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
+    """V121: the laid-out descriptor form must show the values the file writes."""
+    for m in compare(written(b), derive(episode_values(tl.episodes))):
+        node = source_of(b, m.name)
+        ctx.error("V121", f"{m.name} is declared {m.declared} but no layout of this file "
+                  f"can show more than {m.measured}", node.span if node else b.span,
+                  hint="pauses need motion between them (an approach, a retreat, a gaze...); "
+                  "a retreat needs a pause before and after it, a gaze one after it",
+                  descriptor=m.name, declared=m.declared, realised=m.measured)
+
+
+def check_whole(ctx: Ctx, b: Behaviour) -> Timeline | None:
+    """Check the behaviour as a whole; its timeline, or None when it cannot be laid out."""
+    if not _episodes(ctx, b):
+        return None
+    if b.form == "sequence" and not _standoff(ctx, b):
+        return None
+    tl = layout(b)
+    if not _time(ctx, b, tl):
+        return None
+    if not tl.episodes:
+        ctx.error("V124", "the behaviour has nothing to move or hold: no primitive makes an "
+                  "episode", b.span, hint="add a primitive, e.g. `approach` or `pause 1s`")
+        return tl
+    _reach(ctx, b, tl)
+    if b.form == "descriptor":
+        _realisable(ctx, b, tl)
+    return tl
