@@ -59,7 +59,7 @@ class Descriptor:
         kind: the primitive kind whose episodes it is read from.
         key: the episode value it aggregates (unused for counts).
         aggregate: how episodes combine.
-        field: the field of the kind's IR node that sets it in the descriptor form, and
+        ir_field: the field of the kind's IR node that sets it in the descriptor form, and
             ``scale``, the factor from the descriptor's unit to the IR's (degrees to
             radians); ``count`` for counts.
         rel_tol, abs_tol: a measured value matches a declared ``x`` within
@@ -74,7 +74,7 @@ class Descriptor:
     kind: str
     key: str
     aggregate: Aggregate
-    field: str
+    ir_field: str
     scale: float = 1.0
     rel_tol: float = 0.0
     abs_tol: float = 0.0

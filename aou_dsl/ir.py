@@ -21,7 +21,7 @@ __all__ = ["DEFAULTS", "Behaviour", "Effort", "Node", "Settings", "State"]
 
 
 class State(enum.StrEnum):
-    """The five canonical states of MODEL.md s2, in the table's order (ties break by it)."""
+    """The five canonical states (docs/model.md), in their table's order (ties break by it)."""
 
     CONFIDENT = "confident"
     CURIOUS = "curious"
@@ -58,7 +58,7 @@ class Node(BaseModel):
 
 
 class Effort(Node):
-    """The Laban Effort vector of MODEL.md s1, each factor in [-1, 1]."""
+    """The Laban Effort vector (docs/model.md), each factor in [-1, 1]."""
 
     W: float = Field(ge=-1.0, le=1.0)
     T: float = Field(ge=-1.0, le=1.0)

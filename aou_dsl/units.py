@@ -1,7 +1,7 @@
 """Units of the language: every quantity becomes an SI float with a checked dimension.
 
 Angles are stored in radians, angular speeds in rad/s; output converts to degrees
-where MODEL.md asks for degrees.
+where the descriptors are in degrees.
 """
 
 from __future__ import annotations
@@ -45,7 +45,7 @@ UNITS: dict[str, tuple[Dim, float]] = {
     "Hz": (Dim.FREQUENCY, 1.0),
 }
 
-#: The SI unit a bare keyword value takes, per dimension (LANGUAGE.md: "its SI unit").
+#: The SI unit a bare keyword value takes, per dimension .
 SI_UNIT: dict[Dim, str] = {
     Dim.LENGTH: "m",
     Dim.TIME: "s",

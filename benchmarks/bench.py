@@ -1,8 +1,8 @@
 """Benchmarks of aou's speed claims; prints its figures (ratios where machines differ).
 
     python benchmarks/bench.py            # everything
-    python benchmarks/bench.py compile    # issue 3: compile speed and the by-hand pipeline
-    python benchmarks/bench.py measure    # issue 4: a 60 s trajectory at 1 kHz
+    python benchmarks/bench.py compile    # compile speed and the by-hand pipeline
+    python benchmarks/bench.py measure    # a 60 s trajectory at 1 kHz
 
 compile, per shipped behaviour:
 - cold: a fresh Python process that imports aou and compiles the file (imports, robot

@@ -111,7 +111,7 @@ class Synth:
             self._add(self._pose(), float(x))
         return self
 
-    def recording(self, noise: float = 0.0, seed: int = 0) -> Recording:
+    def recording(self, noise: float = 0.0, seed: int = 0) -> Trajectory:
         q = self._ik()
         q[:, -1] += np.asarray(self.joint_offsets)
         if noise:

@@ -1,4 +1,4 @@
-"""`aouc compile` as a user meets it: the trajectory file's contract (LANGUAGE.md), byte-
+"""`aouc compile` as a user meets it: the trajectory file's contract, byte-
 identical output, atomic writes, inputs never overwritten, batches, exit codes."""
 
 import json

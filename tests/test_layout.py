@@ -4,7 +4,7 @@ than the standoff, and realises the declared counts."""
 import pytest
 
 from aou_dsl.declared import declared, written
-from aou_dsl.descriptors import compare, derive
+from aou_dsl.descriptors import derive
 from aou_dsl.layout import episode_values, layout
 from aou_dsl.linter import load
 

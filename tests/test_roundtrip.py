@@ -165,7 +165,7 @@ def test_shipped_behaviours_on_ur5_compile_or_say_why(tmp_path, name):
         assert any(d.fields.get("joint") for d in explained)
 
 
-#: MODEL.md s6, Table II: the study's four stimuli (None: the primitive is absent).
+#: Table II of the study: the study's four stimuli (None: the primitive is absent).
 TABLE_II = {
     "confident": dict(approach_acceleration=0.1, pause_count=1, pause_duration=1.67,
                       retreat_count=0, retreat_distance=None, retreat_acceleration=None,

@@ -1,10 +1,10 @@
 """Stage 4, geometry: poses of the reach -> end-effector targets in SE(3), gaze locked.
 
-The start frame ``R0 = [x0, y0, z0]`` (MODEL.md s4):
+The start frame ``R0 = [x0, y0, z0]`` (docs/model.md, "Frames"):
 
 - ``z0`` points from the start pose to the goal (the gaze axis);
 - ``y0`` is the world's up direction made perpendicular to ``z0``, so the plane with
-  normal ``y0`` (MODEL.md's horizontal plane) is horizontal in the world and a
+  normal ``y0`` (the model's horizontal plane) is horizontal in the world and a
   horizontal gaze looks left and right; if ``z0`` is vertical, the world x axis is used;
 - ``x0 = y0 x z0``.
 

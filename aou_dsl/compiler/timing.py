@@ -200,7 +200,7 @@ def _import_toppra():
     if "matplotlib" not in sys.modules:
         stubs["matplotlib"] = _LazyModule("matplotlib")
         stubs["matplotlib.pyplot"] = _LazyModule("matplotlib.pyplot")
-        stubs["matplotlib"].pyplot = stubs["matplotlib.pyplot"]  # `import a.b as c`
+        setattr(stubs["matplotlib"], "pyplot", stubs["matplotlib.pyplot"])  # noqa: B010
         sys.modules.update(stubs)
     try:
         import toppra

@@ -281,8 +281,36 @@ def _motion_episodes(sig: _Signals, a: int, b: int, speed: np.ndarray
             continue
         piece = _classify(sig, s, e)
         if piece is not None:
-            pieces.append(piece)
+            pieces.append(_refined(piece, sig, speed, s, e))
     return _merge_shivers(pieces, sig.q, t)
+
+
+def _edge(t: np.ndarray, speed: np.ndarray, i: int, direction: int) -> float:
+    """Clean data: where the motion leaving (``direction`` +1) or reaching (-1) the rest
+    instant ``i`` is at zero speed. Near rest the time law has a constant acceleration,
+    so the speed is linear: a line through the next samples, extrapolated to zero, within
+    one sample of ``i``."""
+    idx = [i + direction * k for k in range(1, 5)]
+    if min(idx) < 0 or max(idx) >= len(t):
+        return float(t[i])
+    slope, icpt = np.polyfit(t[idx], speed[idx], 1)
+    if slope == 0:
+        return float(t[i])
+    lo, hi = float(t[max(i - 1, 0)]), float(t[min(i + 1, len(t) - 1)])
+    return float(np.clip(-icpt / slope, lo, hi))
+
+
+def _refined(ep: EpisodeValues, sig: _Signals, speed: np.ndarray, s: int, e: int
+             ) -> EpisodeValues:
+    """An episode with its edges moved from the samples to where it starts and stops
+    (clean data); a tilt's velocity is its angle over that duration."""
+    if sig.pacc is None:
+        return ep
+    t0, t1 = _edge(sig.t, speed, s, +1), _edge(sig.t, speed, e, -1)
+    values = dict(ep.values)
+    if ep.kind == "tilt":
+        values["velocity"] = values["angle"] / max(t1 - t0, 1e-9)
+    return EpisodeValues(ep.kind, t0, t1, values)
 
 
 #: A gaze moved in a plane when its angle there changed by more than this [deg].

@@ -106,7 +106,9 @@ def _effort(ctx: Ctx, st: Statement, args: Args) -> Any:
             factors[k] = kv.value.value
     for a in args.positional:
         ctx.error("V113", "`effort` takes only W= T= S= F=", a.span)
-    return Effort(span=st.span, **factors) if len(factors) == 4 else None
+    if len(factors) != 4:
+        return None
+    return Effort(span=st.span, W=factors["W"], T=factors["T"], S=factors["S"], F=factors["F"])
 
 
 #: setting keyword -> (IR field, reader, the keys it takes)

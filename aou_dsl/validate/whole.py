@@ -3,6 +3,8 @@ can show what it declares."""
 
 from __future__ import annotations
 
+from typing import Any
+
 from ..declared import source_of, written
 from ..descriptors import compare, derive
 from ..ir import Behaviour
@@ -44,7 +46,8 @@ def _standoff(ctx: Ctx, b: Behaviour) -> bool:
     """A sequence's moves toward the goal stop at the standoff (V120)."""
     s = b.settings
     dist = s.start
-    for p in b.primitives:
+    for node in b.primitives:
+        p: Any = node
         if p.kind not in ("approach", "retreat"):
             continue
         for _ in range(p.count):
