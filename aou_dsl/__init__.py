@@ -3,9 +3,9 @@
 The public API (see docs/api.md)::
 
     import aou_dsl
-    result = aou_dsl.linter("behaviours/hesitant.aou")        # diagnostics, C-V point
+    result = aou_dsl.lint("behaviours/hesitant.aou")        # diagnostics, C-V point
     build = aou_dsl.compile("behaviours/hesitant.aou")      # trajectory, descriptors
-    measured = aou_dsl.measuring("recording.csv", robot="panda", goal=(0.55, 0, 0.25))
+    measured = aou_dsl.measure("recording.csv", robot="panda", goal=(0.55, 0, 0.25))
 
 Importing the package is cheap: the numerical stages (Pinocchio, TOPP-RA, PyBullet)
 load only when a function that needs them runs.

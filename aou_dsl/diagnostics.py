@@ -321,7 +321,8 @@ _RULE_LIST = [
          "t,panda_joint9"),
     Rule("R403", "unequal-episodes", _W,
          "Episodes of one kind measure different values; the model assumes they are equal.",
-         "The reported descriptor is their mean; per-episode values are in the JSON output.",
+         "The descriptor follows its rule (median, or maximum for peaks and gazes); "
+         "per-episode values are in the JSON output.",
          "two retreats of 4 cm and 8 cm"),
     # --- I: input/output and usage -----------------------------------------------------
     Rule("I501", "cannot-read", _E,
