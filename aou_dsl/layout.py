@@ -12,9 +12,10 @@ A sequence is laid out as written. The descriptor form is laid out in three step
    wins back the last withdrawal and makes an equal share of the net progress, so the
    reach never gets closer than the standoff and ends there.
 3. *Pauses* go into the gaps between motion episodes: first those the definitions need
-   (after every gaze, before and after every retreat), then the pause stops, the hold at
-   the end, then any gap left, the start last. Two pauses never touch: they would read
-   as one.
+   (before and after every retreat; after the first gaze of each plane, since a gaze
+   descriptor is an angle, read at a pause that ends a gaze), then the pause stops, the
+   hold at the end, then any gap left (after the other gazes first), the start last.
+   Two pauses never touch: they would read as one.
 """
 
 from __future__ import annotations
@@ -144,11 +145,13 @@ def _plan(b: Behaviour, has_approach: bool) -> _Plan:
 def _motion(b: Behaviour, approach: Any, stops: list[_Stop]
             ) -> tuple[list[Episode], set[int], list[int]]:
     """The motion episodes in order; the gaps that need a pause (gap ``i`` is before
-    episode ``i``); the gaps where a pause stop sits."""
+    episode ``i``); then the gaps that want one, best first (after the other gazes, then
+    where a pause stop sits)."""
     s = b.settings
     k, net = len(stops), s.start - s.standoff
     pose, out = Pose(s.start), []
     required: set[int] = set()
+    gaze_gaps: dict[str | None, list[int]] = {}  # per plane, the gaps after its gazes
     stop_gaps: list[int] = []
     for j, stop in enumerate(stops):
         target = s.standoff + net * (k - j) / (k + 1)
@@ -164,11 +167,20 @@ def _motion(b: Behaviour, approach: Any, stops: list[_Stop]
                 required.add(len(out))
             out.append(ep)
             pose = ep.end
-            if ep.kind in ("retreat", "gaze"):
+            if ep.kind == "retreat":
                 required.add(len(out))
+            elif ep.kind == "gaze":
+                gaze_gaps.setdefault(ep.plane, []).append(len(out))
     if approach is not None and pose.d > s.standoff + 1e-12:
         out.append(translation(approach, approach.span, pose, s.standoff))
-    return out, required, stop_gaps
+    # A plane's gaze angle is read at a pause that ends one of its gazes: one per plane is
+    # needed (shared with a retreat's pause where one follows a gaze); the rest are wanted.
+    wanted: list[int] = []
+    for gaps in gaze_gaps.values():
+        if not required.intersection(gaps):
+            required.add(gaps[-1])
+        wanted += [g for g in gaps if g not in required]
+    return out, required, sorted(wanted) + stop_gaps
 
 
 def _descriptor(b: Behaviour, state: State) -> list[Episode]:
@@ -178,9 +190,9 @@ def _descriptor(b: Behaviour, state: State) -> list[Episode]:
     plan = _plan(b, approach is not None)
     order = STOP_ORDER[state]
     plan.stops.sort(key=lambda st: order.index(st.kind))  # stable: keeps alternation
-    motion, required, stop_gaps = _motion(b, approach, plan.stops)
+    motion, required, preferred = _motion(b, approach, plan.stops)
     n = len(motion)
-    wanted = sorted(required) + stop_gaps + ([n] if plan.end_hold else [])
+    wanted = sorted(required) + preferred + ([n] if plan.end_hold else [])
     wanted += [g for g in range(n, -1, -1)]  # any gap left, from the end to the start
     gaps: list[int] = []
     for g in wanted:

@@ -334,7 +334,12 @@ def _toppra(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vmax:
         return None, TimingFailure(f"TOPP-RA: {inst.problem_data.return_code}", None)
     sd = np.asarray(sd, dtype=float)
     sd[0] = sd[-1] = 0.0
-    seg = PathSegment(s_way, q_way, TimeLaw.from_speeds(grid, sd), spline=path.cspl)
+    try:
+        law = TimeLaw.from_speeds(grid, sd)
+    except ValueError:  # the path speed is zero inside the path: no motion can follow it
+        return None, TimingFailure("TOPP-RA: the path speed drops to zero inside the path",
+                                   None)
+    seg = PathSegment(s_way, q_way, law, spline=path.cspl)
     peak = float(np.max(np.abs(seg.law.u)))
     if peak < a * 0.97:
         return seg, TimingFailure("joint limits bind before the declared acceleration",

@@ -359,14 +359,20 @@ def _classify(sig: _Signals, s: int, e: int) -> EpisodeValues | None:
         "joint": float(np.argmax(rng))})
 
 
+def _continues_shiver(a: EpisodeValues, b: EpisodeValues) -> bool:
+    """Two roll pieces that may belong to one oscillation: they alternate in direction."""
+    if a.kind != "tilt" or b.kind != "tilt":
+        return False
+    return a.values["signed"] * b.values["signed"] < 0
+
+
 def _merge_shivers(pieces: list[EpisodeValues], q, t) -> list[EpisodeValues]:
     """Three or more roll pieces in a row that alternate in direction are one shiver."""
     out: list[EpisodeValues] = []
     i = 0
     while i < len(pieces):
         j = i
-        while (j + 1 < len(pieces) and pieces[j].kind == "tilt" and pieces[j + 1].kind == "tilt"
-               and pieces[j].values["signed"] * pieces[j + 1].values["signed"] < 0):
+        while j + 1 < len(pieces) and _continues_shiver(pieces[j], pieces[j + 1]):
             j += 1
         if j - i + 1 >= 3:
             t0, t1 = pieces[i].t_start, pieces[j].t_end
