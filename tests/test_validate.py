@@ -91,3 +91,16 @@ def test_missing_unit_says_which_units_fit():
 def test_resource_bound_on_time_is_an_error_not_a_hang():
     _, diags = load("approach a=1e-6", "t.aou")
     assert [d.code for d in diags] == ["V110"]
+
+
+def test_a_start_beyond_reach_is_refused_at_the_start_line():
+    """`start 2m` puts the end-effector 2 m from the goal before anything moves: V119 on
+    the `start` line, not a late IK failure."""
+    _, diags = load("start 2m\napproach\npause 1s\n", "t.aou")
+    assert [(d.code, d.span.line) for d in diags] == [("V119", 1)]
+
+
+def test_retreats_that_carry_the_hand_too_far_are_refused():
+    """Three 0.3 m retreats in a row end 1.1 m from the goal: V119, before compiling."""
+    _, diags = load("approach a=0.1; pause 1s x4; retreat 0.3m x3", "t.aou")
+    assert "V119" in {d.code for d in diags}

@@ -66,11 +66,15 @@ def _standoff(ctx: Ctx, b: Behaviour) -> bool:
 
 
 def _reach(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
-    far = max((e.end for e in tl.episodes), key=lambda p: p.d, default=None)
-    worst = max(tl.episodes, key=lambda e: e.end.d, default=None)
-    if far is not None and worst is not None and far.d > MAX_REACH_DISTANCE + 1e-9:
-        ctx.error("V119", f"the end-effector would be {far.d:.3g} m from the goal; at most "
-                  f"{MAX_REACH_DISTANCE:g} m", worst.span, distance=far.d)
+    """V119: no pose of the timeline, its start included, lies further than
+    :data:`MAX_REACH_DISTANCE` from the goal."""
+    far = max(((max(e.start.d, e.end.d), e) for e in tl.episodes), key=lambda x: x[0],
+              default=None)
+    if far is not None and far[0] > MAX_REACH_DISTANCE + 1e-9:
+        where = b.settings.spans.get("start") if far[1] is tl.episodes[0] and \
+            far[1].start.d >= far[1].end.d else None
+        ctx.error("V119", f"the end-effector would be {far[0]:.3g} m from the goal; at most "
+                  f"{MAX_REACH_DISTANCE:g} m", where or far[1].span, distance=far[0])
 
 
 def _realisable(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
