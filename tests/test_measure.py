@@ -182,3 +182,15 @@ def test_csv_errors_name_row_and_column():
     with pytest.raises(AouError) as info:
         read_csv("r.csv", "time,panda_joint1\n0,0\n", "panda", None, None)
     assert "first column must be `t`" in info.value.diagnostics[0].message
+
+
+def test_a_tilt_beside_a_shiver_is_a_tilt():
+    """A rest-to-rest tilt right after a tremor, with no rest between, is told apart by
+    its duration: the shiver's half periods are equal, the tilt lasts longer."""
+    from aou_dsl.build import build_source
+
+    res = build_source("tilt 5deg v=8deg/s x1\nshiver 2deg f=2Hz for 1.5s\n", "t.aou",
+                       check=False)
+    d = res.measured.descriptors
+    assert d["tilt_angle"] == pytest.approx(5.0, abs=0.5)
+    assert d["shiver_amplitude"] == pytest.approx(2.0, abs=0.5)

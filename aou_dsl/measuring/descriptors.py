@@ -360,14 +360,18 @@ def _classify(sig: _Signals, s: int, e: int) -> EpisodeValues | None:
 
 
 def _continues_shiver(a: EpisodeValues, b: EpisodeValues) -> bool:
-    """Two roll pieces that may belong to one oscillation: they alternate in direction."""
+    """Two roll pieces of one oscillation: they alternate in direction and last about as
+    long (half periods of one frequency: the envelope changes their size, not their
+    length). A rest-to-rest tilt beside a tremor lasts longer than its half periods."""
     if a.kind != "tilt" or b.kind != "tilt":
         return False
-    return a.values["signed"] * b.values["signed"] < 0
+    da, db = a.t_end - a.t_start, b.t_end - b.t_start
+    return a.values["signed"] * b.values["signed"] < 0 and max(da, db) <= 2.0 * min(da, db)
 
 
 def _merge_shivers(pieces: list[EpisodeValues], q, t) -> list[EpisodeValues]:
-    """Three or more roll pieces in a row that alternate in direction are one shiver."""
+    """Three or more roll pieces in a row that alternate in direction, at one frequency,
+    are one shiver."""
     out: list[EpisodeValues] = []
     i = 0
     while i < len(pieces):
