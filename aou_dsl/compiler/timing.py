@@ -234,13 +234,20 @@ def binding_joint(arm: ArmModel, seg: PathSegment) -> tuple[str, float]:
     return arm.joint_names[j], float(ratio[j])
 
 
+#: The Cartesian peak is checked at least this often [Hz] (the default output rate):
+#: between sparser instants a bend of the joint path can overshoot unseen.
+PEAK_RATE = 250.0
+
+
 def cartesian_peak(arm: ArmModel, seg: PathSegment, samples: int = 100) -> float:
     """Peak translational acceleration of the end-effector on a segment [m/s^2]: the
-    classical acceleration ``J q'' + J' q'`` from Pinocchio, at ``samples`` instants."""
+    classical acceleration ``J q'' + J' q'`` from Pinocchio, at ``samples`` instants or
+    :data:`PEAK_RATE`, whichever is denser."""
     import pinocchio as pin
 
     model, data = arm.model, arm.model.createData()
-    q, qd, qdd = seg.sample(np.linspace(0.0, seg.duration, samples))
+    n = max(samples, int(math.ceil(seg.duration * PEAK_RATE)) + 1)
+    q, qd, qdd = seg.sample(np.linspace(0.0, seg.duration, n))
     peak = 0.0
     for qi, vi, ai in zip(q, qd, qdd, strict=True):
         pin.forwardKinematics(model, data, qi, vi, ai)
