@@ -7,7 +7,8 @@ from typing import Literal
 from ..ir import DEFAULTS, Node
 from ..timeline import Pose
 from ..units import Dim
-from .base import MIN_RETREAT, Key, Kind, fmt, move, repeat
+from .approach import translation
+from .base import MIN_RETREAT, Key, Kind, fmt, repeat
 
 __all__ = ["Retreat", "RetreatKind"]
 
@@ -47,9 +48,8 @@ class RetreatKind(Kind):
         return None
 
     def episode(self, node, pose: Pose):
-        end = Pose(pose.d + node.length, pose.h, pose.v, pose.roll)
-        kind = "retreat" if node.length >= 0 else "approach"
-        return move(kind, node.span, pose, end, node.a, node.v)
+        """Away from the goal by ``length`` (toward it when negative: an approach)."""
+        return translation(node, node.span, pose, pose.d + node.length)
 
     def values(self, node):
         return {"distance": abs(node.length), "peak_acceleration": node.a}
