@@ -75,7 +75,7 @@ def _with_robot(lint: FileResult, robot: str | None) -> list[Diagnostic]:
     return []
 
 
-def _check(res: BuildResult, scene: SceneOptions | None) -> dict:
+def _check(res: BuildResult, rate: float, scene: SceneOptions | None) -> dict:
     """The kinematic replay, as C306 diagnostics and the document's ``checks``."""
     from .compiler.pipeline import sample
     from .safety.replay import replay
@@ -84,8 +84,7 @@ def _check(res: BuildResult, scene: SceneOptions | None) -> dict:
     assert res.compiled is not None
     tr = res.compiled.trajectory
     assert tr is not None
-    rate = 1.0 / max(float(tr.t[1] - tr.t[0]), 1e-9) if len(tr.t) > 1 else CHECK_RATE
-    dense = tr if rate >= CHECK_RATE - 1e-6 else sample(res.compiled, CHECK_RATE)
+    dense = tr if rate >= CHECK_RATE else sample(res.compiled, CHECK_RATE)
     report = replay(dense, options=scene or SceneOptions())
     res.checks = report.checks
     for c in report.failed():
@@ -120,7 +119,7 @@ def build_lint(lint: FileResult, *, robot: str | None = None, rate: float | None
         return res
     checks_json: dict[str, Any] = {"kinematic": "skipped (--no-check)"}
     if check:
-        checks_json = _check(res, scene)
+        checks_json = _check(res, opts.rate, scene)
         if has_errors(res.diagnostics):
             res.seconds = time.perf_counter() - start
             return res

@@ -128,6 +128,9 @@ REGISTRY: dict[str, Descriptor] = {d.name: d for d in (
 )}
 
 
+_INDEX = {name: i for i, name in enumerate(REGISTRY)}
+
+
 class Descriptors(Mapping[str, float | int | None]):
     """The eleven values of one behaviour or trajectory, frozen; ``None`` for an absent
     primitive. A mapping from name to value, in :data:`REGISTRY`'s order."""
@@ -142,7 +145,7 @@ class Descriptors(Mapping[str, float | int | None]):
         self._values = tuple(given.get(name) for name in REGISTRY)
 
     def __getitem__(self, name: str) -> float | int | None:
-        return self._values[list(REGISTRY).index(name)]
+        return self._values[_INDEX[name]]
 
     def __iter__(self) -> Iterator[str]:
         return iter(REGISTRY)
@@ -276,9 +279,3 @@ def compare(declared: Mapping[str, float | int | None],
         if not d.matches(want, got):
             out.append(Mismatch(name, want, got))
     return out
-
-
-def for_kind(kind: str, plane: str | None = None) -> list[Descriptor]:
-    """The descriptors a primitive kind sets (a gaze: those of its plane)."""
-    return [d for d in REGISTRY.values()
-            if d.kind == kind and (plane is None or d.key in (plane, "") or d.kind != "gaze")]

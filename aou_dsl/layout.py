@@ -65,9 +65,7 @@ def _sequence_episode(p: Any, pose: Pose, standoff: float) -> Episode:
         d = standoff if p.length is None else pose.d - p.length
         return translation(p, p.span, pose, d)
     kind: Any = KINDS[p.kind]
-    if p.kind == "gaze":
-        return kind.episode(p, pose, p.angle)
-    if p.kind == "tilt":
+    if p.kind in ("gaze", "tilt"):  # to a plane angle, by a roll: as written
         return kind.episode(p, pose, p.angle)
     return kind.episode(p, pose)
 

@@ -11,6 +11,8 @@ from typing import Any
 
 import numpy as np
 
+from .diagnostics import AouError, Span, diag
+
 __all__ = ["Trajectory"]
 
 
@@ -54,5 +56,15 @@ class Trajectory:
         return replace(self, **changes)
 
     def columns(self, names: tuple[str, ...]) -> np.ndarray:
-        """Indices of ``names`` among the columns (each must be present)."""
+        """Indices of ``names`` among the columns.
+
+        Raises:
+            AouError: R402 naming the joints the trajectory lacks.
+        """
+        missing = [n for n in names if n not in self.joint_names]
+        if missing:
+            raise AouError(diag(
+                "R402", f"the trajectory lacks joint(s) {', '.join(missing)} of robot "
+                f"`{self.robot}`; its columns are {', '.join(self.joint_names)}",
+                Span.whole_file(self.path), missing=missing))
         return np.array([self.joint_names.index(n) for n in names], dtype=int)

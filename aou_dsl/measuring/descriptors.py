@@ -95,21 +95,11 @@ def _roll(r0: np.ndarray, r1: np.ndarray) -> float:
 # --- measuring ------------------------------------------------------------------------------
 
 
-def _joint_columns(rec: Trajectory, arm: ArmModel) -> np.ndarray:
-    missing = [n for n in arm.joint_names if n not in rec.joint_names]
-    if missing:
-        raise AouError(diag(
-            "R402", f"the trajectory lacks joint(s) {', '.join(missing)} of robot "
-            f"`{rec.robot}`; its columns are {', '.join(rec.joint_names)}",
-            Span.whole_file(rec.path), missing=missing))
-    return rec.columns(arm.joint_names)
-
-
 def _signals(rec: Trajectory, arm: ArmModel) -> tuple[_Signals, np.ndarray, int, float]:
     """Resampled joints, their noise, derivatives and forward kinematics; the joint
     speed (N,), the filter window and the end time."""
     t, q = _uniform(np.asarray(rec.t, float),
-                    np.asarray(rec.q, float)[:, _joint_columns(rec, arm)])
+                    np.asarray(rec.q, float)[:, rec.columns(arm.joint_names)])
     dt = float(t[1] - t[0])
     sigma = _noise(q)
     clean = sigma < 1e-7

@@ -22,7 +22,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..diagnostics import AouError, Span, diag
 from ..kinematics import load_arm
 from ..trajectory import Trajectory
 from .limits import Check, check_limits
@@ -130,10 +129,6 @@ def replay(tr: Trajectory, *, options: SceneOptions | None = None,
         AouError: R402 when the trajectory lacks a joint of the robot.
     """
     arm = load_arm(tr.robot, tr.ee_frame)
-    missing = [n for n in arm.joint_names if n not in tr.joint_names]
-    if missing:
-        raise AouError(diag("R402", f"the trajectory lacks joint(s) {', '.join(missing)} of "
-                            f"robot `{tr.robot}`", Span.whole_file(tr.path), missing=missing))
     cols = tr.columns(arm.joint_names)
     t, q = tr.t, tr.q[:, cols]
     if tr.qd is not None and tr.qdd is not None:
