@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from .diagnostics import AouError, Span, diag
-from .robots import ROBOTS, RobotSpec
+from .robots import DEFAULT_JOINT_JERK, ROBOTS, RobotSpec
 
 __all__ = ["ArmModel", "load_arm"]
 
@@ -30,6 +30,7 @@ class ArmModel:
         lower, upper: joint position limits [rad], shape (n,).
         vmax: joint velocity limits from the URDF [rad/s], shape (n,).
         amax: joint acceleration limits from the robot table [rad/s^2], shape (n,).
+        jmax: joint jerk limits from the robot table [rad/s^3], shape (n,).
         effort: joint effort limits from the URDF [N m], shape (n,).
     """
 
@@ -41,6 +42,7 @@ class ArmModel:
     vmax: np.ndarray
     amax: np.ndarray
     effort: np.ndarray
+    jmax: np.ndarray
 
     @property
     def joint_names(self) -> tuple[str, ...]:
@@ -124,4 +126,5 @@ def load_arm(robot: str, ee_frame: str | None = None) -> ArmModel:
         vmax=np.array(model.velocityLimit),
         amax=np.array(spec.joint_accel),
         effort=np.array(model.effortLimit),
+        jmax=np.array(spec.joint_jerk or (DEFAULT_JOINT_JERK,) * len(spec.arm_joints)),
     )

@@ -47,8 +47,11 @@ class Quantity:
 
 @dataclass(frozen=True, slots=True)
 class Word:
+    """A bare word, or a double-quoted text (``quoted``; ``text`` without the quotes)."""
+
     text: str
     span: Span
+    quoted: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -144,6 +147,10 @@ class _ToSyntax(Transformer):
     def word(self, children: list[Token]) -> Word:
         (tok,) = children
         return Word(str(tok), _tok_span(self.path, tok))
+
+    def text(self, children: list[Token]) -> Word:
+        (tok,) = children
+        return Word(str(tok)[1:-1], _tok_span(self.path, tok), quoted=True)
 
     def colon(self, children: list[Token]) -> Colon:
         return Colon(_tok_span(self.path, children[0]))

@@ -19,10 +19,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["DEFAULT_JOINT_ACCEL", "ROBOTS", "RobotSpec"]
+__all__ = ["DEFAULT_JOINT_ACCEL", "DEFAULT_JOINT_JERK", "ROBOTS", "RobotSpec"]
 
 #: Joint acceleration limit [rad/s^2] for a robot whose datasheet gives none.
 DEFAULT_JOINT_ACCEL = 3.0
+
+#: Joint jerk limit [rad/s^3] for a robot whose datasheet gives none.
+DEFAULT_JOINT_JERK = 1000.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -38,6 +41,8 @@ class RobotSpec:
         posture: joint configuration [rad] the redundancy is resolved toward; also the IK
             seed. Shape (len(arm_joints),).
         joint_accel: joint acceleration limits [rad/s^2], shape (len(arm_joints),).
+        joint_jerk: joint jerk limits [rad/s^3], shape (len(arm_joints),); empty when
+            no source gives them (then :data:`DEFAULT_JOINT_JERK` applies).
         shiver_joint: the redundant joint that shivers (rotates about the forward axis
             without moving the end-effector position).
         velocity_scale: fraction of the URDF velocity limit the compiler plans with.
@@ -55,6 +60,7 @@ class RobotSpec:
     posture: tuple[float, ...]
     joint_accel: tuple[float, ...]
     shiver_joint: str
+    joint_jerk: tuple[float, ...] = ()
     velocity_scale: float = 0.9
     accel_scale: float = 0.95
     limit_margin: float = 0.05
@@ -73,6 +79,9 @@ ROBOTS: dict[str, RobotSpec] = {
         start_direction=(-0.6, 0.0, 0.8),
         posture=(0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.785398),
         joint_accel=(15.0, 7.5, 10.0, 12.5, 15.0, 20.0, 20.0),
+        # Same source (and libfranka's rate limiter): 7500, 3750, 5000, 6250, 7500,
+        # 10000, 10000 rad/s^3.
+        joint_jerk=(7500.0, 3750.0, 5000.0, 6250.0, 7500.0, 10000.0, 10000.0),
         shiver_joint="panda_joint7",
         # The hand's mesh overlaps link 7's at the flange (link 8 between them has no
         # shape), and the two fingers touch when the gripper is closed.
