@@ -60,7 +60,11 @@ def encode(doc: dict, fmt: str) -> bytes:
     if fmt == "json":
         return (json.dumps(doc, separators=(",", ":")) + "\n").encode()
     if fmt == "csv":
-        lines = [",".join(["t", *doc["joint_names"]])]
+        # Comment lines carry what a CSV has no column for; readers skip `#` lines.
+        goal = ",".join(repr(float(x)) for x in doc["goal"]["position"])
+        lines = [f"# format: {doc['format']}", f"# robot: {doc['robot']}",
+                 f"# ee_frame: {doc['ee_frame']}", f"# goal: {goal}",
+                 ",".join(["t", *doc["joint_names"]])]
         lines += [",".join(repr(v) for v in [t, *row]) for t, row in zip(doc["t"], doc["q"],
                                                                            strict=True)]
         return ("\n".join(lines) + "\n").encode()
