@@ -240,7 +240,8 @@ _RULE_LIST = [
          "No arm aou knows reaches that far; such a value is almost always a typo.",
          "goal (30, 0, 0.3)"),
     Rule("V123", "below-resolution", _E,
-         "An angle under 1 deg or a retreat under 5 mm: too small to be seen, or measured.",
+         "An angle under 1 deg, a retreat under 5 mm, or a gaze whose arc around the goal "
+         "moves the end-effector less than 5 mm: too small to be seen, or measured.",
          "The descriptors are measured to 0.5 deg and 1 mm; a smaller motion cannot be told "
          "from a pause, and the compiled motion would not show what the file declares.",
          "shiver 0.1deg"),
@@ -249,6 +250,10 @@ _RULE_LIST = [
          "whose moves all vanish.",
          "There is no motion to compile and nothing to measure.",
          "behaviour b : inactive\nrobot panda"),
+    Rule("V125", "touching-pauses", _N,
+         "Two pauses follow each other with no motion between them; they are one pause.",
+         "A pause is a hold; two holds in a row are seen (and measured) as one longer hold.",
+         "sequence {\n  approach 0.2m\n  pause 1s\n  pause 1s\n}"),
     # --- M: the C-V model --------------------------------------------------------------
     Rule("M201", "state-mismatch", _W,
          "The state inferred from the behaviour's primitives differs from the declared one.",
@@ -276,7 +281,7 @@ _RULE_LIST = [
     Rule("C302", "joint-limit", _E,
          "A pose of the path is only reachable with a joint at or beyond its position limit.",
          "The trajectory would be stopped by the controller, or worse.",
-         "sequence {\n  gaze horizontal 85deg\n  pause 1s\n}"),
+         "start 0.32m\nsequence {\n  gaze vertical -30deg\n  pause 1s\n}"),
     Rule("C303", "singularity", _E,
          "The path passes through (or too near) a kinematic singularity.",
          "Near a singularity small Cartesian motions need huge joint speeds.",

@@ -129,6 +129,7 @@ def _plan(b: Behaviour, has_approach: bool) -> _Plan:
         else:
             stops.append(_Stop("tilt", [(tilt, delta)]))
     retreat_stops = [s for s in stops if s.kind == "retreat"]
+    _share_pauses(stops, gaze_stops, retreat_stops, n_p - need_r - (clusters - 1))
     for i in range(_count(shiver)):
         if retreat_stops:
             retreat_stops[i % len(retreat_stops)].items.append((shiver, None))
@@ -138,6 +139,21 @@ def _plan(b: Behaviour, has_approach: bool) -> _Plan:
     pause_stops = max(0, spare - 1) if has_approach else 0
     stops += [_Stop("pause") for _ in range(pause_stops)]
     return _Plan(stops, pause_stops, end_hold)
+
+
+def _share_pauses(stops: list[_Stop], gaze_stops: list[_Stop], retreat_stops: list[_Stop],
+                  free: int) -> None:
+    """When pauses are too few for every gaze plane to end at one of its own, a gaze
+    joins a retreat stop, just before the retreats: the pause that starts them ends it."""
+    firsts: dict[str, _Stop] = {}
+    for st in gaze_stops:
+        plane = next(n.plane for n, _ in st.items if n.kind == "gaze")
+        firsts.setdefault(plane, st)
+    short = max(0, len(firsts) - max(0, free))
+    for st, host in zip(list(firsts.values())[len(firsts) - short:], retreat_stops,
+                        strict=False):
+        stops.remove(st)
+        host.items[:0] = st.items
 
 
 def _motion(b: Behaviour, approach: Any, stops: list[_Stop]

@@ -499,7 +499,8 @@ def _seq_gaze(ch, feats: set[str], q: _Seq, kind: str, cnt: int) -> str:
     target = ch.uniform(-30, 30)
     if ch.chance(0.1) and abs(cur) > 3:
         target = 0.0
-    if abs(target - cur) < 3:
+    # A gaze must move the hand at least 5 mm (an arc of 4 deg at the closest stand-off).
+    if abs(target - cur) < 4:
         target = cur + (6 if cur < 0 else -6)
     t, ang = quantity(ch, target, "angle", feats)
     if ang < 0:

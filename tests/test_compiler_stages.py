@@ -122,10 +122,13 @@ def test_encodings_carry_the_same_samples():
     import io
     import zipfile
 
-    doc = {"format": "aou-trajectory/1", "joint_names": ["a", "b"], "t": [0.0, 0.1],
+    doc = {"format": "aou-trajectory/1", "robot": "panda", "ee_frame": "f",
+           "goal": {"position": [0.5, 0.0, 0.25]}, "joint_names": ["a", "b"], "t": [0.0, 0.1],
            "q": [[0.1, 0.2], [0.3, 0.4]], "qd": [[0, 0], [0, 0]], "qdd": [[0, 0], [0, 0]]}
     assert json.loads(encode(doc, "json"))["q"] == doc["q"]
-    rows = encode(doc, "csv").decode().splitlines()
+    lines = encode(doc, "csv").decode().splitlines()
+    assert "# goal: 0.5,0.0,0.25" in lines and "# robot: panda" in lines
+    rows = [r for r in lines if not r.startswith("#")]
     assert rows[0] == "t,a,b" and rows[2] == "0.1,0.3,0.4"
     with zipfile.ZipFile(io.BytesIO(encode(doc, "npz"))) as zf:
         q = np.load(io.BytesIO(zf.read("q.npy")))

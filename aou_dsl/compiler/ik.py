@@ -23,6 +23,12 @@ ROT_TOL = 1e-6  # rad
 MAX_ITER = 60
 DAMPING = 1e-8
 POSTURE_GAIN = 0.2
+#: Newton iterations of one solve that also pull toward the posture. The pull acts in the
+#: Jacobian's null space only approximately (the inverse is damped), so a solve that pulls
+#: on every iteration can fail to converge and slide far along the self-motion manifold:
+#: a branch flip between neighbouring waypoints. Pulling only at first keeps each solve's
+#: redundancy step small and lets the remaining iterations converge.
+POSTURE_ITERS = 3
 #: Largest joint step of one Newton iteration [rad].
 MAX_ITER_STEP = 0.2
 #: Continuation steps from the posture's own pose to the first target.
@@ -104,7 +110,8 @@ class _Solver:
             je = -pin.Jlog6(dm.inverse()) @ jac
             pinv = je.T @ np.linalg.solve(je @ je.T + DAMPING * eye6, eye6)
             dq = -pinv @ err
-            dq += (np.eye(n) - pinv @ je) @ (POSTURE_GAIN * (self.posture - q))
+            if it < POSTURE_ITERS:
+                dq += (np.eye(n) - pinv @ je) @ (POSTURE_GAIN * (self.posture - q))
             step = np.max(np.abs(dq))
             if step > MAX_ITER_STEP:  # far from the target: Newton steps overshoot
                 dq *= MAX_ITER_STEP / step

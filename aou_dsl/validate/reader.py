@@ -39,6 +39,9 @@ class Ctx:
               **fields: Any) -> None:
         self.diags.append(diag(code, message, span, hint=hint, **fields))
 
+    #: The severity comes from the rule: ``report`` reads better for notes and warnings.
+    report = error
+
     def has_errors(self) -> bool:
         return any(d.severity == "error" for d in self.diags)
 

@@ -3,12 +3,14 @@ can show what it declares."""
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 from ..declared import source_of, written
 from ..descriptors import compare, derive
 from ..ir import Behaviour
 from ..layout import episode_values, layout
+from ..primitives import MIN_RETREAT
 from ..timeline import Timeline
 from .reader import Ctx
 
@@ -77,6 +79,33 @@ def _reach(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
                   f"{MAX_REACH_DISTANCE:g} m", where or far[1].span, distance=far[0])
 
 
+def _swept(ctx: Ctx, tl: Timeline) -> None:
+    """V123: a gaze moves the end-effector around the goal; an arc shorter than the
+    smallest visible motion cannot be seen, whatever its angle."""
+    for e in tl.episodes:
+        if e.kind != "gaze":
+            continue
+        turn = math.hypot(e.end.h - e.start.h, e.end.v - e.start.v)
+        arc = 2.0 * e.start.d * math.sin(turn / 2.0)
+        if 0.0 < arc < MIN_RETREAT:
+            ctx.error("V123", f"this gaze of {math.degrees(turn):.3g} deg at "
+                      f"{e.start.d:.3g} m from the goal moves the end-effector "
+                      f"{arc * 1e3:.2g} mm; at least {MIN_RETREAT * 1e3:g} mm can be seen",
+                      e.span, hint="a larger angle, or gaze from further away",
+                      swept=arc, least=MIN_RETREAT)
+            return
+
+
+def _touching(ctx: Ctx, tl: Timeline) -> None:
+    """V125: two pauses in a row are one hold."""
+    for a, b in zip(tl.episodes, tl.episodes[1:], strict=False):
+        if a.kind == b.kind == "pause":
+            ctx.report("V125", f"this pause follows another with no motion between them: "
+                       f"they are seen and measured as one hold of "
+                       f"{a.duration + b.duration:.3g} s", b.span,
+                       hint="put a motion between them, or write one longer pause")
+
+
 def _realisable(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
     """V121: the laid-out descriptor form must show the values the file writes."""
     for m in compare(written(b), derive(episode_values(tl.episodes))):
@@ -102,6 +131,8 @@ def check_whole(ctx: Ctx, b: Behaviour) -> Timeline | None:
                   "episode", b.span, hint="add a primitive, e.g. `approach` or `pause 1s`")
         return tl
     _reach(ctx, b, tl)
+    _swept(ctx, tl)
+    _touching(ctx, tl)
     if b.form == "descriptor":
         _realisable(ctx, b, tl)
     return tl
