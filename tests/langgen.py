@@ -619,42 +619,28 @@ def _retreat_rules(segs, vals: dict[str, Any], unc: dict[str, str], notes: list[
         away = [e for e in seg if e.kind == "radial" and e.value > 0]
         if len(seg) == 1 and away and b0 and b1:
             counted.append(seg[0])
-        elif away:
+        elif away:  # settled: each move away must itself start and end at a pause
             loose_away = True
-            if b0 and b1 and len(away) == len(seg):
-                why = "consecutive moves away between two pauses: one episode or several?"
-                for name in ("retreat_count", "retreat_distance", "retreat_acceleration"):
-                    unc[name] = why
     vals["retreat_count"] = len(counted)
     if counted:
         vals["retreat_distance"] = statistics.median(e.value for e in counted)
         vals["retreat_acceleration"] = max(e.acc or 0.0 for e in counted)
-    if loose_away:
+    if loose_away:  # settled: the peak is over the retreats that count
         notes.append("a move away that does not start and end at a pause is not a retreat")
-        unc.setdefault("retreat_acceleration", "is the peak over counted retreats only, or "
-                       "over every move away? not settled")
 
 
 def _gaze_rules(events: list[_Ev], vals: dict[str, Any], unc: dict[str, str]) -> None:
     ended = [ev for ev, nxt in zip(events, events[1:], strict=False)
              if ev.kind in ("gaze-h", "gaze-v") and nxt.kind == "pause"]
-    for axis, plane, name in ((0, "gaze-h", "horizontal_gaze"), (1, "gaze-v", "vertical_gaze")):
+    for plane, name in (("gaze-h", "horizontal_gaze"), ("gaze-v", "vertical_gaze")):
+        # settled: a plane is read at the pauses that end a gaze in that plane, as a
+        # bearing from the initial line of sight
         own = [abs(ev.value) for ev in ended if ev.kind == plane]
-        relative = [abs(ev.rel) for ev in ended if ev.kind == plane]
-        # the literal rule reads this plane at every pause that ends a gaze of either plane
-        literal = [abs(ev.hv[axis]) for ev in ended if abs(ev.hv[axis]) >= 0.5]
         if own:
             vals[name] = max(own)
-            if abs(max(own) - max(relative)) > 0.25:
-                unc[name] = ("a signed gaze angle in a sequence: bearing from the initial "
-                             "line of sight (documented) or a turn from the current one? "
-                             "the language says only 'direction'")
-        if max(literal, default=0.0) > max(own, default=0.0) + 0.25:
-            unc[name] = ("this plane's bearing at a pause that ends a gaze in the other "
-                         "plane: is it read? the rule says 'a pause that ends a gaze'")
         gz = [e for e in events if e.kind == plane]
-        if len(gz) > 1 and any(e.value == 0 for e in gz):
-            unc[name] = "a zero-degree gaze (look back) in a sequence"
+        if own and max(own) == 0 and any(e.value != 0 for e in gz):
+            unc[name] = "only the look back to 0 deg ends at a pause: 0 deg or no gaze?"
 
 
 def _roll_rules(events: list[_Ev], vals: dict[str, Any], unc: dict[str, str]) -> None:

@@ -11,7 +11,8 @@ measures the eleven descriptors straight from the model's definitions:
   (approach), rises (retreat), the goal vector turns (gaze), the end-effector rolls about
   its forward axis (tilt; three or more fast alternating rolls make a shiver);
 - a retreat counts only when it is the whole motion between two pauses;
-- a gaze is read at every pause that ends a gaze episode, as the angle between the
+- a plane's gaze is read at every pause that ends a gaze episode turning in that plane,
+  as the angle between the
   projections of g_0 and g_i on the plane with normal y_e(0) (horizontal) or x_e(0)
   (vertical); a plane whose angle there is under 0.3 deg was not looked along;
 - tilt angle = roll change within one episode, tilt velocity = angle / duration;
@@ -241,11 +242,13 @@ def measure(doc: dict[str, Any]) -> Measurement:
         values["retreat_distance"] = statistics.median(per["retreat_distance"])
         values["retreat_acceleration"] = max(_peak(acc, e) for e in ret)
 
-    # each plane is read at every pause that ends a gaze episode (of either plane)
+    # a plane is read at every pause that ends a gaze episode that turned in that plane
     for name, ang in (("horizontal_gaze", hang), ("vertical_gaze", vang)):
         reads = []
         for e in episodes:
-            if "gaze" in e.kinds and e.ends_at_pause and abs(float(ang[e.b])) >= MIN_ANGLE:
+            turned = float(np.abs(ang[e.a:e.b + 1] - ang[e.a]).max()) >= MIN_ANGLE
+            if "gaze" in e.kinds and e.ends_at_pause and turned \
+                    and abs(float(ang[e.b])) >= MIN_ANGLE:
                 reads.append(abs(float(ang[e.b])))
         per[name] = reads
         if reads:
