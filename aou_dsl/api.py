@@ -46,7 +46,8 @@ def lint(path: Source | None = None, *, source: str | None = None) -> FileResult
 
 def compile(path: Source | None = None, *, source: str | None = None,  # noqa: A001
             robot: str | None = None, rate: float | None = None, check: bool = True,
-            target_size: float = 0.05, table_height: float | None = 0.0) -> BuildResult:
+            target_size: float = 0.05, table_height: float | None = 0.0,
+            collision_check: bool = True) -> BuildResult:
     """Lint, compile, check and measure one behaviour.
 
     Args:
@@ -55,6 +56,8 @@ def compile(path: Source | None = None, *, source: str | None = None,  # noqa: A
         rate: output sample rate [Hz] (default 250).
         check: run the safety replay (a trajectory that fails it has no document).
         target_size, table_height: the scene the checks use [m] (None: no table).
+        collision_check: False accepts a robot without collision shapes (C312); the
+            document's ``checks.collision_checked`` then says so.
 
     Returns:
         A :class:`~aou_dsl.build.BuildResult`: ``ok``, ``diagnostics``, ``trajectory``,
@@ -63,7 +66,8 @@ def compile(path: Source | None = None, *, source: str | None = None,  # noqa: A
     from .safety.scene import SceneOptions
 
     scene = SceneOptions(target_size=target_size, table_height=table_height)
-    options: dict[str, Any] = {"robot": robot, "rate": rate, "check": check, "scene": scene}
+    options: dict[str, Any] = {"robot": robot, "rate": rate, "check": check, "scene": scene,
+                               "collision_check": collision_check}
     if source is not None:
         return build_source(source, os.fspath(path) if path is not None else "<string>",
                             **options)

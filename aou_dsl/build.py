@@ -62,13 +62,14 @@ class BuildResult:
 
 def _with_robot(lint: FileResult, robot: str | None) -> list[Diagnostic]:
     """Point the behaviour at another robot (``--robot``); V109 for an unknown one."""
-    from .robots import ROBOTS
+    from .robots import ROBOTS, is_robot_file
 
     if robot is None or lint.behaviour is None:
         return []
-    if robot not in ROBOTS:
-        return [diag("V109", f"unknown robot `{robot}`: expected one of {', '.join(ROBOTS)}",
-                     Span.whole_file(lint.path), found=robot, valid=list(ROBOTS))]
+    if robot not in ROBOTS and not is_robot_file(robot):
+        from .arms.load import unknown_robot
+
+        return [unknown_robot(robot, Span.whole_file(lint.path))]
     b = lint.behaviour
     lint.behaviour = b.model_copy(update={"settings": b.settings.model_copy(
         update={"robot": robot})})
@@ -95,9 +96,24 @@ def _check(res: BuildResult, rate: float, scene: SceneOptions | None) -> dict:
     return {"kinematic": report.to_json()}
 
 
+def _robot_diagnostics(b, check: bool, collision_check: bool) -> list[Diagnostic]:
+    """What the build says of its robot (limits from no source, no collision shapes)."""
+    from .arms import robot_diagnostics
+
+    try:
+        return robot_diagnostics(b.settings.robot, collision_check=check and collision_check,
+                                 span=b.settings.spans.get("robot", b.span))
+    except AouError as err:
+        return list(err.diagnostics)
+
+
 def build_lint(lint: FileResult, *, robot: str | None = None, rate: float | None = None,
-               check: bool = True, scene: SceneOptions | None = None) -> BuildResult:
-    """Compile, check and measure a linted file (see the module's docstring)."""
+               check: bool = True, scene: SceneOptions | None = None,
+               collision_check: bool = True) -> BuildResult:
+    """Compile, check and measure a linted file (see the module's docstring).
+
+    ``collision_check=False`` lets a robot without collision shapes compile; the
+    document's ``checks`` then records that self-collision was not checked."""
     from .compiler.output import trajectory_document
     from .compiler.pipeline import CompileOptions, compile_behaviour
     from .declared import declared
@@ -110,6 +126,9 @@ def build_lint(lint: FileResult, *, robot: str | None = None, rate: float | None
     b, tl = lint.behaviour, lint.timeline
     if has_errors(res.diagnostics) or b is None or tl is None or lint.cv is None:
         return res
+    res.diagnostics += _robot_diagnostics(b, check, collision_check)
+    if has_errors(res.diagnostics):
+        return res
     opts = CompileOptions() if rate is None else CompileOptions(rate=rate)
     res.compiled = compiled = compile_behaviour(b, opts, tl)
     res.diagnostics += compiled.diagnostics
@@ -119,7 +138,10 @@ def build_lint(lint: FileResult, *, robot: str | None = None, rate: float | None
         return res
     checks_json: dict[str, Any] = {"kinematic": "skipped (--no-check)"}
     if check:
-        checks_json = _check(res, opts.rate, scene)
+        from .arms import load_robot
+
+        checks_json["collision_checked"] = load_robot(b.settings.robot).collision
+        checks_json |= _check(res, opts.rate, scene)
         if has_errors(res.diagnostics):
             res.seconds = time.perf_counter() - start
             return res

@@ -13,6 +13,7 @@ import sys
 from collections.abc import Callable, Sequence
 
 from .cli_args import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, build_parser
+from .cli_robot import cmd_robot
 from .diagnostics import RULES, AouError, Diagnostic, Severity
 from .report import format_github, format_json, format_text
 
@@ -137,7 +138,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     worst = EXIT_OK
     for k, ((src, _), dest) in enumerate(zip(inputs, dests, strict=True), 1):
         res = compile_file(src, robot=args.robot, rate=args.rate, check=not args.no_check,
-                           **_scene_kw(args))
+                           collision_check=not args.no_collision_check, **_scene_kw(args))
         _print_diags(res.diagnostics, sources={src: res.lint.source or ""})
         if not res.ok or res.document is None:
             worst = max(worst, _exit_for(res.diagnostics))
@@ -165,6 +166,12 @@ def _cmd_check(args: argparse.Namespace) -> int:
     from .report import format_check
 
     tr = read_trajectory(args.path, **_read_kw(args))
+    from .arms import robot_diagnostics
+
+    refused = robot_diagnostics(tr.robot, collision_check=not args.no_collision_check)
+    _print_diags(refused)
+    if any(d.severity == Severity.ERROR for d in refused):
+        return EXIT_ERRORS
     report = check(tr, dynamic=not args.no_dynamic, **_scene_kw(args))
     if args.format == "json":
         print(format_json({"path": args.path, **report.to_json()}))
@@ -269,6 +276,7 @@ _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "lint": _cmd_lint, "rules": _cmd_rules, "explain": _cmd_explain,
     "compile": _cmd_compile, "check": _cmd_check, "measure": _cmd_measure,
     "plot": _cmd_plot, "render": _cmd_render, "variants": _cmd_variants,
+    "robot": cmd_robot,
 }
 
 
@@ -279,6 +287,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help(sys.stderr)
         return EXIT_USAGE
     try:
+        if getattr(args, "package_dir", None):
+            from .arms import set_package_dirs
+
+            set_package_dirs(args.package_dir)
         return _COMMANDS[args.command](args)
     except AouError as err:
         return _fail(err)

@@ -73,8 +73,25 @@ LENGTH = number(0.0, 2.0, what="a length in metres")
 HEIGHT = number(-2.0, 2.0, what="a height in metres")
 
 
+ROBOT_HELP = ("robot: a built-in name (panda, ur5, xarm7, ...; `aouc robot --list`) or a "
+              "path to a .urdf or a .toml robot description; overrides the file's `robot`")
+
+
+def _robot(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--robot", metavar="NAME|PATH", help=ROBOT_HELP)
+    p.add_argument("--package-dir", action="append", default=[], metavar="DIR",
+                   help="a folder holding ROS packages, searched first for the URDF's "
+                   "package:// meshes (repeatable)")
+
+
+def _collision(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--no-collision-check", action="store_true",
+                   help="accept a robot without collision shapes (self-collision is then "
+                   "not checked, and the output says so)")
+
+
 def _recording(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--robot", help="robot (a name such as panda or ur5); overrides the file's")
+    _robot(p)
     p.add_argument("--ee-frame", help="end-effector frame (default: the robot's)")
     p.add_argument("--goal", metavar="X,Y,Z", type=point, help="goal position in metres")
 
@@ -121,9 +138,10 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     comp.add_argument("--format", choices=("json", "csv", "npz"),
                       help="output format (default: from -o's extension, else json)")
     comp.add_argument("--rate", type=RATE, metavar="HZ", help="sample rate in Hz (default 250)")
-    comp.add_argument("--robot", help="robot to compile for; overrides the file's `robot`")
+    _robot(comp)
     comp.add_argument("--no-check", action="store_true",
                       help="skip the safety checks (recorded in the output)")
+    _collision(comp)
     _scene(comp)
     c["check"] = chk = sub.add_parser(
         "check", help="replay a behaviour or trajectory in PyBullet and report every check")
@@ -131,6 +149,7 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     chk.add_argument("--format", choices=("text", "json"), default="text")
     chk.add_argument("--no-dynamic", action="store_true",
                      help="kinematic checks only (skip the physics replay)")
+    _collision(chk)
     _recording(chk)
     _scene(chk)
     c["plot"] = plot = sub.add_parser(
@@ -162,6 +181,15 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     meas.add_argument("path", metavar="FILE", help="a trajectory .json/.npz, or a .csv")
     _recording(meas)
     meas.add_argument("--format", choices=("table", "json"), default="table")
+    c["robot"] = rob = sub.add_parser(
+        "robot", help="show what aou knows or derives of a robot (frames, limits, posture)")
+    rob.add_argument("robot", nargs="?", metavar="NAME|PATH",
+                     help="a built-in name, or a .urdf or .toml path")
+    rob.add_argument("--list", action="store_true", help="list the built-in robots")
+    rob.add_argument("--format", choices=("text", "json", "toml"), default="text",
+                     help="toml: a robot description pinning every value")
+    rob.add_argument("--package-dir", action="append", default=[], metavar="DIR",
+                     help="a folder holding ROS packages (repeatable)")
     c["rules"] = rules = sub.add_parser("rules", help="list the diagnostic codes, or explain some")
     rules.add_argument("codes", nargs="*", metavar="CODE")
     rules.add_argument("--format", choices=("text", "json"), default="text")

@@ -181,8 +181,10 @@ _RULE_LIST = [
          "The two forms lay out time differently; a file must choose one.",
          "pause 1s\nsequence { approach }"),
     Rule("V109", "unknown-robot", _E,
-         "The `robot` setting names a robot aou has no table for.",
-         "aou needs the robot's end-effector frame, default goal and acceleration limits.",
+         "The `robot` setting (or --robot) names no built-in arm, and no robot file (a URDF "
+         "or a TOML robot description) aou can use.",
+         "aou needs the robot's kinematics, its end-effector frame, a default goal and its "
+         "limits; `aouc robot PATH` shows what it reads or derives from a file.",
          "robot panda2"),
     Rule("V110", "resource-bound", _E,
          "The behaviour asks for more than 10 minutes of motion or more than 1000 episodes.",
@@ -315,6 +317,18 @@ _RULE_LIST = [
          "The motion does not show what the file declares; usually a joint limit slowed it "
          "(see C304).",
          "approach a=50   # the joints cannot accelerate the hand that fast"),
+    Rule("C312", "no-collision-geometry", _E,
+         "The robot's URDF has no collision shapes, so self-collision cannot be checked.",
+         "A trajectory whose collisions were not checked is written only when the user opts "
+         "out explicitly (--no-collision-check); the output records it.",
+         'robot "arm_without_collision_shapes.urdf"\napproach\npause 1s'),
+    Rule("C313", "default-limits", _W,
+         "The robot has no sourced joint acceleration (or jerk) limits; a conservative "
+         "default is used.",
+         "URDFs carry no acceleration limits; a robot description file (TOML) beside the URDF "
+         "pins them (docs/robots.md says how).",
+         "robot z1\napproach\npause 1s"),
+    # --- R: reading trajectories -------------------------------------------------------
     # --- R: reading trajectories -------------------------------------------------------
     Rule("R401", "bad-trajectory", _E,
          "A trajectory file is not valid: missing keys or columns, non-increasing time, NaN.",

@@ -1,22 +1,23 @@
-"""Robot models for the numerical stages: Pinocchio, loaded from example-robot-data.
+"""Robot models for the numerical stages: Pinocchio models of the arm's joints.
 
-Shared by the compiler and by ``aouc measure``; it knows only the robot (URDF and
-:mod:`aou_dsl.robots`), never a behaviour. Pinocchio is imported here, so only the
+Shared by the compiler and by ``aouc measure``; it knows only the robot (its URDF,
+:mod:`aou_dsl.robots`, a robot description), never a behaviour. The robot is loaded by
+:mod:`aou_dsl.arms.load`, once per process; Pinocchio is imported there, so only the
 commands that need kinematics pay for it.
 """
 
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from .diagnostics import AouError, Span, diag
-from .robots import DEFAULT_JOINT_JERK, ROBOTS, RobotSpec
+from .robots import DEFAULT_JOINT_JERK, RobotSpec
 
-__all__ = ["ArmModel", "load_arm"]
+__all__ = ["ArmModel", "arm_model", "frame_id", "load_arm"]
 
 
 @dataclass(frozen=True)
@@ -24,14 +25,17 @@ class ArmModel:
     """A robot reduced to its arm joints, with the limits aou plans with.
 
     Attributes:
-        spec: the robot's entry of :data:`aou_dsl.robots.ROBOTS`.
-        model: the reduced ``pinocchio.Model`` (arm joints only; fingers locked).
+        spec: the robot's spec (a built-in arm of :data:`aou_dsl.robots.ROBOTS`, or one
+            read from a robot file).
+        model: the reduced ``pinocchio.Model`` (arm joints only; grippers locked;
+            continuous joints as revolute joints of one angle).
         frame_id: id of the end-effector frame in ``model``.
         lower, upper: joint position limits [rad], shape (n,).
-        vmax: joint velocity limits from the URDF [rad/s], shape (n,).
-        amax: joint acceleration limits from the robot table [rad/s^2], shape (n,).
-        jmax: joint jerk limits from the robot table [rad/s^3], shape (n,).
-        effort: joint effort limits from the URDF [N m], shape (n,).
+        vmax: joint velocity limits from the URDF (or the robot file) [rad/s], shape (n,).
+        amax: joint acceleration limits from the robot's spec [rad/s^2], shape (n,).
+        jmax: joint jerk limits from the robot's spec [rad/s^3], shape (n,).
+        effort: joint effort limits from the URDF [N m] (inf where it gives none),
+            shape (n,).
     """
 
     spec: RobotSpec
@@ -74,7 +78,7 @@ class ArmModel:
         """
         import pinocchio as pin
 
-        fid = self.frame_id if frame is None else self.model.getFrameId(frame)
+        fid = self.frame_id if frame is None else frame_id(self.model, frame)
         data = self.model.createData()
         q = np.atleast_2d(np.asarray(q, dtype=float))
         pos = np.empty((len(q), 3))
@@ -87,44 +91,57 @@ class ArmModel:
         return pos, rot
 
 
-@functools.cache
-def load_arm(robot: str, ee_frame: str | None = None) -> ArmModel:
-    """Load a robot of :data:`ROBOTS` from example-robot-data, reduced to its arm.
-
-    Raises:
-        AouError: V109 for a robot aou has no table for, R402 for a frame the model
-            lacks (listing the valid ones), I501 when the model's joints are not the
-            table's.
-    """
-    import example_robot_data as erd
+def frame_id(model: Any, name: str) -> int:
+    """The id of frame ``name`` in ``model``: the link's (body) frame when a joint has the
+    same name as a link; -1 when there is none."""
     import pinocchio as pin
 
-    spec = ROBOTS.get(robot)
-    where = Span.whole_file(f"<robot {robot}>")
-    if spec is None:
-        raise AouError(diag("V109", f"unknown robot `{robot}`: expected one of "
-                            f"{', '.join(ROBOTS)}", where))
-    full = erd.load(robot).model
-    lock = [full.getJointId(n) for n in full.names[1:] if n not in spec.arm_joints]
-    q_ref = pin.neutral(full)
-    model = pin.buildReducedModel(full, lock, q_ref) if lock else full
-    names = list(model.names[1:])
-    if tuple(names) != spec.arm_joints:
-        raise AouError(diag("I501", f"robot `{robot}` has joints {names}, expected "
-                            f"{list(spec.arm_joints)}", where))
-    frame = ee_frame or spec.ee_frame
-    if not model.existFrame(frame):
-        valid = sorted({f.name for f in model.frames})
-        raise AouError(diag("R402", f"robot `{robot}` has no frame `{frame}`", where,
-                            hint=f"frames: {', '.join(valid)}", valid=valid))
+    ids = [i for i, f in enumerate(model.frames) if f.name == name]
+    bodies = [i for i in ids if model.frames[i].type == pin.FrameType.BODY]
+    return (bodies or ids or [-1])[0]
+
+
+def arm_model(spec: RobotSpec, model: Any, *, no_effort: tuple[str, ...] = ()) -> ArmModel:
+    """An :class:`ArmModel` of a reduced Pinocchio ``model`` whose joints are
+    ``spec.arm_joints``; joints in ``no_effort`` (no effort limit in the URDF) get an
+    infinite one."""
+    effort = np.array(model.effortLimit, dtype=float)
+    for j in no_effort:
+        effort[spec.arm_joints.index(j)] = np.inf
+    n = len(spec.arm_joints)
+    vmax = np.array(spec.joint_velocity or model.velocityLimit, dtype=float)
     return ArmModel(
         spec=spec,
         model=model,
-        frame_id=model.getFrameId(frame),
+        frame_id=frame_id(model, spec.ee_frame),
         lower=np.array(model.lowerPositionLimit),
         upper=np.array(model.upperPositionLimit),
-        vmax=np.array(model.velocityLimit),
-        amax=np.array(spec.joint_accel),
-        effort=np.array(model.effortLimit),
-        jmax=np.array(spec.joint_jerk or (DEFAULT_JOINT_JERK,) * len(spec.arm_joints)),
+        vmax=vmax,
+        amax=np.array(spec.joint_accel, dtype=float),
+        effort=effort,
+        jmax=np.array(spec.joint_jerk or (DEFAULT_JOINT_JERK,) * n, dtype=float),
     )
+
+
+@functools.cache
+def load_arm(robot: str, ee_frame: str | None = None) -> ArmModel:
+    """The arm of ``robot`` (a built-in name or a robot file's path), its kinematics built
+    from the URDF's joints alone (no mesh is read), once per process.
+
+    Raises:
+        AouError: V109 for an unknown robot or a robot file aou cannot use (I501 when it
+            cannot be read), R402 for a frame the model lacks (listing the valid ones).
+    """
+    from .arms.load import load_robot
+
+    r = load_robot(robot)
+    arm = arm_model(r.spec, r.model, no_effort=r.no_effort)
+    if ee_frame is None or ee_frame == r.spec.ee_frame:
+        return arm
+    fid = frame_id(r.model, ee_frame)
+    if fid < 0:
+        valid = sorted({f.name for f in r.model.frames})
+        raise AouError(diag("R402", f"robot `{robot}` has no frame `{ee_frame}`",
+                            Span.whole_file(f"<robot {robot}>"),
+                            hint=f"frames: {', '.join(valid)}", valid=valid))
+    return replace(arm, frame_id=fid)

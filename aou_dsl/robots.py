@@ -1,14 +1,14 @@
 """The robots aou knows: per-robot defaults and limits, as plain data (no heavy imports).
 
-URDFs carry position, velocity and effort limits but no acceleration limits, so
-the joint acceleration limits here come from the manufacturers' datasheets:
+Each built-in arm is a URDF of example-robot-data plus what the URDF does not say, each
+value with where it comes from (``sources``). A user's robot is a URDF, or a robot
+description file (TOML) naming one; :mod:`aou_dsl.arms` reads it and derives what no
+file pins, into the same :class:`RobotSpec`.
 
-- Franka Emika Panda: "Robot and interface specifications" (Franka Control Interface
-  documentation), joint acceleration limits 15, 7.5, 10, 12.5, 15, 20, 20 rad/s^2.
-- Universal Robots UR5 (CB3): the datasheet gives no joint acceleration limit; the
-  teach pendant's default joint acceleration is 1.4 rad/s^2 and the controller allows
-  up to about 40 rad/s^2 (it limits torque, not acceleration). aou uses 3.0 rad/s^2,
-  the conservative default :data:`DEFAULT_JOINT_ACCEL` for robots without a datasheet value.
+URDFs carry position, velocity and effort limits but no acceleration limits. The
+acceleration (and jerk) limits below are the manufacturers' where they publish them,
+each number with its source; an arm without a source gets
+:data:`DEFAULT_JOINT_ACCEL` / :data:`DEFAULT_JOINT_JERK` and a C313 warning.
 
 Velocity limits are read from the URDF at compile time; the compiler plans at
 ``velocity_scale`` of them and at ``accel_scale`` of the acceleration limits, to keep a
@@ -19,13 +19,24 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["DEFAULT_JOINT_ACCEL", "DEFAULT_JOINT_JERK", "ROBOTS", "RobotSpec"]
+from .arms.table import GEOMETRY
 
-#: Joint acceleration limit [rad/s^2] for a robot whose datasheet gives none.
+__all__ = ["DEFAULT_JOINT_ACCEL", "DEFAULT_JOINT_JERK", "DEFAULT_JOINT_VELOCITY", "NO_SOURCE",
+           "ROBOTS", "ROBOT_FILE_TYPES", "UNSOURCED", "RobotSpec", "is_robot_file"]
+
+#: Joint acceleration limit [rad/s^2] for a robot no source gives one for: the lowest
+#: of the sourced arms' planning values (Universal Robots' 5 rad/s^2 is the next).
 DEFAULT_JOINT_ACCEL = 3.0
 
 #: Joint jerk limit [rad/s^3] for a robot whose datasheet gives none.
 DEFAULT_JOINT_JERK = 1000.0
+
+#: Joint velocity limit [rad/s] for a joint whose URDF gives none, when no other joint of
+#: the arm has one either (otherwise the arm's smallest).
+DEFAULT_JOINT_VELOCITY = 1.0
+
+#: What a quoted ``robot "..."`` may name: a URDF, or a robot description file.
+ROBOT_FILE_TYPES = (".urdf", ".toml")
 
 
 @dataclass(frozen=True, slots=True)
@@ -33,7 +44,7 @@ class RobotSpec:
     """What aou needs to know of a robot beyond its URDF.
 
     Attributes:
-        name: the example-robot-data name.
+        name: the robot as the user named it: a built-in name, or a robot file's path.
         ee_frame: frame whose z axis is the end-effector's forward (gaze) axis.
         arm_joints: the moving joints, in column order of the trajectory's ``q``.
         goal: default goal position in the base frame [m], shape (3,).
@@ -50,6 +61,20 @@ class RobotSpec:
             meets its limits at its grid points; in between, the spline's curvature can
             add a percent or so, which this margin absorbs (the checks use the full limit).
         limit_margin: distance [rad] kept from every joint position limit.
+        allowed_contacts: link pairs allowed to touch beyond adjacent links (meshes that
+            overlap by design).
+        urdf: the URDF: a path inside example-robot-data's ``robots`` folder for a
+            built-in arm, an absolute path otherwise.
+        ee_link: the URDF link ``ee_frame`` is welded to when aou adds ``ee_frame``
+            (its z axis then is the link's ``forward`` axis); empty when ``ee_frame`` is
+            the URDF's own link.
+        forward: the axis of ``ee_link`` (or of ``ee_frame``) that looks forward.
+        ee_offset: how far [m] ahead of ``ee_link`` along ``forward`` aou puts
+            ``ee_frame`` (a tool's tip beyond the link's origin).
+        ee_roll: the turn [rad] of ``ee_frame`` about ``forward``: which way is up for
+            the hand when the gaze is locked.
+        joint_velocity: velocity limits [rad/s] overriding the URDF's; empty for none.
+        sources: where each value comes from, ``(field, text)`` pairs.
     """
 
     name: str
@@ -64,45 +89,93 @@ class RobotSpec:
     velocity_scale: float = 0.9
     accel_scale: float = 0.95
     limit_margin: float = 0.05
-    #: Link pairs allowed to touch beyond adjacent links (meshes that overlap by design).
     allowed_contacts: tuple[tuple[str, str], ...] = ()
+    urdf: str = ""
+    ee_link: str = ""
+    forward: str = "+z"
+    ee_offset: float = 0.0
+    ee_roll: float = 0.0
+    joint_velocity: tuple[float, ...] = ()
+    sources: tuple[tuple[str, str], ...] = ()
+
+    def source(self, key: str) -> str:
+        """Where the value of field ``key`` comes from ("" when unknown)."""
+        return dict(self.sources).get(key, "")
 
 
-ROBOTS: dict[str, RobotSpec] = {
-    "panda": RobotSpec(
-        name="panda",
-        ee_frame="panda_hand_tcp",
-        arm_joints=tuple(f"panda_joint{i}" for i in range(1, 8)),
-        # In front of the robot at table height + 25 cm, reached from above and behind:
-        # the start pose looks down and forward at the goal, as in the study's videos.
-        goal=(0.55, 0.0, 0.25),
-        start_direction=(-0.6, 0.0, 0.8),
-        posture=(0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.785398),
-        joint_accel=(15.0, 7.5, 10.0, 12.5, 15.0, 20.0, 20.0),
-        # Same source (and libfranka's rate limiter): 7500, 3750, 5000, 6250, 7500,
-        # 10000, 10000 rad/s^3.
-        joint_jerk=(7500.0, 3750.0, 5000.0, 6250.0, 7500.0, 10000.0, 10000.0),
-        shiver_joint="panda_joint7",
-        # The hand's mesh overlaps link 7's at the flange (link 8 between them has no
-        # shape), and the two fingers touch when the gripper is closed.
-        allowed_contacts=(("panda_link7", "panda_hand"),
-                          ("panda_leftfinger", "panda_rightfinger")),
-    ),
-    "ur5": RobotSpec(
-        name="ur5",
-        ee_frame="tool0",
-        arm_joints=(
-            "shoulder_pan_joint",
-            "shoulder_lift_joint",
-            "elbow_joint",
-            "wrist_1_joint",
-            "wrist_2_joint",
-            "wrist_3_joint",
-        ),
-        goal=(0.45, 0.15, 0.15),
-        start_direction=(-0.6, 0.0, 0.8),
-        posture=(0.3, -1.3, 1.8, -2.1, -1.5708, 0.0),
-        joint_accel=(DEFAULT_JOINT_ACCEL,) * 6,
-        shiver_joint="wrist_3_joint",
-    ),
+# --- Sourced limits ---------------------------------------------------------------------
+# Each number with its source. "No source" means the manufacturer publishes none that
+# we found; the arm then plans with the conservative default and says so (C313).
+
+#: Franka Emika Panda: "Robot and interface specifications", Franka Control Interface
+#: documentation (frankaemika.github.io/docs/control_parameters.html): joint acceleration
+#: limits [rad/s^2] and jerk limits [rad/s^3]; libfranka's rate limiter uses the same
+#: (franka/rate_limiting.h, kMaxJointAcceleration, kMaxJointJerk).
+PANDA_ACCEL = (15.0, 7.5, 10.0, 12.5, 15.0, 20.0, 20.0)
+PANDA_JERK = (7500.0, 3750.0, 5000.0, 6250.0, 7500.0, 10000.0, 10000.0)
+PANDA_SOURCE = "Franka Control Interface, Robot and interface specifications"
+
+#: Universal Robots (UR3, UR5, UR10, CB3): 5 rad/s^2 on every joint, Universal Robots'
+#: own planning value (Universal_Robots_ROS2_Driver, ur_moveit_config/config/
+#: joint_limits.yaml, "chosen conservatively to work in most use cases"; pull request
+#: 645). The robot itself limits torque, not acceleration (ur_description
+#: config/ur5/joint_limits.yaml: "acceleration limits are not publicly available").
+#: No jerk limit is published.
+UR_ACCEL = 5.0
+UR_SOURCE = ("Universal Robots' ROS 2 driver, ur_moveit_config joint_limits.yaml "
+             "(5 rad/s^2, chosen conservatively)")
+
+#: UFactory xArm7: 20 rad/s^2 on every joint (xarm_ros2, xarm_moveit_config/config/
+#: xarm7/joint_limits.yaml, max_acceleration: 20.0). No jerk limit is published.
+XARM_ACCEL = 20.0
+XARM_SOURCE = "UFactory xarm_ros2, xarm_moveit_config/config/xarm7/joint_limits.yaml"
+
+#: Kinova Jaco2 6-DOF (j2s6s200, example-robot-data's `kinova`): no source. Kinova's own
+#: configuration for this arm (kinova-ros, j2s6s200_moveit_config/config/joint_limits.yaml)
+#: sets has_acceleration_limits: false; the 8.6 rad/s^2 of ros2_kortex is the Gen3's,
+#: another arm.
+#: Unitree Z1 and Reach Robotics Bravo 7: no source found.
+NO_SOURCE = ("no source: the manufacturer publishes no joint acceleration limit; "
+             "aou's conservative default")
+
+LIMITS: dict[str, dict] = {
+    "panda": {"joint_accel": PANDA_ACCEL, "joint_jerk": PANDA_JERK},
+    "ur3": {"joint_accel": (UR_ACCEL,) * 6},
+    "ur3_limited": {"joint_accel": (UR_ACCEL,) * 6},
+    "ur3_gripper": {"joint_accel": (UR_ACCEL,) * 6},
+    "ur5": {"joint_accel": (UR_ACCEL,) * 6},
+    "ur5_limited": {"joint_accel": (UR_ACCEL,) * 6},
+    "ur5_gripper": {"joint_accel": (UR_ACCEL,) * 6},
+    "ur10": {"joint_accel": (UR_ACCEL,) * 6},
+    "ur10_limited": {"joint_accel": (UR_ACCEL,) * 6},
+    "xarm7": {"joint_accel": (XARM_ACCEL,) * 7},
+    "kinova": {"joint_accel": (DEFAULT_JOINT_ACCEL,) * 6},
+    "z1": {"joint_accel": (DEFAULT_JOINT_ACCEL,) * 6},
+    "bravo7_no_ee": {"joint_accel": (DEFAULT_JOINT_ACCEL,) * 6},
+    "bravo7_gripper": {"joint_accel": (DEFAULT_JOINT_ACCEL,) * 6},
 }
+
+_LIMIT_SOURCES = {"panda": PANDA_SOURCE, "xarm7": XARM_SOURCE,
+                  **{n: UR_SOURCE for n in LIMITS if n.startswith("ur")}}
+
+
+def _spec(name: str, fields: dict) -> RobotSpec:
+    limits = LIMITS[name]
+    src = _LIMIT_SOURCES.get(name, NO_SOURCE)
+    sources = (("joint_accel", src),
+               ("joint_jerk", src if "joint_jerk" in limits else NO_SOURCE),
+               *fields.pop("sources", ()))
+    return RobotSpec(name=name, **fields, **limits, sources=sources)
+
+
+ROBOTS: dict[str, RobotSpec] = {name: _spec(name, dict(fields))
+                                for name, fields in GEOMETRY.items() if name in LIMITS}
+
+#: Arms whose limits come from no source (planned with the defaults, with a C313 warning).
+UNSOURCED = frozenset(n for n in ROBOTS if n not in _LIMIT_SOURCES)
+
+
+def is_robot_file(robot: str) -> bool:
+    """Whether ``robot`` names a robot file (a path) rather than a built-in arm."""
+    return robot not in ROBOTS and (robot.lower().endswith(ROBOT_FILE_TYPES)
+                                    or "/" in robot or "\\" in robot)

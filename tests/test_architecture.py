@@ -62,13 +62,22 @@ UNREACHED = {"C303", "C305"}
 @pytest.mark.parametrize("code", [pytest.param(c, marks=pytest.mark.xfail(
     strict=True, reason="no input known to reach it")) if c in UNREACHED else c
     for c in RULES if c[0] == "C"])
-def test_each_compiler_rule_example_triggers_its_own_code(code):
+def test_each_compiler_rule_example_triggers_its_own_code(code, tmp_path, monkeypatch):
     """A C-rule's example lints clean of errors and then fails (or warns) in compile
-    with that very code."""
+    with that very code. An example naming a robot file gets one: the Panda's URDF
+    with its collision shapes removed."""
+    import re
+
+    from aou_dsl.arms.load import scene_urdf
     from aou_dsl.build import build_source
 
     example = RULES[code].example
-    res = build_source(example, "example.aou")
+    for name in re.findall(r'robot "([^"]+)"', example):
+        text = open(scene_urdf("panda")).read()
+        (tmp_path / name).write_text(re.sub(r"<collision>.*?</collision>", "", text,
+                                            flags=re.S))
+    monkeypatch.chdir(tmp_path)
+    res = build_source(example, str(tmp_path / "example.aou"))
     assert code in {d.code for d in res.diagnostics}, (example, [
         (d.code, d.message) for d in res.diagnostics])
 

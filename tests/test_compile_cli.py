@@ -65,7 +65,7 @@ def test_other_formats_are_deterministic_and_carry_the_same_data(tmp_path, fmt, 
         assert np.array_equal(z["q"], np.array(doc["q"]))
         assert np.array_equal(z["t"], np.array(doc["t"]))
     else:
-        rows = a.read_text().splitlines()
+        rows = [r for r in a.read_text().splitlines() if not r.startswith("#")]
         assert rows[0] == "t," + ",".join(doc["joint_names"])
         assert len(rows) == len(doc["t"]) + 1
 
@@ -181,3 +181,18 @@ def test_check_reads_a_csv_recording_with_its_robot(tmp_path, hesitant_json, cap
     assert "--robot" in capsys.readouterr().err
     assert main(["check", str(csv), "--robot", "panda", "--no-dynamic"]) == EXIT_OK
     assert "pass  target-contact" in capsys.readouterr().out
+
+
+def test_robot_command_lists_and_describes_arms(capsys):
+    assert main(["robot", "--list"]) == EXIT_OK
+    names = [line.split()[0] for line in capsys.readouterr().out.splitlines()]
+    assert {"panda", "ur5", "xarm7", "kinova", "z1"} <= set(names)
+    assert main(["robot", "xarm7", "--format", "json"]) == EXIT_OK
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["ee_frame"] == "link_eef" and len(doc["joints"]) == 7
+    assert doc["sources"]["joint_accel"]  # every limit says where it comes from
+
+
+def test_robot_command_on_an_unknown_robot_is_v109(capsys):
+    assert main(["robot", "kuka_lbr"]) == 1
+    assert "V109" in capsys.readouterr().err

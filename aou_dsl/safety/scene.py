@@ -1,7 +1,10 @@
-"""A PyBullet world (DIRECT mode, no display) holding the robot from example-robot-data.
+"""A PyBullet world (DIRECT mode, no display) holding the robot.
 
-PyBullet is imported here and only here; each :class:`Scene` owns its own physics
-client, so several can coexist and none leaks into another.
+The robot is loaded from the copy of its URDF that :func:`aou_dsl.arms.load.scene_urdf`
+writes once per process (mesh paths absolute; visual meshes only when the scene is
+drawn, since the checks need collision shapes only). PyBullet is imported here and
+only here; each :class:`Scene` owns its own physics client, so several can coexist and
+none leaks into another.
 """
 
 from __future__ import annotations
@@ -13,13 +16,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..robots import ROBOTS
+from ..diagnostics import AouError, Span, diag
 
-__all__ = ["Scene", "SceneOptions", "import_pybullet", "urdf_path"]
+__all__ = ["Scene", "SceneOptions", "import_pybullet", "quiet", "urdf_path"]
 
 
 @contextlib.contextmanager
-def _quiet():
+def quiet():
     """Keep PyBullet's C library from printing its banner ("pybullet build time: ...")
     on standard output or error: it would corrupt ``--format json`` output."""
     sys.stdout.flush()
@@ -37,31 +40,25 @@ def _quiet():
             os.close(fd)
 
 
+_quiet = quiet
+
+
 def import_pybullet():
-    """Import PyBullet quietly (see :func:`_quiet`)."""
+    """Import PyBullet quietly (see :func:`quiet`)."""
     if "pybullet" not in sys.modules:
         with _quiet():
             import pybullet  # noqa: F401
     return sys.modules["pybullet"]
 
 
-#: The URDF of each robot inside example-robot-data's share folder.
-_URDF = {
-    "panda": "panda_description/urdf/panda.urdf",
-    "ur5": "ur_description/urdf/ur5_robot.urdf",
-}
+def urdf_path(robot: str, *, visuals: bool = False) -> tuple[str, str]:
+    """The URDF PyBullet loads for ``robot`` (a name or a robot file's path; every mesh
+    path in it absolute, the end-effector frame aou adds included; visual shapes only if
+    ``visuals``) and its folder."""
+    from ..arms.load import scene_urdf
 
-
-def urdf_path(robot: str) -> tuple[str, str]:
-    """The robot's URDF path and the folder its ``package://`` meshes resolve from."""
-    import example_robot_data as erd
-
-    robots = erd.getModelPath(_URDF[robot])
-    urdf = os.path.join(robots, "robots", _URDF[robot])
-    if not os.path.exists(urdf):  # layouts differ between releases of the data package
-        urdf = os.path.join(robots, _URDF[robot])
-    share = os.path.normpath(os.path.join(os.path.dirname(urdf), *[".."] * 3))
-    return urdf, os.path.dirname(share)
+    urdf = scene_urdf(robot, visuals=visuals)
+    return urdf, os.path.dirname(urdf)
 
 
 @dataclass(frozen=True)
@@ -79,23 +76,37 @@ class SceneOptions:
 
 @dataclass
 class Scene:
-    """The robot (and optionally the target and table) in a private PyBullet client."""
+    """The robot (and optionally the target and table) in a private PyBullet client.
+
+    ``visuals`` loads the visual meshes too (for drawing); the checks need only the
+    collision shapes, which load many times faster.
+    """
 
     robot: str
     goal: tuple[float, ...] | None = None
     options: SceneOptions = field(default_factory=SceneOptions)
+    visuals: bool = True
 
     def __post_init__(self):
+        from ..arms.load import load_robot
+
+        spec = load_robot(self.robot).spec
+        urdf, _ = urdf_path(self.robot, visuals=self.visuals)
         pb = import_pybullet()
         self.pb = pb
         with _quiet():
             self.client = pb.connect(pb.DIRECT)
-        urdf, search = urdf_path(self.robot)
-        pb.setAdditionalSearchPath(search, physicsClientId=self.client)
         flags = pb.URDF_USE_SELF_COLLISION | pb.URDF_USE_SELF_COLLISION_EXCLUDE_PARENT
-        self.body = pb.loadURDF(urdf, useFixedBase=True, flags=flags,
-                                physicsClientId=self.client)
-        spec = ROBOTS[self.robot]
+        try:
+            with _quiet():  # PyBullet prints warnings about the URDF (inertia, materials)
+                self.body = pb.loadURDF(urdf, useFixedBase=True, flags=flags,
+                                        physicsClientId=self.client)
+        except pb.error as exc:
+            self.close()
+            raise AouError(diag("V109", f"PyBullet cannot load robot `{self.robot}`: {exc}",
+                                Span.whole_file(urdf))) from None
+        #: The arm's joint names, in the order of :meth:`set_arm`'s ``q``.
+        self.arm_joints: tuple[str, ...] = spec.arm_joints
         self.joint_index: dict[str, int] = {}
         self.link_index: dict[str, int] = {}
         for j in range(pb.getNumJoints(self.body, physicsClientId=self.client)):

@@ -4,13 +4,14 @@
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable
 from typing import Any
 
 from ..diagnostics import Span
 from ..ir import DEFAULTS, Effort, Settings
 from ..parse import Quantity, Statement, Vector, Word
-from ..robots import ROBOTS
+from ..robots import ROBOT_FILE_TYPES, ROBOTS
 from ..units import Dim
 from .reader import Args, Ctx, did_you_mean, positive, si, split_args
 
@@ -22,17 +23,42 @@ SETTINGS = ("robot", "goal", "from", "start", "standoff", "effort")
 
 
 def _robot(ctx: Ctx, st: Statement, args: Args) -> Any:
+    """A built-in arm's name, or a quoted path to a robot file (a URDF or a robot
+    description), relative to this file's folder. The file must exist; its content is
+    read when the behaviour compiles."""
     pos = args.positional
     if len(pos) != 1 or not isinstance(pos[0], Word):
-        ctx.error("V113", "`robot` takes one name, e.g. `robot panda`", st.keyword_span)
+        ctx.error("V113", '`robot` takes one name, e.g. `robot panda`, or a quoted path, '
+                  'e.g. `robot "my_arm.urdf"`', st.keyword_span)
         return None
-    name = pos[0].text
-    if name not in ROBOTS:
-        ctx.error("V109", f"unknown robot `{name}`: expected one of {', '.join(ROBOTS)}",
-                  pos[0].span, hint=did_you_mean(name, ROBOTS), found=name,
+    word = pos[0]
+    if word.quoted:
+        return _robot_file(ctx, word)
+    if word.text not in ROBOTS:
+        ctx.error("V109", f"unknown robot `{word.text}`: expected one of "
+                  f"{', '.join(ROBOTS)}, or a quoted path to a robot file",
+                  word.span, hint=did_you_mean(word.text, ROBOTS), found=word.text,
                   valid=list(ROBOTS))
         return None
-    return name
+    return word.text
+
+
+def _robot_file(ctx: Ctx, word: Word) -> str | None:
+    """The quoted path joined to the file's folder (as given when absolute)."""
+    text = word.text
+    if not text.lower().endswith(ROBOT_FILE_TYPES):
+        ctx.error("V109", f"robot file `{text}` is neither a URDF nor a robot description",
+                  word.span, hint=f"a robot file ends in {' or '.join(ROBOT_FILE_TYPES)}",
+                  found=text)
+        return None
+    folder = os.path.dirname(ctx.path) if not ctx.path.startswith("<") else ""
+    path = text if os.path.isabs(text) else os.path.normpath(os.path.join(folder, text))
+    if not os.path.isfile(path):
+        ctx.error("V109", f"robot file `{text}` not found (looked for `{path}`)", word.span,
+                  hint="a relative path starts from the folder of the .aou file",
+                  found=text)
+        return None
+    return path
 
 
 def _vector(ctx: Ctx, st: Statement, args: Args) -> tuple[Vector, list[float]] | None:
