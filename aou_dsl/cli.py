@@ -13,7 +13,7 @@ import sys
 from collections.abc import Callable, Sequence
 
 from .cli_args import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, build_parser
-from .cli_robot import cmd_robot
+from .cli_tools import cmd_robot, cmd_synth
 from .diagnostics import RULES, AouError, Diagnostic, Severity
 from .report import format_github, format_json, format_text
 
@@ -276,7 +276,7 @@ _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "lint": _cmd_lint, "rules": _cmd_rules, "explain": _cmd_explain,
     "compile": _cmd_compile, "check": _cmd_check, "measure": _cmd_measure,
     "plot": _cmd_plot, "render": _cmd_render, "variants": _cmd_variants,
-    "robot": cmd_robot,
+    "robot": cmd_robot, "synth": cmd_synth,
 }
 
 

@@ -71,6 +71,7 @@ def frame_size(text: str) -> tuple[int, int]:
 RATE = number(1.0, 10000.0, what="a sample rate in Hz")
 LENGTH = number(0.0, 2.0, what="a length in metres")
 HEIGHT = number(-2.0, 2.0, what="a height in metres")
+UNIT_RANGE = number(-1.0, 1.0, what="a coordinate of the C-V plane")
 
 
 ROBOT_HELP = ("robot: a built-in name (panda, ur5, xarm7, ...; `aouc robot --list`) or a "
@@ -190,6 +191,23 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
                      help="toml: a robot description pinning every value")
     rob.add_argument("--package-dir", action="append", default=[], metavar="DIR",
                      help="a folder holding ROS packages (repeatable)")
+    c["synth"] = syn = sub.add_parser(
+        "synth", help="write a .aou file for a state, or a point of the C-V plane, at an "
+        "intensity")
+    which = syn.add_mutually_exclusive_group(required=True)
+    which.add_argument("--state", choices=("confident", "curious", "hesitant", "fearful",
+                                           "inactive"))
+    which.add_argument("--C", type=UNIT_RANGE, dest="C", metavar="C",
+                       help="commitment in [-1, 1] (with --V)")
+    syn.add_argument("--V", type=UNIT_RANGE, dest="V", metavar="V",
+                     help="vigilance in [-1, 1] (with --C)")
+    syn.add_argument("--intensity", type=number(0.0, 1.0, what="an intensity"), default=0.5,
+                     metavar="I", help="in [0, 1]; 0.5 gives the study's stimulus")
+    _robot(syn)
+    syn.add_argument("--no-verify", action="store_true",
+                     help="skip the compile that fits the values to the arm")
+    syn.add_argument("-o", "--output", metavar="FILE.aou",
+                     help="output file (default: standard output)")
     c["rules"] = rules = sub.add_parser("rules", help="list the diagnostic codes, or explain some")
     rules.add_argument("codes", nargs="*", metavar="CODE")
     rules.add_argument("--format", choices=("text", "json"), default="text")

@@ -59,8 +59,16 @@ def _check_plot_profile(out: Path, stdout: str) -> None:
     assert "shiver" in stdout and "retreat" in stdout
 
 
+def _check_live_regulation(out: Path, stdout: str) -> None:
+    png = out / "live-regulation.png"
+    assert png.read_bytes()[:8] == PNG_MAGIC and f"wrote {png}" in stdout
+    m = re.search(r"(\d+) ticks, (\d+) re-plans", stdout)
+    assert m and m.group(1) == "600" and 1 <= int(m.group(2)) < 600, stdout
+
+
 CHECKS = {
     "compile_loop.py": _check_compile_loop,
+    "live_regulation.py": _check_live_regulation,
     "measure_csv.py": _check_measure_csv,
     "plot_profile.py": _check_plot_profile,
 }

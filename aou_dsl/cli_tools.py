@@ -1,0 +1,56 @@
+"""``aouc robot`` (what aou knows or derives of an arm) and ``aouc synth`` (a behaviour
+file for a state or a point of the C-V plane, fitted to the arm)."""
+
+from __future__ import annotations
+
+import argparse
+
+from .cli_args import EXIT_OK, EXIT_USAGE
+from .report import format_json
+
+__all__ = ["cmd_robot", "cmd_synth"]
+
+
+def cmd_robot(args: argparse.Namespace) -> int:
+    from .robots import ROBOTS
+
+    if args.list or args.robot is None:
+        if args.robot is None and not args.list:
+            print("aouc robot: give a robot name or path, or --list")
+            return EXIT_USAGE
+        for name, spec in ROBOTS.items():
+            print(f"{name:14s} {len(spec.arm_joints)} joints, end-effector {spec.ee_frame}")
+        return EXIT_OK
+    from .arms import describe_robot
+
+    doc, text = describe_robot(args.robot)
+    if args.format == "json":
+        print(format_json(doc))
+    elif args.format == "toml":
+        print(doc["toml"], end="" if doc["toml"].endswith("\n") else "\n")
+    else:
+        print(text)
+    return EXIT_OK
+
+
+def cmd_synth(args: argparse.Namespace) -> int:
+    """``aouc synth``: a behaviour file for a state or a C-V point, fitted to the arm."""
+    import sys
+
+    from .diagnostics import AouError, Span, diag
+    from .files import check_output, write_atomic
+    from .synth import synthesize
+
+    if (args.C is None) != (args.V is None):
+        raise AouError(diag("I501", "a point of the C-V plane needs both --C and --V",
+                            Span.whole_file("<command line>")))
+    if args.output is not None:
+        check_output(args.output, ("aou",))
+    text = synthesize(args.state, C=args.C, V=args.V, intensity=args.intensity,
+                      robot=args.robot, verify=not args.no_verify)
+    if args.output is None:
+        sys.stdout.write(text)
+        return EXIT_OK
+    write_atomic(args.output, text.encode())
+    print(f"wrote {args.output}", file=sys.stderr)
+    return EXIT_OK
