@@ -638,9 +638,7 @@ def _gaze_rules(events: list[_Ev], vals: dict[str, Any], unc: dict[str, str]) ->
         own = [abs(ev.value) for ev in ended if ev.kind == plane]
         if own:
             vals[name] = max(own)
-        gz = [e for e in events if e.kind == plane]
-        if own and max(own) == 0 and any(e.value != 0 for e in gz):
-            unc[name] = "only the look back to 0 deg ends at a pause: 0 deg or no gaze?"
+
 
 
 def _roll_rules(events: list[_Ev], vals: dict[str, Any], unc: dict[str, str]) -> None:

@@ -14,7 +14,7 @@ measures the eleven descriptors straight from the model's definitions:
 - a plane's gaze is read at every pause that ends a gaze episode turning in that plane,
   as the angle between the
   projections of g_0 and g_i on the plane with normal y_e(0) (horizontal) or x_e(0)
-  (vertical); a plane whose angle there is under 0.3 deg was not looked along;
+  (vertical); a look back to g_0 before the pause reads 0 deg;
 - tilt angle = roll change within one episode, tilt velocity = angle / duration;
 - shiver amplitude = peak-to-peak range of the joint that oscillates most in the tremor;
 - accelerations are second differences of the end-effector position.
@@ -247,8 +247,7 @@ def measure(doc: dict[str, Any]) -> Measurement:
         reads = []
         for e in episodes:
             turned = float(np.abs(ang[e.a:e.b + 1] - ang[e.a]).max()) >= MIN_ANGLE
-            if "gaze" in e.kinds and e.ends_at_pause and turned \
-                    and abs(float(ang[e.b])) >= MIN_ANGLE:
+            if "gaze" in e.kinds and e.ends_at_pause and turned:
                 reads.append(abs(float(ang[e.b])))
         per[name] = reads
         if reads:
