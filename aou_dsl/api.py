@@ -47,7 +47,7 @@ def lint(path: Source | None = None, *, source: str | None = None) -> FileResult
 def compile(path: Source | None = None, *, source: str | None = None,  # noqa: A001
             robot: str | None = None, rate: float | None = None, check: bool = True,
             target_size: float = 0.05, table_height: float | None = 0.0,
-            collision_check: bool = True) -> BuildResult:
+            collision_check: bool = True, controller: str | None = None) -> BuildResult:
     """Lint, compile, check and measure one behaviour.
 
     Args:
@@ -58,6 +58,8 @@ def compile(path: Source | None = None, *, source: str | None = None,  # noqa: A
         target_size, table_height: the scene the checks use [m] (None: no table).
         collision_check: False accepts a robot without collision shapes (C312); the
             document's ``checks.collision_checked`` then says so.
+        controller: ``"franka"`` or ``"ur"``: also check that motion generator's rate and
+            published limits (joint jerk at 1 kHz against the robot's is always checked).
 
     Returns:
         A :class:`~aou_dsl.build.BuildResult`: ``ok``, ``diagnostics``, ``trajectory``,
@@ -67,7 +69,7 @@ def compile(path: Source | None = None, *, source: str | None = None,  # noqa: A
 
     scene = SceneOptions(target_size=target_size, table_height=table_height)
     options: dict[str, Any] = {"robot": robot, "rate": rate, "check": check, "scene": scene,
-                               "collision_check": collision_check}
+                               "collision_check": collision_check, "controller": controller}
     if source is not None:
         return build_source(source, os.fspath(path) if path is not None else "<string>",
                             **options)
@@ -101,13 +103,24 @@ def measure(what: Trajectory | Source, **options: Any) -> Measured:
 
 
 def check(what: Trajectory | Source, *, dynamic: bool = True, target_size: float = 0.05,
-          table_height: float | None = 0.0, **options: Any) -> CheckReport:
+          table_height: float | None = 0.0, controller: str | None = None,
+          **options: Any) -> CheckReport:
     """The safety replay of a trajectory (or a file) in PyBullet: limits, collisions,
-    contacts, kinematics agreement and, with ``dynamic``, torques under physics."""
+    contacts, kinematics agreement and, with ``dynamic``, torques under physics.
+
+    The motion as a controller reads it (joint jerk at its rate, interpolated between the
+    samples as a ``joint_trajectory_controller`` does) is checked too when ``controller``
+    is named, or when the trajectory carries velocities (a compiled one); a recording of
+    positions alone is too noisy for a third derivative unless asked."""
+    from .controllers import controller_checks
     from .safety.replay import replay
     from .safety.scene import SceneOptions
 
     scene = SceneOptions(target_size=target_size, table_height=table_height)
-    return replay(_trajectory(what, **options), options=scene, dynamic=dynamic)
+    tr = _trajectory(what, **options)
+    report = replay(tr, options=scene, dynamic=dynamic)
+    if controller is not None or tr.qd is not None:
+        report.checks += controller_checks(tr, controller)
+    return report
 
 

@@ -76,9 +76,12 @@ def _with_robot(lint: FileResult, robot: str | None) -> list[Diagnostic]:
     return []
 
 
-def _check(res: BuildResult, rate: float, scene: SceneOptions | None) -> dict:
-    """The kinematic replay, as C306 diagnostics and the document's ``checks``."""
+def _check(res: BuildResult, rate: float, scene: SceneOptions | None,
+           controller: str | None = None) -> dict:
+    """The kinematic replay and the controller's view of the motion (joint jerk at its
+    rate), as C306/C311 diagnostics and the document's ``checks``."""
     from .compiler.pipeline import sample
+    from .controllers import controller_checks, describe
     from .safety.replay import replay
     from .safety.scene import SceneOptions
 
@@ -87,8 +90,16 @@ def _check(res: BuildResult, rate: float, scene: SceneOptions | None) -> dict:
     assert tr is not None
     dense = tr if rate >= CHECK_RATE else sample(res.compiled, CHECK_RATE)
     report = replay(dense, options=scene or SceneOptions())
+    motion = controller_checks(res.compiled, controller)
+    report.checks += motion
     res.checks = report.checks
     for c in report.failed():
+        if any(c is m for m in motion):
+            res.diagnostics.append(diag(
+                "C311" if c.name == "joint-jerk" else "C306",
+                f"{c.name} check failed: {describe(c)}", _span_at(res.compiled, c.time),
+                check=c.name, time=c.time, joint=c.joint, value=c.value, limit=c.limit))
+            continue
         res.diagnostics.append(diag(
             "C306", f"{c.name} check failed at t={c.time:.3f}s: {_what(c)}",
             _span_at(res.compiled, c.time), check=c.name, time=c.time, joint=c.joint,
@@ -109,11 +120,13 @@ def _robot_diagnostics(b, check: bool, collision_check: bool) -> list[Diagnostic
 
 def build_lint(lint: FileResult, *, robot: str | None = None, rate: float | None = None,
                check: bool = True, scene: SceneOptions | None = None,
-               collision_check: bool = True) -> BuildResult:
+               collision_check: bool = True, controller: str | None = None) -> BuildResult:
     """Compile, check and measure a linted file (see the module's docstring).
 
     ``collision_check=False`` lets a robot without collision shapes compile; the
-    document's ``checks`` then records that self-collision was not checked."""
+    document's ``checks`` then records that self-collision was not checked.
+    ``controller`` (``franka``, ``ur``) adds that motion generator's rate and limits to
+    the checks (the robot's joint jerk limit at 1 kHz is always checked)."""
     from .compiler.output import trajectory_document
     from .compiler.pipeline import CompileOptions, compile_behaviour
     from .declared import declared
@@ -141,7 +154,7 @@ def build_lint(lint: FileResult, *, robot: str | None = None, rate: float | None
         from .arms import load_robot
 
         checks_json["collision_checked"] = load_robot(b.settings.robot).collision
-        checks_json |= _check(res, opts.rate, scene)
+        checks_json |= _check(res, opts.rate, scene, controller)
         if has_errors(res.diagnostics):
             res.seconds = time.perf_counter() - start
             return res

@@ -117,7 +117,7 @@ def _cmd_explain(args: argparse.Namespace) -> int:
 
 def _cmd_compile(args: argparse.Namespace) -> int:
     from .api import compile as compile_file
-    from .compiler.output import encode, output_paths, write_atomic
+    from .compiler.output import output_paths, write_output
     from .diagnostics import has_errors
     from .linter import collect_inputs
 
@@ -138,14 +138,15 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     worst = EXIT_OK
     for k, ((src, _), dest) in enumerate(zip(inputs, dests, strict=True), 1):
         res = compile_file(src, robot=args.robot, rate=args.rate, check=not args.no_check,
-                           collision_check=not args.no_collision_check, **_scene_kw(args))
+                           collision_check=not args.no_collision_check,
+                           controller=args.controller, **_scene_kw(args))
         _print_diags(res.diagnostics, sources={src: res.lint.source or ""})
         if not res.ok or res.document is None:
             worst = max(worst, _exit_for(res.diagnostics))
             print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)
             continue
         try:
-            write_atomic(dest, encode(res.document, fmt), inputs=sources)
+            write_output(dest, res.document, fmt, inputs=sources)
         except AouError as err:
             worst = max(worst, _fail(err))
             continue
@@ -172,7 +173,8 @@ def _cmd_check(args: argparse.Namespace) -> int:
     _print_diags(refused)
     if any(d.severity == Severity.ERROR for d in refused):
         return EXIT_ERRORS
-    report = check(tr, dynamic=not args.no_dynamic, **_scene_kw(args))
+    report = check(tr, dynamic=not args.no_dynamic, controller=args.controller,
+                   **_scene_kw(args))
     if args.format == "json":
         print(format_json({"path": args.path, **report.to_json()}))
     else:

@@ -85,6 +85,12 @@ def _robot(p: argparse.ArgumentParser) -> None:
                    "package:// meshes (repeatable)")
 
 
+def _controller(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--controller", choices=("franka", "ur"),
+                   help="also check that motion generator's rate and published limits "
+                   "(franka: 1 kHz FCI; ur: 500 Hz e-Series)")
+
+
 def _collision(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-collision-check", action="store_true",
                    help="accept a robot without collision shapes (self-collision is then "
@@ -136,13 +142,16 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     comp.add_argument("-o", "--output", metavar="FILE|DIR",
                       help="output file, or folder (files found in a folder keep their "
                       "path below it; default: the current folder)")
-    comp.add_argument("--format", choices=("json", "csv", "npz"),
-                      help="output format (default: from -o's extension, else json)")
+    comp.add_argument("--format", choices=("json", "csv", "npz", "mcap", "yaml"),
+                      help="output format (default: from -o's extension, else json); mcap: "
+                      "a ROS 2 bag (a folder) with one JointTrajectory, yaml: the same "
+                      "message as YAML (docs/ros2.md)")
     comp.add_argument("--rate", type=RATE, metavar="HZ", help="sample rate in Hz (default 250)")
     _robot(comp)
     comp.add_argument("--no-check", action="store_true",
                       help="skip the safety checks (recorded in the output)")
     _collision(comp)
+    _controller(comp)
     _scene(comp)
     c["check"] = chk = sub.add_parser(
         "check", help="replay a behaviour or trajectory in PyBullet and report every check")
@@ -151,6 +160,7 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     chk.add_argument("--no-dynamic", action="store_true",
                      help="kinematic checks only (skip the physics replay)")
     _collision(chk)
+    _controller(chk)
     _recording(chk)
     _scene(chk)
     c["plot"] = plot = sub.add_parser(

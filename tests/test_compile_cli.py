@@ -196,3 +196,18 @@ def test_robot_command_lists_and_describes_arms(capsys):
 def test_robot_command_on_an_unknown_robot_is_v109(capsys):
     assert main(["robot", "kuka_lbr"]) == 1
     assert "V109" in capsys.readouterr().err
+
+
+def test_compile_to_a_ros2_bag_holds_the_trajectory(tmp_path, hesitant_json):
+    from aou_dsl.compiler.ros import read_bag
+
+    doc = json.loads(hesitant_json.read_text())
+    out = tmp_path / "h.mcap"
+    assert main(["compile", str(BEHAVIOURS / "hesitant.aou"), "-o", str(out),
+                 "--controller", "franka"]) == EXIT_OK
+    topic, msgtype, msg = read_bag(str(tmp_path / "h"))
+    assert msgtype == "trajectory_msgs/msg/JointTrajectory"
+    assert msg["joint_names"] == doc["joint_names"]
+    assert len(msg["points"]) == len(doc["t"])
+    assert np.allclose(msg["points"][-1]["positions"], doc["q"][-1])
+    assert not np.any(msg["points"][-1]["velocities"])  # the last point is at rest

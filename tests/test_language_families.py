@@ -93,8 +93,7 @@ def _close(name: str, expected: float, found: float) -> bool:
 
 
 #: Cases whose fix is not in yet: strict, so the fix must remove them from here.
-PENDING = {"big-tilt-unwraps": "measure wraps the roll at 180 deg",
-           "speed-cap-short-ramp": "the time law loses the acceleration of a short ramp"}
+PENDING = {"big-tilt-unwraps": "measure wraps the roll at 180 deg"}
 
 
 @pytest.mark.parametrize("case", [

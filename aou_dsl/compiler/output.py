@@ -1,12 +1,14 @@
 """Stage 8, output: the trajectory file, written atomically and deterministically.
 
-Three formats: ``json`` (``aou-trajectory/1``), ``csv`` (``t`` then one column per joint)
-and ``npz`` (numpy arrays plus the JSON header). Floats are written with Python's
-shortest round-trip representation (up to 17 significant digits). Nothing that varies
-between runs (times, paths, dates) is written, so the same input and versions give the
-same bytes. A file is written to a temporary name beside the target and renamed over it
-only when complete (:func:`aou_dsl.files.write_atomic`): on any error no output appears
-and an existing file is untouched.
+Five formats: ``json`` (``aou-trajectory/1``), ``csv`` (``t`` then one column per joint),
+``npz`` (numpy arrays plus the JSON header), and for ROS 2 (:mod:`.ros`) ``mcap`` (a bag
+folder holding one ``trajectory_msgs/msg/JointTrajectory``) and ``yaml`` (that message
+as YAML). Floats are written with Python's shortest round-trip representation (up to 17
+significant digits). Nothing that varies between runs (times, paths, dates) is written,
+so the same input and versions give the same bytes. A file is written to a temporary
+name beside the target and renamed over it only when complete
+(:func:`aou_dsl.files.write_atomic`; a bag: a temporary folder, renamed): on any error no
+output appears and an existing file is untouched.
 """
 
 from __future__ import annotations
@@ -21,10 +23,14 @@ import numpy as np
 from .. import __version__
 from ..diagnostics import AouError, Span, diag
 from ..files import write_atomic
+from .ros import is_bag
 
-__all__ = ["FORMATS", "encode", "output_paths", "trajectory_document", "write_atomic"]
+__all__ = ["FORMATS", "encode", "output_paths", "trajectory_document", "write_atomic",
+           "write_output"]
 
-FORMATS = ("json", "csv", "npz")
+FORMATS = ("json", "csv", "npz", "mcap", "yaml")
+#: Formats whose output is a folder (a ROS 2 bag), not a file.
+FOLDER_FORMATS = ("mcap",)
 
 
 def trajectory_document(result, *, measured: dict, declared: dict, cv: dict,
@@ -56,7 +62,8 @@ def trajectory_document(result, *, measured: dict, declared: dict, cv: dict,
 
 
 def encode(doc: dict, fmt: str) -> bytes:
-    """The bytes of ``doc`` in ``fmt``."""
+    """The bytes of ``doc`` in ``fmt`` (a file format: ``mcap`` is a folder, written by
+    :func:`write_output`)."""
     if fmt == "json":
         return (json.dumps(doc, separators=(",", ":")) + "\n").encode()
     if fmt == "csv":
@@ -81,8 +88,30 @@ def encode(doc: dict, fmt: str) -> bytes:
             zf.writestr(zipfile.ZipInfo("header.json", (1980, 1, 1, 0, 0, 0)),
                         json.dumps(header, indent=1))
         return buf.getvalue()
+    if fmt == "yaml":
+        from .ros import encode_yaml
+
+        return encode_yaml(doc)
+    if fmt in FOLDER_FORMATS:
+        raise AouError(diag("I502", f"`{fmt}` output is a folder (a ROS 2 bag), not bytes: "
+                            "write it with write_output", Span.whole_file("<output>")))
     raise AouError(diag("I502", f"unknown output format `{fmt}`: expected one of "
                         f"{', '.join(FORMATS)}", Span.whole_file("<output>")))
+
+
+def write_output(path: str, doc: dict, fmt: str, *, inputs: list[str] | tuple = ()) -> None:
+    """Write ``doc`` in ``fmt`` at ``path`` (a file, or for ``mcap`` a bag folder),
+    atomically and never over one of ``inputs``.
+
+    Raises:
+        AouError: I502 when it cannot be written.
+    """
+    if fmt in FOLDER_FORMATS:
+        from .ros import write_bag
+
+        write_bag(doc, path, inputs=inputs)
+    else:
+        write_atomic(path, encode(doc, fmt), inputs=inputs)
 
 
 def output_paths(inputs: list[tuple[str, str | None]], output: str | None, fmt: str | None
@@ -94,12 +123,17 @@ def output_paths(inputs: list[tuple[str, str | None]], output: str | None, fmt: 
     files found in a folder keep their path below it, so ``x/same.aou`` and
     ``y/same.aou`` never land on one output.
 
+    A ROS 2 bag (``mcap``) is a folder named without the extension: ``-o x.mcap`` writes
+    the bag ``x/`` (holding ``x.mcap`` and ``metadata.yaml``); an existing bag folder given
+    as ``-o`` is that output, not a folder of outputs.
+
     Raises:
         AouError: I502 for an unknown format, ``-o FILE`` with several inputs, or two
             inputs that would write the same output.
     """
     many = len(inputs) > 1 or any(root is not None for _, root in inputs)
-    is_dir = output is not None and (output.endswith(os.sep) or os.path.isdir(output))
+    is_dir = output is not None and (output.endswith(os.sep) or (
+        os.path.isdir(output) and not is_bag(output)))
     if fmt is None:
         ext = os.path.splitext(output or "")[1].lstrip(".")
         fmt = ext if output and not many and not is_dir and ext else "json"
@@ -110,12 +144,15 @@ def output_paths(inputs: list[tuple[str, str | None]], output: str | None, fmt: 
         raise AouError(diag("I502", f"several inputs need -o to be a folder, found "
                             f"`{output}`", Span.whole_file(output)))
     folder = output if (many or is_dir) else None
+    suffix = "" if fmt in FOLDER_FORMATS else f".{fmt}"
     dests = []
     for src, root in inputs:
         rel = os.path.relpath(src, root) if root is not None else os.path.basename(src)
-        name = os.path.splitext(rel)[0] + f".{fmt}"
+        name = os.path.splitext(rel)[0] + suffix
         if folder is not None:
             dests.append(os.path.join(folder, name))
+        elif output and fmt in FOLDER_FORMATS:
+            dests.append(output[:-len(".mcap")] if output.endswith(".mcap") else output)
         else:
             dests.append(output or name)
     seen: dict[str, str] = {}

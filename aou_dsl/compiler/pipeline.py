@@ -27,8 +27,9 @@ from .timing import (
     LIMIT_SLACK,
     JointSegment,
     PathSegment,
-    TimeLaw,
     binding_joint,
+    fixed_segment,
+    jerk_ratio,
     shiver_segment,
     time_path,
 )
@@ -37,6 +38,7 @@ __all__ = [
     "CompileOptions",
     "CompileResult",
     "compile_behaviour",
+    "evaluate",
     "sample",
     "target_path",
 ]
@@ -177,13 +179,15 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
             worst_p = max(worst_p, ik.worst_position_error)
             worst_r = max(worst_r, ik.worst_rotation_error)
             if timing == "fixed":
-                seg = PathSegment(s, ik.q, TimeLaw.bang_bang(ep.path_length, ep.duration))
+                seg = fixed_segment(arm, s, ik.q, ep.duration)
                 j, over = binding_joint(arm, seg)
-                if over > 1.0 + LIMIT_SLACK:
+                over_jerk = jerk_ratio(arm, seg)
+                if max(over, over_jerk) > 1.0 + LIMIT_SLACK:
+                    what = (f"{over:.1f}x the limits of {j}" if over >= over_jerk else
+                            f"{over_jerk:.1f}x the planned jerk limits")
                     res.diagnostics.append(diag(
                         "C309", f"tilt of {math.degrees(ep.path_length):g} deg in "
-                        f"{ep.duration:.2f}s needs {over:.1f}x the limits of {j}",
-                        ep.span, joint=j))
+                        f"{ep.duration:.2f}s needs {what}", ep.span, joint=j))
                     return res
             else:
                 seg, fail = time_path(arm, s, ik.q, ep.a, ep.vmax,
@@ -196,7 +200,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
                     unit = "m/s^2" if KINDS[ep.kind].translation else "rad/s^2"
                     res.diagnostics.append(diag(
                         "C304", f"{ep.kind} reaches {fail.achieved:.3g} {unit}, not the "
-                        f"declared {fail.wanted:.3g} {unit}: {fail.joint} is at its limit",
+                        f"declared {fail.wanted:.3g} {unit}: {fail.reason}",
                         ep.span, joint=fail.joint, achieved=fail.achieved,
                         declared=fail.wanted))
             lap("timing")
@@ -256,14 +260,22 @@ def _clock(total: float, rate: float) -> np.ndarray:
     return t
 
 
-def _sample(arm: ArmModel, b: Behaviour, tl: Timeline,
-            segments: list[PathSegment | JointSegment], rate: float) -> Trajectory:
-    """Sample the segments on one clock at ``rate``; the last sample is the end."""
-    if not segments:
-        raise AouError(diag("V124", "the behaviour has nothing to move or hold", b.span))
+def evaluate(res: CompileResult, t: np.ndarray
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Joint positions, velocities and accelerations of the compiled motion at any times
+    ``t`` [s], shape (N,): each (N, n). Before the start and after the end the arm rests
+    in its first and last configuration (as a controller holds it)."""
+    if res.trajectory is None or not res.segments:
+        raise AouError(diag("C305", "the compilation failed: there is nothing to sample",
+                            res.behaviour.span))
+    return _evaluate(res.segments, np.asarray(t, dtype=float))
+
+
+def _evaluate(segments: list[PathSegment | JointSegment], t: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     bounds = np.concatenate([[0.0], np.cumsum([s.duration for s in segments])])
-    t = _clock(float(bounds[-1]), rate)
-    q = np.empty((len(t), arm.n))
+    n = segments[0].sample(np.zeros(1))[0].shape[1]
+    q = np.empty((len(t), n))
     qd = np.empty_like(q)
     qdd = np.empty_like(q)
     idx = np.clip(np.searchsorted(bounds, t, side="right") - 1, 0, len(segments) - 1)
@@ -271,6 +283,17 @@ def _sample(arm: ArmModel, b: Behaviour, tl: Timeline,
         m = idx == k
         if m.any():
             q[m], qd[m], qdd[m] = seg.sample(t[m] - bounds[k])
+    return q, qd, qdd
+
+
+def _sample(arm: ArmModel, b: Behaviour, tl: Timeline,
+            segments: list[PathSegment | JointSegment], rate: float) -> Trajectory:
+    """Sample the segments on one clock at ``rate``; the last sample is the end."""
+    if not segments:
+        raise AouError(diag("V124", "the behaviour has nothing to move or hold", b.span))
+    bounds = np.concatenate([[0.0], np.cumsum([s.duration for s in segments])])
+    t = _clock(float(bounds[-1]), rate)
+    q, qd, qdd = _evaluate(segments, t)
     spec = arm.spec
     goal = tuple(float(x) for x in (b.settings.goal or spec.goal))
     episodes = tuple((e.kind, float(bounds[i]), float(bounds[i + 1]))

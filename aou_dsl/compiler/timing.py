@@ -2,7 +2,7 @@
 
 Every moving episode is a path ``q(s)`` over its own coordinate ``s`` (metres along the
 line of sight for approach and retreat, radians of bearing for gaze, radians of roll for
-tilt) and starts and ends at rest.
+tilt) and starts and ends at rest, with zero acceleration.
 
 TOPP-RA parametrises approach, retreat and gaze time-optimally under the joint velocity
 limits (URDF, scaled) and joint acceleration limits (:mod:`aou_dsl.robots`). The
@@ -11,30 +11,39 @@ to the path as one more coordinate, with velocity limit ``v=`` and acceleration 
 ``a=``. On a straight line the end-effector acceleration is ``s''``, so the time-optimal
 law peaks at exactly the declared acceleration whenever no real joint binds first.
 
-Tilts have a fixed duration (the tilt velocity descriptor is angle / duration); shivers
-are analytic joint oscillations; pauses are exact holds.
+TOPP-RA's law has a piecewise constant ``s''``: its jerk is infinite where ``s''``
+jumps. Every law is therefore smoothed by a moving average of a few milliseconds
+(:class:`~.timelaw.SmoothLaw`), the shortest that keeps every joint's jerk within
+:data:`JERK_SCALE` of its limit; the peak acceleration is kept, the duration grows by
+the window.
+
+Tilts have a fixed duration (the tilt velocity descriptor is angle / duration): a
+smoothed bang-bang law of exactly that duration. Shivers are analytic joint oscillations;
+pauses are exact holds.
 """
 
 from __future__ import annotations
 
-import functools
-import importlib
-import logging
 import math
-import sys
-import types
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..kinematics import ArmModel
+from .timelaw import SmoothLaw, TimeLaw
+from .topp import parametrize
 
 __all__ = [
+    "JERK_SCALE",
     "JointSegment",
     "PathSegment",
+    "SmoothLaw",
     "TimeLaw",
     "TimingFailure",
     "binding_joint",
+    "fixed_segment",
+    "jerk_ratio",
     "limit_ratios",
     "shiver_segment",
     "time_path",
@@ -42,70 +51,42 @@ __all__ = [
 
 #: Relative slack when checking a result against a limit.
 LIMIT_SLACK = 1e-3
-
-
-@dataclass(frozen=True)
-class TimeLaw:
-    """``s(t)`` with constant ``s''`` between grid points (TOPP-RA's own output form).
-
-    Attributes:
-        s: grid of the path coordinate, shape (K,), increasing.
-        sd: path speed at the grid points, shape (K,); zero at both ends.
-        t: time at the grid points [s], shape (K,).
-        u: path acceleration on each interval, shape (K - 1,).
-    """
-
-    s: np.ndarray
-    sd: np.ndarray
-    t: np.ndarray
-    u: np.ndarray
-
-    @classmethod
-    def from_speeds(cls, s: np.ndarray, sd: np.ndarray) -> TimeLaw:
-        ds = np.diff(s)
-        mean = sd[:-1] + sd[1:]
-        if np.any(mean <= 0):
-            raise ValueError("path speed is zero on an interval")
-        dt = 2.0 * ds / mean
-        u = (sd[1:] ** 2 - sd[:-1] ** 2) / (2.0 * ds)
-        return cls(s, sd, np.concatenate([[0.0], np.cumsum(dt)]), u)
-
-    @classmethod
-    def bang_bang(cls, length: float, duration: float) -> TimeLaw:
-        """Rest to rest over ``length`` in exactly ``duration``: accelerate, decelerate."""
-        peak = 2.0 * length / duration
-        return cls.from_speeds(np.array([0.0, length / 2, length]), np.array([0.0, peak, 0.0]))
-
-    @property
-    def duration(self) -> float:
-        return float(self.t[-1])
-
-    def __call__(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``s, s', s''`` at local times ``tau`` (clipped to [0, duration])."""
-        tau = np.clip(tau, 0.0, self.duration)
-        i = np.clip(np.searchsorted(self.t, tau, side="right") - 1, 0, len(self.u) - 1)
-        dt = tau - self.t[i]
-        u = self.u[i]
-        sd = self.sd[i] + u * dt
-        s = self.s[i] + self.sd[i] * dt + 0.5 * u * dt * dt
-        return s, sd, u
+#: Fraction of the joint jerk limits the time laws are planned with (the checks hold the
+#: trajectory to the full limits).
+JERK_SCALE = 0.9
+#: Shortest smoothing window [s]: two periods of a 1 kHz controller.
+MIN_WINDOW = 2e-3
+#: A time law reaches its declared acceleration when its peak is at least this fraction
+#: of it (it is exact when nothing binds; below, C304 says what binds). Stricter than the
+#: descriptors' 3 % tolerance, so a shortfall the measurement may see is explained.
+REACHED = 0.99
 
 
 class PathSegment:
     """A timed joint path: ``q(t) = path(s(t))``, shape (n,) per sample.
 
     ``spline`` may have more columns than joints (TOPP-RA's path carries the virtual
-    coordinate last); only the first ``n`` are the joints.
+    coordinate last); only the first ``n`` are the joints. ``law`` is a
+    :class:`~.timelaw.TimeLaw` or a :class:`~.timelaw.SmoothLaw`.
     """
 
-    def __init__(self, s_way: np.ndarray, q_way: np.ndarray, law: TimeLaw, spline=None):
+    def __init__(self, s_way: np.ndarray, q_way: np.ndarray, law: TimeLaw | SmoothLaw,
+                 spline=None):
         from scipy.interpolate import CubicSpline
 
         self.n = q_way.shape[1]
         self.spline = CubicSpline(s_way, q_way, axis=0) if spline is None else spline
         self.d1 = self.spline.derivative(1)
         self.d2 = self.spline.derivative(2)
+        self.d3 = self.spline.derivative(3)
         self.law = law
+
+    def with_law(self, law: TimeLaw | SmoothLaw) -> PathSegment:
+        """The same path under another time law."""
+        seg = object.__new__(PathSegment)
+        seg.__dict__.update(self.__dict__)
+        seg.law = law
+        return seg
 
     @property
     def duration(self) -> float:
@@ -118,6 +99,19 @@ class PathSegment:
         qs, qss = self.d1(s)[:, :n], self.d2(s)[:, :n]
         return (self.spline(s)[:, :n], qs * sd[:, None],
                 qss * (sd * sd)[:, None] + qs * sdd[:, None])
+
+    def jerk(self, tau: np.ndarray) -> np.ndarray:
+        """Joint jerks at local times, shape (len(tau), n):
+        ``q_sss s'^3 + 3 q_ss s' s'' + q_s s'''`` (a plain law's ``s'''`` counts as 0)."""
+        if isinstance(self.law, SmoothLaw):
+            s, sd, sdd, sddd = self.law.derivatives(tau)
+        else:
+            s, sd, sdd = self.law(tau)
+            sddd = np.zeros_like(s)
+        n = self.n
+        return (self.d3(s)[:, :n] * (sd**3)[:, None]
+                + 3.0 * self.d2(s)[:, :n] * (sd * sdd)[:, None]
+                + self.d1(s)[:, :n] * sddd[:, None])
 
 
 class JointSegment:
@@ -138,7 +132,7 @@ class JointSegment:
         qd = np.zeros_like(q)
         qdd = np.zeros_like(q)
         if self.amplitude:
-            x, xd, xdd = _shiver_offset(tau, self.amplitude, self.f, self.duration)
+            x, xd, xdd, _ = _shiver_offset(tau, self.amplitude, self.f, self.duration)
             q[:, self.joint] += x
             qd[:, self.joint] = xd
             qdd[:, self.joint] = xdd
@@ -146,10 +140,11 @@ class JointSegment:
 
 
 def _shiver_offset(tau: np.ndarray, amplitude: float, f: float, duration: float
-                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(A/2) sin(2 pi f t) e(t)``: a sine whose envelope ``e`` rises as sin^2 over the
-    first cycle and falls over the last, so it starts and ends at rest; the middle cycles
-    have the full peak-to-peak amplitude ``A``."""
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(A/2) sin(2 pi f t) e(t)`` and its first three derivatives: a sine whose envelope
+    ``e`` rises as sin^2 over the first cycle and falls over the last, so it starts and
+    ends at rest with zero acceleration; the middle cycles have the full peak-to-peak
+    amplitude ``A``."""
     w = 2.0 * math.pi * f
     ramp = 1.0 / f
     tau = np.clip(tau, 0.0, duration)
@@ -160,69 +155,25 @@ def _shiver_offset(tau: np.ndarray, amplitude: float, f: float, duration: float
     e = np.where(inside, np.sin(k * edge) ** 2, 1.0)
     ed = np.where(inside, k * np.sin(2.0 * k * edge) * sign, 0.0)
     edd = np.where(inside, 2.0 * k * k * np.cos(2.0 * k * edge), 0.0)
+    eddd = np.where(inside, -4.0 * k**3 * np.sin(2.0 * k * edge) * sign, 0.0)
     a = amplitude / 2.0
     s, c = np.sin(w * tau), np.cos(w * tau)
     x = a * s * e
     xd = a * (w * c * e + s * ed)
     xdd = a * (-w * w * s * e + 2.0 * w * c * ed + s * edd)
-    return x, xd, xdd
+    xddd = a * (-w**3 * c * e - 3.0 * w * w * s * ed + 3.0 * w * c * edd + s * eddd)
+    return x, xd, xdd, xddd
 
 
 @dataclass(frozen=True)
 class TimingFailure:
-    """Why an episode could not be timed as declared; ``joint`` is the binding one."""
+    """Why an episode could not be timed as declared: ``reason`` names the binding
+    constraint in words, ``joint`` the binding joint when it is one."""
 
     reason: str
     joint: str | None
     achieved: float | None = None
     wanted: float | None = None
-
-
-class _LazyModule(types.ModuleType):
-    """Stands in for a module until one of its attributes is used, then imports it."""
-
-    def __getattr__(self, attr: str):
-        return getattr(importlib.import_module(self.__name__), attr)
-
-
-def _import_toppra():
-    """toppra, imported without matplotlib.
-
-    toppra's algorithm module imports ``matplotlib.pyplot`` at its top, for plotting
-    helpers aou never calls; that import costs every compile a fraction of a second. While
-    toppra is imported, lazy stand-ins take matplotlib's place in ``sys.modules``; they
-    are removed right after, so a later ``import matplotlib`` (``aouc plot``) is the real
-    one, and toppra's own reference imports it only if it is ever used.
-    """
-    if "toppra" in sys.modules:
-        return sys.modules["toppra"]
-    stubs: dict[str, types.ModuleType] = {}
-    if "matplotlib" not in sys.modules:
-        stubs["matplotlib"] = _LazyModule("matplotlib")
-        stubs["matplotlib.pyplot"] = _LazyModule("matplotlib.pyplot")
-        setattr(stubs["matplotlib"], "pyplot", stubs["matplotlib.pyplot"])  # noqa: B010
-        sys.modules.update(stubs)
-    try:
-        import toppra
-        import toppra.algorithm  # noqa: F401
-        import toppra.constraint  # noqa: F401
-    finally:
-        for name, stub in stubs.items():
-            if sys.modules.get(name) is stub:
-                del sys.modules[name]
-    return toppra
-
-
-@functools.lru_cache(maxsize=256)
-def _constraints(jv: tuple[float, ...], ja: tuple[float, ...], a: float, vmax: float):
-    """TOPP-RA's joint velocity and acceleration constraints, the virtual joint last.
-    They do not depend on the path, and building one formats its limits as text (slow),
-    so they are made once per set of limits."""
-    constraint = _import_toppra().constraint
-    vlim = np.column_stack([-np.append(jv, vmax), np.append(jv, vmax)])
-    alim = np.column_stack([-np.append(ja, a), np.append(ja, a)])
-    return (constraint.JointVelocityConstraint(vlim),
-            constraint.JointAccelerationConstraint(alim))
 
 
 def binding_joint(arm: ArmModel, seg: PathSegment) -> tuple[str, float]:
@@ -258,10 +209,79 @@ def cartesian_peak(arm: ArmModel, seg: PathSegment, samples: int = 100) -> float
     return peak
 
 
+def limit_ratios(arm: ArmModel, seg: PathSegment, samples: int = 1500
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """Per joint, the largest velocity and acceleration over the planned limits on a
+    segment sampled densely (finer than any output rate); shapes (n,)."""
+    tau = np.linspace(0.0, seg.duration, samples)
+    _, qd, qdd = seg.sample(tau)
+    return (np.abs(qd).max(axis=0) / arm.plan_vmax, np.abs(qdd).max(axis=0) / arm.plan_amax)
+
+
+def jerk_ratio(arm: ArmModel, seg: PathSegment) -> float:
+    """The largest joint jerk over the planned jerk limits (``JERK_SCALE`` of the
+    robot's) on a segment, seen at every piece of its smoothed law."""
+    law = seg.law
+    tau = (law.probe_times() if isinstance(law, SmoothLaw)
+           else np.linspace(0.0, seg.duration, 1500))
+    return float(np.max(np.abs(seg.jerk(tau)) / (arm.jmax * JERK_SCALE)))
+
+
+def _smoothed(arm: ArmModel, make: Callable[[float], PathSegment], first: float,
+              longest: float) -> PathSegment:
+    """The segment ``make(window)`` with the shortest window (from ``first``, at least
+    :data:`MIN_WINDOW`, at most ``longest``) whose joint jerks stay within the planned
+    limits. Jerk falls as 1 / window, so each try scales the window by the jerk ratio."""
+    w = min(max(MIN_WINDOW, first), longest)
+    seg = make(w)
+    r = jerk_ratio(arm, seg)
+    for _ in range(6):
+        if r <= 1.0 or w >= longest:
+            break
+        w = min(longest, w * r * 1.05)
+        seg = make(w)
+        r = jerk_ratio(arm, seg)
+    if r < 0.8 and w > MIN_WINDOW:  # the first guess was generous: try a shorter window
+        shorter = make(max(MIN_WINDOW, w * r * 1.05))
+        if jerk_ratio(arm, shorter) <= 1.0:
+            return shorter
+    return seg
+
+
+def _window_guess(arm: ArmModel, seg: PathSegment, base: TimeLaw) -> float:
+    """A first window [s]: over a window ``T``, a joint whose acceleration swings by
+    ``dA`` gets a jerk of about ``dA / T``. Accelerations are read at the middle of each
+    interval of the base law (where ``s''`` is constant)."""
+    mid = (base.t[:-1] + base.t[1:]) / 2.0
+    _, _, qdd = seg.with_law(base).sample(np.concatenate([[0.0], mid, [base.duration]]))
+    swing = qdd.max(axis=0) - qdd.min(axis=0)
+    return float(np.max(swing / (arm.jmax * JERK_SCALE)))
+
+
+def smooth(arm: ArmModel, seg: PathSegment) -> PathSegment:
+    """A segment timed by a plain law, re-timed by its jerk-limited version."""
+    base = seg.law.base if isinstance(seg.law, SmoothLaw) else seg.law
+    return _smoothed(arm, lambda w: seg.with_law(SmoothLaw(base, w)),
+                     _window_guess(arm, seg, base), base.duration)
+
+
+def fixed_segment(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, duration: float
+                  ) -> PathSegment:
+    """A rest-to-rest segment of exactly ``duration`` [s] along the whole path: a
+    bang-bang law over ``duration - T`` smoothed over ``T`` (the tilt's law)."""
+    length = float(s_way[-1])
+    probe = PathSegment(s_way, q_way, TimeLaw.bang_bang(length, duration))
+    base = probe.law
+    assert isinstance(base, TimeLaw)
+    return _smoothed(arm, lambda w: probe.with_law(
+        SmoothLaw(TimeLaw.bang_bang(length, duration - w), w)),
+        _window_guess(arm, probe, base), duration / 2.0)
+
+
 def time_path(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vmax: float,
               *, gridpoints: int = 80, cartesian: bool = False
               ) -> tuple[PathSegment | None, TimingFailure | None]:
-    """Time a joint path rest to rest with TOPP-RA.
+    """Time a joint path rest to rest: TOPP-RA, then the jerk-limiting smoothing.
 
     Args:
         arm: the robot (limits).
@@ -269,7 +289,7 @@ def time_path(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vma
         q_way: joint waypoints, shape (K, n).
         a: limit on ``|s''|`` (the declared peak acceleration) [m/s^2 or rad/s^2].
         vmax: limit on ``|s'|`` (the speed cap) [m/s or rad/s].
-
+        gridpoints: uniform points of TOPP-RA's grid (:func:`.topp.grid` adds more).
         cartesian: ``s`` is arc length on a straight line, and ``a`` the declared peak
             end-effector acceleration. The joint path is a spline through IK waypoints,
             so the hand's real path bends a little; its curvature adds ``p'' s'^2`` to the
@@ -279,16 +299,26 @@ def time_path(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vma
 
     Returns:
         ``(segment, failure)``: the segment (None if TOPP-RA failed) and, when the
-        declared acceleration could not be reached, a failure naming the binding joint.
+        declared acceleration could not be reached, a failure naming the binding
+        constraint.
     """
     jv, ja = arm.plan_vmax.copy(), arm.plan_amax.copy()
     a_virtual = a
-    seg, fail = _toppra(arm, s_way, q_way, a_virtual, vmax, gridpoints, jv, ja)
+
+    def timed() -> tuple[PathSegment | None, str | None]:
+        law, spline, why = parametrize(s_way, q_way, a_virtual, vmax, gridpoints, jv, ja)
+        if law is None:
+            return None, why
+        return smooth(arm, PathSegment(s_way, q_way, law, spline=spline)), None
+
+    seg, why = timed()
+    if seg is None:
+        return None, TimingFailure(why or "no time law", None)
     for _ in range(3):
-        if seg is None:
-            break
         retime = False
-        if cartesian and fail is None:
+        law = seg.law
+        assert isinstance(law, SmoothLaw)
+        if cartesian and law.peak_acceleration() >= REACHED * a_virtual:
             peak = cartesian_peak(arm, seg)
             if peak > a * (1.0 + 2e-3):
                 a_virtual *= a / peak
@@ -303,72 +333,61 @@ def time_path(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vma
             retime = True
         if not retime:
             break
-        seg2, fail2 = _toppra(arm, s_way, q_way, a_virtual, vmax, gridpoints, jv, ja)
+        seg2, _ = timed()
         if seg2 is None:
             break
-        seg, fail = seg2, (fail2 if not cartesian or fail2 is None or fail is not None
-                           else None)
-    return seg, fail
+        seg = seg2
+    return seg, _shortfall(arm, seg, a, a_virtual, vmax, cartesian)
 
 
-def limit_ratios(arm: ArmModel, seg: PathSegment, samples: int = 1500
-                  ) -> tuple[np.ndarray, np.ndarray]:
-    """Per joint, the largest velocity and acceleration over the planned limits on a
-    segment sampled densely (finer than any output rate); shapes (n,)."""
-    tau = np.linspace(0.0, seg.duration, samples)
-    _, qd, qdd = seg.sample(tau)
-    return (np.abs(qd).max(axis=0) / arm.plan_vmax, np.abs(qdd).max(axis=0) / arm.plan_amax)
-
-
-def _toppra(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vmax: float,
-            gridpoints: int, jv: np.ndarray, ja: np.ndarray
-            ) -> tuple[PathSegment | None, TimingFailure | None]:
-    toppra = _import_toppra()
-    algo = toppra.algorithm
-    logging.getLogger("toppra").setLevel(logging.ERROR)
-    aug = np.column_stack([q_way, s_way])
-    path = toppra.SplineInterpolator(s_way, aug)
-    # A uniform grid plus every waypoint: the spline's second derivative is piecewise
-    # linear, so its extremes sit at the waypoints (knots), which the grid must include.
-    grid = np.union1d(np.linspace(s_way[0], s_way[-1], gridpoints), s_way)
-    inst = algo.TOPPRA(list(_constraints(tuple(jv), tuple(ja), a, vmax)),
-                       path, gridpoints=grid, solver_wrapper="seidel")
-    try:
-        _, sd, _, _ = inst.compute_parameterization(0.0, 0.0, return_data=True)
-    except Exception as exc:  # toppra raises bare exceptions on degenerate input
-        return None, TimingFailure(f"TOPP-RA failed: {exc}", None)
-    if inst.problem_data.return_code != algo.ParameterizationReturnCode.Ok or sd is None:
-        return None, TimingFailure(f"TOPP-RA: {inst.problem_data.return_code}", None)
-    sd = np.asarray(sd, dtype=float)
-    sd[0] = sd[-1] = 0.0
-    try:
-        law = TimeLaw.from_speeds(grid, sd)
-    except ValueError:  # the path speed is zero inside the path: no motion can follow it
-        return None, TimingFailure("TOPP-RA: the path speed drops to zero inside the path",
-                                   None)
-    seg = PathSegment(s_way, q_way, law, spline=path.cspl)
-    peak = float(np.max(np.abs(seg.law.u)))
-    if peak < a * 0.97:
-        return seg, TimingFailure("joint limits bind before the declared acceleration",
-                                  binding_joint(arm, seg)[0], peak, a)
-    return seg, None
+def _shortfall(arm: ArmModel, seg: PathSegment, a: float, a_virtual: float, vmax: float,
+               cartesian: bool) -> TimingFailure | None:
+    """None when the law reaches the declared acceleration (``a_virtual``, the virtual
+    limit left after the curvature correction); else what binds, in words: the joint at
+    its acceleration (or velocity) limit, at least 95 % of it on the segment; else the
+    jerk ramp, longer than the accelerating phase that the speed cap ends after ``v / a``
+    (or that the move's length allows)."""
+    law = seg.law
+    assert isinstance(law, SmoothLaw)
+    peak = law.peak_acceleration()
+    if peak >= REACHED * a_virtual:
+        return None
+    achieved = cartesian_peak(arm, seg) if cartesian else peak
+    rv, ra = limit_ratios(arm, seg)
+    for ratios, kind in ((ra, "acceleration"), (rv, "velocity")):
+        j = int(np.argmax(ratios))
+        if ratios[j] >= 0.95:
+            joint = arm.joint_names[j]
+            return TimingFailure(f"{joint} is at its {kind} limit", joint, achieved, a)
+    ms = law.window * 1e3
+    if np.max(law.base.sd) >= 0.99 * vmax:
+        reason = (f"the speed cap v={vmax:.3g} is reached after {vmax / a * 1e3:.3g} ms of "
+                  f"acceleration, shorter than the {ms:.3g} ms the joint jerk limits need "
+                  "to build the acceleration up")
+    else:
+        reason = (f"the move is too short to build the acceleration up within the joint "
+                  f"jerk limits (a {ms:.3g} ms ramp)")
+    return TimingFailure(reason, None, achieved, a)
 
 
 def shiver_segment(arm: ArmModel, q_hold: np.ndarray, amplitude: float, f: float,
                    duration: float) -> tuple[JointSegment, TimingFailure | None]:
     """An oscillation of the robot's shiver joint about ``q_hold``; checked against that
-    joint's velocity and acceleration limits."""
+    joint's velocity, acceleration and jerk limits (planned fractions)."""
     j = arm.joint_names.index(arm.spec.shiver_joint)
     seg = JointSegment(q_hold, duration, j, amplitude, f)
-    tau = np.linspace(0.0, duration, max(200, int(duration * f * 40)))
-    _, xd, xdd = _shiver_offset(tau, amplitude, f, duration)
+    tau = np.linspace(0.0, duration, max(400, int(duration * f * 80)))
+    _, xd, xdd, xddd = _shiver_offset(tau, amplitude, f, duration)
     r_v = float(np.max(np.abs(xd))) / arm.plan_vmax[j]  # scales with f
     r_a = float(np.max(np.abs(xdd))) / arm.plan_amax[j]  # scales with f^2
-    if max(r_v, r_a) > 1.0 + LIMIT_SLACK:
-        f_ok = f * min(1.0 / max(r_v, 1e-12), 1.0 / math.sqrt(max(r_a, 1e-12)))
-        which = "acceleration" if r_a >= r_v else "velocity"
+    r_j = float(np.max(np.abs(xddd))) / (arm.jmax[j] * JERK_SCALE)  # scales with f^3
+    worst = max(r_v, r_a, r_j)
+    if worst > 1.0 + LIMIT_SLACK:
+        f_ok = f * min(1.0 / max(r_v, 1e-12), 1.0 / math.sqrt(max(r_a, 1e-12)),
+                       1.0 / math.cbrt(max(r_j, 1e-12)))
+        which = ("velocity", "acceleration", "jerk")[int(np.argmax([r_v, r_a, r_j]))]
         return seg, TimingFailure(
             f"a {math.degrees(amplitude):g} deg shiver at {f:g} Hz needs "
-            f"{max(r_v, r_a):.1f}x {arm.spec.shiver_joint}'s {which} limit; at most about "
+            f"{worst:.1f}x {arm.spec.shiver_joint}'s {which} limit; at most about "
             f"{f_ok:.2g} Hz at this amplitude", arm.spec.shiver_joint, f, f_ok)
     return seg, None

@@ -4,6 +4,11 @@ Position limits come from the URDF, velocity limits from the URDF (unscaled: the
 compiler plans at ``velocity_scale`` of them, the check allows the full limit), and
 acceleration limits from :mod:`aou_dsl.robots` (planned at ``accel_scale``, checked in
 full). Each check reports its worst sample.
+
+:func:`check_rates` checks what a motion generator computes from the positions it is
+sent at its rate: velocity, acceleration and jerk by backward differences (the jerk
+limits come from :mod:`aou_dsl.robots`, or a controller's, see
+:mod:`aou_dsl.controllers`).
 """
 
 from __future__ import annotations
@@ -14,7 +19,7 @@ import numpy as np
 
 from ..kinematics import ArmModel
 
-__all__ = ["Check", "check_limits"]
+__all__ = ["Check", "check_limits", "check_rates"]
 
 #: Relative slack on velocity and acceleration limits (numerical differentiation).
 SLACK = 1e-3
@@ -66,3 +71,38 @@ def check_limits(arm: ArmModel, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
     acc = _worst("joint-acceleration", t, qdd, arm.amax, names,
                  "within the robot table's acceleration limits")
     return [pos, vel, acc]
+
+
+def check_rates(joints: tuple[str, ...], q: np.ndarray, rate: float, *, t0: float = 0.0,
+                vmax: np.ndarray | None = None, amax: np.ndarray | None = None,
+                jmax: np.ndarray | None = None, source: str = "the robot table's"
+                ) -> list[Check]:
+    """Joint velocity, acceleration and jerk of positions commanded at ``rate`` [Hz], by
+    backward differences, against the limits given (a limit left None is not checked).
+
+    Args:
+        joints: the column names.
+        q: positions [rad], shape (N, n), sampled every ``1 / rate`` from ``t0`` [s]; a
+            motion generator holds the arm at rest before and after, so ``q`` should
+            begin and end with three copies of the rest positions (then a motion that
+            starts with a jump of acceleration shows it as a jerk).
+        vmax, amax, jmax: limits [rad/s, rad/s^2, rad/s^3], shape (n,).
+        source: where the limits come from, for the checks' details.
+
+    Returns:
+        ``joint-rate-velocity``, ``joint-rate-acceleration`` and ``joint-jerk`` checks, for
+        the limits given; the time of a difference is that of its newest sample.
+    """
+    checks = []
+    dt = 1.0 / rate
+    for order, name, limit, what in ((1, "joint-rate-velocity", vmax, "velocity"),
+                                     (2, "joint-rate-acceleration", amax, "acceleration"),
+                                     (3, "joint-jerk", jmax, "jerk")):
+        if limit is None or len(q) <= order:
+            continue
+        d = np.diff(q, order, axis=0) / dt**order
+        t = t0 + (np.arange(len(d)) + order) * dt
+        checks.append(_worst(name, t, d, np.asarray(limit, dtype=float), joints,
+                             f"{what} from differences at {rate:g} Hz, within {source} "
+                             "limits"))
+    return checks

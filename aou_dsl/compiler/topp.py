@@ -1,0 +1,130 @@
+"""TOPP-RA, as the timing stage uses it: imported lazily (without matplotlib), its
+constraints built once per set of limits, its grid fine enough for the declared limits.
+
+:func:`parametrize` returns TOPP-RA's time-optimal law (piecewise constant ``s''``) over
+a joint path with the path coordinate appended as a *virtual joint* (see
+:mod:`.timing`), or the reason it failed.
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib
+import logging
+import sys
+import types
+
+import numpy as np
+
+from .timelaw import TimeLaw
+
+__all__ = ["grid", "parametrize"]
+
+
+class _LazyModule(types.ModuleType):
+    """Stands in for a module until one of its attributes is used, then imports it."""
+
+    def __getattr__(self, attr: str):
+        return getattr(importlib.import_module(self.__name__), attr)
+
+
+def _import_toppra():
+    """toppra, imported without matplotlib.
+
+    toppra's algorithm module imports ``matplotlib.pyplot`` at its top, for plotting
+    helpers aou never calls; that import costs every compile a fraction of a second. While
+    toppra is imported, lazy stand-ins take matplotlib's place in ``sys.modules``; they
+    are removed right after, so a later ``import matplotlib`` (``aouc plot``) is the real
+    one, and toppra's own reference imports it only if it is ever used.
+    """
+    if "toppra" in sys.modules:
+        return sys.modules["toppra"]
+    stubs: dict[str, types.ModuleType] = {}
+    if "matplotlib" not in sys.modules:
+        stubs["matplotlib"] = _LazyModule("matplotlib")
+        stubs["matplotlib.pyplot"] = _LazyModule("matplotlib.pyplot")
+        setattr(stubs["matplotlib"], "pyplot", stubs["matplotlib.pyplot"])  # noqa: B010
+        sys.modules.update(stubs)
+    try:
+        import toppra
+        import toppra.algorithm  # noqa: F401
+        import toppra.constraint  # noqa: F401
+    finally:
+        for name, stub in stubs.items():
+            if sys.modules.get(name) is stub:
+                del sys.modules[name]
+    return toppra
+
+
+@functools.lru_cache(maxsize=256)
+def _constraints(jv: tuple[float, ...], ja: tuple[float, ...], a: float, vmax: float):
+    """TOPP-RA's joint velocity and acceleration constraints, the virtual joint last.
+    They do not depend on the path, and building one formats its limits as text (slow),
+    so they are made once per set of limits."""
+    constraint = _import_toppra().constraint
+    vlim = np.column_stack([-np.append(jv, vmax), np.append(jv, vmax)])
+    alim = np.column_stack([-np.append(ja, a), np.append(ja, a)])
+    return (constraint.JointVelocityConstraint(vlim),
+            constraint.JointAccelerationConstraint(alim))
+
+
+def grid(s_way: np.ndarray, gridpoints: int, a: float, vmax: float) -> np.ndarray:
+    """TOPP-RA's grid over the path coordinate, shape (G,), increasing.
+
+    A uniform grid plus every waypoint: the spline's second derivative is piecewise
+    linear, so its extremes sit at the waypoints (knots), which the grid must include.
+    TOPP-RA's ``s''`` is constant on each interval, so when the speed cap is reached
+    after ``v^2 / 2a`` (often shorter than one uniform step), the grid also holds that
+    point and a few before it, from both ends: the accelerating phase then runs at
+    exactly ``a`` instead of being averaged over a whole interval.
+    """
+    length = float(s_way[-1])
+    pts = [np.linspace(s_way[0], length, gridpoints), s_way]
+    reach = vmax * vmax / (2.0 * a)
+    if 0.0 < reach < length / 2.0:
+        inner = np.linspace(0.0, reach, 5)[1:]
+        pts += [inner, length - inner]
+    g = np.unique(np.concatenate(pts))
+    # Points closer than a nanometre (or nanoradian) would make degenerate intervals.
+    tol = 1e-9 * max(length, 1.0)
+    out = [g[0]]
+    for x in g[1:-1]:
+        if x - out[-1] > tol and g[-1] - x > tol:
+            out.append(x)
+    out.append(g[-1])
+    return np.array(out)
+
+
+def parametrize(s_way: np.ndarray, q_way: np.ndarray, a: float, vmax: float,
+                gridpoints: int, jv: np.ndarray, ja: np.ndarray):
+    """TOPP-RA's rest-to-rest law over the joint path through ``q_way`` (shape (K, n)).
+
+    Args:
+        jv, ja: joint velocity and acceleration limits, shape (n,).
+        a, vmax: the virtual joint's limits (path acceleration and speed).
+
+    Returns:
+        ``(law, spline, None)`` on success, where ``spline`` is the path (joints and the
+        virtual coordinate last); ``(None, None, reason)`` when TOPP-RA fails.
+    """
+    toppra = _import_toppra()
+    algo = toppra.algorithm
+    logging.getLogger("toppra").setLevel(logging.ERROR)
+    aug = np.column_stack([q_way, s_way])
+    path = toppra.SplineInterpolator(s_way, aug)
+    g = grid(s_way, gridpoints, a, vmax)
+    inst = algo.TOPPRA(list(_constraints(tuple(jv), tuple(ja), a, vmax)),
+                       path, gridpoints=g, solver_wrapper="seidel")
+    try:
+        _, sd, _, _ = inst.compute_parameterization(0.0, 0.0, return_data=True)
+    except Exception as exc:  # toppra raises bare exceptions on degenerate input
+        return None, None, f"TOPP-RA failed: {exc}"
+    if inst.problem_data.return_code != algo.ParameterizationReturnCode.Ok or sd is None:
+        return None, None, f"TOPP-RA: {inst.problem_data.return_code}"
+    sd = np.asarray(sd, dtype=float)
+    sd[0] = sd[-1] = 0.0
+    try:
+        law = TimeLaw.from_speeds(g, sd)
+    except ValueError:  # the path speed is zero inside the path: no motion can follow it
+        return None, None, "TOPP-RA: the path speed drops to zero inside the path"
+    return law, path.cspl, None
