@@ -317,6 +317,12 @@ _RULE_LIST = [
          "The motion does not show what the file declares; usually a joint limit slowed it "
          "(see C304).",
          "approach a=50   # the joints cannot accelerate the hand that fast"),
+    Rule("C311", "jerk-limit", _E,
+         "The trajectory, sampled at the controller's rate, needs more joint jerk than the "
+         "robot (or the controller named by --controller) allows.",
+         "Motion generators reject acceleration jumps (Franka aborts with an acceleration "
+         "discontinuity; UR arms protective-stop): such a trajectory is not safe to send.",
+         "aouc check --controller franka recorded.json   # a trajectory with acceleration jumps"),
     Rule("C312", "no-collision-geometry", _E,
          "The robot's URDF has no collision shapes, so self-collision cannot be checked.",
          "A trajectory whose collisions were not checked is written only when the user opts "
