@@ -190,10 +190,12 @@ def _ticks(start: float, end: float, rate: float) -> np.ndarray:
 
 
 def _interpolate(tr: Trajectory, cols: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Positions of a trajectory file at times ``t`` (held outside its span), as a
-    ``joint_trajectory_controller`` interpolates its points: quintic Hermite between
-    samples with velocities and accelerations, cubic Hermite with velocities only, else a
-    cubic spline through the positions (a controller would interpolate those linearly)."""
+    """Positions of a trajectory file at times ``t``, as a ``joint_trajectory_controller``
+    interpolates its points: quintic Hermite between samples with velocities and
+    accelerations, cubic Hermite with velocities only, else a cubic spline through the
+    positions (a controller would interpolate those linearly). Outside its span the
+    motion goes on with its first and last state (a file that starts moving continues a
+    motion: a re-plan from the arm's state); at rest that is a hold."""
     from scipy.interpolate import CubicSpline
 
     ts, q = np.asarray(tr.t, float), np.asarray(tr.q, float)[:, cols]
@@ -214,9 +216,13 @@ def _interpolate(tr: Trajectory, cols: np.ndarray, t: np.ndarray) -> np.ndarray:
                 + (3 * x2 - 2 * x3) * p1 + (x3 - x2) * v1)
     qdd = np.asarray(tr.qdd, float)[:, cols]
     a0, a1 = qdd[i] * h * h, qdd[i + 1] * h * h
-    return ((1 - 10 * x3 + 15 * x4 - 6 * x5) * p0 + (x - 6 * x3 + 8 * x4 - 3 * x5) * v0
-            + (x2 - 3 * x3 + 3 * x4 - x5) / 2 * a0 + (x3 - 2 * x4 + x5) / 2 * a1
-            + (-4 * x3 + 7 * x4 - 3 * x5) * v1 + (10 * x3 - 15 * x4 + 6 * x5) * p1)
+    inside = ((1 - 10 * x3 + 15 * x4 - 6 * x5) * p0 + (x - 6 * x3 + 8 * x4 - 3 * x5) * v0
+              + (x2 - 3 * x3 + 3 * x4 - x5) / 2 * a0 + (x3 - 2 * x4 + x5) / 2 * a1
+              + (-4 * x3 + 7 * x4 - 3 * x5) * v1 + (10 * x3 - 15 * x4 + 6 * x5) * p1)
+    for k, mask in ((0, t < ts[0]), (-1, t > ts[-1])):
+        dt = (t[mask] - ts[k])[:, None]
+        inside[mask] = q[k] + qd[k] * dt + 0.5 * qdd[k] * dt * dt
+    return inside
 
 
 _UNITS = {"joint-rate-velocity": "rad/s", "joint-rate-acceleration": "rad/s^2",
