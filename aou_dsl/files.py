@@ -14,7 +14,7 @@ from collections.abc import Iterator, Sequence
 
 from .diagnostics import AouError, Span, diag
 
-__all__ = ["atomic", "check_output", "write_atomic"]
+__all__ = ["read_text", "atomic", "check_output", "write_atomic"]
 
 
 def check_output(path: str, formats: Sequence[str] = ()) -> str:
@@ -74,3 +74,18 @@ def write_atomic(path: str, data: bytes, *, inputs: Sequence[str] = ()) -> None:
     """Write ``data`` to ``path`` atomically; never over one of ``inputs``."""
     with atomic(path, inputs=inputs) as tmp, open(tmp, "wb") as fh:
         fh.write(data)
+
+
+def read_text(path: str, what: str = "") -> str:
+    """The text of an input file.
+
+    Raises:
+        AouError: I501 naming the file (and ``what`` it is) and the reason.
+    """
+    try:
+        with open(path, encoding="utf-8") as fh:
+            return fh.read()
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise AouError(diag("I501", f"cannot read {what + ' ' if what else ''}`{path}`: "
+                            f"{reason}", Span.whole_file(path))) from None

@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..diagnostics import AouError, Span, diag
+from ..files import read_text
 
 __all__ = ["KEYS", "Description", "read_description"]
 
@@ -157,13 +158,7 @@ def read_description(path: str) -> Description:
         AouError: I501 when it cannot be read; V109 for what does not fit, at its line.
     """
     path = os.path.abspath(path)
-    try:
-        with open(path, encoding="utf-8") as fh:
-            text = fh.read()
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise AouError(diag("I501", f"cannot read the robot file `{path}`: {reason}",
-                            Span.whole_file(path))) from None
+    text = read_text(path, "the robot file")
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

@@ -25,6 +25,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from ..diagnostics import AouError, Span, diag
+from ..files import read_text
 
 __all__ = ["CONTINUOUS_RANGE", "GAZE_FRAME", "Joint", "Urdf", "gaze_rpy", "kinematic_xml",
            "gaze_offset", "read_urdf", "resolve_uri", "scene_xml", "unlimited"]
@@ -136,13 +137,7 @@ def read_urdf(path: str) -> Urdf:
         AouError: I501 when it cannot be read, V109 when it is not a URDF aou can use.
     """
     path = os.path.abspath(path)
-    try:
-        with open(path, encoding="utf-8") as fh:
-            text = fh.read()
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise AouError(diag("I501", f"cannot read the robot file `{path}`: {reason}",
-                            Span.whole_file(path))) from None
+    text = read_text(path, "the robot file")
     try:
         root = ET.fromstring(text)
         if root.tag != "robot":

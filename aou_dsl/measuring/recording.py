@@ -17,6 +17,7 @@ import os
 import numpy as np
 
 from ..diagnostics import AouError, Span, diag
+from ..files import read_text
 from ..trajectory import Trajectory
 
 __all__ = ["read_csv", "read_json", "read_recording"]
@@ -135,13 +136,7 @@ def read_recording(path: str, *, robot: str | None = None,
                    goal: tuple[float, float, float] | None = None,
                    ee_frame: str | None = None) -> Trajectory:
     """Read a ``.json`` trajectory or a ``.csv`` recording (which needs ``robot``)."""
-    try:
-        with open(path, encoding="utf-8") as fh:
-            text = fh.read()
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise AouError(diag("I501", f"cannot read `{path}`: {reason}",
-                            Span.whole_file(path))) from None
+    text = read_text(path)
     if path.endswith(".csv"):
         if robot is None:
             raise AouError(diag("I501", "a CSV recording needs `--robot NAME`",
