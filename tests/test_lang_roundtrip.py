@@ -45,6 +45,8 @@ def _explain(o: Outcome) -> str:
 
 def _check_one(o: Outcome) -> None:
     assert o.status != "crash", "the tools crashed or exited 2:\n" + _explain(o)
+    if o.status.endswith("refused"):
+        return  # counted, with its code, by the refusal-share tests
     assert not o.certain, "the trajectory does not show what the file declares:\n" + _explain(o)
 
 
