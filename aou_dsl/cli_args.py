@@ -80,6 +80,10 @@ ROBOT_HELP = ("robot: a built-in name (panda, ur5, xarm7, ...; `aouc robot --lis
 
 def _robot(p: argparse.ArgumentParser) -> None:
     p.add_argument("--robot", metavar="NAME|PATH", help=ROBOT_HELP)
+    _package_dir(p)
+
+
+def _package_dir(p: argparse.ArgumentParser) -> None:
     p.add_argument("--package-dir", action="append", default=[], metavar="DIR",
                    help="a folder holding ROS packages, searched first for the URDF's "
                    "package:// meshes (repeatable)")
@@ -199,8 +203,7 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     rob.add_argument("--list", action="store_true", help="list the built-in robots")
     rob.add_argument("--format", choices=("text", "json", "toml"), default="text",
                      help="toml: a robot description pinning every value")
-    rob.add_argument("--package-dir", action="append", default=[], metavar="DIR",
-                     help="a folder holding ROS packages (repeatable)")
+    _package_dir(rob)
     c["synth"] = syn = sub.add_parser(
         "synth", help="write a .aou file for a state, or a point of the C-V plane, at an "
         "intensity")

@@ -433,8 +433,6 @@ class _Ev:
     value: float = 0.0  # duration s, radial change m (+ = away), bearing deg, roll deg, amp
     acc: float | None = None
     vel: float | None = None
-    rel: float = 0.0  # gaze bearing under a relative reading of the signed angle
-    hv: tuple[float, float] = (0.0, 0.0)  # both bearings after a gaze (absolute reading)
 
 
 @dataclass
@@ -443,10 +441,8 @@ class _Seq:
 
     s: _Settings
     d: float
-    h: float = 0.0  # bearings (deg) under the documented absolute reading
+    h: float = 0.0  # bearings (deg) from the initial line of sight
     v: float = 0.0
-    hr: float = 0.0  # the same under a relative reading
-    vr: float = 0.0
     roll: float = 0.0
     events: list[_Ev] = field(default_factory=list)
     lines: list[str] = field(default_factory=list)
@@ -508,11 +504,10 @@ def _seq_gaze(ch, feats: set[str], q: _Seq, kind: str, cnt: int) -> str:
     feats.add(f"prim:{kind}")
     if cnt:
         if kind == "gaze-h":
-            q.h, q.hr = ang, q.hr + ang
+            q.h = ang
         else:
-            q.v, q.vr = ang, q.vr + ang
-        rel = q.hr if kind == "gaze-h" else q.vr
-        q.events.append(_Ev(kind, ang, rel=rel, hv=(q.h, q.v)))
+            q.v = ang
+        q.events.append(_Ev(kind, ang))
     plane = "horizontal" if kind == "gaze-h" else "vertical"
     return f"gaze {plane} {t}" + _ang_speed_key(ch, feats, 0.35)
 
