@@ -79,13 +79,17 @@ def compile(path: Source | None = None, *, source: str | None = None,  # noqa: A
 
 
 def read_trajectory(path: Source, *, robot: str | None = None,
-                    goal: tuple[float, float, float] | None = None,
-                    ee_frame: str | None = None) -> Trajectory:
-    """A trajectory from a file: aou's JSON, or a CSV recording (which needs ``robot``);
-    a ``.aou`` file is compiled. ``goal`` and ``ee_frame`` override the file's."""
+                    goal: tuple[float, float, float] | str | None = None,
+                    ee_frame: str | None = None, angle_unit: str | None = None,
+                    time_unit: str | None = None) -> Trajectory:
+    """A trajectory from a file: aou's JSON or NPZ, or a CSV recording (which needs
+    ``robot``); a ``.aou`` file is compiled. ``goal`` (or ``"final"``: the end-effector's
+    last position) and ``ee_frame`` override the file's; ``angle_unit="deg"`` and
+    ``time_unit="ms"`` read a recording in those units (docs/measure.md)."""
     from .build import load_motion
 
-    return load_motion(os.fspath(path), robot=robot, goal=goal, ee_frame=ee_frame)
+    return load_motion(os.fspath(path), robot=robot, goal=goal, ee_frame=ee_frame,
+                       angle_unit=angle_unit, time_unit=time_unit)
 
 
 def _trajectory(what: Trajectory | Source, **options: Any) -> Trajectory:

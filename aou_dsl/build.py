@@ -215,8 +215,9 @@ def _span_at(compiled, t: float | None) -> Span:
 
 
 def load_motion(path: str, *, robot: str | None = None,
-                goal: tuple[float, float, float] | None = None,
-                ee_frame: str | None = None) -> Trajectory:
+                goal: tuple[float, float, float] | str | None = None,
+                ee_frame: str | None = None, angle_unit: str | None = None,
+                time_unit: str | None = None) -> Trajectory:
     """A ``.aou`` file compiled (without the safety checks), or a trajectory file read
     (a CSV recording needs ``robot``; ``goal`` and ``ee_frame`` override the file's).
 
@@ -230,4 +231,5 @@ def load_motion(path: str, *, robot: str | None = None,
         if not res.ok:
             raise AouError(res.diagnostics)
         return res.trajectory.with_(path=path)
-    return read_recording(path, robot=robot, goal=goal, ee_frame=ee_frame)
+    return read_recording(path, robot=robot, goal=goal, ee_frame=ee_frame,
+                          angle_unit=angle_unit, time_unit=time_unit)

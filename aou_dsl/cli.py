@@ -15,7 +15,7 @@ from collections.abc import Callable, Sequence
 from .cli_args import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, build_parser
 from .cli_tools import cmd_robot, cmd_synth
 from .diagnostics import RULES, AouError, Diagnostic, Severity
-from .report import format_github, format_json, format_text
+from .report import format_github, format_json, format_suppressed, format_text
 
 __all__ = ["EXIT_ERRORS", "EXIT_OK", "EXIT_USAGE", "main"]
 
@@ -45,7 +45,8 @@ def _scene_kw(args: argparse.Namespace) -> dict:
 
 
 def _read_kw(args: argparse.Namespace) -> dict:
-    return {"robot": args.robot, "goal": args.goal, "ee_frame": args.ee_frame}
+    return {"robot": args.robot, "goal": args.goal, "ee_frame": args.ee_frame,
+            "angle_unit": args.angle_unit, "time_unit": args.time_unit}
 
 
 # --- lint, rules, explain ---------------------------------------------------------------
@@ -66,6 +67,9 @@ def _cmd_lint(args: argparse.Namespace) -> int:
         _print_diags(problems, args.format)
         for r in results:
             _print_diags(r.diagnostics, args.format, {r.path: r.source or ""}, sys.stdout)
+            note = format_suppressed(r.path, r.suppressed)
+            if note:
+                print(note)
         if args.format == "text":
             n = len(results)
             print(f"{n} file{'s' * (n != 1)} checked: {counts[Severity.ERROR]} errors, "
@@ -116,10 +120,11 @@ def _cmd_explain(args: argparse.Namespace) -> int:
 
 
 def _cmd_compile(args: argparse.Namespace) -> int:
-    from .api import compile as compile_file
     from .compiler.output import output_paths, write_output
     from .diagnostics import has_errors
     from .linter import collect_inputs
+    from .parallel import build_many, default_jobs
+    from .safety.scene import SceneOptions
 
     inputs, problems = collect_inputs(args.paths)
     if problems:
@@ -135,11 +140,12 @@ def _cmd_compile(args: argparse.Namespace) -> int:
         print(f"aouc: cannot create the output folder: {exc.strerror}", file=sys.stderr)
         return EXIT_USAGE
     sources = [src for src, _ in inputs]
+    options = {"robot": args.robot, "rate": args.rate, "check": not args.no_check,
+               "scene": SceneOptions(**_scene_kw(args)),
+               "collision_check": not args.no_collision_check, "controller": args.controller}
+    results = build_many(sources, options, args.jobs or default_jobs(), cluster=args.cluster)
     worst = EXIT_OK
-    for k, ((src, _), dest) in enumerate(zip(inputs, dests, strict=True), 1):
-        res = compile_file(src, robot=args.robot, rate=args.rate, check=not args.no_check,
-                           collision_check=not args.no_collision_check,
-                           controller=args.controller, **_scene_kw(args))
+    for k, ((src, _), dest, res) in enumerate(zip(inputs, dests, results, strict=True), 1):
         _print_diags(res.diagnostics, sources={src: res.lint.source or ""})
         if not res.ok or res.document is None:
             worst = max(worst, _exit_for(res.diagnostics))

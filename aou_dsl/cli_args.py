@@ -46,6 +46,20 @@ def number(lo: float, hi: float, *, lo_open: bool = False, what: str = "a number
     return parse
 
 
+def int_in(lo: int, hi: int) -> Callable[[str], int]:
+    """An argparse type: a whole number in [lo, hi]."""
+    def parse(text: str) -> int:
+        try:
+            x = int(text)
+        except ValueError:
+            x = lo - 1
+        if not lo <= x <= hi:
+            raise argparse.ArgumentTypeError(f"expected a whole number in [{lo}, {hi}], "
+                                             f"found `{text}`")
+        return x
+    return parse
+
+
 def point(text: str) -> tuple[float, float, float]:
     """argparse type of X,Y,Z options (metres, finite, within 10 m)."""
     parts = text.strip("()").split(",")
@@ -101,10 +115,22 @@ def _collision(p: argparse.ArgumentParser) -> None:
                    "not checked, and the output says so)")
 
 
+def goal_point(text: str) -> tuple[float, float, float] | str:
+    """argparse type of --goal: X,Y,Z in metres, or `final`."""
+    return "final" if text.strip().lower() == "final" else point(text)
+
+
 def _recording(p: argparse.ArgumentParser) -> None:
     _robot(p)
+    p.add_argument("--angle-unit", choices=("rad", "deg"),
+                   help="the joint columns of a recording are in this unit (default rad; "
+                   "values that look like degrees are an error unless said)")
+    p.add_argument("--time-unit", choices=("s", "ms"),
+                   help="the t column of a recording is in this unit (default s)")
     p.add_argument("--ee-frame", help="end-effector frame (default: the robot's)")
-    p.add_argument("--goal", metavar="X,Y,Z", type=point, help="goal position in metres")
+    p.add_argument("--goal", metavar="X,Y,Z|final", type=goal_point,
+                   help="goal position in metres, or `final`: the end-effector's last "
+                   "position (for a recording without a goal)")
 
 
 def _scene(p: argparse.ArgumentParser) -> None:
@@ -152,6 +178,12 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
                       "message as YAML (docs/ros2.md)")
     comp.add_argument("--rate", type=RATE, metavar="HZ", help="sample rate in Hz (default 250)")
     _robot(comp)
+    comp.add_argument("-j", "--jobs", type=int_in(0, 256), default=1, metavar="N",
+                      help="build N files at once in warm worker processes (0: one per "
+                      "core); output identical to --jobs 1, in input order")
+    comp.add_argument("--cluster", metavar="ADDRESS",
+                      help="build on a Dask cluster, e.g. tcp://host:8786 (needs the "
+                      "`cluster` extra; docs/speed.md)")
     comp.add_argument("--no-check", action="store_true",
                       help="skip the safety checks (recorded in the output)")
     _collision(comp)

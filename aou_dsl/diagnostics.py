@@ -349,6 +349,26 @@ _RULE_LIST = [
          "The descriptor follows its rule (median, or maximum for peaks and gazes); "
          "per-episode values are in the JSON output.",
          "two retreats of 4 cm and 8 cm"),
+    Rule("R404", "implausible-units", _E,
+         "The columns of a recording look like degrees (or its times like milliseconds), "
+         "not radians and seconds.",
+         "Descriptors measured from wrong units are nonsense; say the unit "
+         "(--angle-unit deg, --time-unit ms) if the file really uses it.",
+         "t,panda_joint1\n0,45\n1,90"),
+    Rule("R405", "missing-goal", _W,
+         "A recording carries no goal and none was given; gaze descriptors need one.",
+         "Give --goal X,Y,Z, or --goal final to take the end-effector's final position "
+         "(the gaze angles are then relative to it).",
+         '{"format": "aou-trajectory/1", "robot": "panda", "joint_names": '
+         '["panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4", "panda_joint5", '
+         '"panda_joint6", "panda_joint7"], "t": [0, 0.1, 0.2], "q": ['
+         '[0, 0, 0, -1.5, 0, 1.5, 0.8], [0, 0, 0, -1.5, 0, 1.5, 0.8], '
+         '[0, 0, 0, -1.5, 0, 1.5, 0.8]]}'),
+    Rule("R406", "inconsistent-measurement", _E,
+         "A measured value contradicts the joint motion it came from (for instance a "
+         "Cartesian acceleration the joint accelerations cannot produce).",
+         "aou reports an internal inconsistency instead of a wrong number.",
+         "a recording whose measured peak exceeds what its joint accelerations allow"),
     # --- I: input/output and usage -----------------------------------------------------
     Rule("I501", "cannot-read", _E,
          "An input file or folder cannot be read (missing, a directory, permissions, encoding).",

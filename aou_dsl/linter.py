@@ -18,13 +18,23 @@ from .parse import parse
 from .timeline import Timeline
 from .validate import Validated, validate_tree
 
-__all__ = ["FileResult", "collect_files", "collect_inputs", "lint_file", "lint_paths",
-           "lint_source", "load", "read_source", "severity_counts"]
+__all__ = ["MAX_DIAGNOSTICS", "FileResult", "collect_files", "collect_inputs", "lint_file",
+           "lint_paths", "lint_source", "load", "read_source", "severity_counts"]
+
+
+#: At most this many diagnostics are kept per file (the most severe, earliest first);
+#: the others are only counted (:attr:`FileResult.suppressed`).
+MAX_DIAGNOSTICS = 100
+
+_RANK = {Severity.ERROR: 0, Severity.WARNING: 1, Severity.NOTE: 2}
 
 
 @dataclass
 class FileResult:
-    """What lint found in one file. ``behaviour`` and ``cv`` are None when it has errors."""
+    """What lint found in one file. ``behaviour`` and ``cv`` are None when it has errors.
+
+    ``suppressed`` counts, per severity, the diagnostics beyond :data:`MAX_DIAGNOSTICS`
+    that were found but not kept."""
 
     path: str
     diagnostics: list[Diagnostic] = field(default_factory=list)
@@ -32,20 +42,37 @@ class FileResult:
     cv: CVPoint | None = None
     source: str | None = None
     timeline: Timeline | None = None
+    suppressed: dict[Severity, int] = field(default_factory=dict)
 
     @property
     def ok(self) -> bool:
-        return not has_errors(self.diagnostics)
+        return not has_errors(self.diagnostics) and not self.suppressed.get(Severity.ERROR)
 
     def to_json(self) -> dict:
         b = self.behaviour
-        return {
+        out = {
             "path": self.path,
             "behaviour": b.name if b else None,
             "state": b.state.value if b and b.state else None,
             "cv": self.cv.to_json() if self.cv else None,
             "diagnostics": [d.to_json() for d in self.diagnostics],
         }
+        if any(self.suppressed.values()):  # only a file past the cap says so
+            out["suppressed"] = {str(k): v for k, v in self.suppressed.items() if v}
+        return out
+
+
+def _cap(result: FileResult) -> None:
+    """Keep the :data:`MAX_DIAGNOSTICS` most severe diagnostics (earliest first among
+    equals), in file order; count the rest by severity."""
+    diags = result.diagnostics
+    if len(diags) > MAX_DIAGNOSTICS:
+        ranked = sorted(diags, key=lambda d: (_RANK[d.severity], d.span.line, d.span.col,
+                                              d.code))
+        for d in ranked[MAX_DIAGNOSTICS:]:
+            result.suppressed[d.severity] = result.suppressed.get(d.severity, 0) + 1
+        diags = ranked[:MAX_DIAGNOSTICS]
+    result.diagnostics = sorted(diags, key=lambda d: (d.span.line, d.span.col, d.code))
 
 
 def behaviour_cv(b: Behaviour, timeline: Timeline | None) -> tuple[CVPoint, list]:
@@ -127,7 +154,7 @@ def lint_source(text: str, path: str = "<string>", *,
         point, model_diags = _model_checks(b, v.timeline, weights)
         result.behaviour, result.cv, result.timeline = b, point, v.timeline
         result.diagnostics.extend(model_diags)
-    result.diagnostics.sort(key=lambda d: (d.span.line, d.span.col, d.code))
+    _cap(result)
     return result
 
 
@@ -184,8 +211,11 @@ def lint_paths(paths: list[str], *, weights: CVWeights = DEFAULT_WEIGHTS
 
 
 def severity_counts(results: list[FileResult]) -> dict[Severity, int]:
+    """Diagnostics per severity over all files, those not kept included."""
     counts = dict.fromkeys(Severity, 0)
     for r in results:
         for d in r.diagnostics:
             counts[d.severity] += 1
+        for sev, n in r.suppressed.items():
+            counts[sev] += n
     return counts

@@ -7,13 +7,17 @@ a statement is a keyword and its arguments. This stage only checks the shape;
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import os
+import sys
+import threading
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
 import lark
-from lark import Lark, Token, Transformer, v_args
+from lark import Lark, Token, Transformer
 
 from .diagnostics import AouError, Span, diag
 from .units import parse_quantity
@@ -114,67 +118,131 @@ def grammar_text() -> str:
 
 
 def build_parser(*, strict: bool = False) -> Lark:
-    """A fresh LALR parser. ``strict=True`` fails on any grammar conflict or collision."""
+    """A fresh LALR parser that builds Lark trees (with positions). ``strict=True`` fails
+    on any grammar conflict or collision."""
     return Lark(grammar_text(), parser="lalr", propagate_positions=True, strict=strict)
+
+
+def cache_dir() -> str | None:
+    """Where aou keeps files it can rebuild (the parser's tables): ``$AOU_CACHE_DIR``, else
+    the user's cache folder (``$XDG_CACHE_HOME`` or ``~/.cache``, ``%LOCALAPPDATA%`` on
+    Windows, ``~/Library/Caches`` on macOS) + ``/aou-dsl``. None when there is no home."""
+    if os.environ.get("AOU_CACHE_DIR"):
+        return os.environ["AOU_CACHE_DIR"]
+    if sys.platform == "win32":
+        base = os.environ.get("LOCALAPPDATA")
+    elif sys.platform == "darwin":
+        base = os.path.expanduser("~/Library/Caches")
+    else:
+        base = os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache")
+    return os.path.join(base, "aou-dsl") if base and not base.startswith("~") else None
 
 
 @functools.cache
 def _parser() -> Lark:
-    return build_parser()
+    """The parser :func:`parse` uses: LALR, building the syntax tree while it parses.
+
+    Lark's analysis of the grammar (its tables, and the terminal-collision check it runs
+    when ``interegular`` is installed) takes most of a cold start; it is cached in
+    :func:`cache_dir` under a name that changes with the grammar, Lark and Python. The
+    cache is written to a private temporary file and renamed, so concurrent processes
+    never read half a file; a folder that cannot be written (read-only, full) only
+    means no cache.
+    """
+    import hashlib
+
+    text = grammar_text()
+    options = {"parser": "lalr", "transformer": _ToSyntax()}
+    where = cache_dir()
+    if where is None:
+        return Lark(text, **options)
+    key = hashlib.sha256(f"{text}|{lark.__version__}|{sys.version_info[:2]}".encode())
+    path = os.path.join(where, f"grammar-{key.hexdigest()[:20]}.lark-cache")
+    if os.path.isfile(path):
+        return Lark(text, cache=path, **options)
+    tmp = f"{path}.{os.getpid()}.{threading.get_ident()}.tmp"
+    try:
+        os.makedirs(where, exist_ok=True)
+        parser = Lark(text, cache=tmp, **options)  # Lark writes its tables to tmp
+        os.replace(tmp, path)
+    except OSError:
+        with contextlib.suppress(OSError):
+            os.remove(tmp)
+        return Lark(text, **options)
+    return parser
 
 
-# --- Tree -> syntax tree ----------------------------------------------------------------
+# --- Tokens -> syntax tree, while parsing ------------------------------------------------
+
+#: The file being parsed (its path for spans, its text for a vector's parentheses); per
+#: thread, since the parser (and its transformer) is shared.
+_CURRENT = threading.local()
 
 
 def _tok_span(path: str, tok: Token) -> Span:
     return Span(path, tok.line or 1, tok.column or 1, tok.end_line or 1, tok.end_column or 1)
 
 
-def _meta_span(path: str, meta: lark.tree.Meta) -> Span:
-    return Span(path, meta.line, meta.column, meta.end_line, meta.end_column)
+def _join(path: str, first: Token, last: Span | Token) -> Span:
+    """From the start of token ``first`` to the end of ``last``."""
+    if isinstance(last, Token):
+        last = _tok_span(path, last)
+    return Span(path, first.line or 1, first.column or 1, last.end_line, last.end_col)
+
+
+_BLANK = " \t\f\r"
 
 
 class _ToSyntax(Transformer):
-    def __init__(self, path: str):
-        super().__init__()
-        self.path = path
+    """Builds each node as the parser reduces its rule (no Lark tree is made). Spans run
+    from a node's first token to its last, as Lark's positions would."""
 
     def quantity(self, children: list[Token]) -> Quantity:
         (tok,) = children
         value, unit = parse_quantity(str(tok))
-        return Quantity(value, unit, str(tok), _tok_span(self.path, tok))
+        return Quantity(value, unit, str(tok), _tok_span(_CURRENT.path, tok))
 
     def word(self, children: list[Token]) -> Word:
         (tok,) = children
-        return Word(str(tok), _tok_span(self.path, tok))
+        return Word(str(tok), _tok_span(_CURRENT.path, tok))
 
     def text(self, children: list[Token]) -> Word:
         (tok,) = children
-        return Word(str(tok)[1:-1], _tok_span(self.path, tok), quoted=True)
+        return Word(str(tok)[1:-1], _tok_span(_CURRENT.path, tok), quoted=True)
 
     def colon(self, children: list[Token]) -> Colon:
-        return Colon(_tok_span(self.path, children[0]))
+        return Colon(_tok_span(_CURRENT.path, children[0]))
 
-    @v_args(meta=True)
-    def keyval(self, meta: lark.tree.Meta, children: list) -> KeyVal:
+    def keyval(self, children: list) -> KeyVal:
         key, value = children
-        return KeyVal(str(key), value, _meta_span(self.path, meta))
+        return KeyVal(str(key), value, _join(_CURRENT.path, key, value.span))
 
-    @v_args(meta=True)
-    def vector(self, meta: lark.tree.Meta, children: list) -> Vector:
-        items = tuple(self.quantity([c]) if isinstance(c, Token) else c for c in children)
-        return Vector(items, _meta_span(self.path, meta))  # type: ignore[arg-type]
+    def vector(self, children: list[Token]) -> Vector:
+        """``( a, b, c )`` on one line: the span takes in the parentheses, which the
+        grammar does not keep, by finding them in the text around the numbers."""
+        path, text = _CURRENT.path, _CURRENT.text
+        first, last = children[0], children[-1]
+        open_at, close_at = (first.start_pos or 0) - 1, last.end_pos or 0
+        while open_at > 0 and text[open_at] in _BLANK:
+            open_at -= 1
+        while close_at < len(text) - 1 and text[close_at] in _BLANK:
+            close_at += 1
+        line = first.line or 1
+        span = Span(path, line, (first.column or 1) - ((first.start_pos or 0) - open_at),
+                    last.end_line or line,
+                    (last.end_column or 1) + (close_at - (last.end_pos or 0)) + 1)
+        items = tuple(self.quantity([c]) for c in children)
+        return Vector(items, span)  # type: ignore[arg-type]
 
-    @v_args(meta=True)
-    def statement(self, meta: lark.tree.Meta, children: list) -> Statement:
+    def statement(self, children: list) -> Statement:
         kw, *args = children
-        return Statement(str(kw), _tok_span(self.path, kw), tuple(args),
-                         _meta_span(self.path, meta))
+        path = _CURRENT.path
+        return Statement(str(kw), _tok_span(path, kw), tuple(args),
+                         _join(path, kw, args[-1].span if args else kw))
 
-    @v_args(meta=True)
-    def sequence(self, meta: lark.tree.Meta, children: list) -> SequenceBlock:
+    def sequence(self, children: list) -> SequenceBlock:
         stmts = tuple(c for c in children if isinstance(c, Statement))
-        return SequenceBlock(stmts, _meta_span(self.path, meta))
+        return SequenceBlock(stmts, _join(_CURRENT.path, children[0], children[-1]))
 
     def start(self, children: list) -> tuple:
         return tuple(children)
@@ -257,9 +325,12 @@ def parse(text: str, path: str = "<string>") -> SyntaxTree:
     Raises:
         AouError: with one ``S`` diagnostic for the first syntax error.
     """
+    parser = _parser()
+    _CURRENT.path, _CURRENT.text = path, text
     try:
-        tree = _parser().parse(text)
+        items = parser.parse(text)
     except lark.exceptions.UnexpectedInput as err:
         raise _syntax_error(path, text, err) from None
-    items = _ToSyntax(path).transform(tree)
-    return SyntaxTree(path, items)
+    finally:
+        _CURRENT.text = None
+    return SyntaxTree(path, items)  # type: ignore[arg-type]

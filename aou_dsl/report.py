@@ -12,15 +12,28 @@ __all__ = [
     "format_github",
     "format_json",
     "format_measured",
+    "format_suppressed",
     "format_text",
     "format_timeline",
 ]
 
 
+_LAST: tuple[str | None, list[str]] = (None, [])  # the last source formatted, its lines
+
+
+def _lines(source: str) -> list[str]:
+    """The lines of ``source``, split once however many diagnostics point into it."""
+    global _LAST
+    last = _LAST
+    if last[0] is not source:
+        last = _LAST = (source, source.splitlines())
+    return last[1]
+
+
 def _source_excerpt(d: Diagnostic, source: str | None) -> list[str]:
     if not source or d.span.line < 1:
         return []
-    lines = source.splitlines()
+    lines = _lines(source)
     if d.span.line > len(lines):
         return []
     text = lines[d.span.line - 1].expandtabs(1)
@@ -37,6 +50,18 @@ def format_text(d: Diagnostic, source: str | None = None) -> str:
     if d.hint:
         out.append(f"     = hint: {d.hint}")
     return "\n".join(out)
+
+
+def format_suppressed(path: str, suppressed: dict) -> str | None:
+    """The line saying how many diagnostics of a file were not shown (None: all were)."""
+    n = sum(suppressed.values())
+    if not n:
+        return None
+    from .linter import MAX_DIAGNOSTICS
+
+    parts = ", ".join(f"{v} {k}{'s' * (v != 1)}" for k, v in suppressed.items() if v)
+    return (f"{path}: {n} more diagnostic{'s' * (n != 1)} not shown ({parts}); at most "
+            f"{MAX_DIAGNOSTICS} are kept per file, the most severe first")
 
 
 def format_github(d: Diagnostic) -> str:

@@ -93,7 +93,7 @@ def _close(name: str, expected: float, found: float) -> bool:
 
 
 #: Cases whose fix is not in yet: strict, so the fix must remove them from here.
-PENDING = {"big-tilt-unwraps": "measure wraps the roll at 180 deg"}
+PENDING: dict[str, str] = {}
 
 
 @pytest.mark.parametrize("case", [

@@ -1,62 +1,85 @@
-"""Reading joint trajectories: aou's JSON or a CSV recording, as a
+"""Reading joint trajectories: aou's JSON, CSV and NPZ, or a recording of a real arm, as a
 :class:`~aou_dsl.trajectory.Trajectory`.
 
 What measuring needs is times, joint positions by joint name, the robot, its
 end-effector frame and the goal. The compiler's timeline and declared values are read
 only for plots and replays, never for measuring, so recordings of real arms measure
 the same way as compiled trajectories.
+
+Every format aou writes reads back with its robot, frame and goal: the JSON and the NPZ
+carry them in the document, the CSV in comment lines before its header
+(``# robot: NAME``, ``# ee_frame: F``, ``# goal: X,Y,Z``). Options given to
+:func:`read_recording` override the file. A recording whose units look wrong (angles in
+degrees, times in milliseconds) is refused unless the unit is given.
 """
 
 from __future__ import annotations
 
 import csv
+import io
 import json
 import math
 import os
+import zipfile
+from typing import Any
 
 import numpy as np
 
-from ..diagnostics import AouError, Span, diag
-from ..files import read_text
+from ..diagnostics import AouError, Severity, Span, diag
 from ..trajectory import Trajectory
 
-__all__ = ["read_csv", "read_json", "read_recording"]
+__all__ = ["ANGLE_UNITS", "TIME_UNITS", "read_csv", "read_json", "read_npz",
+           "read_recording"]
+
+ANGLE_UNITS = {"rad": 1.0, "deg": math.pi / 180.0}
+TIME_UNITS = {"s": 1.0, "ms": 1e-3}
+#: A clock slower than this [s per sample] is taken for milliseconds read as seconds.
+SLOWEST_STEP = 0.2
 
 
 def _bad(path: str, message: str, hint: str | None = None, **fields) -> AouError:
     return AouError(diag("R401", message, Span.whole_file(path), hint=hint, **fields))
 
 
-def _check_arrays(path: str, t: np.ndarray, q: np.ndarray, names: tuple[str, ...]) -> None:
+def _check_arrays(path: str, t: np.ndarray, q: np.ndarray, names: tuple[str, ...],
+                  rows: list[int] | None = None) -> None:
+    """Shapes, finite values and distinct names; ``rows`` gives each sample's line in a
+    text file (for the messages)."""
+    where = (lambda i: f"row {rows[i]}") if rows else (lambda i: f"sample {i}")
     if t.ndim != 1 or len(t) < 3:
         raise _bad(path, f"a trajectory needs at least 3 samples, found {t.size}")
     if q.shape != (len(t), len(names)):
         raise _bad(path, f"`q` has shape {q.shape}; expected ({len(t)}, {len(names)}) "
                    "(one row per time, one column per joint name)")
+    if len(set(names)) != len(names):
+        raise _bad(path, "a joint name appears twice among the columns")
     bad = ~np.isfinite(t)
     if bad.any():
-        raise _bad(path, f"time is not a finite number at sample {int(np.argmax(bad))}")
-    rows = ~np.isfinite(q).all(axis=1)
-    if rows.any():
-        i = int(np.argmax(rows))
+        i = int(np.argmax(bad))
+        raise _bad(path, f"{where(i)}: the time is not a finite number", sample=i)
+    bad_rows = ~np.isfinite(q).all(axis=1)
+    if bad_rows.any():
+        i = int(np.argmax(bad_rows))
         j = names[int(np.argmax(~np.isfinite(q[i])))]
-        raise _bad(path, f"joint `{j}` is not a finite number at sample {i} (t={t[i]:g}s)",
+        raise _bad(path, f"{where(i)} (t={t[i]:g}): joint `{j}` is not a finite number",
                    sample=i, joint=j)
+
+
+def _check_clock(path: str, t: np.ndarray, rows: list[int] | None = None) -> None:
     step = np.diff(t)
     if (step <= 0).any():
         i = int(np.argmax(step <= 0)) + 1
-        raise _bad(path, f"time must increase strictly: sample {i} has t={t[i]:g}s after "
-                   f"t={t[i - 1]:g}s", sample=i)
-    if len(set(names)) != len(names):
-        raise _bad(path, "a joint name appears twice among the columns")
+        at = f"row {rows[i]}" if rows else f"sample {i}"
+        raise _bad(path, f"time must increase strictly: {at} has t={t[i]:g} after "
+                   f"t={t[i - 1]:g}", sample=i)
 
 
 def _optional(doc: dict, q: np.ndarray) -> dict:
     """The velocities, accelerations and episodes a compiled file carries, when sound."""
     out: dict = {}
     try:
-        qd = np.asarray(doc.get("qd", []), dtype=float)
-        qdd = np.asarray(doc.get("qdd", []), dtype=float)
+        qd = np.asarray(doc.get("qd") if doc.get("qd") is not None else [], dtype=float)
+        qdd = np.asarray(doc.get("qdd") if doc.get("qdd") is not None else [], dtype=float)
         if qd.shape == q.shape and qdd.shape == q.shape:
             out["qd"], out["qdd"] = qd, qdd
         out["episodes"] = tuple((str(e["kind"]), float(e["t_start"]), float(e["t_end"]))
@@ -66,8 +89,49 @@ def _optional(doc: dict, q: np.ndarray) -> dict:
     return out
 
 
+def _goal_of(path: str, doc: dict) -> tuple[float, ...] | None:
+    goal = doc.get("goal")
+    if goal is None:
+        return None
+    try:
+        pos = goal["position"] if isinstance(goal, dict) else goal
+        out = tuple(float(x) for x in pos)
+    except (TypeError, ValueError, KeyError):
+        raise _bad(path, "`goal.position` must be 3 numbers") from None
+    if len(out) != 3 or not all(math.isfinite(x) for x in out):
+        raise _bad(path, "`goal.position` must be 3 finite numbers")
+    return out
+
+
+def _from_document(path: str, doc: dict, t: Any, q: Any) -> Trajectory:
+    """A trajectory from a document of the trajectory format and its arrays."""
+    missing = [k for k in ("robot", "joint_names") if k not in doc]
+    if missing:
+        raise _bad(path, f"missing key(s): {', '.join(missing)}")
+    try:
+        names = tuple(str(n) for n in doc["joint_names"])
+        t = np.asarray(t, dtype=float)
+        rows = list(q)
+        for i, row in enumerate(rows):
+            if len(row) != len(names):
+                raise _bad(path, f"sample {i} has {len(row)} values; `joint_names` has "
+                           f"{len(names)}", sample=i)
+        q = np.asarray(rows, dtype=float).reshape(len(rows), len(names))
+    except (TypeError, ValueError) as exc:
+        raise _bad(path, f"malformed trajectory: {exc}") from None
+    _check_arrays(path, t, q, names)
+    title = str(doc.get("behaviour") or os.path.splitext(os.path.basename(path))[0])
+    ee = doc.get("ee_frame")
+    return Trajectory(t, q, names, str(doc["robot"]), None if ee is None else str(ee),
+                      _goal_of(path, doc), path=path, title=title, **_optional(doc, q))
+
+
+def _written_by_aou(doc: dict) -> bool:
+    return str(doc.get("generator", "")).startswith("aouc")
+
+
 def read_json(path: str, text: str) -> Trajectory:
-    """An ``aou-trajectory/1`` document."""
+    """An ``aou-trajectory/1`` document (the goal may be missing)."""
     try:
         doc = json.loads(text)
     except json.JSONDecodeError as exc:
@@ -78,72 +142,235 @@ def read_json(path: str, text: str) -> Trajectory:
     fmt = doc.get("format")
     if fmt != "aou-trajectory/1":
         raise _bad(path, f"expected format `aou-trajectory/1`, found {fmt!r}")
-    missing = [k for k in ("robot", "joint_names", "goal", "t", "q") if k not in doc]
+    missing = [k for k in ("robot", "joint_names", "t", "q") if k not in doc]
     if missing:
         raise _bad(path, f"missing key(s): {', '.join(missing)}")
+    if not isinstance(doc["q"], list):
+        raise _bad(path, "`q` must be a list of rows")
+    rec = _from_document(path, doc, doc["t"], doc["q"])
+    _check_clock(path, rec.t)
+    return rec
+
+
+def read_npz(path: str, data: bytes) -> Trajectory:
+    """aou's NPZ: ``t.npy``, ``q.npy`` (and ``qd``, ``qdd``) with ``header.json``."""
     try:
-        t = np.asarray(doc["t"], dtype=float)
-        q = np.asarray(doc["q"], dtype=float)
-        names = tuple(str(n) for n in doc["joint_names"])
-        goal = tuple(float(x) for x in doc["goal"]["position"])
-    except (TypeError, ValueError, KeyError) as exc:
-        raise _bad(path, f"malformed trajectory: {exc}") from None
-    if len(goal) != 3:
-        raise _bad(path, "`goal.position` must have 3 coordinates")
-    _check_arrays(path, t, q, names)
-    title = str(doc.get("behaviour") or os.path.splitext(os.path.basename(path))[0])
-    return Trajectory(t, q, names, str(doc["robot"]), doc.get("ee_frame"), goal,
-                      path=path, title=title, **_optional(doc, q))
+        with zipfile.ZipFile(io.BytesIO(data)) as zf:
+            doc = json.loads(zf.read("header.json"))
+            arrays = {}
+            for key in ("t", "q", "qd", "qdd"):
+                if f"{key}.npy" in zf.namelist():
+                    arrays[key] = np.lib.format.read_array(io.BytesIO(zf.read(f"{key}.npy")),
+                                                           allow_pickle=False)
+    except (zipfile.BadZipFile, KeyError, ValueError, OSError) as exc:
+        raise _bad(path, f"not an aou NPZ trajectory: {exc}",
+                   hint="an NPZ of aou holds t.npy, q.npy and header.json") from None
+    if not isinstance(doc, dict) or "t" not in arrays or "q" not in arrays:
+        raise _bad(path, "not an aou NPZ trajectory: `t.npy` or `q.npy` is missing")
+    doc = {**doc, **{k: v for k, v in arrays.items() if k in ("qd", "qdd")}}
+    q = arrays["q"]
+    if q.ndim != 2:
+        raise _bad(path, f"`q` has shape {q.shape}; expected (samples, joints)")
+    rec = _from_document(path, doc, arrays["t"], q)
+    _check_clock(path, rec.t)
+    return rec
 
 
-def read_csv(path: str, text: str, robot: str, goal: tuple[float, float, float] | None,
-             ee_frame: str | None) -> Trajectory:
-    """A CSV with a header row: ``t`` then one column per joint name."""
-    rows = list(csv.reader(text.splitlines()))
-    rows = [r for r in rows if r and not r[0].startswith("#")]
-    if not rows:
-        raise _bad(path, "the CSV file is empty")
-    header = [h.strip() for h in rows[0]]
-    if not header or header[0] != "t":
-        raise _bad(path, f"the first column must be `t`, found `{header[0] if header else ''}`",
-                   hint="a header row `t,joint_a,joint_b,...` names the columns")
-    values = np.full((len(rows) - 1, len(header)), math.nan)
-    for i, r in enumerate(rows[1:]):
+def _comments(lines: list[str]) -> dict[str, str]:
+    """``# key: value`` lines before the header."""
+    out = {}
+    for line in lines:
+        body = line.lstrip("#").strip()
+        if ":" in body:
+            key, value = body.split(":", 1)
+            out[key.strip().lower()] = value.strip()
+    return out
+
+
+def _csv_values(path: str, rows: list[tuple[int, list[str]]], header: list[str]
+                ) -> np.ndarray:
+    values = np.full((len(rows), len(header)), math.nan)
+    for i, (line, r) in enumerate(rows):
         if len(r) != len(header):
-            raise _bad(path, f"row {i + 2} has {len(r)} columns; the header has {len(header)}",
-                       row=i + 2)
+            raise _bad(path, f"row {line} has {len(r)} columns; the header has "
+                       f"{len(header)}", row=line)
         for j, cell in enumerate(r):
             try:
                 values[i, j] = float(cell)
             except ValueError:
-                raise _bad(path, f"row {i + 2}, column `{header[j]}`: `{cell}` is not a "
-                           "number", row=i + 2) from None
-    if goal is None:
-        from ..robots import ROBOTS
+                raise _bad(path, f"row {line}, column `{header[j]}`: `{cell}` is not a "
+                           "number", row=line) from None
+    return values
 
-        spec = ROBOTS.get(robot)
-        if spec is None:
-            raise _bad(path, f"unknown robot `{robot}`")
-        goal = spec.goal
+
+def _read_csv(path: str, text: str, robot: str | None,
+              goal: tuple[float, float, float] | None, ee_frame: str | None
+              ) -> tuple[Trajectory, list[int], bool]:
+    """:func:`read_csv` without the clock check; also each sample's line in the file and
+    whether aou wrote the file."""
+    lines = text.splitlines()
+    notes = _comments([ln for ln in lines if ln.startswith("#")])
+    rows = [(k + 1, r) for k, r in enumerate(csv.reader(lines)) if r and not r[0].startswith("#")]
+    if not rows:
+        raise _bad(path, "the CSV file is empty")
+    header = [h.strip() for h in rows[0][1]]
+    if header[0] != "t":
+        raise _bad(path, f"the first column must be `t`, found `{header[0]}`",
+                   hint="a header row `t,joint_a,joint_b,...` names the columns")
+    values = _csv_values(path, rows[1:], header)
+    robot = robot or notes.get("robot")
+    if not robot:
+        raise AouError(diag("I501", "a CSV recording needs `--robot NAME`",
+                            Span.whole_file(path)))
+    if goal is None and notes.get("goal"):
+        try:
+            goal = tuple(float(x) for x in notes["goal"].split(","))  # type: ignore[assignment]
+        except ValueError:
+            raise _bad(path, f"the `# goal:` comment must be X,Y,Z, found "
+                       f"`{notes['goal']}`") from None
+    ee = ee_frame or (notes.get("ee_frame") if notes.get("ee_frame") not in (None, "None")
+                      else None)
     names = tuple(header[1:])
-    _check_arrays(path, values[:, 0], values[:, 1:], names)
+    line_of = [line for line, _ in rows[1:]]
+    _check_arrays(path, values[:, 0], values[:, 1:], names, line_of)
     title = os.path.splitext(os.path.basename(path))[0]
-    return Trajectory(values[:, 0], values[:, 1:], names, robot, ee_frame, tuple(goal),
-                      path=path, title=title)
+    rec = Trajectory(values[:, 0], values[:, 1:], names, robot, ee,
+                     tuple(goal) if goal is not None else None, path=path, title=title)
+    return rec, line_of, "aou-trajectory/1" in notes.get("format", "")
+
+
+def read_csv(path: str, text: str, robot: str | None = None,
+             goal: tuple[float, float, float] | None = None,
+             ee_frame: str | None = None) -> Trajectory:
+    """A CSV with a header row ``t,JOINT,...``, after optional ``# key: value`` comment
+    lines (aou writes ``robot``, ``ee_frame`` and ``goal`` there). ``robot``, ``goal``
+    and ``ee_frame`` override the comments."""
+    rec, rows, _ = _read_csv(path, text, robot, goal, ee_frame)
+    _check_clock(path, rec.t, rows)
+    return rec
+
+
+def _check_units(rec: Trajectory, angle_unit: str | None, time_unit: str | None,
+                 trusted: bool) -> Trajectory:
+    """Convert the units given; refuse values that look like degrees or milliseconds when
+    none is given (R404)."""
+    from ..kinematics import load_arm
+
+    for unit, table, what in ((angle_unit, ANGLE_UNITS, "angle"),
+                              (time_unit, TIME_UNITS, "time")):
+        if unit is not None and unit not in table:
+            raise AouError(diag("R404", f"unknown {what} unit `{unit}`: expected one of "
+                                f"{', '.join(table)}", Span.whole_file(rec.path)))
+    where = Span.whole_file(rec.path)
+    t = np.asarray(rec.t, float) * TIME_UNITS[time_unit or "s"]
+    if time_unit is None and not trusted:
+        step = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
+        if step >= SLOWEST_STEP:
+            raise AouError(diag("R404", f"the times look like milliseconds: one sample every "
+                                f"{step:g} s", where, hint="give --time-unit ms, or "
+                                "--time-unit s if the clock really is that slow"))
+    arm = load_arm(rec.robot, rec.ee_frame)
+    q = np.asarray(rec.q, float).copy()
+    revolute = [j for j, name in enumerate(arm.joint_names)
+                if arm.model.joints[j + 1].shortname().startswith("JointModelR")]
+    for j in revolute:
+        name = arm.joint_names[j]
+        if name not in rec.joint_names:
+            continue
+        col = rec.joint_names.index(name)
+        if angle_unit is not None:
+            q[:, col] *= ANGLE_UNITS[angle_unit]
+        elif not trusted:
+            _plausible_angles(rec, q[:, col], name, float(arm.lower[j]), float(arm.upper[j]))
+    return rec.with_(t=t, q=q)
+
+
+def _plausible_angles(rec: Trajectory, col: np.ndarray, name: str, lo: float, hi: float
+                      ) -> None:
+    """R404 when a joint's values leave its limits and read as degrees they would not."""
+    lo, hi = (lo, hi) if math.isfinite(lo) and math.isfinite(hi) else (-4 * math.pi,
+                                                                        4 * math.pi)
+    slack = 0.1 * (hi - lo)
+    out = (col < lo - slack) | (col > hi + slack)
+    if not out.any():
+        return
+    rad = np.radians(col)
+    if ((rad >= lo - slack) & (rad <= hi + slack)).all():
+        i = int(np.argmax(out))
+        raise AouError(diag(
+            "R404", f"joint `{name}` reads {col[i]:g} at sample {i}, outside its limits "
+            f"[{lo:.3g}, {hi:.3g}] rad: the angles look like degrees",
+            Span.whole_file(rec.path), hint="give --angle-unit deg, or --angle-unit rad "
+            "if they really are radians", joint=name, sample=i))
+
+
+def final_goal(rec: Trajectory) -> tuple[float, float, float]:
+    """The end-effector's position at the last sample: the goal of ``goal="final"``."""
+    from ..kinematics import load_arm
+    from .fk import batch_fk
+
+    arm = load_arm(rec.robot, rec.ee_frame)
+    cols = rec.columns(arm.joint_names)
+    pos, _ = batch_fk(arm, np.asarray(rec.q, float)[-1:, cols])
+    return (float(pos[0, 0]), float(pos[0, 1]), float(pos[0, 2]))
 
 
 def read_recording(path: str, *, robot: str | None = None,
-                   goal: tuple[float, float, float] | None = None,
-                   ee_frame: str | None = None) -> Trajectory:
-    """Read a ``.json`` trajectory or a ``.csv`` recording (which needs ``robot``)."""
-    text = read_text(path)
-    if path.endswith(".csv"):
-        if robot is None:
-            raise AouError(diag("I501", "a CSV recording needs `--robot NAME`",
-                                Span.whole_file(path)))
-        return read_csv(path, text, robot, goal, ee_frame)
-    rec = read_json(path, text)
-    if goal is not None or ee_frame is not None or robot is not None:
-        rec = rec.with_(robot=robot or rec.robot, ee_frame=ee_frame or rec.ee_frame,
-                        goal=tuple(goal) if goal else rec.goal)
+                   goal: tuple[float, float, float] | str | None = None,
+                   ee_frame: str | None = None, angle_unit: str | None = None,
+                   time_unit: str | None = None) -> Trajectory:
+    """Read a ``.json`` or ``.npz`` trajectory or a ``.csv`` recording.
+
+    Args:
+        robot, ee_frame: override the file's (a CSV without a ``# robot:`` line needs
+            ``robot``); ``robot`` is a name or a robot file's path.
+        goal: X, Y, Z [m] overriding the file's, or ``"final"``: the end-effector's
+            position at the last sample (gaze angles are then bearings of that point).
+            Without any goal, measuring warns (R405) and leaves the gazes unknown.
+        angle_unit: ``"rad"`` or ``"deg"`` for the revolute joints; ``time_unit``:
+            ``"s"`` or ``"ms"``. When not given, values that look like degrees or
+            milliseconds are refused (R404); files written by aou are trusted.
+
+    Raises:
+        AouError: I501 when the file cannot be read; R401 for a malformed trajectory
+            (with the row or sample); R404 for implausible units.
+    """
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read()
+        text = None if path.endswith(".npz") else data.decode("utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise AouError(diag("I501", f"cannot read `{path}`: {reason}",
+                            Span.whole_file(path))) from None
+    rows = None
+    if path.endswith(".npz"):
+        rec = read_npz(path, data)
+        trusted = _written_by_aou(json.loads(zipfile.ZipFile(io.BytesIO(data))
+                                             .read("header.json")))
+    elif path.endswith(".csv"):
+        rec, rows, trusted = _read_csv(path, text or "", robot,
+                                       None if isinstance(goal, str) else goal, ee_frame)
+    else:
+        rec = read_json(path, text or "")
+        try:
+            trusted = _written_by_aou(json.loads(text or ""))
+        except ValueError:
+            trusted = False
+    changes: dict[str, Any] = {}
+    if robot:
+        changes["robot"] = robot
+    if ee_frame:
+        changes["ee_frame"] = ee_frame
+    if goal is not None and not isinstance(goal, str):
+        changes["goal"] = tuple(float(x) for x in goal)
+    if changes:
+        rec = rec.with_(**changes)
+    rec = _check_units(rec, angle_unit, time_unit, trusted)
+    _check_clock(path, rec.t, rows)
+    if isinstance(goal, str):
+        if goal != "final":
+            raise AouError(diag("R405", f"unknown goal `{goal}`: give X,Y,Z or `final`",
+                                Span.whole_file(path), severity=Severity.ERROR))
+        rec = rec.with_(goal=final_goal(rec))
     return rec

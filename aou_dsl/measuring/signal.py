@@ -1,55 +1,51 @@
-"""Signal processing for measuring recordings: a uniform clock, the noise, derivatives,
-and where motion comes to rest."""
+"""Signal processing for measuring recordings: continuous joints unwrapped, the noise of
+each joint, one uniform clock, and the filters whose windows the noise sets.
+
+A recording is not a compiled trajectory: its clock jitters and drops samples, its
+moving joints carry encoder noise while joints that never move are constant to the last
+bit, and its positions may be rounded (an encoder's resolution, a fixed number of
+decimals). Every threshold of the measurement is derived here from what the data show,
+joint by joint (docs/measure.md explains the choices).
+"""
 
 from __future__ import annotations
 
+import functools
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["derivatives", "noise", "refine", "refine_noisy", "runs", "uniform"]
+__all__ = [
+    "Grid",
+    "JointNoise",
+    "curvature_gain",
+    "filter_at",
+    "sg_coefficients",
+    "joint_noise",
+    "odd",
+    "runs",
+    "short_window",
+    "slope_gain",
+    "smooth",
+    "to_grid",
+    "unwrap",
+]
+
+#: Slowest joint speed the rest test is meant to resolve [rad/s]; the velocity filter is
+#: made just long enough for that, within :data:`MAX_SHORT_WINDOW`.
+SPEED_RESOLUTION = 5e-3
+#: Longest velocity filter [s]: it still passes the fastest shiver the compiler accepts
+#: (about 7 Hz at 1 deg: the filter keeps more than 80 % of that speed).
+MAX_SHORT_WINDOW = 0.06
+#: A filtered velocity is motion when it exceeds this many times its noise std.
+NOISE_SIGMAS = 5.5
 
 
-def uniform(t: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Resample onto a uniform clock at the median step (exact if already uniform).
-
-    A trajectory whose last step alone is shorter (it ends between two ticks of its
-    clock) keeps its samples; the last one is dropped and its time kept by the caller.
-    """
-    steps = np.diff(t)
-    dt = float(np.median(steps))
-    if np.allclose(steps[:-1], dt, rtol=1e-6, atol=1e-9):
-        if abs(steps[-1] - dt) < 1e-9:
-            return t - t[0], q
-        return t[:-1] - t[0], q[:-1]
-    from scipy.interpolate import CubicSpline
-
-    n = int(math.floor((t[-1] - t[0]) / dt + 1e-9)) + 1
-    tu = t[0] + np.arange(n) * dt
-    return tu - t[0], CubicSpline(t, q, axis=0)(tu)
-
-
-def noise(q: np.ndarray) -> float:
-    """Joint noise [rad] from the median absolute third difference (robust to motion)."""
-    if len(q) < 8:
-        return 0.0
-    d3 = np.diff(q, n=3, axis=0)
-    # For white noise of std s, the third difference has std s * sqrt(20).
-    return float(np.median(np.abs(d3)) / 0.6745 / math.sqrt(20.0))
-
-
-def derivatives(x: np.ndarray, dt: float, window: int
-                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Value, first and second derivative along axis 0: central differences when
-    ``window`` <= 2, else a cubic Savitzky-Golay filter of ``window`` samples (odd)."""
-    if window <= 2:
-        v = np.gradient(x, dt, axis=0)
-        return x, v, np.gradient(v, dt, axis=0)
-    from scipy.signal import savgol_filter
-
-    w = min(window, len(x) if len(x) % 2 else len(x) - 1)
-    return (savgol_filter(x, w, 3, axis=0), savgol_filter(x, w, 3, deriv=1, delta=dt, axis=0),
-            savgol_filter(x, w, 3, deriv=2, delta=dt, axis=0))
+def odd(n: float, least: int = 3) -> int:
+    """The odd integer nearest ``n``, at least ``least``."""
+    k = max(least, int(round(n)))
+    return k if k % 2 else k + 1
 
 
 def runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -62,55 +58,193 @@ def runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(starts.tolist(), ends.tolist(), strict=True))
 
 
-def refine(t: np.ndarray, speed: np.ndarray, i: int, direction: int, thr: float) -> float:
-    """Clean data: the time where the speed reaches zero next to the rest sample ``i``.
+def unwrap(q: np.ndarray) -> tuple[np.ndarray, list[int]]:
+    """Columns that jump by about a full turn between two samples (a continuous joint
+    reported in [-pi, pi)) made continuous; and which columns were. No joint turns by
+    pi within one sample, so a jump of more than pi is a wrap."""
+    jumps = np.abs(np.diff(q, axis=0)) > math.pi
+    cols = [int(j) for j in np.flatnonzero(jumps.any(axis=0))]
+    if not cols:
+        return q, []
+    q = q.copy()
+    q[:, cols] = np.unwrap(q[:, cols], axis=0)
+    return q, cols
 
-    Motion comes to rest (and leaves it) with a nearly constant acceleration, so the speed
-    is linear in time there: a line through the few moving samples beside the rest run
-    (``direction`` -1: before it, +1: after it), while the speed keeps growing away from
-    the rest, is extrapolated to zero. This undoes the one-sample smear of central
-    differences.
+
+@dataclass(frozen=True)
+class JointNoise:
+    """Per joint: white noise std [rad or m], resolution (0 when the values are not on a
+    grid), and whether the column changes at all."""
+
+    sigma: np.ndarray
+    quantum: np.ndarray
+    moving: np.ndarray
+
+    @property
+    def effective(self) -> np.ndarray:
+        """The noise a filter sees: the larger of the white noise and the rounding error
+        of the resolution (uniform, std quantum / sqrt(12)); 0 for a still column."""
+        return np.where(self.moving, np.maximum(self.sigma, self.quantum / math.sqrt(12.0)),
+                        0.0)
+
+
+def _residuals(t: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Each sample minus the cubic through its two neighbours on either side (Lagrange
+    interpolation at its own time, so any clock works), scaled to the noise's std: for
+    white noise of std s the result has std s. Smooth motion leaves almost nothing."""
+    idx = np.arange(2, len(t) - 2)
+    nb = np.stack([idx - 2, idx - 1, idx + 1, idx + 2])  # (4, K)
+    x = t[idx]
+    tn = t[nb]
+    w = np.ones_like(tn)
+    for a in range(4):
+        for m in range(4):
+            if m != a:
+                w[a] *= (x - tn[m]) / (tn[a] - tn[m])
+    fit = np.einsum("ak,akj->kj", w, q[nb])
+    return (q[idx] - fit) / np.sqrt(1.0 + (w * w).sum(axis=0))[:, None]
+
+
+def _quantum(col: np.ndarray) -> float:
+    """The column's resolution when all its steps are whole multiples of the smallest
+    one (positions rounded to an encoder count or to decimals), else 0."""
+    d = np.abs(np.diff(col))
+    d = d[d > 0]
+    if len(d) < 10:
+        return 0.0
+    step = float(d.min())
+    if step <= 1e-12 * max(1.0, float(np.abs(col).max())):
+        return 0.0
+    ratio = d / step
+    whole = np.abs(ratio - np.round(ratio)) < 0.02
+    return step if whole.mean() >= 0.95 else 0.0
+
+
+def joint_noise(t: np.ndarray, q: np.ndarray) -> JointNoise:
+    """Noise of each joint from its own samples (median absolute residual, robust to
+    the motion); the resolution of rounded columns; still columns have neither."""
+    n = q.shape[1]
+    moving = np.ptp(q, axis=0) > 0 if len(q) else np.zeros(n, bool)
+    sigma = np.zeros(n)
+    if len(t) >= 8:
+        r = _residuals(t, q)
+        sigma = 1.4826 * np.median(np.abs(r), axis=0)
+    quantum = np.array([_quantum(q[:, j]) if moving[j] else 0.0 for j in range(n)])
+    return JointNoise(np.where(moving, sigma, 0.0), quantum, moving)
+
+
+@dataclass(frozen=True)
+class Grid:
+    """Samples on one uniform clock.
+
+    Attributes:
+        t: times from the first sample [s], (N,).
+        q: joint positions, (N, n).
+        h: the step [s].
+        density: distinct raw samples per grid step around each grid point (1 for a
+            uniform recording; under 1 across a logging gap), (N,).
+        t_last: the recording's last time [s] (may lie after ``t[-1]``).
+        resampled: whether the recording's own clock was not uniform.
     """
-    idx: list[int] = []
-    j = i + direction
-    while 0 <= j < len(t) and len(idx) < 6:
-        if idx and speed[j] < speed[idx[-1]]:
-            break  # no longer moving away from rest
-        idx.append(j)
-        j += direction
-    if len(idx) < 3:
-        return float(t[i])
-    slope, icpt = np.polyfit(t[idx], speed[idx], 1)
-    if slope == 0:
-        return float(t[i])
-    lo, hi = sorted((float(t[idx[-1]]), float(t[i])))
-    return float(np.clip(-icpt / slope, lo, hi))
+
+    t: np.ndarray
+    q: np.ndarray
+    h: float
+    density: np.ndarray
+    t_last: float
+    resampled: bool
 
 
-def refine_noisy(t: np.ndarray, qd: np.ndarray, i: int, direction: int, half: int) -> float:
-    """Noisy data: where the motion next to rest sample ``i`` starts or stops.
+def to_grid(t: np.ndarray, q: np.ndarray, window: float) -> Grid:
+    """The recording on a uniform clock at its median step.
 
-    The joint moving fastest 0.3 s away is followed back toward the rest: its *signed*
-    filtered velocity is linear in time near a constant-deceleration stop and its noise
-    averages out, unlike the speed (a maximum of absolute values, biased upward). The
-    samples within half a filter window of the rest are skipped (the filter rounds the
-    corner there); a line through the next 0.2 s is extrapolated to zero.
+    A uniform clock is kept as is (a shorter last step is allowed: compiled trajectories
+    end between two ticks; that sample is dropped and its time kept as ``t_last``).
+    Otherwise the joints are interpolated linearly: a spline through noisy samples
+    taken 0.04 ms apart overshoots, a straight line cannot. ``window`` [s] is the span
+    over which the raw sample density is counted.
     """
-    dt = t[1] - t[0]
-    far = i + direction * int(round(0.3 / dt))
-    if not 0 <= far < len(t):
-        return float(t[i])
-    j = int(np.argmax(np.abs(qd[far])))
-    idx = np.arange(i + direction * half, i + direction * (half + int(round(0.2 / dt))),
-                    direction)
-    idx = idx[(idx >= 0) & (idx < len(t))]
-    if len(idx) < 5:
-        return float(t[i])
-    slope, icpt = np.polyfit(t[idx], qd[idx, j], 1)
-    if slope == 0:
-        return float(t[i])
-    t0 = -icpt / slope
-    lo, hi = sorted((float(t[i]), float(t[idx[0]])))
-    # The stop lies between the rest sample and the first sample used, give or take the
-    # filter's reach.
-    return float(np.clip(t0, lo - half * dt, hi + half * dt))
+    t = t - t[0]
+    steps = np.diff(t)
+    h = float(np.median(steps))
+    t_last = float(t[-1])
+    if np.allclose(steps[:-1], h, rtol=1e-6, atol=1e-9):
+        ones = np.ones(len(t))
+        if abs(steps[-1] - h) < 1e-9 or len(t) < 4:
+            return Grid(t, q, h, ones, t_last, False)
+        return Grid(t[:-1], q[:-1], h, ones[:-1], t_last, False)
+    n = int(math.floor(t_last / h + 1e-9)) + 1
+    tg = np.arange(n) * h
+    qg = np.empty((n, q.shape[1]))
+    for j in range(q.shape[1]):
+        qg[:, j] = np.interp(tg, t, q[:, j])
+    # The raw samples the interpolation actually uses around each grid point (bunched
+    # samples share one grid step, a gap leaves many steps on two samples).
+    used = np.searchsorted(t, tg, "right")
+    fresh = np.concatenate([[1], (np.diff(used) > 0).astype(int)])
+    total = np.concatenate([[0], np.cumsum(fresh)])
+    half = max(int(round(window / h)), 3) // 2
+    lo = np.clip(np.arange(n) - half, 0, n)
+    hi = np.clip(np.arange(n) + half + 1, 0, n)
+    density = (total[hi] - total[lo]) / (hi - lo)
+    return Grid(tg, qg, h, np.maximum(density, 1.0 / (2 * half + 1)), t_last, True)
+
+
+def smooth(x: np.ndarray, window: int, deriv: int, h: float, order: int = 3) -> np.ndarray:
+    """A Savitzky-Golay filter along axis 0: the value (``deriv`` 0) or a derivative of
+    the local polynomial of degree ``order`` through ``window`` samples. Window 3 is the
+    central difference. Near the ends the polynomial is fitted to the first or last
+    window."""
+    from scipy.signal import savgol_filter
+
+    n = len(x)
+    w = min(window, n if n % 2 else n - 1)
+    if w < 3:
+        return np.gradient(x, h, axis=0) if deriv == 1 else (
+            x if deriv == 0 else np.zeros_like(x))
+    return savgol_filter(x, w, min(order, w - 1), deriv=deriv, delta=h, axis=0)
+
+
+@functools.lru_cache(maxsize=256)
+def sg_coefficients(window: int, order: int, deriv: int, h: float) -> np.ndarray:
+    """The Savitzky-Golay filter's weights for the centre sample (cached)."""
+    from scipy.signal import savgol_coeffs
+
+    return savgol_coeffs(window, min(order, window - 1), deriv=deriv, delta=h, use="dot")
+
+
+def filter_at(x: np.ndarray, window: int, deriv: int, h: float, lo: int, hi: int,
+              order: int = 3) -> np.ndarray:
+    """:func:`smooth` of ``x`` evaluated only at samples ``lo``..``hi`` (inclusive), each
+    of which must have ``window // 2`` samples on either side."""
+    half = window // 2
+    c = sg_coefficients(window, order, deriv, h)
+    seg = x[lo - half:hi + half + 1]
+    views = np.lib.stride_tricks.sliding_window_view(seg, window, axis=0)
+    return views @ c
+
+
+def slope_gain(window: int, h: float) -> float:
+    """Std of the filtered first derivative per unit of white noise (window samples)."""
+    m = window // 2
+    s2 = m * (m + 1) * (2 * m + 1) / 3.0  # sum of k^2 over -m..m
+    return 1.0 / (h * math.sqrt(s2))
+
+
+def curvature_gain(window: int, h: float) -> float:
+    """Std of the filtered second derivative per unit of white noise (window samples)."""
+    m = window // 2
+    n = 2 * m + 1
+    s2 = m * (m + 1) * (2 * m + 1) / 3.0
+    s4 = m * (m + 1) * (2 * m + 1) * (3 * m * m + 3 * m - 1) / 15.0
+    return 2.0 / (h * h * math.sqrt(max(s4 - s2 * s2 / n, 1e-300)))
+
+
+def short_window(sigma: float, h: float) -> int:
+    """The velocity filter's window [samples]: the shortest whose noise leaves joint
+    speeds of :data:`SPEED_RESOLUTION` visible, within :data:`MAX_SHORT_WINDOW`."""
+    longest = odd(MAX_SHORT_WINDOW / h)
+    w = 3
+    while w < longest and NOISE_SIGMAS * sigma * slope_gain(w, h) > SPEED_RESOLUTION:
+        w += 2
+    return w

@@ -7,7 +7,7 @@ the trajectory, so what is drawn is exactly what was computed (tests check it).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -27,10 +27,13 @@ class ProfileData:
     Attributes:
         t: times [s], shape (N,).
         speed: end-effector speed [m/s], shape (N,).
-        distance: distance to the goal [m], shape (N,).
+        distance: distance to the goal [m], shape (N,) (NaN without a goal).
         q, qd: joint positions [rad] and velocities [rad/s], shape (N, n).
         lower, upper, vmax: joint limits, shape (n,).
-        episodes: (kind, t_start, t_end) per episode.
+        episodes: (kind, t_start, t_end) per episode: the compiler's, or for a recording
+            the ones ``aouc measure`` finds (``measured`` True).
+        sight: for a recording with a goal, the line-of-sight angle [deg] over time
+            (``sight_t`` [s]), else empty.
     """
 
     title: str
@@ -44,29 +47,44 @@ class ProfileData:
     upper: np.ndarray
     vmax: np.ndarray
     episodes: tuple[tuple[str, float, float], ...]
+    measured: bool = False
+    sight_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    sight: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 def profile_data(rec: Trajectory) -> ProfileData:
     """From a trajectory: its compiler episodes are shaded, or, for a recording, the
-    episodes ``aouc measure`` finds."""
+    episodes ``aouc measure`` finds (with the line of sight).
+
+    Raises:
+        AouError: as :func:`aou_dsl.measuring.descriptors.measure` for a recording that
+            cannot be measured.
+    """
     from ..kinematics import load_arm
+    from ..measuring.fk import batch_fk
 
     arm = load_arm(rec.robot, rec.ee_frame)
-    cols = [rec.joint_names.index(n) for n in arm.joint_names]
+    cols = rec.columns(arm.joint_names)
     t = np.asarray(rec.t, float)
     q = np.asarray(rec.q, float)[:, cols]
-    pos, _ = arm.fk(q)
+    pos, _ = batch_fk(arm, q)
     speed = np.linalg.norm(np.gradient(pos, t, axis=0), axis=1)
     qd = np.gradient(q, t, axis=0)
     episodes = rec.episodes
+    extra: dict = {}
     if not episodes:
         from ..measuring.descriptors import measure
 
-        episodes = tuple((e.kind, e.t_start + t[0], e.t_end + t[0])
-                         for e in measure(rec).episodes)
-    return ProfileData(rec.title, arm.joint_names, t, speed,
-                       np.linalg.norm(np.asarray(rec.goal) - pos, axis=1), q, qd,
-                       arm.lower, arm.upper, arm.vmax, tuple(episodes))
+        m = measure(rec)
+        episodes = tuple((e.kind, e.t_start + t[0], e.t_end + t[0]) for e in m.episodes)
+        extra["measured"] = True
+        if m.line_of_sight is not None:
+            extra["sight_t"] = m.line_of_sight.t + t[0]
+            extra["sight"] = m.line_of_sight.angle
+    distance = (np.linalg.norm(np.asarray(rec.goal) - pos, axis=1) if rec.goal is not None
+                else np.full(len(t), np.nan))
+    return ProfileData(rec.title, arm.joint_names, t, speed, distance, q, qd,
+                       arm.lower, arm.upper, arm.vmax, tuple(episodes), **extra)
 
 
 def _pyplot():
@@ -81,11 +99,14 @@ def _pyplot():
 def profile_figure(d: ProfileData):
     """Four panels over time: end-effector speed (episodes shaded and labelled, like the
     paper's velocity profiles), goal distance, joint positions and joint velocities as
-    fractions of their limits."""
+    fractions of their limits; for a recording, a fifth: the line of sight (how far the
+    hand's forward axis points away from the goal)."""
     plt = _pyplot()
-    fig, axes = plt.subplots(4, 1, figsize=(10, 9), sharex=True,
-                             gridspec_kw={"height_ratios": [2, 1, 1.3, 1.3]})
-    ax_v, ax_d, ax_q, ax_qd = axes
+    sight = len(d.sight) > 0
+    ratios = [2, 1, 1.3, 1.3] + ([1] if sight else [])
+    fig, axes = plt.subplots(len(ratios), 1, figsize=(10, 9 + 1.6 * sight), sharex=True,
+                             gridspec_kw={"height_ratios": ratios})
+    ax_v, ax_d, ax_q, ax_qd = axes[:4]
     ax_v.plot(d.t, d.speed, color="black", lw=1.2, label="end-effector speed")
     top = max(float(d.speed.max()), 1e-3) * 1.25
     for kind, a, b in d.episodes:
@@ -95,7 +116,8 @@ def profile_figure(d: ProfileData):
                   rotation=90 if b - a < 0.08 * (d.t[-1] - d.t[0]) else 0)
     ax_v.set_ylim(0, top)
     ax_v.set_ylabel("speed [m/s]")
-    ax_v.set_title(d.title or "velocity profile")
+    title = d.title or "velocity profile"
+    ax_v.set_title(f"{title} (episodes as measured)" if d.measured else title)
     ax_d.plot(d.t, d.distance, color="#34495e", lw=1.2)
     ax_d.set_ylabel("goal distance [m]")
     mid = (d.upper + d.lower) / 2
@@ -109,7 +131,10 @@ def profile_figure(d: ProfileData):
         ax.set_ylabel(label)
         ax.set_ylim(-1.1, 1.1)
     ax_q.legend(fontsize=6, ncol=4, loc="lower left")
-    ax_qd.set_xlabel("time [s]")
+    if sight:
+        axes[4].plot(d.sight_t, d.sight, color="#8e44ad", lw=1)
+        axes[4].set_ylabel("line of sight [deg]")
+    axes[-1].set_xlabel("time [s]")
     fig.tight_layout()
     return fig
 

@@ -7,8 +7,14 @@
   links without a collision shape) nor listed in the robot's ``allowed_contacts``;
 - contact with the target, a cube at the goal that nothing may touch (the task is a
   pre-grasp), and with the table plane (the robot's base stands on it and is exempt);
-- agreement of two kinematics engines: the end-effector pose from PyBullet against
-  Pinocchio's, within 1 mm and 0.5 deg.
+- agreement of two kinematics engines: the end-effector pose of the URDF (as PyBullet
+  loads it) against Pinocchio's, within 1 mm and 0.5 deg.
+
+Contacts and clearances are PyBullet's exact distances, asked only where they can have
+changed enough to matter (:mod:`.sweep`): the verdicts, first samples of contact and
+clearances are those of a query at every sample. The end-effector pose of every sample
+comes from the replay's own kinematics of the URDF (:mod:`.fk`), compared with
+Pinocchio's at every sample and with PyBullet's wherever PyBullet was put.
 
 **Dynamic replay** (`aouc check`): the arm follows the trajectory under position control
 with gravity, physics stepped at 1 kHz; the report gives the maximum and RMS tracking
@@ -24,8 +30,10 @@ import numpy as np
 
 from ..kinematics import load_arm
 from ..trajectory import Trajectory
+from .fk import chain_fk, urdf_chain
 from .limits import Check, check_limits
-from .scene import Scene, SceneOptions
+from .scene import Scene, SceneOptions, urdf_path
+from .sweep import CONTACT_MARGIN, QUERY_RANGE, Geometry, Sweep, geometry
 
 __all__ = ["CheckReport", "replay"]
 
@@ -34,6 +42,11 @@ AGREE_POSITION = 1e-3  # m
 AGREE_ROTATION = 0.5  # deg
 #: Self-clearance is sampled at this rate [Hz]; contacts are checked at every sample.
 CLEARANCE_RATE = 10.0
+#: Self-clearance counts link pairs nearer than this [m].
+SELF_RANGE = 0.1
+#: PyBullet's end-effector pose is compared at every sample the contact search puts
+#: PyBullet in, and at least at this many samples spread over the motion.
+AGREE_SPOTS = 32
 #: Physics rate of the dynamic replay [Hz].
 PHYSICS_RATE = 1000.0
 
@@ -62,55 +75,10 @@ class CheckReport:
                 "dynamic": self.dynamic}
 
 
-def _pairs(scene: Scene, allowed: tuple[tuple[str, str], ...]) -> list[tuple[int, int]]:
-    """Link pairs that must not touch: not adjacent (through shapeless links) and not
-    allowed by the robot table."""
-    pb, c, body = scene.pb, scene.client, scene.body
-    n = pb.getNumJoints(body, physicsClientId=c)
-    parent = {j: pb.getJointInfo(body, j, physicsClientId=c)[16] for j in range(n)}
-    shaped = {j for j in range(-1, n) if pb.getCollisionShapeData(body, j, physicsClientId=c)}
-
-    def shaped_parent(j: int) -> int:
-        p = parent.get(j, -1)
-        while p != -1 and p not in shaped:
-            p = parent.get(p, -1)
-        return p
-
-    by_name = {name: j for name, j in scene.link_index.items()}
-    allowed_ids = {frozenset((by_name[a], by_name[b])) for a, b in allowed}
-    links = sorted(shaped)
-    out = []
-    for i, a in enumerate(links):
-        for b in links[i + 1:]:
-            if shaped_parent(b) == a or shaped_parent(a) == b:
-                continue
-            if frozenset((a, b)) in allowed_ids:
-                continue
-            out.append((a, b))
-    return out
-
-
-def _base_links(scene: Scene) -> set[int]:
-    """The root link and every link welded to it by fixed joints (UR5: ``world`` and
-    ``base_link``): the robot stands on the table through them."""
-    pb, c, body = scene.pb, scene.client, scene.body
-    base = {-1}
-    for j in range(pb.getNumJoints(body, physicsClientId=c)):
-        info = pb.getJointInfo(body, j, physicsClientId=c)
-        if info[2] == pb.JOINT_FIXED and info[16] in base:
-            base.add(j)
-    return base
-
-
 def _link_name(scene: Scene, j: int) -> str:
     if j == -1:
         return scene.pb.getBodyInfo(scene.body, physicsClientId=scene.client)[0].decode()
     return scene.pb.getJointInfo(scene.body, j, physicsClientId=scene.client)[12].decode()
-
-
-def _angle_deg(r1: np.ndarray, r2: np.ndarray) -> float:
-    c = (np.trace(r1.T @ r2) - 1.0) / 2.0
-    return math.degrees(math.acos(max(-1.0, min(1.0, c))))
 
 
 def replay(tr: Trajectory, *, options: SceneOptions | None = None,
@@ -130,7 +98,7 @@ def replay(tr: Trajectory, *, options: SceneOptions | None = None,
     """
     arm = load_arm(tr.robot, tr.ee_frame)
     cols = tr.columns(arm.joint_names)
-    t, q = tr.t, tr.q[:, cols]
+    t, q = tr.t, np.ascontiguousarray(tr.q[:, cols], dtype=float)
     if tr.qd is not None and tr.qdd is not None:
         qd, qdd = tr.qd[:, cols], tr.qdd[:, cols]
     else:
@@ -138,10 +106,16 @@ def replay(tr: Trajectory, *, options: SceneOptions | None = None,
         qdd = np.gradient(qd, t, axis=0)
     checks = check_limits(arm, t, q, qd, qdd)
     goal = tuple(float(x) for x in tr.goal) if tr.goal is not None else None
-    scene = _scene(tr.robot, goal, options or SceneOptions())
-    kin_checks, clear, agree = _kinematic(scene, arm, t, q)
-    checks += kin_checks
-    report = CheckReport(tr.robot, checks, clear, agree)
+    scene, geo = _scene(tr.robot, options or SceneOptions())
+    if scene.target is not None:  # the scene's cube stands at the goal (or far away)
+        scene.pb.resetBasePositionAndOrientation(scene.target, goal or _AWAY, (0, 0, 0, 1),
+                                                 physicsClientId=scene.client)
+    frame = tr.ee_frame or arm.spec.ee_frame
+    sweep = Sweep(scene, geo, q, scene.link_index.get(frame, scene.joint_index.get(frame)),
+                  target=goal is not None)
+    kin_checks, clear = _contacts(sweep, t)
+    agree_check, agree = _agreement(sweep, arm, frame, t, q)
+    report = CheckReport(tr.robot, checks + kin_checks + [agree_check], clear, agree)
     if dynamic:
         dyn_check, report.dynamic = _dynamic(scene, arm, t, q, qd)
         report.checks.append(dyn_check)
@@ -149,95 +123,115 @@ def replay(tr: Trajectory, *, options: SceneOptions | None = None,
 
 
 _SCENES: dict = {}
+#: Where the target cube waits when a trajectory has no goal [m].
+_AWAY = (0.0, 0.0, -100.0)
 
 
-def _scene(robot: str, goal: tuple[float, ...] | None, options: SceneOptions) -> Scene:
-    """A scene per robot, goal and options, kept: loading the URDF is the slow part.
-    Each replay sets the joint states and physics settings it relies on."""
-    key = (robot, goal, options)
+def _scene(robot: str, options: SceneOptions) -> tuple[Scene, Geometry]:
+    """A scene per robot and options, kept with its geometry: loading the URDF is the
+    slow part. Each replay sets the joint states, the cube's place and the physics
+    settings it relies on."""
+    key = (robot, options)
     if key not in _SCENES:
         if len(_SCENES) >= 8:
-            for old in _SCENES.values():
+            for old, _ in _SCENES.values():
                 old.close()
             _SCENES.clear()
-        _SCENES[key] = Scene(robot, goal, options)
+        scene = Scene(robot, _AWAY, options, visuals=False)
+        _SCENES[key] = (scene, geometry(scene, load_arm(robot).spec.allowed_contacts))
     return _SCENES[key]
 
 
-def _kinematic(scene: Scene, arm, t: np.ndarray, q: np.ndarray
-               ) -> tuple[list[Check], dict, dict]:
-    pb, c, body = scene.pb, scene.client, scene.body
-    pairs = _pairs(scene, arm.spec.allowed_contacts)
-    pair_set = {frozenset(p) for p in pairs}
-    base = _base_links(scene)
-    pin_pos, pin_rot = arm.fk(q)
-    self_hit = target_hit = table_hit = None
-    self_clear = target_clear = table_clear = math.inf
-    worst_pos = worst_rot = 0.0
-    worst_agree_t = None
-    stride = max(1, int(round(1.0 / (CLEARANCE_RATE * float(np.median(np.diff(t)))))))
-    for i, qi in enumerate(q):
-        scene.set_arm(qi)
-        pb.performCollisionDetection(physicsClientId=c)
-        if self_hit is None:
-            for cp in pb.getContactPoints(body, body, physicsClientId=c):
-                if cp[8] < 0 and frozenset((cp[3], cp[4])) in pair_set:
-                    self_hit = (i, cp[3], cp[4], cp[8])
-                    break
-        if scene.target is not None:
-            d = [p[8] for p in pb.getClosestPoints(body, scene.target, 1.0,
-                                                   physicsClientId=c)]
-            if d:
-                target_clear = min(target_clear, min(d))
-                if target_hit is None and min(d) <= 0.0:
-                    target_hit = (i, min(d))
-        if scene.table is not None:
-            d = [p[8] for p in pb.getClosestPoints(body, scene.table, 1.0, physicsClientId=c)
-                 if p[3] not in base]
-            if d:
-                table_clear = min(table_clear, min(d))
-                if table_hit is None and min(d) <= 0.0:
-                    table_hit = (i, min(d))
-        if i % stride == 0 or i == len(q) - 1:
-            for a, b in pairs:
-                for p in pb.getClosestPoints(body, body, 0.1, a, b, physicsClientId=c):
-                    self_clear = min(self_clear, p[8])
-        pos, rot = scene.ee_pose()
-        dp = float(np.linalg.norm(pos - pin_pos[i]))
-        dr = _angle_deg(rot, pin_rot[i])
-        if dp > worst_pos or dr > worst_rot:
-            worst_agree_t = float(t[i])
-        worst_pos, worst_rot = max(worst_pos, dp), max(worst_rot, dr)
-
+def _contacts(sweep: Sweep, t: np.ndarray) -> tuple[list[Check], dict]:
+    """Self-collision, target and table contact at every sample; the clearances (the
+    self-clearance at :data:`CLEARANCE_RATE`)."""
+    scene = sweep.scene
+    step = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
+    stride = max(1, int(round(1.0 / (CLEARANCE_RATE * step)))) if step > 0 else 1
+    sweep.seed([len(t) // 2])
     checks = []
-    if self_hit is None:
-        checks.append(Check("self-collision", True, detail=f"{len(pairs)} link pairs checked"))
+    self_clear = sweep.minimum("self", stride)
+    hit = sweep.first_contact("self", lambda d: d < 0.0)
+    if hit is None:
+        checks.append(Check("self-collision", True,
+                            detail=f"{len(sweep.geo.pairs)} link pairs checked"))
     else:
-        i, a, b, d = self_hit
+        i, p = hit
+        it = sweep.items[p]
         checks.append(Check("self-collision", False, float(t[i]),
-                            f"{_link_name(scene, a)} / {_link_name(scene, b)}", d, 0.0,
-                            "links penetrate (distance < 0)"))
-    checks.append(Check("target-contact", target_hit is None,
-                        None if target_hit is None else float(t[target_hit[0]]), "target",
-                        None if target_hit is None else target_hit[1], 0.0,
-                        "the hand must never touch the object it is about to grasp"))
-    checks.append(Check("table-contact", table_hit is None,
-                        None if table_hit is None else float(t[table_hit[0]]), "table",
-                        None if table_hit is None else table_hit[1], 0.0,
-                        "no link but the base touches the table plane"))
-    agree_ok = worst_pos <= AGREE_POSITION and worst_rot <= AGREE_ROTATION
-    checks.append(Check("kinematics-agreement", agree_ok, worst_agree_t, None,
-                        worst_pos, AGREE_POSITION,
-                        f"PyBullet vs Pinocchio end-effector pose: {worst_pos * 1000:.4f} mm, "
-                        f"{worst_rot:.4f} deg"))
+                            f"{_link_name(scene, it.a)} / {_link_name(scene, it.b)}",
+                            sweep.measure(p, i), 0.0, "links penetrate (distance < 0)"))
+    clear = {}
+    for kind, what, detail in (
+            ("target", "target", "the hand must never touch the object it is about to grasp"),
+            ("table", "table", "no link but the base touches the table plane")):
+        low = sweep.minimum(kind)
+        hit = None if low > CONTACT_MARGIN else sweep.first_contact(kind, lambda d: d <= 0.0)
+        value = None
+        if hit is not None:
+            value = min(sweep.measure(p, hit[0]) for p, it in enumerate(sweep.items)
+                        if it.kind == kind)
+        checks.append(Check(f"{kind}-contact", hit is None,
+                            None if hit is None else float(t[hit[0]]), what, value, 0.0,
+                            detail))
+        clear[kind] = low
+    clear["self"] = self_clear if self_clear <= SELF_RANGE else math.inf
 
     def finite(x: float) -> float | None:
-        return None if math.isinf(x) else round(x, 6)
+        return None if math.isinf(x) or x >= QUERY_RANGE else round(x, 6)
 
-    clear = {"target": finite(target_clear), "self": finite(self_clear),
-             "table": finite(table_clear)}
-    agree = {"position_mm": worst_pos * 1000, "rotation_deg": worst_rot}
-    return checks, clear, agree
+    return checks, {k: finite(clear[k]) for k in ("target", "self", "table")}
+
+
+def _agreement(sweep: Sweep, arm, frame: str, t: np.ndarray, q: np.ndarray
+               ) -> tuple[Check, dict]:
+    """The end-effector pose by the replay's own kinematics (the URDF, evaluated here)
+    against the compiler's Pinocchio model at every sample (evaluated for all samples at
+    once, and by Pinocchio itself at :data:`AGREE_SPOTS` samples spread over the
+    motion), and against PyBullet's at every sample the replay put PyBullet in (those
+    spots included)."""
+    from ..measuring.fk import batch_fk
+
+    spots = np.unique(np.linspace(0, len(t) - 1, AGREE_SPOTS).astype(int))
+    for j in spots:
+        sweep.visit(int(j))
+    chain = urdf_chain(urdf_path(sweep.scene.robot, visuals=False)[0], frame,
+                       arm.joint_names)
+    pos, rot = chain_fk(chain, q)
+    pin_pos, pin_rot = batch_fk(arm, q)
+    dp = np.linalg.norm(pos - pin_pos, axis=1)
+    dr = _angles_deg(rot, pin_rot)
+    own_pos, own_rot = arm.fk(q[spots])  # Pinocchio's own forward kinematics
+    dp[spots] = np.maximum(dp[spots], np.linalg.norm(pos[spots] - own_pos, axis=1))
+    dr[spots] = np.maximum(dr[spots], _angles_deg(rot[spots], own_rot))
+    if sweep.visited:
+        at = np.array(sorted(sweep.visited))
+        pb = sweep.scene.pb
+        pb_pos = np.array([sweep.visited[j][0] for j in at])
+        pb_rot = np.array([np.reshape(pb.getMatrixFromQuaternion(sweep.visited[j][1]), (3, 3))
+                           for j in at])
+        dp[at] = np.maximum(dp[at], np.linalg.norm(pos[at] - pb_pos, axis=1))
+        dr[at] = np.maximum(dr[at], _angles_deg(rot[at], pb_rot))
+    worst = int(np.argmax(np.maximum(dp / AGREE_POSITION, dr / AGREE_ROTATION)))
+    worst_pos, worst_rot = float(dp.max()), float(dr.max())
+    ok = worst_pos <= AGREE_POSITION and worst_rot <= AGREE_ROTATION
+    check = Check("kinematics-agreement", ok, float(t[worst]), None, worst_pos, AGREE_POSITION,
+                  f"end-effector pose against Pinocchio's: {worst_pos * 1000:.4f} mm, "
+                  f"{worst_rot:.4f} deg (the URDF's kinematics at all {len(t)} samples, "
+                  f"PyBullet's at {len(sweep.visited)} of them)")
+    return check, {"position_mm": worst_pos * 1000, "rotation_deg": worst_rot}
+
+
+def _angles_deg(r1: np.ndarray, r2: np.ndarray) -> np.ndarray:
+    """The angle between rotations, row by row [deg], accurate for small angles too."""
+
+    def rel(i: int, j: int) -> np.ndarray:  # (r1^T r2)[i, j] for every row
+        return (r1[:, :, i] * r2[:, :, j]).sum(axis=1)
+
+    cos = (rel(0, 0) + rel(1, 1) + rel(2, 2) - 1.0) / 2.0
+    sin = np.sqrt((rel(2, 1) - rel(1, 2)) ** 2 + (rel(0, 2) - rel(2, 0)) ** 2
+                  + (rel(1, 0) - rel(0, 1)) ** 2) / 2.0
+    return np.degrees(np.arctan2(sin, cos))
 
 
 def _dynamic(scene: Scene, arm, t: np.ndarray, q: np.ndarray, qd: np.ndarray

@@ -1,0 +1,253 @@
+"""Episodes: the motion between the boundaries of :mod:`.holds`, classified by what moved.
+
+- The hand translated more than :data:`STILL_TRANSLATION`, mostly along the goal vector:
+  an approach (closer) or a retreat (further). Without a goal, along the hand's forward
+  axis (the line of sight the model assumes).
+- The hand translated around the goal: a gaze, read as the goal vector's bearing from
+  its start direction in the planes fixed by the start pose.
+- The hand stayed in place and turned: a roll piece, made into tilts and shivers by
+  :mod:`.roll`.
+
+Peak accelerations are read over a window set by the motion and the noise (see
+:func:`peak_acceleration`), and checked against what the joints can produce.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..descriptors import EpisodeValues
+from ..diagnostics import AouError, Span, diag
+from ..kinematics import ArmModel
+from .fk import classical_acceleration, linear_jacobian
+from .holds import Boundary, Rest
+from .signal import curvature_gain, filter_at, odd, smooth
+
+__all__ = ["STILL_TRANSLATION", "Context", "Piece", "peak_acceleration", "pieces",
+           "translation"]
+
+#: Translation under which an episode has not moved the hand [m].
+STILL_TRANSLATION = 2e-3
+#: A gaze moved in a plane when its bearing there changed by more than this [deg].
+MIN_GAZE_SWEEP = 0.25
+#: Relative std of a peak acceleration that the noise may cause.
+ACCEL_NOISE = 0.01
+#: How long an arm's own tracking transients last after each switch of the acceleration
+#: [s]: the acceleration is averaged over at least this long (never longer than the
+#: phase it is read in).
+TRANSIENT = 0.1
+
+
+@dataclass(frozen=True)
+class Context:
+    """Everything an episode is measured from (arrays over the grid's N samples).
+
+    Attributes:
+        arm: the robot model; path: the recording, for diagnostics.
+        rest: the rest test's signals (times, step, joint velocities, thresholds).
+        q: joint positions on the grid, (N, n); noise: each joint's noise [rad], (n,).
+        pos, pos_s: end-effector position, raw and filtered [m], (N, 3).
+        rot: end-effector rotations, (N, 3, 3).
+        roll: the hand's roll about its forward axis since the first sample,
+            unwrapped [rad], (N,).
+        goal: goal position [m] or None.
+        y0, x0: the start pose's y and x axes: normals of the horizontal and vertical
+            gaze planes.
+        edge_rest: whether the arm is at rest at the first and at the last sample. A
+            file that carries its joint velocities says so exactly (a jerk-limited start
+            barely moves in its first samples, so a fit there would call it moving);
+            otherwise the rest test decides.
+    """
+
+    arm: ArmModel
+    path: str
+    rest: Rest
+    q: np.ndarray
+    noise: np.ndarray
+    pos: np.ndarray
+    pos_s: np.ndarray
+    rot: np.ndarray
+    roll: np.ndarray
+    goal: np.ndarray | None
+    y0: np.ndarray
+    x0: np.ndarray
+    edge_rest: tuple[bool, bool]
+
+
+@dataclass(frozen=True)
+class Piece:
+    """The motion between two boundaries: times, grid samples (inclusive), and the
+    hand's position and roll at both ends (averaged over a pause where one is)."""
+
+    t0: float
+    t1: float
+    i0: int
+    i1: int
+    p0: np.ndarray
+    p1: np.ndarray
+    roll0: float
+    roll1: float
+    at_rest0: bool  # starts where the arm was at rest (not at the recording's first sample)
+    at_rest1: bool
+
+
+def _anchor(c: Context, b: Boundary, side: int) -> tuple[np.ndarray, float]:
+    """The hand's position and roll at a boundary: the mean over a pause's inner
+    samples, or the filtered value at an instant."""
+    t = c.rest.t
+    if b.pause:
+        inner = (t >= b.t0 + 0.25 * (b.t1 - b.t0)) & (t <= b.t1 - 0.25 * (b.t1 - b.t0))
+        idx = np.flatnonzero(inner)
+        if len(idx) == 0:
+            idx = np.arange(b.i0, b.i1 + 1)
+        return c.pos[idx].mean(axis=0), float(c.roll[idx].mean())
+    tt = b.t0 if side < 0 else b.t1
+    p = np.array([np.interp(tt, t, c.pos_s[:, k]) for k in range(3)])
+    return p, float(np.interp(tt, t, c.roll))
+
+
+def pieces(c: Context, bounds: list[Boundary]) -> list[Piece | Boundary]:
+    """The boundaries' pauses and the motion pieces between them, in time order."""
+    t = c.rest.t
+    n = len(t)
+    out: list[Piece | Boundary] = []
+    first = Boundary(float(t[0]), float(t[0]), 0, 0, False)
+    last = Boundary(c.rest.t_last, c.rest.t_last, n - 1, n - 1, False)
+    seq = [first, *bounds, last]
+    for a, b in zip(seq[:-1], seq[1:], strict=True):
+        if a.pause and a is not first:
+            out.append(a)
+        ta, tb = a.t1, b.t0
+        i0 = int(np.searchsorted(t, ta, "left"))
+        i1 = int(np.searchsorted(t, tb, "right")) - 1
+        if tb - ta <= 0 or i1 - i0 < 1:
+            continue
+        p0, r0 = _anchor(c, a, +1) if a is not first else (c.pos_s[0], float(c.roll[0]))
+        p1, r1 = _anchor(c, b, -1) if b is not last else (c.pos_s[-1], float(c.roll[-1]))
+        rest0 = a is not first or c.edge_rest[0]
+        rest1 = b is not last or c.edge_rest[1]
+        out.append(Piece(ta, tb, i0, i1, p0, p1, r0, r1, rest0, rest1))
+    return out
+
+
+def _bearing(a: np.ndarray, b: np.ndarray, normal: np.ndarray) -> float:
+    """Angle from ``a`` to ``b`` about ``normal`` [deg]; both projected onto its plane."""
+    a = a - (a @ normal) * normal
+    b = b - (b @ normal) * normal
+    return math.degrees(math.atan2(float(np.cross(a, b) @ normal), float(a @ b)))
+
+
+def translation(c: Context, p: Piece, g0: np.ndarray | None) -> EpisodeValues | None:
+    """An approach, retreat or gaze; None when the hand did not translate."""
+    seg = c.pos_s[p.i0:p.i1 + 1]
+    travel = max(float(np.linalg.norm(seg - p.p0, axis=1).max()),
+                 float(np.linalg.norm(p.p1 - p.p0)))
+    if travel <= STILL_TRANSLATION:
+        return None
+    d = p.p1 - p.p0
+    if c.goal is not None:
+        along = float(np.linalg.norm(c.goal - p.p1) - np.linalg.norm(c.goal - p.p0))
+        along = -along  # positive: closer to the goal
+    else:
+        along = float(d @ c.rot[p.i0][:, 2])  # along the forward axis
+    if abs(along) >= 0.7 * travel:
+        kind = "approach" if along > 0 else "retreat"
+        u = d / max(float(np.linalg.norm(d)), 1e-12)
+        peak, sd = peak_acceleration(c, p, u)
+        return EpisodeValues(kind, p.t0, p.t1, {
+            "distance": float(np.linalg.norm(d)), "peak_acceleration": peak,
+            "peak_acceleration_sd": sd})
+    values: dict[str, float] = {}
+    if c.goal is not None and g0 is not None:
+        ga, gb = c.goal - p.p0, c.goal - p.p1
+        for plane, normal in (("horizontal", c.y0), ("vertical", c.x0)):
+            start, end = _bearing(g0, ga, normal), _bearing(g0, gb, normal)
+            if abs(end - start) > MIN_GAZE_SWEEP:
+                values[plane] = abs(end)
+        values["angle"] = max(values.values(), default=0.0)
+    return EpisodeValues("gaze", p.t0, p.t1, values)
+
+
+def _phases(c: Context, p: Piece, speed: np.ndarray) -> list[tuple[int, int, float]]:
+    """The speeding-up and slowing-down phases of a piece: (first, last sample,
+    duration [s]); a phase cut by the recording's start or end is left out, unless
+    nothing else is left."""
+    t = c.rest.t[p.i0:p.i1 + 1]
+    top = speed.max()
+    fast = np.flatnonzero(speed >= 0.95 * top)
+    out = []
+    a, b = int(fast[0]), int(fast[-1])
+    if p.at_rest0:
+        out.append((0, a, float(t[a] - p.t0)))
+    if p.at_rest1:
+        out.append((b, len(t) - 1, float(p.t1 - t[b])))
+    return out or [(0, len(t) - 1, float(p.t1 - p.t0))]
+
+
+def peak_acceleration(c: Context, p: Piece, u: np.ndarray) -> tuple[float, float]:
+    """Peak acceleration of the hand along the direction of travel ``u`` [m/s^2], and
+    the std the joints' noise gives it.
+
+    The acceleration is a Savitzky-Golay second derivative: a weighted mean of the
+    true acceleration with positive weights, so it never overshoots a plateau and equals
+    it when the window fits inside. The window is half of the speeding-up (or
+    slowing-down) phase, and at least :data:`TRANSIENT`, so that the arm's own
+    transients at each switch average out; longer when the noise needs it (relative
+    std :data:`ACCEL_NOISE`); never longer than the phase.
+
+    Raises:
+        AouError: R406 when the joints' own accelerations cannot produce the peak.
+    """
+    r, h = c.rest, c.rest.h
+    x = c.pos[p.i0:p.i1 + 1] @ u
+    speed = np.abs(smooth(x, r.window, 1, h, order=2))
+    jac = linear_jacobian(c.arm, c.q[(p.i0 + p.i1) // 2])
+    sigma_x = float(np.sqrt(np.sum(((u @ jac) * c.noise) ** 2)))
+    best, at, win = 0.0, p.i0, 3
+    for a, b, dur in _phases(c, p, speed):
+        steps = max(dur / h, 1.0)
+        a_est = 0.95 * float(speed.max()) / max(dur, h)
+        w = odd(max(0.5 * steps, TRANSIENT / h))
+        while w < steps and sigma_x * curvature_gain(w, h) > ACCEL_NOISE * a_est:
+            w += 2
+        w = min(w, max(3, odd(steps) - 2), len(x) if len(x) % 2 else len(x) - 1)
+        if w < 3:
+            continue
+        half = w // 2
+        # Only where the window stays inside the piece.
+        k0, k1 = max(a, half), min(b, len(x) - 1 - half)
+        if k1 < k0:
+            k0 = k1 = min(max((a + b) // 2, half), len(x) - 1 - half)
+        acc = np.abs(filter_at(x, w, 2, h, k0, k1))
+        k = int(np.argmax(acc))
+        if acc[k] > best:
+            best, at, win = float(acc[k]), p.i0 + k0 + k, w
+    if best > 0:
+        _self_check(c, best, at, win, u, sigma_x)
+    return best, sigma_x * curvature_gain(win, h)
+
+
+def _self_check(c: Context, peak: float, at: int, window: int, u: np.ndarray,
+                sigma_x: float) -> None:
+    """R406 when the joint motion around sample ``at`` cannot produce ``peak``: the
+    hand's acceleration there is ``J qdd + Jdot qd`` from the joints' filtered
+    velocities and accelerations over the same window."""
+    n, h = len(c.rest.t), c.rest.h
+    half = window // 2
+    near = np.unique(np.clip(np.linspace(at - half, at + half, 5).round().astype(int),
+                             half, n - 1 - half))
+    lo, hi = int(near[0]), int(near[-1])
+    q = c.q[near]
+    qd = filter_at(c.q, window, 1, h, lo, hi)[near - lo]
+    qdd = filter_at(c.q, window, 2, h, lo, hi)[near - lo]
+    joint_side = classical_acceleration(c.arm, q, qd, qdd) @ u
+    bound = 1.25 * float(np.abs(joint_side).max()) + 4.0 * sigma_x * curvature_gain(window, h)
+    if peak > bound + 1e-6:
+        raise AouError(diag(
+            "R406", f"the hand's peak acceleration {peak:.4g} m/s^2 at t={c.rest.t[at]:.3f}s "
+            f"is more than the joints' motion there produces ({bound:.4g} m/s^2); this is "
+            "an error of the measurement, not a value", Span.whole_file(c.path),
+            measured=peak, bound=bound))

@@ -1,0 +1,378 @@
+"""Where the arm is at rest: pauses (holds), and the instants where one motion ends and
+the next begins without a hold.
+
+A sample is at rest when every joint's filtered speed is under its own noise threshold.
+Noise makes a slowly decelerating motion look still for a while before it stops, so the
+edges of a rest run are not where the motion stops: each edge is refined by following
+the motion beside it back to zero velocity (it stops with a nearly constant
+deceleration, so its velocity is a straight line there). A rest whose refined span lasts
+:data:`MIN_PAUSE` or more, and in which the joints hold one position within their noise
+for most of it, is a pause; a shorter one is the boundary between two episodes (a
+rest-to-rest boundary, or a reversal). Motion that reverses or stops without ever
+looking still (a fast shiver, coarse sampling) is found from the speed's dips to zero.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .signal import NOISE_SIGMAS, odd, runs, sg_coefficients, slope_gain, smooth
+
+__all__ = ["MIN_PAUSE", "REST_SPEED", "Boundary", "Rest", "boundaries", "rest_signals"]
+
+#: Shortest rest that counts as a pause [s] (the language's shortest pause is 0.2 s).
+MIN_PAUSE = 0.15
+#: Joint speed under which clean data are at rest [rad/s].
+REST_SPEED = 1e-4
+#: Window of the slow-motion check inside long rests [s].
+LONG_WINDOW = 0.3
+#: A held joint stays within this many times its filtered noise of one position.
+HELD_SIGMAS = 5.0
+#: Drift of a held joint that is no motion [rad] (0.001 deg).
+STILL_ANGLE = 2e-5
+#: A joint is clearly moving at this many times its rest threshold (16 noise std).
+CLEARLY = 3.0
+#: The velocity ramp beside a stop is followed up to this fraction of its peak.
+RAMP_TOP = 0.6
+
+
+@dataclass(frozen=True)
+class Rest:
+    """The signals the rest test works on (arrays over the grid's N samples).
+
+    Attributes:
+        t: times [s]; h: the step [s]; window: the velocity filter [samples].
+        v: filtered joint velocities, (N, n).
+        thr: each joint's rest threshold [rad/s] at each sample, (N, n) (larger where
+            a logging gap leaves fewer raw samples).
+        level: the largest joint speed over its threshold, (N,): under 1 is rest.
+        v_long, thr_long: the same over :data:`LONG_WINDOW` (None for clean data).
+        t_last: the recording's end [s].
+        q: joint positions, (N, n); noise: each joint's noise [rad], (n,);
+        quantum: each joint's resolution [rad] (0: none), (n,).
+        held: joint positions filtered over ``window`` (raw for clean data), for the
+            hold test, (N, n); held_gain: that filter's noise std per unit of noise.
+        sparse: how much noisier a filtered value is than where the log has all its
+            samples (above 1 across a logging gap), (N,).
+        carried: the joint velocities and accelerations the file carries on these
+            samples (a compiled trajectory, a logger that records them), or None.
+    """
+
+    t: np.ndarray
+    h: float
+    window: int
+    v: np.ndarray
+    thr: np.ndarray
+    level: np.ndarray
+    v_long: np.ndarray | None
+    thr_long: np.ndarray | None
+    t_last: float
+    q: np.ndarray
+    noise: np.ndarray
+    quantum: np.ndarray
+    held: np.ndarray
+    held_gain: float
+    sparse: np.ndarray
+    carried: tuple[np.ndarray, np.ndarray] | None = None
+
+
+@dataclass(frozen=True)
+class Boundary:
+    """A pause from ``t0`` to ``t1``, or the boundary between two episodes: the first
+    stops at ``t0``, the next starts at ``t1`` (the same instant, unless motion too slow
+    to see lies between). ``i0``..``i1`` are the grid samples it covers (inclusive)."""
+
+    t0: float
+    t1: float
+    i0: int
+    i1: int
+    pause: bool
+
+
+def rest_signals(t: np.ndarray, h: float, q: np.ndarray, noise: np.ndarray,
+                 quantum: np.ndarray, density: np.ndarray, window: int, t_last: float,
+                 carried: tuple[np.ndarray, np.ndarray] | None = None) -> Rest:
+    """Joint velocities over ``window`` samples and per-joint rest thresholds from the
+    joints' ``noise`` [rad] (0: a still or clean joint, threshold :data:`REST_SPEED`)."""
+    v = smooth(q, window, 1, h, order=2)
+    scale = 1.0 / np.sqrt(np.clip(density, 1e-3, 1.0))[:, None]
+    thr = np.maximum(NOISE_SIGMAS * noise[None, :] * slope_gain(window, h) * scale,
+                     REST_SPEED)
+    level = np.max(np.abs(v) / thr, axis=1)
+    v_long = thr_long = None
+    held, gain = q, 1.0
+    if window > 3:
+        held = smooth(q, window, 0, h, order=3)
+        gain = float(np.linalg.norm(sg_coefficients(window, 3, 0, 1.0)))
+    if window > 3 and len(t) > odd(LONG_WINDOW / h):
+        wl = odd(LONG_WINDOW / h)
+        v_long = smooth(q, wl, 1, h, order=1)
+        thr_long = np.maximum(NOISE_SIGMAS * noise[None, :] * slope_gain(wl, h) * scale,
+                              REST_SPEED)
+    return Rest(t, h, window, v, thr, level, v_long, thr_long, t_last, q, noise, quantum,
+                held, gain, scale[:, 0], carried)
+
+
+def _rest_runs(r: Rest) -> tuple[list[tuple[int, int]], set[int]]:
+    """Runs of rest samples: isolated noise spikes inside a rest are closed, and a rest
+    long enough for the slow check is split where slow motion shows; also the run ends
+    that such a split made (their motion is followed with the long filter)."""
+    rest = r.level < 1.0
+    # A short spell of "motion" inside a rest is closed when it is a noise spike (shorter
+    # than half the filter) or when no joint left the rest position by more than its
+    # noise (a rounded position flickering between two neighbouring steps).
+    short = r.window // 2 if r.window > 3 else 0
+    longest = max(r.window, odd(0.1 / r.h))
+    for i0, i1 in runs(~rest):
+        if i0 == 0 or i1 == len(rest) - 1 or i1 - i0 + 1 > longest:
+            continue
+        away = np.abs(r.q[i0:i1 + 2] - r.q[i0 - 1]).max(axis=0)
+        if i1 - i0 < short or np.all(away <= 4.0 * r.noise + 1.01 * r.quantum + 1e-12):
+            rest[i0:i1 + 1] = True
+    slow_edges: set[int] = set()
+    if r.v_long is not None and r.thr_long is not None:
+        # A full window from each end: next to a rest, the start of a slow motion looks
+        # still for a while; its edge is refined, not split off.
+        width = odd(LONG_WINDOW / r.h)
+        for i0, i1 in runs(rest):
+            a, b = i0 + width, i1 - width
+            if b > a:
+                slow = np.max(np.abs(r.v_long[a:b + 1]) / r.thr_long[a:b + 1], axis=1) >= 1
+                for s0, s1 in runs(slow):
+                    slow_edges.update((a + s0 - 1, a + s1 + 1))
+                rest[a:b + 1] &= ~slow
+    return runs(rest), slow_edges
+
+
+def _lead(r: Rest, seg: np.ndarray, slow: bool) -> tuple[np.ndarray, int] | None:
+    """The velocity of the joint that leads the motion over ``seg`` (the samples beside
+    a rest, away from it), signed positive and in units of its rest threshold; and the
+    filter's window. Of the short and the long filter, the one that sees the motion
+    first (the long one sees it half its window early, which is allowed for), or the
+    long one for an edge that slow motion made (``slow``)."""
+    found = []
+    for v, thr, window in ((r.v, r.thr, r.window), (r.v_long, r.thr_long, 0)):
+        if v is None or thr is None:
+            continue
+        width = window or odd(LONG_WINDOW / r.h)
+        ratio = np.abs(v[seg]) / thr[seg]
+        moving = np.flatnonzero(ratio.max(axis=1) > CLEARLY)
+        if len(moving) == 0:
+            continue
+        near = ratio[moving[0]:moving[0] + max(3, width)]
+        j = int(np.argmax(near.max(axis=0)))
+        k = moving[0] + int(np.argmax(near[:, j]))
+        vj = v[seg, j] * (1.0 if v[seg[k], j] >= 0 else -1.0) / thr[seg, j]
+        up = np.flatnonzero(vj > CLEARLY)
+        if len(up):
+            # A filter sees motion half its window before it starts.
+            found.append((int(up[0]) + width // 2, vj, width, window == 0))
+    if not found:
+        return None
+    found.sort(key=lambda f: (not f[3]) if slow else f[0])
+    return found[0][1], found[0][2]
+
+
+def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False
+               ) -> tuple[float, bool]:
+    """Where the motion beside rest sample ``i`` (after it for ``step`` +1, before it for
+    -1) is at zero velocity: the signed velocity of its leading joint, a straight line
+    near a stop, is fitted from the edge up to :data:`RAMP_TOP` of its first peak and
+    followed back to zero. The result lies between the rest sample ``far`` and the
+    first clearly moving sample; motion too weak to follow leaves the edge where it is.
+    Also whether a straight ramp was followed (a firm edge)."""
+    if r.carried is not None:
+        exact = _carried_edge(r, i, step)
+        if exact is not None:
+            return exact, True
+    t, n = r.t, len(r.t)
+    reach = max(3, int(round(1.0 / r.h)))
+    seg = (np.arange(i + 1, min(i + 1 + reach, n)) if step > 0
+           else np.arange(i - 1, max(i - 1 - reach, -1), -1))
+    lead = _lead(r, seg, slow) if len(seg) >= 2 else None
+    if lead is None:
+        return float(t[i]), False
+    vj, window = lead
+    up = int(np.argmax(vj > CLEARLY))
+    # The first peak: after the velocity is clearly up, where it falls back under 80 %
+    # of its running maximum. The ramp runs from the last sample at or under zero (a
+    # settling wiggle is no part of it) up to RAMP_TOP of that peak.
+    run = np.maximum.accumulate(vj[up:])
+    past = np.flatnonzero(vj[up:] < 0.8 * run)
+    peak = run[past[0]] if len(past) else run[-1]
+    m = max(up + int(np.argmax(vj[up:] >= RAMP_TOP * peak)), 2)
+    low = np.flatnonzero(vj[:up] <= 0)
+    first = int(low[-1]) + 1 if len(low) else 0
+    ramp, vr = t[seg[first:m]], vj[first:m]
+    # The motion stops between its first clearly moving sample and the far end of the
+    # rest (give or take a step), and no further into the rest than its ramp takes to
+    # fall through the threshold (twice that, plus the filter's reach).
+    slope = abs(float(np.polyfit(ramp - ramp[0], vr, 1)[0])) if len(ramp) >= 2 else 0.0
+    reach_in = 2.0 / slope + (window // 2 + 1) * r.h if slope > 0 else math.inf
+    edge = float(t[i])
+    far_t = edge - step * min(abs(float(t[far]) - edge) + r.h, reach_in)
+    bounds = sorted((far_t, float(t[seg[up]])))
+    t0 = _zero(ramp, vr)
+    if t0 is None:
+        return edge, False
+    # The filter rounds the corner at the stop: samples whose window reaches across it
+    # are left out of a second fit.
+    keep = np.abs(ramp - t0) > (window // 2) * r.h
+    if keep.sum() >= 2:
+        t0 = _zero(ramp[keep], vr[keep], straight=True)
+        if t0 is None:
+            return edge, False
+    return float(min(max(t0, bounds[0]), bounds[1])), True
+
+
+def _carried_edge(r: Rest, i: int, step: int) -> float | None:
+    """Where the motion beside sample ``i`` (after it for ``step`` +1, before it for -1)
+    leaves rest, from the positions, velocities and accelerations the file carries.
+
+    Near its start a motion from rest goes as a power of the time since it started,
+    ``dq ~ tau^k`` (k = 2 at constant acceleration, 3 under a jerk limit), so at its first
+    moving sample ``qd/qdd = tau/(k-1)`` and ``dq/qd = tau/k``: both give ``k`` and
+    ``tau`` without assuming either. The first sample near ``i`` whose start falls
+    between it and its neighbour on the rest side gives the edge; None when none does.
+    """
+    assert r.carried is not None
+    qd, qdd = r.carried
+    n = len(r.t)
+    j = int(np.argmax(np.abs(qd[min(max(i + 3 * step, 0), n - 1)])))
+    for b in range(i - 2 * step, i + 5 * step, step):
+        a = b - step
+        if not (0 <= a < n and 0 <= b < n):
+            continue
+        dq = float(r.q[b, j] - r.q[a, j])
+        v, acc = float(qd[b, j]) * step, float(qdd[b, j])
+        if abs(v) <= REST_SPEED or dq == 0.0:
+            continue
+        sign = math.copysign(1.0, dq)
+        v, acc, dq = v * sign, acc * sign, abs(dq)
+        if v <= 0 or acc <= 0:
+            continue
+        r1, r2 = v / acc, dq / v
+        if r1 <= r2:
+            continue
+        k = r1 / (r1 - r2)
+        tau = k * r2
+        if 1.0 <= k <= 8.0 and tau <= abs(float(r.t[b] - r.t[a])) * (1 + 1e-9):
+            return float(r.t[b]) - step * tau
+    return None
+
+
+def _zero(t: np.ndarray, v: np.ndarray, straight: bool = False) -> float | None:
+    """Where the velocity ``v`` (positive, over the ramp ``t``) reached zero: the line
+    through it followed back. With ``straight``, None unless the ramp is a straight line
+    within 10 % of its height (a ramp that bends, like a shiver's soft start, is not
+    followed: its rest edge is kept)."""
+    if len(t) < 2:
+        return None
+    x = t - t[0]
+    slope, icpt = np.polyfit(x, v, 1)
+    if not np.isfinite(slope) or abs(slope) < 1e-15:
+        return None
+    if straight and len(t) >= 4:
+        miss = float(np.sqrt(np.mean((np.polyval([slope, icpt], x) - v) ** 2)))
+        if miss > 0.1 * float(np.max(np.abs(v))) + 1.0 / NOISE_SIGMAS:
+            return None
+    return float(t[0] - icpt / slope)
+
+
+def _dips(r: Rest, taken: np.ndarray) -> list[tuple[float, float, int]]:
+    """Where the motion passes through zero speed without a rest sample: local minima of
+    the speed level that fall under 30 % of the peaks on both sides. Where the leading
+    joint reverses, the instant is its velocity's zero crossing; else the motion on each
+    side is followed to zero as beside a rest. (stop, start, sample) each."""
+    from scipy.signal import find_peaks
+
+    lv = r.level
+    idx, props = find_peaks(-lv, prominence=0.0)
+    out = []
+    for k, prom in zip(idx.tolist(), props["prominences"].tolist(), strict=True):
+        if taken[k] or lv[k] > 0.3 * (lv[k] + prom):
+            continue
+        j = int(np.argmax(np.abs(r.v[k - 1]) / r.thr[k - 1] + np.abs(r.v[k + 1]) / r.thr[k + 1]))
+        v = r.v if r.carried is None else r.carried[0]
+        a, b = (k - 1, k) if v[k - 1, j] * v[k, j] <= 0 else (k, k + 1)
+        va, vb = v[a, j], v[b, j]
+        if va * vb <= 0 and va != vb:
+            tk = float(r.t[a] + (r.t[b] - r.t[a]) * va / (va - vb))
+            out.append((tk, tk, k))
+            continue
+        t0, t1 = _ramp_zero(r, k, -1, k)[0], _ramp_zero(r, k, +1, k)[0]
+        out.append((t0, t1, k) if t1 > t0 else ((t0 + t1) / 2, (t0 + t1) / 2, k))
+    return out
+
+
+def boundaries(r: Rest) -> list[Boundary]:
+    """Pauses and episode boundaries in time order (see the module's docstring)."""
+    n = len(r.t)
+    out: list[Boundary] = []
+    taken = np.zeros(n, bool)
+    found, slow = _rest_runs(r)
+    edge = r.window // 2  # the filter's reach: a rest that close to an end starts there
+    for i0, i1 in found:
+        i0 = 0 if i0 <= edge else i0
+        i1 = n - 1 if i1 >= n - 1 - edge else i1
+        taken[i0:i1 + 1] = True
+        t0 = float(r.t[0]) if i0 == 0 else _ramp_zero(r, i0, -1, i1, i0 in slow)[0]
+        t1 = r.t_last if i1 == n - 1 else _ramp_zero(r, i1, +1, i0, i1 in slow)[0]
+        h0, h1 = _held(r, t0, t1) if t1 - t0 >= MIN_PAUSE else (t0, t0)
+        if h1 - h0 >= max(MIN_PAUSE, 0.5 * (t1 - t0)):
+            # Motion too slow to see in the speed but not in the positions (the soft
+            # start of a shiver) is no part of the hold.
+            out.append(Boundary(max(t0, h0), min(t1, h1), i0, i1, True))
+        elif 0 < i0 and i1 < n - 1:
+            # The instant between two episodes; when motion too slow to see fills the
+            # gap between where one stops and the next starts, that gap belongs to
+            # neither (it is the soft end of a shiver, or its soft start).
+            t0, t1 = (t0, t1) if t1 > t0 else ((t0 + t1) / 2,) * 2
+            out.append(Boundary(t0, t1, i0, i1, False))
+    for t0, t1, k in _dips(r, taken):
+        out.append(Boundary(t0, t1, k, k, False))
+    out.sort(key=lambda b: b.t0)
+    return _merged(out)
+
+
+def _held(r: Rest, t0: float, t1: float) -> tuple[float, float]:
+    """The longest stretch of ``t0``..``t1`` in which the joints stay within their noise
+    of one position (the one they hold in its middle third): a pause is a hold. The
+    speed of a motion can hide under the noise for a while (the soft ends of two
+    shivers back to back); its positions cannot."""
+    k0 = int(np.searchsorted(r.t, t0, "left"))
+    k1 = int(np.searchsorted(r.t, t1, "right"))
+    p = r.held[k0:k1]
+    if len(p) < 3:
+        return t0, t0
+    # Across a logging gap fewer raw samples make each filtered value: more noise.
+    band = (HELD_SIGMAS * r.noise * r.held_gain * r.sparse[k0:k1, None] + 1.01 * r.quantum
+            + STILL_ANGLE)
+    third = len(p) // 3
+    ref = np.median(p[third:len(p) - third], axis=0)
+    inside = np.all(np.abs(p - ref) <= band, axis=1)
+    # A brief excursion inside is noise (a logging gap); one at an end is motion.
+    for a, b in runs(~inside):
+        if a > 0 and b < len(inside) - 1 and b - a < r.window:
+            inside[a:b + 1] = True
+    a, b = max(runs(inside), key=lambda ab: ab[1] - ab[0], default=(0, -1))
+    if b < a:
+        return t0, t0
+    return (t0 if a == 0 else float(r.t[k0 + a]),
+            t1 if b == len(p) - 1 else float(r.t[k0 + b]))
+
+
+def _merged(bounds: list[Boundary]) -> list[Boundary]:
+    """Boundaries that overlap once refined are one (a pause if either is)."""
+    out: list[Boundary] = []
+    for b in bounds:
+        last = out[-1] if out else None
+        if last is not None and b.t0 <= last.t1 + 1e-9:
+            out[-1] = Boundary(min(last.t0, b.t0), max(last.t1, b.t1), min(last.i0, b.i0),
+                               max(last.i1, b.i1), last.pause or b.pause)
+            continue
+        out.append(b)
+    return out

@@ -1,0 +1,327 @@
+"""The speed goals of aou, measured: each figure printed beside its goal (see bench.py).
+
+Sections (each a function of this module):
+
+- ``build``: the warm checked build of hesitant.aou (lint, compile, safety replay,
+  measure) in one process, as a robot re-planning would run it; its real-time factor
+  and its ratio to the compile alone, with where the time goes.
+- ``cold``: ``aouc compile`` and ``aouc lint`` started fresh, against the time Python
+  takes to import what they depend on (ratios measured in the same run, interleaved).
+- ``lint``: time and memory of linting ever longer files (linear? bounded?), and a
+  folder of 1000 generated files.
+- ``jobs``: ``aouc compile --jobs N``'s pool against one process.
+- ``render``: a 640x480 video of hesitant.aou against its duration.
+"""
+
+from __future__ import annotations
+
+import gc
+import json
+import os
+import random
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+HESITANT = ROOT / "behaviours" / "hesitant.aou"
+AOUC = [sys.executable, "-m", "aou_dsl"]
+
+
+@dataclass
+class Figure:
+    key: str
+    label: str
+    value: float
+    unit: str
+    goal: str | None = None
+    met: bool | None = None
+
+
+FIGURES: list[Figure] = []
+OUT = sys.stdout  # bench.py points this at stderr under --json
+
+
+def say(text: str) -> None:
+    print(text, file=OUT, flush=True)
+
+
+def figure(key: str, label: str, value: float, unit: str = "", *, at_most: float | None = None,
+           at_least: float | None = None, fmt: str = "{:.1f}") -> Figure:
+    """Record and print one figure, beside its goal when it has one."""
+    goal, met = None, None
+    if at_most is not None:
+        goal, met = f"<= {fmt.format(at_most)} {unit}".rstrip(), value <= at_most
+    elif at_least is not None:
+        goal, met = f">= {fmt.format(at_least)} {unit}".rstrip(), value >= at_least
+    f = Figure(key, label, float(value), unit, goal, met)
+    FIGURES.append(f)
+    tail = "" if goal is None else f"   goal {goal}: {'met' if met else 'NOT MET'}"
+    say(f"  {label}: {fmt.format(value)} {unit}{tail}".replace(" :", ":"))
+    return f
+
+
+def as_json() -> str:
+    return json.dumps({"figures": [asdict(f) for f in FIGURES], "machine": machine()},
+                      indent=2)
+
+
+def machine() -> dict:
+    return {"cores": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+            else os.cpu_count(), "load": os.getloadavg()[0] if hasattr(os, "getloadavg")
+            else None, "python": sys.version.split()[0]}
+
+
+def _median_ms(fn, repeat: int) -> tuple[float, object]:
+    """Median wall time of ``fn()`` [ms], garbage collector paused as timeit does."""
+    out = None
+    gc.collect()
+    gc.disable()
+    times = []
+    try:
+        for _ in range(repeat):
+            t = time.perf_counter()
+            out = fn()
+            times.append(time.perf_counter() - t)
+    finally:
+        gc.enable()
+    return statistics.median(times) * 1000, out
+
+
+# --- build ------------------------------------------------------------------------------
+
+
+def bench_build(repeat: int = 15) -> None:
+    from aou_dsl.build import CHECK_RATE, build_file
+    from aou_dsl.compiler.pipeline import DEFAULT_RATE, compile_behaviour, sample
+    from aou_dsl.linter import lint_file
+    from aou_dsl.measuring.descriptors import measure
+    from aou_dsl.safety.replay import replay
+
+    say("warm checked build of behaviours/hesitant.aou (lint, compile, safety replay, "
+        "measure), one process")
+    path = str(HESITANT)
+    for _ in range(3):
+        res = build_file(path)
+    assert res.ok, res.diagnostics
+    build_ms, res = _median_ms(lambda: build_file(path), repeat)
+    lint = lint_file(path)
+    lint_ms, _ = _median_ms(lambda: lint_file(path), repeat)
+    compile_ms, comp = _median_ms(
+        lambda: compile_behaviour(lint.behaviour, timeline=lint.timeline), repeat)
+    tr = comp.trajectory
+    dense = tr if DEFAULT_RATE >= CHECK_RATE else sample(comp, CHECK_RATE)  # as the build
+    replay_ms, _ = _median_ms(lambda: replay(dense), repeat)
+    measure_ms, _ = _median_ms(lambda: measure(tr), repeat)
+    duration = tr.duration
+    figure("build_ms", "checked build", build_ms, "ms", at_most=100.0)
+    figure("build_rtf", "real-time factor (motion / checked build)", duration / build_ms * 1000,
+           "", at_least=200.0, fmt="{:.0f}")
+    figure("build_over_compile", "checked build / compile alone", build_ms / compile_ms, "x",
+           fmt="{:.2f}")
+    say(f"  where the time goes: lint {lint_ms:.1f} ms, compile {compile_ms:.1f} ms, "
+        f"safety replay {replay_ms:.1f} ms ({len(dense.t)} samples), measure "
+        f"{measure_ms:.1f} ms; motion {duration:.2f} s")
+    figure("compile_ms", "compile alone", compile_ms, "ms")
+    figure("replay_ms", "safety replay", replay_ms, "ms")
+    figure("measure_ms", "measure", measure_ms, "ms")
+
+
+# --- cold starts ------------------------------------------------------------------------
+
+
+def _run(args: list[str], **kw) -> float:
+    t = time.perf_counter()
+    subprocess.run(args, capture_output=True, check=False, **kw)
+    return time.perf_counter() - t
+
+
+def _compile_dependencies(out: str) -> list[str]:
+    """The modules of other packages that aou's own code imports during a cold
+    ``aouc compile`` (what it depends on directly), in the order it imports them."""
+    code = ("import builtins, sys\n"
+            "seen = []\n"
+            "real = builtins.__import__\n"
+            "def spy(name, globals=None, locals=None, fromlist=(), level=0):\n"
+            "    mod = real(name, globals, locals, fromlist, level)\n"
+            "    caller = (globals or {}).get('__name__', '')\n"
+            "    if caller.startswith('aou_dsl') and level == 0 and name.split('.')[0] not in"
+            " sys.stdlib_module_names and not name.startswith('aou_dsl'):\n"
+            "        for full in [name] + [f'{name}.{f}' for f in fromlist or ()"
+            " if f'{name}.{f}' in sys.modules]:\n"
+            "            if full not in seen:\n"
+            "                seen.append(full)\n"
+            "    return mod\n"
+            "builtins.__import__ = spy\n"
+            "from aou_dsl.cli import main\n"
+            f"main(['compile', {str(HESITANT)!r}, '-o', {out!r}])\n"
+            "print(' '.join(seen))\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       check=True)
+    return r.stdout.strip().splitlines()[-1].split() if r.stdout.strip() else []
+
+
+def _import_all(modules: list[str]) -> str:
+    """Code that imports ``modules`` (quietly: PyBullet prints a banner)."""
+    return ("import importlib, os, sys\n"
+            "null = os.open(os.devnull, os.O_WRONLY); saved = os.dup(1); os.dup2(null, 1)\n"
+            f"for m in {modules!r}:\n"
+            "    try:\n"
+            "        importlib.import_module(m)\n"
+            "    except Exception:\n"
+            "        pass\n"
+            "os.dup2(saved, 1)\n")
+
+
+def bench_cold(repeat: int = 7) -> None:
+    say("cold starts: a fresh `aouc` against importing its dependencies (medians of "
+        f"{repeat}, interleaved)")
+    # An installed package has its bytecode compiled; make sure this checkout's is too.
+    subprocess.run([sys.executable, "-m", "compileall", "-q", str(ROOT / "aou_dsl")],
+                   capture_output=True, check=False)
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "h.json")
+        deps = _compile_dependencies(out)  # also warms the parser cache
+        tops = sorted({d.split(".")[0] for d in deps})
+        say(f"  the modules aou imports from {', '.join(tops)}: {', '.join(deps)}")
+        runs = {
+            "compile floor": [sys.executable, "-c", _import_all(deps)],
+            "aouc compile": [*AOUC, "compile", str(HESITANT), "-o", out],
+            "lint floor": [sys.executable, "-c", "import lark, pydantic"],
+            "aouc lint": [*AOUC, "lint", str(ROOT / "behaviours")],
+        }
+        times: dict[str, list[float]] = {k: [] for k in runs}
+        for _ in range(repeat):
+            for k, args in runs.items():
+                times[k].append(_run(args, cwd=tmp))
+    med = {k: statistics.median(v) * 1000 for k, v in times.items()}
+    figure("cold_compile_ms", "cold `aouc compile hesitant.aou`", med["aouc compile"], "ms")
+    figure("cold_compile_floor_ms", "importing its dependencies", med["compile floor"], "ms")
+    figure("cold_compile_ratio", "cold compile / import floor",
+           med["aouc compile"] / med["compile floor"], "x", at_most=1.3, fmt="{:.2f}")
+    figure("cold_lint_ms", "cold `aouc lint behaviours/`", med["aouc lint"], "ms")
+    figure("cold_lint_floor_ms", "`import lark, pydantic`", med["lint floor"], "ms")
+    figure("cold_lint_ratio", "cold lint / import floor", med["aouc lint"] / med["lint floor"],
+           "x", at_most=2.0, fmt="{:.2f}")
+
+
+# --- lint -------------------------------------------------------------------------------
+
+_LINT_ONE = ("import sys, time\n"
+             "t = time.perf_counter()\n"
+             "from aou_dsl.cli import main\n"
+             "import contextlib, io\n"
+             "out = io.StringIO()\n"
+             "with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):\n"
+             "    main(['lint', sys.argv[1]])\n"
+             "secs = time.perf_counter() - t\n"
+             # The peak resident memory of this process (VmHWM: getrusage's would count
+             # the benchmark that started it, which Linux carries across exec).
+             "peak = [l for l in open('/proc/self/status') if l.startswith('VmHWM')]\n"
+             "mb = int(peak[0].split()[1]) / 1024 if peak else float('nan')\n"
+             "print(secs, mb, out.getvalue().count('\\n'))\n")
+
+
+def _generated(rng: random.Random) -> str:
+    """A behaviour like the shipped ones with other numbers (now and then a mistake)."""
+    state = rng.choice(["confident", "curious", "hesitant", "fearful", "inactive"])
+    lines = [f"# generated {rng.random():.6f}", f"behaviour gen : {state}",
+             f"approach a={rng.uniform(0.03, 0.2):.3f}",
+             f"pause {rng.uniform(0.6, 2.5):.2f}s x{rng.randint(1, 5)}"]
+    if rng.random() < 0.5:
+        lines.append(f"retreat {rng.uniform(0.02, 0.08):.3f}m a={rng.uniform(0.05, 0.5):.2f}"
+                     f" x{rng.randint(1, 3)}")
+    if rng.random() < 0.4:
+        lines.append(f"gaze horizontal {rng.randint(5, 25)}deg x{rng.randint(1, 3)}")
+    if rng.random() < 0.1:
+        lines.append(rng.choice(["pause 1", "retreat 0.06m a=", "gaze sideways 10deg"]))
+    return "\n".join(lines) + "\n"
+
+
+def bench_lint() -> None:
+    say("lint: ever longer files (each line an error), then 1000 generated files")
+    with tempfile.TemporaryDirectory() as tmp:
+        per_line = {}
+        for n in (8000, 16000, 32000, 64000):
+            path = os.path.join(tmp, f"long{n}.aou")
+            Path(path).write_text("pause 1s\n" * n)
+            r = subprocess.run([sys.executable, "-c", _LINT_ONE, path], capture_output=True,
+                               text=True, check=True)
+            secs, rss, printed = r.stdout.split()
+            per_line[n] = float(secs) / n
+            say(f"  {n:>6} lines ({os.path.getsize(path) / 1e6:.2f} MB): {float(secs):.2f} s, "
+                f"peak memory {float(rss):.0f} MB, {printed} lines printed")
+            last_rss = float(rss)
+        figure("lint_time_per_line_growth", "time per line, 64k lines / 8k lines",
+               per_line[64000] / per_line[8000], "x", at_most=1.5, fmt="{:.2f}")
+        figure("lint_peak_mb_64k", "peak memory linting 64k lines", last_rss, "MB")
+        folder = os.path.join(tmp, "generated")
+        os.makedirs(folder)
+        rng = random.Random(14)
+        for i in range(1000):
+            Path(folder, f"g{i:04d}.aou").write_text(_generated(rng))
+        secs = statistics.median(_run([*AOUC, "lint", folder]) for _ in range(3))
+    figure("lint_files_per_s", "`aouc lint` of 1000 generated files (cold, startup included)",
+           1000 / secs, "files/s", at_least=500.0, fmt="{:.0f}")
+
+
+# --- jobs -------------------------------------------------------------------------------
+
+
+def bench_jobs(copies: int = 3) -> None:
+    from aou_dsl.compiler.output import encode
+    from aou_dsl.parallel import BuildPool, build_many, default_jobs
+
+    cores = default_jobs()
+    say(f"`aouc compile --jobs {cores}`: a warm pool against one process "
+        f"({copies} copies of each shipped behaviour)")
+    with tempfile.TemporaryDirectory() as tmp:
+        paths = []
+        for i in range(copies):
+            for src in sorted((ROOT / "behaviours").glob("*.aou")):
+                dst = Path(tmp, f"{src.stem}{i}.aou")
+                shutil.copy(src, dst)
+                paths.append(str(dst))
+        list(build_many(paths[:5], {}, 1))  # this process warm too
+        t = time.perf_counter()
+        one = list(build_many(paths, {}, 1))
+        t1 = time.perf_counter() - t
+        t = time.perf_counter()
+        with BuildPool(cores) as pool:
+            start = time.perf_counter() - t
+            t = time.perf_counter()
+            many = list(pool.map(paths))
+            tn = time.perf_counter() - t
+    same = all((a.document is None and b.document is None)
+               or encode(a.document, "json") == encode(b.document, "json")
+               for a, b in zip(one, many, strict=True))
+    say(f"  {len(paths)} files: 1 process {t1:.2f} s, {cores} workers {tn:.2f} s (the pool "
+        f"started in {start:.2f} s, once); documents identical to --jobs 1: {same}")
+    figure("jobs_speedup", f"speed-up on {cores} cores", t1 / tn, "x",
+           at_least=0.8 * cores, fmt="{:.2f}")
+    figure("jobs_identical", "outputs identical to --jobs 1", float(same), "",
+           at_least=1.0, fmt="{:.0f}")
+
+
+# --- render -----------------------------------------------------------------------------
+
+
+def bench_render() -> None:
+    from aou_dsl.build import build_file
+    from aou_dsl.media.render import render_video
+
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    say(f"render hesitant.aou at 640x480, 30 fps, mp4 ({cores} cores)")
+    tr = build_file(str(HESITANT), check=False).trajectory
+    with tempfile.TemporaryDirectory() as tmp:
+        t = time.perf_counter()
+        info = render_video([tr], os.path.join(tmp, "h.mp4"), quiet=True)
+        secs = time.perf_counter() - t
+    say(f"  {info['frames']} frames, {info['duration']:.2f} s of video in {secs:.1f} s")
+    figure("render_realtime_factor", "video duration / rendering time",
+           info["duration"] / secs, "", at_least=1.0, fmt="{:.2f}")
