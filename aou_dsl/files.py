@@ -11,6 +11,7 @@ import contextlib
 import os
 import tempfile
 from collections.abc import Iterator, Sequence
+from typing import Any
 
 from .diagnostics import AouError, Span, diag
 
@@ -77,14 +78,28 @@ def write_atomic(path: str, data: bytes, *, inputs: Sequence[str] = ()) -> None:
 
 
 def read_text(path: str, what: str = "") -> str:
-    """The text of an input file.
+    """The text of an input file (UTF-8).
 
     Raises:
         AouError: I501 naming the file (and ``what`` it is) and the reason.
     """
+    return _read(path, what, text=True)
+
+
+def read_bytes(path: str, what: str = "") -> bytes:
+    """The bytes of an input file.
+
+    Raises:
+        AouError: I501 naming the file (and ``what`` it is) and the reason.
+    """
+    return _read(path, what, text=False)
+
+
+def _read(path: str, what: str, text: bool) -> Any:
     try:
-        with open(path, encoding="utf-8") as fh:
-            return fh.read()
+        with open(path, "rb") as fh:
+            data = fh.read()
+        return data.decode("utf-8") if text else data
     except (OSError, UnicodeDecodeError) as exc:
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
         raise AouError(diag("I501", f"cannot read {what + ' ' if what else ''}`{path}`: "

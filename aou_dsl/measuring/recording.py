@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from ..diagnostics import AouError, Severity, Span, diag
+from ..files import read_bytes, read_text
 from ..trajectory import Trajectory
 
 __all__ = ["ANGLE_UNITS", "TIME_UNITS", "read_csv", "read_json", "read_npz",
@@ -335,14 +336,8 @@ def read_recording(path: str, *, robot: str | None = None,
         AouError: I501 when the file cannot be read; R401 for a malformed trajectory
             (with the row or sample); R404 for implausible units.
     """
-    try:
-        with open(path, "rb") as fh:
-            data = fh.read()
-        text = None if path.endswith(".npz") else data.decode("utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise AouError(diag("I501", f"cannot read `{path}`: {reason}",
-                            Span.whole_file(path))) from None
+    data = read_bytes(path) if path.endswith(".npz") else b""
+    text = None if path.endswith(".npz") else read_text(path)
     rows = None
     if path.endswith(".npz"):
         rec = read_npz(path, data)
