@@ -142,5 +142,10 @@ def format_measured(path: str, robot: str, measured) -> str:
     for k, v in m.descriptors.items():
         val = "null" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
         lines.append(f"  {k:<22} {val:>10} {REGISTRY[k].unit}".rstrip())
+    los = m.line_of_sight
+    if los is not None and len(los.angle):
+        # The model assumes the hand looks at the goal throughout: how far it did not.
+        lines.append(f"  line of sight off the goal: median {los.median:.3g} deg, "
+                     f"max {los.max:.3g} deg")
     lines.append(f"  C-V: C={m.cv.C:+.2f} V={m.cv.V:+.2f} -> {m.cv.state}")
     return "\n".join(lines)
