@@ -31,7 +31,8 @@ from ..kinematics import load_arm
 from ..trajectory import Trajectory
 from .episodes import STILL_TRANSLATION, Context, Piece, pieces, translation
 from .fk import batch_fk
-from .holds import MIN_PAUSE, REST_SPEED, Boundary, Rest, boundaries, rest_signals
+from .holds import (MIN_PAUSE, REST_SPEED, Boundary, Rest, boundaries, rest_at_end,
+                    rest_signals)
 from .roll import MIN_TILT, Lobe, lobe, roll_angle, rotations
 from .signal import Grid, joint_noise, short_window, smooth, to_grid, unwrap
 
@@ -169,10 +170,9 @@ def _carried(rec: Trajectory, cols: np.ndarray, grid: Grid
 def _edge_rest(rec: Trajectory, rest: Rest) -> tuple[bool, bool]:
     """Whether the arm is at rest at the first and last sample: from the velocities the
     file carries, else from the rest test."""
-    by_fit = (bool(rest.level[0] < 1), bool(rest.level[-1] < 1))
     qd = rec.qd
     if qd is None or np.shape(qd) != np.shape(rec.q) or not np.isfinite(qd).all():
-        return by_fit
+        return rest_at_end(rest, last=False), rest_at_end(rest, last=True)
     speed = np.abs(np.asarray(qd, float))
     return bool(speed[0].max() <= REST_SPEED), bool(speed[-1].max() <= REST_SPEED)
 

@@ -21,7 +21,8 @@ import numpy as np
 
 from .signal import NOISE_SIGMAS, odd, runs, sg_coefficients, slope_gain, smooth
 
-__all__ = ["MIN_PAUSE", "REST_SPEED", "Boundary", "Rest", "boundaries", "rest_signals"]
+__all__ = ["MIN_PAUSE", "REST_SPEED", "Boundary", "Rest", "boundaries", "rest_at_end",
+           "rest_signals"]
 
 #: Shortest rest that counts as a pause [s] (the language's shortest pause is 0.2 s).
 MIN_PAUSE = 0.15
@@ -363,6 +364,27 @@ def _held(r: Rest, t0: float, t1: float) -> tuple[float, float]:
         return t0, t0
     return (t0 if a == 0 else float(r.t[k0 + a]),
             t1 if b == len(p) - 1 else float(r.t[k0 + b]))
+
+
+def rest_at_end(r: Rest, last: bool) -> bool:
+    """Whether the arm is at rest at the recording's first sample (its last with
+    ``last``). A motion that starts from rest right at the first sample (under a jerk
+    limit it barely moves at first) looks moving to a velocity filter there; its velocity,
+    a cubic fitted over the first samples and followed back to the edge, is near zero
+    beside the speed it has reached. A log that starts mid-motion starts at speed."""
+    n = len(r.t)
+    k = n - 1 if last else 0
+    if r.level[k] < 1.0:
+        return True
+    m = min(n, max(2 * r.window + 1, odd(0.05 / r.h), 7))
+    idx = np.arange(n - m, n) if last else np.arange(m)
+    j = int(np.argmax(np.abs(r.q[idx[-1]] - r.q[idx[0]])))
+    tt = r.t[idx] - r.t[k]
+    c = np.polyfit(tt, r.q[idx, j], 3)
+    far = float(tt[0] if last else tt[-1])
+    v_edge = float(c[2])
+    v_far = float(3 * c[0] * far ** 2 + 2 * c[1] * far + c[2])
+    return abs(v_edge) <= max(0.1 * abs(v_far), CLEARLY * float(r.thr[k, j]))
 
 
 def _merged(bounds: list[Boundary]) -> list[Boundary]:
