@@ -172,11 +172,11 @@ def _commanded(motion, arm: ArmModel, rate: float) -> tuple[float, np.ndarray]:
     """Positions at ``rate`` from ``PAD`` ticks before the start to ``PAD`` after the end:
     the first tick's time and the positions, shape (N, n) in the arm's joint order."""
     if hasattr(motion, "segments"):
-        from .compiler.pipeline import evaluate
+        from .compiler.pipeline import positions
 
         tr = motion.trajectory
         t = _ticks(float(tr.t[0]), float(tr.t[-1]), rate)
-        return float(t[0]), evaluate(motion, t)[0]
+        return float(t[0]), positions(motion, t)
     tr = motion
     cols = tr.columns(arm.joint_names)
     t = _ticks(float(tr.t[0]), float(tr.t[-1]), rate)

@@ -91,6 +91,131 @@ class ArmModel:
         return pos, rot
 
 
+    @functools.cached_property
+    def _chain(self):
+        return _revolute_chain(self)
+
+    def accelerations(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray
+                      ) -> np.ndarray | None:
+        """The end-effector's classical linear acceleration ``J qdd + Jdot qd`` [m/s^2]
+        at every row of ``q``, ``qd``, ``qdd`` (N, n), in the base frame's axes, all rows
+        at once with numpy; shape (N, 3). None when the arm has a joint other than a
+        revolute one (:meth:`fk`'s Pinocchio is then the only way).
+
+        The same quantity as Pinocchio's ``getFrameClassicalAcceleration`` (in
+        ``LOCAL_WORLD_ALIGNED``) up to rounding: each link's angular velocity, angular
+        acceleration and origin acceleration follow from its parent's, outwards along
+        the chain."""
+        chain = self._chain
+        if chain is None:
+            return None
+        q, qd, qdd = (np.ascontiguousarray(np.atleast_2d(np.asarray(x, dtype=float)).T)
+                      for x in (q, qd, qdd))
+        n = q.shape[1]
+        # Over the rows at once, samples last: vectors (3, n); rotations by their columns,
+        # (3, 3, n) with cols[k, i] row i of column k. A fixed placement is then one
+        # matrix product, a joint's rotation a few operations on contiguous rows. The
+        # base frame is at rest: its velocities and accelerations are None (zero).
+        cols = {0: np.repeat(np.eye(3)[:, :, None], n, axis=2)}
+        omega: dict[int, Any] = {0: None}
+        alpha: dict[int, Any] = {0: None}
+        acc: dict[int, Any] = {0: None}
+        for i, (parent, iq, axis, r_fix, p_fix) in enumerate(chain[0], start=1):
+            c_par, w_par, a_par = cols[parent], omega[parent], alpha[parent]
+            base = (r_fix.T @ c_par.reshape(3, -1)).reshape(3, 3, n)
+            z = _times(base, axis)  # the joint's axis in the base frame
+            cols[i] = _rotate(base, axis, q[iq])
+            zd, zdd = z * qd[iq], z * qdd[iq]
+            if w_par is None:  # on the base: the joint's origin does not move
+                acc[i], omega[i], alpha[i] = acc[parent], zd, zdd
+                continue
+            r = _times(c_par, p_fix)  # parent origin -> joint origin
+            acc[i] = _cross(a_par, r) + _cross(w_par, _cross(w_par, r))
+            if acc[parent] is not None:
+                acc[i] += acc[parent]
+            omega[i] = w_par + zd
+            alpha[i] = a_par + zdd + _cross(w_par, zd)
+        j, p_frame = chain[1]
+        if omega[j] is None:  # no joint moves the frame
+            return np.zeros((n, 3))
+        r = _times(cols[j], p_frame)
+        w = omega[j]
+        out = _cross(alpha[j], r) + _cross(w, _cross(w, r))
+        if acc[j] is not None:
+            out += acc[j]
+        return out.T
+
+
+def _times(cols: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``R @ v`` for every sample, ``R`` by its columns (3, 3, N): (3, N)."""
+    out = None
+    for k in (0, 1, 2):
+        if v[k]:
+            term = cols[k] if v[k] == 1.0 else cols[k] * v[k]
+            out = term if out is None else out + term
+    return np.zeros(cols.shape[1:]) if out is None else out
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross products of the columns of (3, N) arrays."""
+    out = np.empty_like(a)
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+    return out
+
+
+def _rotate(cols: np.ndarray, axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """``R @ rot(axis, angle)`` for every sample, ``R`` by its columns (3, 3, N)."""
+    c, s = np.cos(angle), np.sin(angle)
+    hit = np.flatnonzero(np.abs(axis) == 1.0)
+    if len(hit) == 1:  # about a coordinate axis: two columns change
+        k = int(hit[0])
+        i, j = (k + 1) % 3, (k + 2) % 3
+        s = s if axis[k] > 0 else -s
+        out = np.empty_like(cols)
+        out[k] = cols[k]
+        out[i] = c * cols[i] + s * cols[j]
+        out[j] = c * cols[j] - s * cols[i]
+        return out
+    x, y, z = axis
+    skew = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    rot = (c[:, None, None] * np.eye(3) + s[:, None, None] * skew
+           + (1.0 - c)[:, None, None] * np.outer(axis, axis))  # (N, 3, 3)
+    return np.einsum("min,nmk->kin", cols, rot)
+
+
+def _revolute_chain(arm: ArmModel):
+    """Per joint of ``arm.model`` (parent, q index, unit axis, placement rotation and
+    translation), and the end-effector frame's (parent joint, translation); None when
+    a joint is not a revolute one of one angle."""
+    model = arm.model
+    joints = [_revolute(model, i) for i in range(1, model.njoints)]
+    if any(j is None for j in joints):
+        return None
+    frame = model.frames[arm.frame_id]
+    return joints, (int(frame.parentJoint), np.array(frame.placement.translation, float))
+
+
+def _revolute(model: Any, i: int) -> tuple | None:
+    """Joint ``i`` of ``model`` as (parent, q index, unit axis, placement rotation and
+    translation); None for a joint other than a revolute one of one angle."""
+    jm = model.joints[i]
+    name = jm.shortname()
+    if jm.nq != 1 or jm.nv != 1:
+        return None
+    if name in ("JointModelRX", "JointModelRY", "JointModelRZ"):
+        axis = np.eye(3)["XYZ".index(name[-1])]
+    elif name == "JointModelRevoluteUnaligned":
+        axis = np.asarray(jm.extract().axis, dtype=float)
+        axis = axis / np.linalg.norm(axis)
+    else:
+        return None
+    m = model.jointPlacements[i]
+    return (int(model.parents[i]), int(jm.idx_q), axis, np.array(m.rotation, dtype=float),
+            np.array(m.translation, dtype=float))
+
+
 def frame_id(model: Any, name: str) -> int:
     """The id of frame ``name`` in ``model``: the link's (body) frame when a joint has the
     same name as a link; -1 when there is none."""

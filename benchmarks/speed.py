@@ -11,14 +11,19 @@ Sections (each a function of this module):
   folder of 1000 generated files.
 - ``jobs``: ``aouc compile --jobs N``'s pool against one process.
 - ``render``: a 640x480 video of hesitant.aou against its duration.
+- ``replan``: a live re-plan in the middle of a motion (``bench_replan.py``, whose
+  printout is passed on), its median against its goal.
 """
 
 from __future__ import annotations
 
+import contextlib
 import gc
+import io
 import json
 import os
 import random
+import re
 import shutil
 import statistics
 import subprocess
@@ -67,8 +72,13 @@ def figure(key: str, label: str, value: float, unit: str = "", *, at_most: float
 
 
 def as_json() -> str:
-    return json.dumps({"figures": [asdict(f) for f in FIGURES], "machine": machine()},
-                      indent=2)
+    """Every figure (with its goal and whether it is met; null when it has none), a
+    summary of the goals, and the machine."""
+    goals = [f for f in FIGURES if f.met is not None]
+    summary = {"goals": len(goals), "met": sum(bool(f.met) for f in goals),
+               "not_met": [f.key for f in goals if not f.met]}
+    return json.dumps({"figures": [asdict(f) for f in FIGURES], "summary": summary,
+                       "machine": machine()}, indent=2)
 
 
 def machine() -> dict:
@@ -77,19 +87,24 @@ def machine() -> dict:
             else None, "python": sys.version.split()[0]}
 
 
-def _median_ms(fn, repeat: int) -> tuple[float, object]:
-    """Median wall time of ``fn()`` [ms], garbage collector paused as timeit does."""
+def _median_ms(fn, repeat: int, cpu: list[float] | None = None) -> tuple[float, object]:
+    """Median wall time of ``fn()`` [ms], garbage collector paused as timeit does; the
+    median CPU time of this process [ms] is appended to ``cpu`` when given (on a shared
+    machine the wall time also counts the other processes' turns)."""
     out = None
     gc.collect()
     gc.disable()
-    times = []
+    times, cpus = [], []
     try:
         for _ in range(repeat):
-            t = time.perf_counter()
+            t, c = time.perf_counter(), time.process_time()
             out = fn()
             times.append(time.perf_counter() - t)
+            cpus.append(time.process_time() - c)
     finally:
         gc.enable()
+    if cpu is not None:
+        cpu.append(statistics.median(cpus) * 1000)
     return statistics.median(times) * 1000, out
 
 
@@ -109,7 +124,8 @@ def bench_build(repeat: int = 15) -> None:
     for _ in range(3):
         res = build_file(path)
     assert res.ok, res.diagnostics
-    build_ms, res = _median_ms(lambda: build_file(path), repeat)
+    cpu: list[float] = []
+    build_ms, res = _median_ms(lambda: build_file(path), repeat, cpu)
     lint = lint_file(path)
     lint_ms, _ = _median_ms(lambda: lint_file(path), repeat)
     compile_ms, comp = _median_ms(
@@ -120,6 +136,7 @@ def bench_build(repeat: int = 15) -> None:
     measure_ms, _ = _median_ms(lambda: measure(tr), repeat)
     duration = tr.duration
     figure("build_ms", "checked build", build_ms, "ms", at_most=100.0)
+    figure("build_cpu_ms", "checked build, CPU time of this process", cpu[0], "ms")
     figure("build_rtf", "real-time factor (motion / checked build)", duration / build_ms * 1000,
            "", at_least=200.0, fmt="{:.0f}")
     figure("build_over_compile", "checked build / compile alone", build_ms / compile_ms, "x",
@@ -325,3 +342,22 @@ def bench_render() -> None:
     say(f"  {info['frames']} frames, {info['duration']:.2f} s of video in {secs:.1f} s")
     figure("render_realtime_factor", "video duration / rendering time",
            info["duration"] / secs, "", at_least=1.0, fmt="{:.2f}")
+
+
+# --- replan -----------------------------------------------------------------------------
+
+
+def bench_replan() -> None:
+    """``bench_replan.py`` (panda, 20 re-plans): its printout, and its median as a figure."""
+    import bench_replan
+
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        bench_replan.main([])
+    text = out.getvalue()
+    say(text.rstrip())
+    found = re.search(r"warm re-plan: median ([0-9.]+) ms", text)
+    if found is None:
+        raise RuntimeError("bench_replan.py no longer prints its median re-plan time")
+    figure("replan_ms", "warm mid-motion re-plan (median)", float(found.group(1)), "ms",
+           at_most=100.0)

@@ -7,6 +7,10 @@ clearances, on random motions that do and do not collide. Also checked directly:
 motion bound the replay skips samples with is never beaten by the distances PyBullet
 measures between consecutive samples.
 
+The compiler's shortcuts (the end-effector accelerations of every instant at once, a
+leaner TOPP-RA loop) are held to the straightforward computation, bit for bit; the bound
+that spares the dense joint-limit check never passes a segment that overshoots.
+
 Lint keeps at most a hundred diagnostics per file and counts the rest; the parser's
 tables are cached on disk, and a cache that cannot be written changes nothing."""
 
@@ -178,6 +182,124 @@ def test_no_distance_changes_faster_than_its_bound(robot):
     # covers that a thousand times over.
     assert np.all(change <= allowed + NOISE), float((change - allowed).max())
     assert both.sum() > len(q)  # the test looked at many distances
+
+
+# --- the compiler's shortcuts: the same numbers, to the last bit --------------------------
+
+
+def _pinocchio_accelerations(arm, q, qd, qdd) -> np.ndarray:
+    """The end-effector's classical acceleration by Pinocchio, one sample at a time."""
+    import pinocchio as pin
+
+    data = arm.model.createData()
+    out = np.empty((len(q), 3))
+    for k in range(len(q)):
+        pin.forwardKinematics(arm.model, data, q[k], qd[k], qdd[k])
+        pin.updateFramePlacements(arm.model, data)
+        out[k] = pin.getFrameClassicalAcceleration(arm.model, data, arm.frame_id,
+                                                   pin.LOCAL_WORLD_ALIGNED).linear
+    return out
+
+
+@pytest.mark.parametrize("robot", ["panda", "ur5", "z1", "kinova", "xarm7"])
+def test_the_vectorised_accelerations_are_pinocchios(robot):
+    arm = load_arm(robot)
+    rng = np.random.default_rng(5)
+    q = rng.uniform(arm.lower, arm.upper, (300, arm.n))
+    qd, qdd = rng.normal(0, 2, (300, arm.n)), rng.normal(0, 10, (300, arm.n))
+    fast = arm.accelerations(q, qd, qdd)
+    assert fast is not None
+    want = _pinocchio_accelerations(arm, q, qd, qdd)
+    assert np.abs(fast - want).max() <= 1e-10 * max(1.0, np.abs(want).max())
+
+
+def test_a_turn_about_any_axis_is_rodrigues():
+    from scipy.spatial.transform import Rotation
+
+    from aou_dsl.kinematics import _rotate
+
+    rng = np.random.default_rng(8)
+    base = Rotation.random(50, random_state=1).as_matrix()  # (N, 3, 3)
+    angle = rng.uniform(-3, 3, 50)
+    for axis in (np.array([0.0, 0.0, 1.0]), np.array([0.0, -1.0, 0.0]),
+                 np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])):
+        want = base @ Rotation.from_rotvec(axis * angle[:, None]).as_matrix()
+        cols = np.ascontiguousarray(base.transpose(2, 1, 0))  # cols[k, i] = row i of col k
+        got = _rotate(cols, axis, angle).transpose(2, 1, 0)
+        assert np.abs(got - want).max() < 1e-12
+
+
+def test_the_cartesian_peak_is_pinocchios_peak_over_every_instant():
+    """The compiler computes every instant at once and only the top ones by Pinocchio:
+    the peak is the one Pinocchio finds at every instant, bit for bit."""
+    from aou_dsl.compiler.pipeline import compile_behaviour
+    from aou_dsl.compiler.timing import PEAK_RATE, PathSegment, cartesian_peak
+    from aou_dsl.linter import lint_file
+
+    for name in ("hesitant", "confident"):
+        lint = lint_file(str(BEHAVIOURS / f"{name}.aou"))
+        res = compile_behaviour(lint.behaviour, timeline=lint.timeline)
+        arm = load_arm(lint.behaviour.settings.robot)
+        segs = [s for s in res.segments if isinstance(s, PathSegment)]
+        assert segs
+        for seg in segs:
+            n = max(100, math.ceil(seg.duration * PEAK_RATE) + 1)
+            acc = _pinocchio_accelerations(arm, *seg.sample(np.linspace(0, seg.duration, n)))
+            want = max(0.0, *(float(np.linalg.norm(a)) for a in acc))
+            assert cartesian_peak(arm, seg) == want
+
+
+def test_the_joint_limit_bound_never_passes_a_segment_that_overshoots():
+    """The timing stage skips its dense joint-limit check where a bound over the whole
+    path is within the limits: on the shipped motions under ever tighter limits, every
+    segment the bound passes is within them at the check's instants."""
+    from dataclasses import replace
+
+    from aou_dsl.compiler.peaks import limit_ratios, within_limits
+    from aou_dsl.compiler.pipeline import compile_behaviour
+    from aou_dsl.compiler.timing import PathSegment
+    from aou_dsl.linter import lint_file
+
+    passed = over = 0
+    for path in sorted(BEHAVIOURS.glob("*.aou")):
+        lint = lint_file(str(path))
+        res = compile_behaviour(lint.behaviour, timeline=lint.timeline)
+        arm = load_arm(lint.behaviour.settings.robot)
+        for scale in (1.0, 0.3, 0.15, 0.1):
+            tight = replace(arm, vmax=arm.vmax * scale, amax=arm.amax * scale * scale)
+            for seg in res.segments:
+                if not isinstance(seg, PathSegment):
+                    continue
+                rv, ra = limit_ratios(tight, seg)
+                if within_limits(tight, seg):
+                    passed += 1
+                    assert rv.max() <= 1.0 and ra.max() <= 1.0
+                over += bool(rv.max() > 1.0 or ra.max() > 1.0)
+    assert passed > 10 and over > 10  # both cases were seen
+
+
+def test_the_lean_toppra_gives_the_stock_law():
+    """Random joint paths, limits that bind and limits that do not: every array of the
+    parametrisation is the stock TOPPRA's, bit for bit."""
+    from aou_dsl.compiler import topp
+
+    toppra = topp._import_toppra()
+    rng = np.random.default_rng(2)
+    arm = load_arm("panda")
+    for k in range(8):
+        s_way = np.linspace(0.0, rng.uniform(0.02, 0.3), rng.integers(8, 40))
+        q_way = arm.lower * 0.3 + np.cumsum(rng.normal(0, 0.02, (len(s_way), arm.n)), axis=0)
+        a, vmax = rng.uniform(0.02, 3.0), rng.uniform(0.05, 0.5)
+        jv, ja = arm.plan_vmax * (0.05 if k % 3 == 0 else 1.0), arm.plan_amax
+        path = toppra.SplineInterpolator(s_way, np.column_stack([q_way, s_way]))
+        grid = topp.grid(s_way, 80, a, vmax)
+        outs = []
+        for cls in (toppra.algorithm.TOPPRA, topp._lean_toppra()):
+            inst = cls(list(topp._constraints(tuple(jv), tuple(ja), a, vmax)), path,
+                       gridpoints=grid, solver_wrapper="seidel")
+            outs.append(inst.compute_parameterization(0.0, 0.0, return_data=True))
+        for stock, lean in zip(*outs, strict=True):
+            assert np.array_equal(stock, lean, equal_nan=True)
 
 
 # --- lint: long files, the cap on diagnostics, the parser's cache ---------------------------

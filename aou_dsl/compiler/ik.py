@@ -10,6 +10,7 @@ stays a margin inside the joint limits.
 from __future__ import annotations
 
 import enum
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -86,40 +87,77 @@ class _Solver:
         self.lo = arm.lower + margin
         self.hi = arm.upper - margin
         self.posture = np.clip(np.array(arm.spec.posture), self.lo, self.hi)
+        self.eye_n = np.eye(arm.n)
+        # LAPACK's routines as numpy.linalg calls them (the same numbers), without the
+        # checks of each call: its matrices here are small, finite and well formed.
+        self.lapack = _Lapack()
 
     def solve(self, p: np.ndarray, r: np.ndarray, q0: np.ndarray
               ) -> tuple[np.ndarray, float, float, float]:
         """One target from ``q0``: returns q, position error, rotation error, and the
         smallest singular value of the Jacobian at the solution."""
+        q, pe, re, jac = self._newton(self.pin.SE3(r, p), q0.copy())
+        if not math.isfinite(jac.sum()):  # a NaN or an infinity in it
+            return q, np.inf, np.inf, 0.0  # diverged: the caller reports it unreachable
+        return q, pe, re, float(self.lapack.svd(jac, signature="d->d")[-1])
+
+    def _newton(self, target, q: np.ndarray) -> tuple[np.ndarray, float, float, np.ndarray]:
         pin = self.pin
-        target = pin.SE3(r, p)
-        q = q0.copy()
-        n = len(q)
         fid = self.arm.frame_id
-        eye6 = np.eye(6)
+        model, data, lo, hi = self.model, self.data, self.lo, self.hi
         for it in range(MAX_ITER + 1):
             # One pass: forward kinematics and every joint's Jacobian; then the frame's
             # placement and Jacobian from them.
-            pin.computeJointJacobians(self.model, self.data, q)
-            dm = pin.updateFramePlacement(self.model, self.data, fid).actInv(target)
-            jac = pin.getFrameJacobian(self.model, self.data, fid, pin.LOCAL)
+            pin.computeJointJacobians(model, data, q)
+            dm = pin.updateFramePlacement(model, data, fid).actInv(target)
+            jac = pin.getFrameJacobian(model, data, fid, pin.LOCAL)
             err = pin.log6(dm).vector
-            pe, re = float(np.linalg.norm(err[:3])), float(np.linalg.norm(err[3:]))
+            ep, er = err[:3], err[3:]
+            pe, re = math.sqrt(ep.dot(ep)), math.sqrt(er.dot(er))  # their norms
             if (pe < POS_TOL and re < ROT_TOL) or it == MAX_ITER:
                 break
             je = -pin.Jlog6(dm.inverse()) @ jac
-            pinv = je.T @ np.linalg.solve(je @ je.T + DAMPING * eye6, eye6)
+            # The damped pseudo-inverse (the matrix is positive definite: damped).
+            pinv = je.T @ self.lapack.solve(je @ je.T + _DAMPED, _EYE6,
+                                            signature="dd->d")
             dq = -pinv @ err
             if it < POSTURE_ITERS:
-                dq += (np.eye(n) - pinv @ je) @ (POSTURE_GAIN * (self.posture - q))
-            step = np.max(np.abs(dq))
+                dq += (self.eye_n - pinv @ je) @ (POSTURE_GAIN * (self.posture - q))
+            step = float(np.abs(dq).max())
             if step > MAX_ITER_STEP:  # far from the target: Newton steps overshoot
                 dq *= MAX_ITER_STEP / step
-            q = np.clip(q + dq, self.lo, self.hi)
-        if not np.all(np.isfinite(jac)):
-            return q, np.inf, np.inf, 0.0  # diverged: the caller reports it unreachable
-        sigma = float(np.linalg.svd(jac, compute_uv=False)[-1])
-        return q, pe, re, sigma
+            q = np.minimum(np.maximum(q + dq, lo), hi)
+        return q, pe, re, jac
+
+
+_EYE6 = np.eye(6)
+_DAMPED = DAMPING * _EYE6
+
+
+class _Lapack:
+    """numpy.linalg's LAPACK calls, one call each: ``solve(a, b)`` and the singular
+    values ``svd(a)`` (descending). Another numpy than 2.x: its public functions."""
+
+    def __init__(self):
+        self.solve = lambda a, b, signature=None: np.linalg.solve(a, b)
+        self.svd = lambda a, signature=None: np.linalg.svd(a, compute_uv=False)
+        raw = getattr(np.linalg, "_umath_linalg", None)
+        if raw is not None and _same_as_public(raw):
+            self.solve, self.svd = raw.solve, raw.svd
+
+
+def _same_as_public(raw) -> bool:
+    """Whether numpy's internal calls give what its public functions give, on a sample
+    (an internal interface may change between numpy versions)."""
+    a = np.array([[4.0, 1.0, 0.5], [1.0, 3.0, 0.2], [0.5, 0.2, 2.0]])
+    b = np.eye(3)
+    j = np.arange(18.0).reshape(3, 6) % 5 + np.eye(3, 6)
+    try:
+        return bool(np.array_equal(raw.solve(a, b, signature="dd->d"), np.linalg.solve(a, b))
+                    and np.array_equal(raw.svd(j, signature="d->d"),
+                                       np.linalg.svd(j, compute_uv=False)))
+    except (AttributeError, TypeError, ValueError):
+        return False
 
 
 def _seed(solver: _Solver, p: np.ndarray, r: np.ndarray) -> np.ndarray:
@@ -157,12 +195,12 @@ def solve_path(arm: ArmModel, targets: list[tuple[np.ndarray, np.ndarray]],
     out = np.empty((len(targets), arm.n))
     worst_p = worst_r = 0.0
     for i, (p, r) in enumerate(targets):
-        if not (np.all(np.isfinite(p)) and np.all(np.isfinite(r))):
+        if not (np.isfinite(p).all() and np.isfinite(r).all()):
             return IKResult(out[:i], worst_p, worst_r,
                             IKFailure(IKStatus.UNREACHABLE, i, np.inf, np.inf))
         q_new, pe, re, sigma = solver.solve(p, r, q)
         failure = None
-        if not (np.all(np.isfinite(q_new)) and np.isfinite(pe) and np.isfinite(re)):
+        if not (np.isfinite(q_new).all() and math.isfinite(pe) and math.isfinite(re)):
             failure = IKFailure(IKStatus.UNREACHABLE, i, np.inf, np.inf)
         elif pe > 1e-4 or re > 1e-3:
             at_limit = (q_new <= solver.lo + 1e-9) | (q_new >= solver.hi - 1e-9)
@@ -173,7 +211,7 @@ def solve_path(arm: ArmModel, targets: list[tuple[np.ndarray, np.ndarray]],
                 failure = IKFailure(IKStatus.UNREACHABLE, i, pe, re)
         elif sigma < MIN_SINGULAR:
             failure = IKFailure(IKStatus.SINGULARITY, i, pe, re)
-        elif i > 0 and np.max(np.abs(q_new - q)) > MAX_STEP:
+        elif i > 0 and np.abs(q_new - q).max() > MAX_STEP:
             j = arm.joint_names[int(np.argmax(np.abs(q_new - q)))]
             failure = IKFailure(IKStatus.DISCONTINUITY, i, pe, re, j)
         if failure is not None:

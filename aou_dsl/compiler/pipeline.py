@@ -39,6 +39,7 @@ __all__ = [
     "CompileResult",
     "compile_behaviour",
     "evaluate",
+    "positions",
     "sample",
     "target_path",
 ]
@@ -268,22 +269,41 @@ def evaluate(res: CompileResult, t: np.ndarray
     if res.trajectory is None or not res.segments:
         raise AouError(diag("C305", "the compilation failed: there is nothing to sample",
                             res.behaviour.span))
-    return _evaluate(res.segments, np.asarray(t, dtype=float))
+    q, qd, qdd = _evaluate(res.segments, np.asarray(t, dtype=float))
+    return q, qd, qdd
 
 
-def _evaluate(segments: list[PathSegment | JointSegment], t: np.ndarray
-              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def positions(res: CompileResult, t: np.ndarray) -> np.ndarray:
+    """Joint positions of the compiled motion at any times ``t`` [s], shape (N,): (N, n);
+    the same as ``evaluate(res, t)[0]``, without the velocities and accelerations (a
+    controller's view of the motion reads positions only)."""
+    if res.trajectory is None or not res.segments:
+        raise AouError(diag("C305", "the compilation failed: there is nothing to sample",
+                            res.behaviour.span))
+    return _evaluate(res.segments, np.asarray(t, dtype=float), positions=True)[0]
+
+
+def _evaluate(segments: list[PathSegment | JointSegment], t: np.ndarray,
+              positions: bool = False) -> tuple[np.ndarray, ...]:
+    """``q, qd, qdd`` at times ``t`` (``q`` alone with ``positions``)."""
     bounds = np.concatenate([[0.0], np.cumsum([s.duration for s in segments])])
     n = segments[0].sample(np.zeros(1))[0].shape[1]
-    q = np.empty((len(t), n))
-    qd = np.empty_like(q)
-    qdd = np.empty_like(q)
+    out = tuple(np.empty((len(t), n)) for _ in range(1 if positions else 3))
     idx = np.clip(np.searchsorted(bounds, t, side="right") - 1, 0, len(segments) - 1)
-    for k, seg in enumerate(segments):
-        m = idx == k
-        if m.any():
-            q[m], qd[m], qdd[m] = seg.sample(t[m] - bounds[k])
-    return q, qd, qdd
+    if len(t) > 1 and np.all(t[1:] >= t[:-1]):  # a clock: each segment's times in a row
+        ends = np.searchsorted(idx, np.arange(len(segments) + 1), side="left")
+        parts: list = [slice(ends[k], ends[k + 1]) for k in range(len(segments))]
+    else:
+        parts = [idx == k for k in range(len(segments))]
+    for k, (seg, m) in enumerate(zip(segments, parts, strict=True)):
+        tau = t[m] - bounds[k]
+        if len(tau) == 0:
+            continue
+        if positions:
+            out[0][m] = seg.positions(tau)
+        else:
+            out[0][m], out[1][m], out[2][m] = seg.sample(tau)
+    return out
 
 
 def _sample(arm: ArmModel, b: Behaviour, tl: Timeline,

@@ -139,8 +139,11 @@ class SmoothLaw:
         ``s'''`` is piecewise constant between :meth:`breakpoints`."""
         tau = np.clip(np.asarray(tau, dtype=float), 0.0, self.duration)
         w = self.window
-        s1, sd1, u1, a1 = self.base.state(tau)
-        s0, sd0, u0, a0 = self.base.state(tau - w)
+        n = len(tau) if tau.ndim else 1
+        # The base law at both ends of the window, in one pass.
+        both = self.base.state(np.concatenate([tau.reshape(-1), tau.reshape(-1) - w]))
+        (s1, sd1, u1, a1), (s0, sd0, u0, a0) = ([x[:n].reshape(tau.shape) for x in both],
+                                                [x[n:].reshape(tau.shape) for x in both])
         s = np.where(tau >= self.duration, self.base.length, (a1 - a0) / w)
         return s, (s1 - s0) / w, (sd1 - sd0) / w, (u1 - u0) / w
 

@@ -31,17 +31,28 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..kinematics import ArmModel
+from .peaks import (
+    JERK_SCALE,
+    PEAK_RATE,
+    binding_joint,
+    cartesian_peak,
+    jerk_ratio,
+    limit_ratios,
+    within_limits,
+)
 from .timelaw import SmoothLaw, TimeLaw
 from .topp import parametrize
 
 __all__ = [
     "JERK_SCALE",
+    "PEAK_RATE",
     "JointSegment",
     "PathSegment",
     "SmoothLaw",
     "TimeLaw",
     "TimingFailure",
     "binding_joint",
+    "cartesian_peak",
     "fixed_segment",
     "jerk_ratio",
     "limit_ratios",
@@ -51,9 +62,6 @@ __all__ = [
 
 #: Relative slack when checking a result against a limit.
 LIMIT_SLACK = 1e-3
-#: Fraction of the joint jerk limits the time laws are planned with (the checks hold the
-#: trajectory to the full limits).
-JERK_SCALE = 0.9
 #: Shortest smoothing window [s]: two periods of a 1 kHz controller.
 MIN_WINDOW = 2e-3
 #: A time law reaches its declared acceleration when its peak is at least this fraction
@@ -66,16 +74,21 @@ class PathSegment:
     """A timed joint path: ``q(t) = path(s(t))``, shape (n,) per sample.
 
     ``spline`` may have more columns than joints (TOPP-RA's path carries the virtual
-    coordinate last); only the first ``n`` are the joints. ``law`` is a
+    coordinate last); only the first ``n``, the joints, are kept. ``law`` is a
     :class:`~.timelaw.TimeLaw` or a :class:`~.timelaw.SmoothLaw`.
     """
 
     def __init__(self, s_way: np.ndarray, q_way: np.ndarray, law: TimeLaw | SmoothLaw,
                  spline=None):
-        from scipy.interpolate import CubicSpline
+        from scipy.interpolate import CubicSpline, PPoly
 
-        self.n = q_way.shape[1]
-        self.spline = CubicSpline(s_way, q_way, axis=0) if spline is None else spline
+        self.n = n = q_way.shape[1]
+        if spline is None:
+            spline = CubicSpline(s_way, q_way, axis=0)
+        elif spline.c.shape[-1] != n:  # the joints' columns only (each is its own cubic)
+            spline = PPoly.construct_fast(np.ascontiguousarray(spline.c[..., :n]), spline.x,
+                                          spline.extrapolate)
+        self.spline = spline
         self.d1 = self.spline.derivative(1)
         self.d2 = self.spline.derivative(2)
         self.d3 = self.spline.derivative(3)
@@ -95,10 +108,13 @@ class PathSegment:
     def sample(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Joint positions, velocities, accelerations at local times; each (len(tau), n)."""
         s, sd, sdd = self.law(tau)
-        n = self.n
-        qs, qss = self.d1(s)[:, :n], self.d2(s)[:, :n]
-        return (self.spline(s)[:, :n], qs * sd[:, None],
+        qs, qss = self.d1(s), self.d2(s)
+        return (self.spline(s), qs * sd[:, None],
                 qss * (sd * sd)[:, None] + qs * sdd[:, None])
+
+    def positions(self, tau: np.ndarray) -> np.ndarray:
+        """Joint positions at local times, (len(tau), n): :meth:`sample`'s first."""
+        return self.spline(self.law(tau)[0])
 
     def jerk(self, tau: np.ndarray) -> np.ndarray:
         """Joint jerks at local times, shape (len(tau), n):
@@ -108,10 +124,8 @@ class PathSegment:
         else:
             s, sd, sdd = self.law(tau)
             sddd = np.zeros_like(s)
-        n = self.n
-        return (self.d3(s)[:, :n] * (sd**3)[:, None]
-                + 3.0 * self.d2(s)[:, :n] * (sd * sdd)[:, None]
-                + self.d1(s)[:, :n] * sddd[:, None])
+        return (self.d3(s) * (sd**3)[:, None] + 3.0 * self.d2(s) * (sd * sdd)[:, None]
+                + self.d1(s) * sddd[:, None])
 
 
 class JointSegment:
@@ -137,6 +151,13 @@ class JointSegment:
             qd[:, self.joint] = xd
             qdd[:, self.joint] = xdd
         return q, qd, qdd
+
+    def positions(self, tau: np.ndarray) -> np.ndarray:
+        """Joint positions at local times, (len(tau), n): :meth:`sample`'s first."""
+        q = np.tile(self.q_hold, (len(tau), 1))
+        if self.amplitude:
+            q[:, self.joint] += _shiver_offset(tau, self.amplitude, self.f, self.duration)[0]
+        return q
 
 
 def _shiver_offset(tau: np.ndarray, amplitude: float, f: float, duration: float
@@ -174,57 +195,6 @@ class TimingFailure:
     joint: str | None
     achieved: float | None = None
     wanted: float | None = None
-
-
-def binding_joint(arm: ArmModel, seg: PathSegment) -> tuple[str, float]:
-    """The joint that comes nearest (or furthest past) its planned velocity or
-    acceleration limit on a segment, and that ratio."""
-    rv, ra = limit_ratios(arm, seg)
-    ratio = np.maximum(rv, ra)
-    j = int(np.argmax(ratio))
-    return arm.joint_names[j], float(ratio[j])
-
-
-#: The Cartesian peak is checked at least this often [Hz] (the default output rate):
-#: between sparser instants a bend of the joint path can overshoot unseen.
-PEAK_RATE = 250.0
-
-
-def cartesian_peak(arm: ArmModel, seg: PathSegment, samples: int = 100) -> float:
-    """Peak translational acceleration of the end-effector on a segment [m/s^2]: the
-    classical acceleration ``J q'' + J' q'`` from Pinocchio, at ``samples`` instants or
-    :data:`PEAK_RATE`, whichever is denser."""
-    import pinocchio as pin
-
-    model, data = arm.model, arm.model.createData()
-    n = max(samples, int(math.ceil(seg.duration * PEAK_RATE)) + 1)
-    q, qd, qdd = seg.sample(np.linspace(0.0, seg.duration, n))
-    peak = 0.0
-    for qi, vi, ai in zip(q, qd, qdd, strict=True):
-        pin.forwardKinematics(model, data, qi, vi, ai)
-        pin.updateFramePlacements(model, data)
-        acc = pin.getFrameClassicalAcceleration(model, data, arm.frame_id,
-                                                pin.LOCAL_WORLD_ALIGNED).linear
-        peak = max(peak, float(np.linalg.norm(acc)))
-    return peak
-
-
-def limit_ratios(arm: ArmModel, seg: PathSegment, samples: int = 1500
-                  ) -> tuple[np.ndarray, np.ndarray]:
-    """Per joint, the largest velocity and acceleration over the planned limits on a
-    segment sampled densely (finer than any output rate); shapes (n,)."""
-    tau = np.linspace(0.0, seg.duration, samples)
-    _, qd, qdd = seg.sample(tau)
-    return (np.abs(qd).max(axis=0) / arm.plan_vmax, np.abs(qdd).max(axis=0) / arm.plan_amax)
-
-
-def jerk_ratio(arm: ArmModel, seg: PathSegment) -> float:
-    """The largest joint jerk over the planned jerk limits (``JERK_SCALE`` of the
-    robot's) on a segment, seen at every piece of its smoothed law."""
-    law = seg.law
-    tau = (law.probe_times() if isinstance(law, SmoothLaw)
-           else np.linspace(0.0, seg.duration, 1500))
-    return float(np.max(np.abs(seg.jerk(tau)) / (arm.jmax * JERK_SCALE)))
 
 
 def _smoothed(arm: ArmModel, make: Callable[[float], PathSegment], first: float,
@@ -325,9 +295,10 @@ def time_path(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vma
                 retime = True
         # TOPP-RA meets the joint limits at its grid points; between them a sharp bend
         # of the joint path (the null space turning a joint fast) can overshoot. Check
-        # densely, and lower the limit of a joint that overshoots by its overshoot.
-        rv, ra = limit_ratios(arm, seg)
-        if rv.max() > 1.0 + LIMIT_SLACK or ra.max() > 1.0 + LIMIT_SLACK:
+        # densely (unless a bound over the whole path rules it out), and lower the limit
+        # of a joint that overshoots by its overshoot.
+        rv, ra = (1.0, 1.0) if within_limits(arm, seg) else limit_ratios(arm, seg)
+        if np.max(rv) > 1.0 + LIMIT_SLACK or np.max(ra) > 1.0 + LIMIT_SLACK:
             jv = jv / np.maximum(rv, 1.0)
             ja = ja / np.maximum(ra, 1.0)
             retime = True

@@ -13,6 +13,7 @@ import importlib
 import logging
 import sys
 import types
+from typing import Any
 
 import numpy as np
 
@@ -37,8 +38,8 @@ def _import_toppra():
     are removed right after, so a later ``import matplotlib`` (``aouc plot``) is the real
     one, and toppra's own reference imports it only if it is ever used.
     """
-    if "toppra" in sys.modules:
-        return sys.modules["toppra"]
+    if _READY:
+        return _READY[0]
     stubs: dict[str, types.ModuleType] = {}
     if "matplotlib" not in sys.modules:
         stubs["matplotlib"] = _LazyModule("matplotlib")
@@ -53,7 +54,18 @@ def _import_toppra():
         for name, stub in stubs.items():
             if sys.modules.get(name) is stub:
                 del sys.modules[name]
+    logging.getLogger("toppra").setLevel(logging.ERROR)
+    # Every TOPP-RA instance asks which solvers are installed, by searching the import
+    # path for two optional packages (a millisecond): the answer cannot change while the
+    # process runs, so it is asked once.
+    wrappers = toppra.solverwrapper
+    available = wrappers.available_solvers(output_msg=False)
+    wrappers.available_solvers = lambda output_msg=True: available
+    _READY.append(toppra)
     return toppra
+
+
+_READY: list = []  # toppra, once imported and prepared
 
 
 @functools.lru_cache(maxsize=256)
@@ -66,6 +78,46 @@ def _constraints(jv: tuple[float, ...], ja: tuple[float, ...], a: float, vmax: f
     alim = np.column_stack([-np.append(ja, a), np.append(ja, a)])
     return (constraint.JointVelocityConstraint(vlim),
             constraint.JointAccelerationConstraint(alim))
+
+
+@functools.cache
+def _lean_toppra():
+    """toppra's ``TOPPRA`` whose two per-stage steps (the backward pass's controllable
+    set, the forward pass's greedy step) skip their per-call allocations and checks: the
+    same solver calls with the same arguments in the same order (the seidel solver
+    warm-starts from its previous call), so the same law to the last bit, about a sixth
+    faster on aou's paths. ``tests/test_speed_props.py`` compares the two."""
+    stock: Any = _import_toppra().algorithm.TOPPRA
+    nan = float("nan")
+
+    class LeanTOPPRA(stock):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            # The linear objectives: the controllable set's upper and lower ends, and
+            # per stage the forward step's (``-2 delta_i u - x``).
+            sw = self.solver_wrapper
+            self._upper = np.zeros(sw.get_no_vars())
+            self._upper[0], self._upper[1] = 1e-9, -1
+            self._lower = -self._upper
+            self._forward = np.zeros((sw.get_no_stages(), sw.get_no_vars()))
+            self._forward[:, 1] = -1
+            self._forward[:, 0] = -2 * sw.get_deltas()
+            self._solve = sw.solve_stagewise_optim
+
+        def _one_step(self, i, K_next):
+            lo, hi = K_next[0], K_next[1]
+            if lo != lo or hi != hi or i < 0 or i > self._N:  # a NaN bound
+                return np.array([nan, nan])
+            x_upper = self._solve(i, None, self._upper, nan, nan, lo, hi)[1]
+            x_lower = self._solve(i, None, self._lower, nan, nan, lo, hi)[1]
+            return np.array([x_lower, x_upper])
+
+        def _forward_step(self, i, x, K_next):
+            if i < 0 or i > self._N or x is None or x != x:
+                return np.array([nan, nan])
+            return self._solve(i, None, self._forward[i], x, x, K_next[0], K_next[1])
+
+    return LeanTOPPRA
 
 
 def grid(s_way: np.ndarray, gridpoints: int, a: float, vmax: float) -> np.ndarray:
@@ -109,12 +161,11 @@ def parametrize(s_way: np.ndarray, q_way: np.ndarray, a: float, vmax: float,
     """
     toppra = _import_toppra()
     algo = toppra.algorithm
-    logging.getLogger("toppra").setLevel(logging.ERROR)
     aug = np.column_stack([q_way, s_way])
     path = toppra.SplineInterpolator(s_way, aug)
     g = grid(s_way, gridpoints, a, vmax)
-    inst = algo.TOPPRA(list(_constraints(tuple(jv), tuple(ja), a, vmax)),
-                       path, gridpoints=g, solver_wrapper="seidel")
+    inst = _lean_toppra()(list(_constraints(tuple(jv), tuple(ja), a, vmax)),
+                          path, gridpoints=g, solver_wrapper="seidel")
     try:
         _, sd, _, _ = inst.compute_parameterization(0.0, 0.0, return_data=True)
     except Exception as exc:  # toppra raises bare exceptions on degenerate input

@@ -31,8 +31,7 @@ from ..kinematics import load_arm
 from ..trajectory import Trajectory
 from .episodes import STILL_TRANSLATION, Context, Piece, pieces, translation
 from .fk import batch_fk
-from .holds import (MIN_PAUSE, REST_SPEED, Boundary, Rest, boundaries, rest_at_end,
-                    rest_signals)
+from .holds import MIN_PAUSE, REST_SPEED, Boundary, Rest, boundaries, rest_at_end, rest_signals
 from .roll import MIN_TILT, Lobe, lobe, roll_angle, rotations
 from .signal import Grid, joint_noise, short_window, smooth, to_grid, unwrap
 

@@ -67,9 +67,11 @@ def _model(urdf: str) -> tuple[frozenset[str], dict[str, tuple[str, ET.Element]]
     return frozenset(el.get("name", "") for el in root.iter("link")), joints
 
 
+@functools.lru_cache(maxsize=64)
 def urdf_chain(urdf: str, frame: str, columns: tuple[str, ...]) -> Chain:
     """The chain from the root to ``frame`` (a link, or a joint: its child link).
     Joints named in ``columns`` move with their column; other joints stay at zero.
+    Made once per file, frame and columns (a replay asks for it every time).
 
     Raises:
         AouError: R402 when the URDF has no such link or joint.

@@ -208,8 +208,8 @@ def _agreement(sweep: Sweep, arm, frame: str, t: np.ndarray, q: np.ndarray
         at = np.array(sorted(sweep.visited))
         pb = sweep.scene.pb
         pb_pos = np.array([sweep.visited[j][0] for j in at])
-        pb_rot = np.array([np.reshape(pb.getMatrixFromQuaternion(sweep.visited[j][1]), (3, 3))
-                           for j in at])
+        pb_rot = np.array([pb.getMatrixFromQuaternion(sweep.visited[j][1])
+                           for j in at]).reshape(-1, 3, 3)
         dp[at] = np.maximum(dp[at], np.linalg.norm(pos[at] - pb_pos, axis=1))
         dr[at] = np.maximum(dr[at], _angles_deg(rot[at], pb_rot))
     worst = int(np.argmax(np.maximum(dp / AGREE_POSITION, dr / AGREE_ROTATION)))
@@ -225,8 +225,11 @@ def _agreement(sweep: Sweep, arm, frame: str, t: np.ndarray, q: np.ndarray
 def _angles_deg(r1: np.ndarray, r2: np.ndarray) -> np.ndarray:
     """The angle between rotations, row by row [deg], accurate for small angles too."""
 
+    # Columns as contiguous rows: a[i, k] is r1[:, k, i] over the rows.
+    a, b = r1.transpose(2, 1, 0).copy(), r2.transpose(2, 1, 0).copy()
+
     def rel(i: int, j: int) -> np.ndarray:  # (r1^T r2)[i, j] for every row
-        return (r1[:, :, i] * r2[:, :, j]).sum(axis=1)
+        return a[i, 0] * b[j, 0] + a[i, 1] * b[j, 1] + a[i, 2] * b[j, 2]
 
     cos = (rel(0, 0) + rel(1, 1) + rel(2, 2) - 1.0) / 2.0
     sin = np.sqrt((rel(2, 1) - rel(1, 2)) ** 2 + (rel(0, 2) - rel(2, 0)) ** 2

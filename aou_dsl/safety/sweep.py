@@ -275,7 +275,10 @@ class Sweep:
         """Put PyBullet's arm at sample ``j``, and note PyBullet's end-effector pose
         there (the replay compares it with its own kinematics)."""
         if j != self.at:
-            set_joints(self.scene, self.scene.arm, self.q[j])
+            scene = self.scene
+            scene.pb.resetJointStatesMultiDof(scene.body, scene.arm,
+                                              [[v] for v in self.q[j].tolist()],
+                                              physicsClientId=scene.client)
             self.at = j
         if self.ee_link is not None and j not in self.visited:
             st = self.scene.pb.getLinkState(self.scene.body, self.ee_link,
@@ -315,7 +318,9 @@ class Sweep:
         before the first, k = last: after the last), and where; only samples that are
         multiples of ``members`` (or the last sample) count."""
         it = self.items[p]
-        cum = self.bound(p)
+        cum = self._bounds[p]
+        if cum is None:
+            cum = self.bound(p)
         last = len(cum) - 1
         if k < 0 or k + 1 >= len(it.js):  # an open end: the bound is lowest at the end
             j, x = (it.js[0], 0) if k < 0 else (it.js[-1], last)
@@ -326,16 +331,18 @@ class Sweep:
         if jb - ja <= 1:
             return None
         da, db = it.ds[k], it.ds[k + 1]
-        meet = (da - db + cum[ja] + cum[jb]) / 2
+        ca, cb = cum[ja], cum[jb]
+        meet = (da - db + ca + cb) / 2
         j = bisect_left(cum, meet, ja, jb + 1)
-        cands: tuple[int, ...] = (j - 1, j)
+        cands: tuple[int, ...] = (j - 1, j)  # the cones meet between j - 1 and j
         if members > 1:
             cands = (min(j // members * members, last), min(-(-j // members) * members, last),
                      (j - 1) // members * members)
         best = None
         for x in cands:
             if ja < x < jb:
-                lb = max(da - (cum[x] - cum[ja]), db - (cum[jb] - cum[x]))
+                cx = cum[x]
+                lb = max(da - (cx - ca), db - (cb - cx))
                 if best is None or lb < best[0]:
                     best = (float(lb), x)
         return best
