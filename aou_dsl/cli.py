@@ -289,6 +289,9 @@ _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    # aou's models use no pydantic plugin: skip reading every installed package's entry
+    # points to look for one (a tenth of a cold `aouc lint`). A user's own setting wins.
+    os.environ.setdefault("PYDANTIC_DISABLE_PLUGINS", "__all__")
     parser, _ = build_parser()
     args = parser.parse_args(argv)
     if args.command is None:

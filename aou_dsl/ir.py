@@ -50,7 +50,7 @@ class Node(BaseModel):
     """An IR node: frozen, unknown fields rejected, spanned. Primitive nodes (one per kind,
     in :mod:`aou_dsl.primitives`) add ``kind`` and ``count``."""
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
+    model_config = ConfigDict(frozen=True, extra="forbid", defer_build=True)
 
     span: Span
     kind: str = ""
@@ -69,7 +69,7 @@ class Effort(Node):
 class Settings(BaseModel):
     """The file's settings with defaults filled in; ``spans`` holds the written ones."""
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
+    model_config = ConfigDict(frozen=True, extra="forbid", defer_build=True)
 
     robot: str = "panda"
     goal: tuple[float, float, float] | None = None  # None: the robot's default
@@ -83,7 +83,7 @@ class Settings(BaseModel):
 class Behaviour(BaseModel):
     """One validated ``.aou`` file."""
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
+    model_config = ConfigDict(frozen=True, extra="forbid", defer_build=True)
 
     name: str
     state: State | None
