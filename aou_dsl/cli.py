@@ -120,10 +120,10 @@ def _cmd_explain(args: argparse.Namespace) -> int:
 
 
 def _cmd_compile(args: argparse.Namespace) -> int:
-    from .compiler.output import output_paths, write_output
+    from .compiler.output import output_paths
     from .diagnostics import has_errors
     from .linter import collect_inputs
-    from .parallel import build_many, default_jobs
+    from .parallel import build_many, default_jobs, write_result
     from .safety.scene import SceneOptions
 
     inputs, problems = collect_inputs(args.paths)
@@ -143,7 +143,8 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     options = {"robot": args.robot, "rate": args.rate, "check": not args.no_check,
                "scene": SceneOptions(**_scene_kw(args)),
                "collision_check": not args.no_collision_check, "controller": args.controller}
-    results = build_many(sources, options, args.jobs or default_jobs(), cluster=args.cluster)
+    results = build_many(sources, options, args.jobs or default_jobs(), cluster=args.cluster,
+                         encode=fmt)  # the workers encode; this process writes bytes
     worst = EXIT_OK
     for k, ((src, _), dest, res) in enumerate(zip(inputs, dests, results, strict=True), 1):
         _print_diags(res.diagnostics, sources={src: res.lint.source or ""})
@@ -152,7 +153,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
             print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)
             continue
         try:
-            write_output(dest, res.document, fmt, inputs=sources)
+            write_result(dest, res, fmt, inputs=sources)
         except AouError as err:
             worst = max(worst, _fail(err))
             continue
@@ -232,17 +233,23 @@ def _render(paths: list[str], output: str, args: argparse.Namespace, read_kw: di
     import time
 
     from .api import read_trajectory
-    from .media.render import Camera, check_output, render_video
+    from .media.render import Camera, check_output, render_video, start_workers
     from .safety.scene import SceneOptions
 
     check_output(output)
     w, h = args.size
     camera = Camera(distance=args.camera_distance, yaw=args.camera_yaw,
                     pitch=args.camera_pitch, target=args.camera_target, width=w, height=h)
-    motions = [read_trajectory(p, **read_kw) for p in paths]
+    workers = start_workers()  # they start while the motions are compiled or read
+    try:
+        motions = [read_trajectory(p, **read_kw) for p in paths]
+    except BaseException:
+        if workers is not None:
+            workers.close()
+        raise
     start = time.perf_counter()
     info = render_video(motions, output, fps=args.fps, camera=camera,
-                        scene_options=SceneOptions(**_scene_kw(args)))
+                        scene_options=SceneOptions(**_scene_kw(args)), workers=workers)
     print(f"wrote {output}: {info['frames']} frames at {info['fps']:g} fps "
           f"({info['duration']:.2f} s), {info['size'][0]}x{info['size'][1]}, rendered in "
           f"{time.perf_counter() - start:.1f} s", file=sys.stderr)

@@ -124,7 +124,7 @@ class ArmModel:
             c_par, w_par, a_par = cols[parent], omega[parent], alpha[parent]
             base = (r_fix.T @ c_par.reshape(3, -1)).reshape(3, 3, n)
             z = _times(base, axis)  # the joint's axis in the base frame
-            cols[i] = _rotate(base, axis, q[iq])
+            cols[i] = rotate_columns(base, axis, q[iq])
             zd, zdd = z * qd[iq], z * qdd[iq]
             if w_par is None:  # on the base: the joint's origin does not move
                 acc[i], omega[i], alpha[i] = acc[parent], zd, zdd
@@ -165,8 +165,9 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
-def _rotate(cols: np.ndarray, axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """``R @ rot(axis, angle)`` for every sample, ``R`` by its columns (3, 3, N)."""
+def rotate_columns(cols: np.ndarray, axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """``R @ rot(axis, angle)`` for every sample, R given by its columns ``cols``
+    (3, 3, N): ``cols[k, i]`` is row i of column k, over the samples."""
     c, s = np.cos(angle), np.sin(angle)
     hit = np.flatnonzero(np.abs(axis) == 1.0)
     if len(hit) == 1:  # about a coordinate axis: two columns change

@@ -8,7 +8,14 @@ order of the inputs, whatever order they finish in; each result is the one
 - ``jobs=1``: one file after another, in this process.
 - ``jobs=N``: a pool of N worker processes (:class:`BuildPool`), started once and kept
   warm (the compiler, the checks and the measurement imported, the default robot
-  loaded, before the first file), each given the next file as it finishes one.
+  loaded, before the first file). This process lints the files (a millisecond each)
+  and hands them out a window at a time, the longest motions first, so that no worker
+  idles at the end while another builds a long one.
+
+The parent's own share is what caps the speed-up, so it is kept small: a document's
+samples come back as the trajectory's arrays (one buffer each, not a float at a time),
+and with ``encode=`` the workers also encode the documents, so that writing them
+(:func:`write_result`) is copying bytes.
 - ``cluster=``: a ``distributed.Client`` or a scheduler address (``"tcp://host:8786"``);
   the files are read here and their text sent, so the workers need aou (the same
   version) but not the inputs. A robot file a behaviour names must exist at the same
@@ -20,7 +27,6 @@ Dask is imported only when a cluster is given (the optional extra ``cluster``).
 from __future__ import annotations
 
 import os
-from collections import deque
 from collections.abc import Iterable, Iterator
 from typing import TYPE_CHECKING, Any
 
@@ -28,12 +34,14 @@ from .diagnostics import AouError
 
 if TYPE_CHECKING:
     from .build import BuildResult
+    from .linter import FileResult
 
-__all__ = ["BuildPool", "build_many", "build_text", "default_jobs", "warm"]
+__all__ = ["BuildPool", "build_many", "build_text", "default_jobs", "encoded", "warm",
+           "write_result"]
 
-#: Files handed to the pool ahead of the one being yielded, per worker: enough to keep
-#: every worker busy, few enough that results waiting their turn stay few.
-_AHEAD = 4
+#: Files linted and handed out at once, per worker, the longest motions first: a
+#: short file last keeps no core idle at the end while another builds a long one.
+_WINDOW = 8
 #: How long a pool waits for its workers to warm up before it hands out files [s].
 _START_TIMEOUT = 120.0
 
@@ -47,8 +55,8 @@ def default_jobs() -> int:
 
 
 def build_many(paths: Iterable[str], options: dict[str, Any] | None = None, jobs: int = 1,
-               *, cluster: Any = None, pool: BuildPool | None = None
-               ) -> Iterator[BuildResult]:
+               *, cluster: Any = None, pool: BuildPool | None = None,
+               encode: str | None = None) -> Iterator[BuildResult]:
     """Build every path with ``build_file(path, **options)``; results in input order.
 
     Args:
@@ -59,41 +67,131 @@ def build_many(paths: Iterable[str], options: dict[str, Any] | None = None, jobs
         cluster: a ``distributed.Client`` or a scheduler address; then ``jobs`` is
             ignored and the cluster's workers build.
         pool: a :class:`BuildPool` to use (kept open) instead of starting one.
+        encode: a file format (``json``, ``csv``, ``npz``, ``yaml``): the workers also
+            encode each document in it, for :func:`write_result` (the writing that is
+            left to this process is then copying bytes).
     """
     paths = list(paths)
     opts = dict(options or {})
     if cluster is not None:
-        yield from _on_cluster(paths, opts, cluster)
+        yield from _on_cluster(paths, opts, cluster, encode)
     elif pool is not None:
-        yield from pool.map(paths, opts)
+        yield from pool.map(paths, opts, encode=encode)
     elif jobs <= 1 or len(paths) <= 1:
         from .build import build_file
 
         for p in paths:
             yield build_file(p, **opts)
     else:
-        with BuildPool(min(jobs, len(paths))) as own:
-            yield from own.map(paths, opts)
+        robot = opts.get("robot")
+        with BuildPool(min(jobs, len(paths)), robots=(robot or "panda",)) as own:
+            yield from own.map(paths, opts, encode=encode)
 
 
-def _read(path: str) -> tuple[str | None, BuildResult | None]:
-    """The file's text, or (when it cannot be read) its finished result."""
-    from .build import build_lint
-    from .linter import FileResult, read_source
-
-    try:
-        return read_source(path), None
-    except AouError as err:
-        return None, build_lint(FileResult(path, err.diagnostics))
-
-
-def build_text(text: str, path: str, options: dict[str, Any]) -> BuildResult:
+def build_text(text: str, path: str, options: dict[str, Any], encode: str | None = None
+               ) -> BuildResult:
     """One build, in a worker: the same as ``build_file(path)`` of a file holding
-    ``text``."""
+    ``text`` (and its document encoded in ``encode``, see :func:`encoded`)."""
     from .build import build_source
 
-    return build_source(text, path, **options)
+    return _pack(build_source(text, path, **options), encode)
 
+
+def _build_linted(lint: FileResult, options: dict[str, Any], encode: str | None
+                  ) -> BuildResult:
+    """One build of a file the parent has linted (``build_lint`` of it)."""
+    from .build import build_lint
+
+    return _pack(build_lint(lint, **options), encode)
+
+
+# --- what goes back to the parent --------------------------------------------------------
+
+#: The attribute a worker puts the encoded document in: ``(format, bytes)``.
+_ENCODED = "_encoded"
+#: The document's samples: the compiled trajectory's arrays as lists, which the result
+#: also holds as arrays (``compiled.trajectory``).
+_SAMPLES = ("t", "q", "qd", "qdd")
+
+
+class _Samples:
+    """Stands in, on the way back, for a document's list of samples: lists pickle float
+    by float, which made reading the results back most of the parent's work; they are
+    made again here from the trajectory's arrays, which travel as raw bytes."""
+
+
+def _pack(res: BuildResult, encode: str | None) -> BuildResult:
+    """In the worker: the result ready to go back; its document also encoded in
+    ``encode`` when asked (a byte format), so that the parent only writes bytes."""
+    doc = res.document
+    if doc is None or res.compiled is None or res.compiled.trajectory is None:
+        return res
+    if encode is not None:
+        from .compiler.output import FOLDER_FORMATS
+        from .compiler.output import encode as encode_doc
+
+        if encode not in FOLDER_FORMATS:
+            setattr(res, _ENCODED, (encode, encode_doc(doc, encode)))
+    res.document = {k: _Samples() if k in _SAMPLES else v for k, v in doc.items()}
+    return res
+
+
+def _unpack(res: BuildResult) -> BuildResult:
+    """In the parent: the document as the build made it (``trajectory_document`` lists
+    the trajectory's arrays; the tests hold the two ways to the same bytes)."""
+    doc = res.document
+    if doc is None or res.compiled is None or res.compiled.trajectory is None:
+        return res
+    import gc
+
+    tr = res.compiled.trajectory
+    # Tens of thousands of lists of floats, which cannot form cycles: the garbage
+    # collector, left on, would walk everything this process holds every few hundred of
+    # them (more than half of the parent's work, measured).
+    collecting = gc.isenabled()
+    gc.disable()
+    try:
+        res.document = {k: getattr(tr, k).tolist() if isinstance(v, _Samples) else v
+                        for k, v in doc.items()}
+    finally:
+        if collecting:
+            gc.enable()
+    return res
+
+
+def encoded(res: BuildResult, fmt: str) -> bytes:
+    """The bytes of ``res.document`` in ``fmt`` (a byte format): those a worker encoded
+    (``build_many(..., encode=fmt)``), else encoded here."""
+    from .compiler.output import encode
+
+    done = getattr(res, _ENCODED, None)
+    if done is not None and done[0] == fmt:
+        return done[1]
+    if res.document is None:
+        raise ValueError(f"{res.path}: the build failed, there is no document")
+    return encode(res.document, fmt)
+
+
+def write_result(path: str, res: BuildResult, fmt: str, *, inputs: list[str] | tuple = ()
+                 ) -> None:
+    """``write_output(path, res.document, fmt, inputs=inputs)`` of a successful build,
+    with the bytes a worker encoded when there are some.
+
+    Raises:
+        AouError: I502 when it cannot be written.
+    """
+    from .compiler.output import FOLDER_FORMATS, write_output
+    from .files import write_atomic
+
+    if fmt not in FOLDER_FORMATS:
+        write_atomic(path, encoded(res, fmt), inputs=inputs)
+    elif res.document is None:
+        raise ValueError(f"{res.path}: the build failed, there is no document")
+    else:
+        write_output(path, res.document, fmt, inputs=inputs)
+
+
+# --- the pool -----------------------------------------------------------------------------
 
 #: A small behaviour built once by each worker before its first file: the parser, the
 #: robot, the compiler's caches, the checks' scene and the measurement all warm.
@@ -116,6 +214,11 @@ def _start(robots: tuple[str, ...], ready) -> None:
         warm(robots)
     finally:
         ready.wait()
+
+
+def _cost(lint: FileResult) -> float:
+    """How long a linted file's build will take, roughly: its planned motion [s]."""
+    return lint.timeline.planned_duration if lint.timeline is not None else 0.0
 
 
 class BuildPool:
@@ -146,24 +249,46 @@ class BuildPool:
         except threading.BrokenBarrierError:  # a slow or failed start: go on regardless
             pass
 
-    def map(self, paths: Iterable[str], options: dict[str, Any] | None = None
-            ) -> Iterator[BuildResult]:
-        """``build_file(path, **options)`` of every path, in input order."""
+    def map(self, paths: Iterable[str], options: dict[str, Any] | None = None, *,
+            encode: str | None = None) -> Iterator[BuildResult]:
+        """``build_file(path, **options)`` of every path, in input order.
+
+        The files are linted here (a millisecond each), a window at a time; a file lint
+        refuses is finished here, the others are handed out longest motion first, the
+        next window while this one is built, so no worker waits between windows.
+        """
         from concurrent.futures import Future
 
         opts = dict(options or {})
-        pending: deque[BuildResult | Future] = deque()
         todo = iter(paths)
-        for p in todo:
-            pending.append(_submit(self._pool, p, opts))
-            if len(pending) >= self.jobs * _AHEAD:
-                break
-        while pending:
-            head = pending.popleft()
-            yield head.result() if isinstance(head, Future) else head
-            for p in todo:
-                pending.append(_submit(self._pool, p, opts))
-                break
+        size = _WINDOW * self.jobs
+        current = self._window(todo, size, opts, encode)
+        while current:
+            upcoming = self._window(todo, size, opts, encode)
+            for got in current:
+                yield _unpack(got.result()) if isinstance(got, Future) else got
+            current = upcoming
+
+    def _window(self, todo: Iterator[str], size: int, options: dict[str, Any],
+                encode: str | None) -> list:
+        """The next ``size`` paths, each a finished result or a submitted build."""
+        from .build import build_lint
+        from .linter import lint_file
+
+        lints = [lint_file(p) for _, p in zip(range(size), todo, strict=False)]
+        out: list = [None] * len(lints)
+        for k in sorted(range(len(lints)), key=lambda k: -_cost(lints[k])):
+            lint = lints[k]
+            if lint.behaviour is None or lint.timeline is None or lint.cv is None:
+                out[k] = build_lint(lint, **options)  # refused: nothing to compile
+            else:
+                out[k] = self._pool.submit(_build_linted, lint, options, encode)
+        return out
+
+    @property
+    def pids(self) -> list[int]:
+        """The workers' process ids (to measure the CPU time they use)."""
+        return sorted(self._pool._processes or {})  # type: ignore[attr-defined]
 
     def close(self) -> None:
         self._pool.shutdown(wait=True, cancel_futures=True)
@@ -175,27 +300,28 @@ class BuildPool:
         self.close()
 
 
-def _submit(pool, path: str, options: dict[str, Any]):
-    text, done = _read(path)
-    return done if done is not None else pool.submit(build_text, text, path, options)
-
-
-def _on_cluster(paths: list[str], options: dict[str, Any], cluster: Any
-                ) -> Iterator[BuildResult]:
+def _on_cluster(paths: list[str], options: dict[str, Any], cluster: Any,
+                encode: str | None) -> Iterator[BuildResult]:
     try:
         from distributed import Client, Future
     except ImportError:  # pragma: no cover - the extra is installed with the tests
         raise ImportError("building on a cluster needs Dask distributed: "
                           "pip install 'aou-dsl[cluster]'") from None
+    from .build import build_lint
+    from .linter import FileResult, read_source
+
     client = cluster if isinstance(cluster, Client) else Client(cluster)
     try:
-        futures = []
+        futures: list = []
         for p in paths:
-            text, done = _read(p)
-            futures.append(done if done is not None else
-                           client.submit(build_text, text, p, options, pure=False))
+            try:
+                text = read_source(p)
+            except AouError as err:  # I501: it cannot be read
+                futures.append(build_lint(FileResult(p, err.diagnostics)))
+                continue
+            futures.append(client.submit(build_text, text, p, options, encode, pure=False))
         for f in futures:
-            yield f.result() if isinstance(f, Future) else f
+            yield _unpack(f.result()) if isinstance(f, Future) else f
     finally:
         if client is not cluster:
             client.close()

@@ -113,6 +113,44 @@ def test_gif_lasts_the_motion_and_side_by_side_is_two_wide(tmp_path):
     assert total == round(frames * 100 / 30) * 10
 
 
+def test_a_frame_is_pybullets_own_picture_of_the_whole_scene():
+    """The still things (table, target, pedestal) are drawn once and the arm laid over
+    them by depth: each frame is, pixel for pixel, the image PyBullet draws of everything
+    together, at the start, with the hand at its nearest to the target, and with the
+    hand pushed through the table (which must hide it)."""
+    from aou_dsl.media.render import Camera, _Clip, _pedestal, _stage, render_configurations
+    from aou_dsl.safety.scene import Scene, SceneOptions
+
+    tr = build_file(str(BEHAVIOURS / "hesitant.aou"), check=False).trajectory
+    clip, cam, opts = _Clip.of(tr, 30.0), Camera(width=160, height=120), SceneOptions()
+    whole = Scene(tr.robot, clip.goal, opts)
+    _pedestal(whole, clip.goal, opts)
+    pb, st = whole.pb, _stage(tr.robot, clip.goal, opts, cam)
+
+    def drawn_together(q):
+        whole.set_arm(q)
+        rgba = pb.getCameraImage(160, 120, st.view, st.proj, renderer=pb.ER_TINY_RENDERER,
+                                 physicsClientId=whole.client)[2]
+        return np.reshape(np.asarray(rgba, dtype=np.uint8), (120, 160, 4))[:, :, :3]
+
+    def hand(q):
+        whole.set_arm(q)
+        return whole.ee_pose()[0]
+
+    nearest = min(range(len(clip.qs)),
+                  key=lambda k: np.linalg.norm(hand(clip.qs[k]) - clip.goal))
+    through = np.array([0.5, 1.7, 0.0, -0.3, 0.0, 1.0, 0.8])
+    assert hand(through)[2] < -0.03  # below the table
+    qs = np.array([clip.qs[0], clip.qs[nearest], through])
+    try:
+        frames = render_configurations(tr.robot, clip.goal, opts, cam, qs)
+        for frame, q in zip(frames, qs, strict=True):
+            assert np.array_equal(frame, drawn_together(q))
+        assert not np.array_equal(frames[0], frames[1])  # the arm is in the picture
+    finally:
+        whole.close()
+
+
 def test_render_rejects_unknown_formats(tmp_path):
     assert main(["render", str(BEHAVIOURS / "inactive.aou"), "-o",
                  str(tmp_path / "x.avi")]) == EXIT_USAGE

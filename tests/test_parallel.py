@@ -5,7 +5,7 @@ import pytest
 
 from aou_dsl.build import build_file
 from aou_dsl.compiler.output import encode
-from aou_dsl.parallel import BuildPool, build_many
+from aou_dsl.parallel import BuildPool, build_many, encoded, write_result
 
 from .conftest import BEHAVIOURS, INVALID
 
@@ -40,12 +40,22 @@ def test_a_pool_of_workers_gives_what_each_build_alone_gives(alone):
 
 
 @pytest.mark.slow
-def test_a_pool_stays_warm_across_maps(alone):
+def test_a_pool_stays_warm_across_maps(alone, tmp_path):
+    """The second map is longer than one window of files handed out (longest motion
+    first), and has the workers encode the documents: the bytes written are those of
+    encoding the document built alone."""
     with BuildPool(2) as pool:
         first = list(pool.map(INPUTS, OPTIONS))
-        again = list(build_many(INPUTS, OPTIONS, pool=pool))
+        again = list(build_many(INPUTS * 4, OPTIONS, pool=pool, encode="json"))
     _same(first, alone)
-    _same(again, alone)
+    for k in range(4):
+        _same(again[5 * k:5 * k + 5], alone)
+    for k, (got, want) in enumerate(zip(again, alone * 4, strict=True)):
+        if want.document is None:
+            continue
+        assert encoded(got, "json") == encode(want.document, "json")
+        write_result(str(tmp_path / f"{k}.csv"), got, "csv")  # not the format encoded
+        assert (tmp_path / f"{k}.csv").read_bytes() == encode(want.document, "csv")
 
 
 def test_one_job_builds_here_in_order(alone):

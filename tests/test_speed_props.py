@@ -216,7 +216,7 @@ def test_the_vectorised_accelerations_are_pinocchios(robot):
 def test_a_turn_about_any_axis_is_rodrigues():
     from scipy.spatial.transform import Rotation
 
-    from aou_dsl.kinematics import _rotate
+    from aou_dsl.kinematics import rotate_columns as _rotate
 
     rng = np.random.default_rng(8)
     base = Rotation.random(50, random_state=1).as_matrix()  # (N, 3, 3)

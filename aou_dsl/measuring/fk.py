@@ -14,29 +14,11 @@ from typing import Any
 
 import numpy as np
 
-from ..kinematics import ArmModel
+from ..kinematics import ArmModel, rotate_columns
 
 __all__ = ["batch_fk", "classical_acceleration", "linear_jacobian"]
 
 _AXES = {"X": 0, "Y": 1, "Z": 2}
-
-
-def _axis_rotations(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """Rotations about the unit ``axis`` by each ``angle`` (Rodrigues), shape (N, 3, 3)."""
-    x, y, z = axis
-    c, s = np.cos(angle), np.sin(angle)
-    v = 1.0 - c
-    out = np.empty((len(angle), 3, 3))
-    out[:, 0, 0] = c + x * x * v
-    out[:, 0, 1] = x * y * v - z * s
-    out[:, 0, 2] = x * z * v + y * s
-    out[:, 1, 0] = y * x * v + z * s
-    out[:, 1, 1] = c + y * y * v
-    out[:, 1, 2] = y * z * v - x * s
-    out[:, 2, 0] = z * x * v - y * s
-    out[:, 2, 1] = z * y * v + x * s
-    out[:, 2, 2] = c + z * z * v
-    return out
 
 
 def _joint_kind(joint: Any) -> tuple[str, np.ndarray] | None:
@@ -73,25 +55,6 @@ def _chain(arm: ArmModel) -> list[tuple[int, int, str, np.ndarray, np.ndarray, n
     return out
 
 
-def _rotate(cols: np.ndarray, axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """``R @ rot(axis, angle)`` for every sample, R given by its columns ``cols``
-    (3, 3, N): ``cols[k, i]`` is row i of column k, over the samples."""
-    c, s = np.cos(angle), np.sin(angle)
-    hit = np.flatnonzero(np.abs(axis) == 1.0)
-    if len(hit) == 1:
-        # About a coordinate axis: only two columns change.
-        k = int(hit[0])
-        i, j = (k + 1) % 3, (k + 2) % 3
-        s = s if axis[k] > 0 else -s
-        out = np.empty_like(cols)
-        out[k] = cols[k]
-        out[i] = c * cols[i] + s * cols[j]
-        out[j] = c * cols[j] - s * cols[i]
-        return out
-    rot = _axis_rotations(axis, angle)  # (N, 3, 3)
-    return np.einsum("min,nmk->kin", cols, rot)
-
-
 def batch_fk(arm: ArmModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """End-effector positions (N, 3) [m] and rotations (N, 3, 3) of every row of ``q``
     (N, n), in the base frame; the same as :meth:`ArmModel.fk`."""
@@ -115,7 +78,7 @@ def batch_fk(arm: ArmModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         base = times(r_fix, c_par)
         p = p_par + np.tensordot(p_fix, c_par, axes=1)
         if kind == "R":
-            cols[i] = _rotate(base, axis, qt[iq])
+            cols[i] = rotate_columns(base, axis, qt[iq])
             poss[i] = p
         else:
             cols[i] = base
