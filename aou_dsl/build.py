@@ -40,12 +40,32 @@ class BuildResult:
     declared: Descriptors | None = None
     measured: Measured | None = None
     checks: list = field(default_factory=list)
-    document: dict | None = None
+    #: The document but its samples (see :attr:`document`); None when the build failed.
+    header: dict | None = None
     seconds: float = 0.0
+    _document: dict | None = field(default=None, init=False, repr=False, compare=False)
 
     @property
     def ok(self) -> bool:
-        return self.document is not None and not has_errors(self.diagnostics)
+        return self.header is not None and not has_errors(self.diagnostics)
+
+    @property
+    def document(self) -> dict | None:
+        """The trajectory document (``aou-trajectory/1``); None when the build failed.
+
+        Its samples (lists of floats) are made from the compiled trajectory's arrays when
+        the document is first asked for: a program that uses the arrays
+        (:attr:`trajectory`), like a robot re-planning as it goes, never pays for them."""
+        if self._document is None and self.header is not None and self.compiled is not None:
+            from .compiler.output import with_samples
+
+            self._document = with_samples(self.header, self.compiled.trajectory)
+        return self._document
+
+    def drop_samples(self) -> None:
+        """Forget the document's lists of samples (they are made again when asked for):
+        the arrays travel between processes as raw bytes, lists float by float."""
+        self._document = None
 
     @property
     def trajectory(self) -> Trajectory:
@@ -127,7 +147,7 @@ def build_lint(lint: FileResult, *, robot: str | None = None, rate: float | None
     document's ``checks`` then records that self-collision was not checked.
     ``controller`` (``franka``, ``ur``) adds that motion generator's rate and limits to
     the checks (the robot's joint jerk limit at 1 kHz is always checked)."""
-    from .compiler.output import trajectory_document
+    from .compiler.output import document_header
     from .compiler.pipeline import CompileOptions, compile_behaviour
     from .declared import declared
     from .descriptors import compare
@@ -165,7 +185,7 @@ def build_lint(lint: FileResult, *, robot: str | None = None, rate: float | None
             "C310", f"{mm.name}: declared {_fmt(mm.declared)}, measured {_fmt(mm.measured)} "
             "on the compiled trajectory", _span_of(b, mm.name), descriptor=mm.name,
             declared=mm.declared, measured=mm.measured))
-    res.document = trajectory_document(
+    res.header = document_header(
         compiled, measured=m.descriptors.to_json(), declared=want.to_json(),
         cv=lint.cv.to_json(), checks=checks_json | {"gaze_error_deg": round(m.gaze_error, 6)},
         rate=opts.rate)

@@ -109,53 +109,19 @@ def _build_linted(lint: FileResult, options: dict[str, Any], encode: str | None
 
 #: The attribute a worker puts the encoded document in: ``(format, bytes)``.
 _ENCODED = "_encoded"
-#: The document's samples: the compiled trajectory's arrays as lists, which the result
-#: also holds as arrays (``compiled.trajectory``).
-_SAMPLES = ("t", "q", "qd", "qdd")
-
-
-class _Samples:
-    """Stands in, on the way back, for a document's list of samples: lists pickle float
-    by float, which made reading the results back most of the parent's work; they are
-    made again here from the trajectory's arrays, which travel as raw bytes."""
-
-
 def _pack(res: BuildResult, encode: str | None) -> BuildResult:
     """In the worker: the result ready to go back; its document also encoded in
-    ``encode`` when asked (a byte format), so that the parent only writes bytes."""
-    doc = res.document
-    if doc is None or res.compiled is None or res.compiled.trajectory is None:
-        return res
-    if encode is not None:
+    ``encode`` when asked (a byte format), so that the parent only writes bytes. The
+    document's lists of samples stay behind: the parent makes them again from the
+    trajectory's arrays when it needs them, which travel as raw bytes (lists pickle
+    float by float, which made reading the results back most of the parent's work)."""
+    if encode is not None and res.document is not None:
         from .compiler.output import FOLDER_FORMATS
         from .compiler.output import encode as encode_doc
 
         if encode not in FOLDER_FORMATS:
-            setattr(res, _ENCODED, (encode, encode_doc(doc, encode)))
-    res.document = {k: _Samples() if k in _SAMPLES else v for k, v in doc.items()}
-    return res
-
-
-def _unpack(res: BuildResult) -> BuildResult:
-    """In the parent: the document as the build made it (``trajectory_document`` lists
-    the trajectory's arrays; the tests hold the two ways to the same bytes)."""
-    doc = res.document
-    if doc is None or res.compiled is None or res.compiled.trajectory is None:
-        return res
-    import gc
-
-    tr = res.compiled.trajectory
-    # Tens of thousands of lists of floats, which cannot form cycles: the garbage
-    # collector, left on, would walk everything this process holds every few hundred of
-    # them (more than half of the parent's work, measured).
-    collecting = gc.isenabled()
-    gc.disable()
-    try:
-        res.document = {k: getattr(tr, k).tolist() if isinstance(v, _Samples) else v
-                        for k, v in doc.items()}
-    finally:
-        if collecting:
-            gc.enable()
+            setattr(res, _ENCODED, (encode, encode_doc(res.document, encode)))
+    res.drop_samples()
     return res
 
 
@@ -266,7 +232,7 @@ class BuildPool:
         while current:
             upcoming = self._window(todo, size, opts, encode)
             for got in current:
-                yield _unpack(got.result()) if isinstance(got, Future) else got
+                yield got.result() if isinstance(got, Future) else got
             current = upcoming
 
     def _window(self, todo: Iterator[str], size: int, options: dict[str, Any],
@@ -321,7 +287,7 @@ def _on_cluster(paths: list[str], options: dict[str, Any], cluster: Any,
                 continue
             futures.append(client.submit(build_text, text, p, options, encode, pure=False))
         for f in futures:
-            yield _unpack(f.result()) if isinstance(f, Future) else f
+            yield f.result() if isinstance(f, Future) else f
     finally:
         if client is not cluster:
             client.close()

@@ -25,7 +25,8 @@ from ..diagnostics import AouError, Span, diag
 from ..files import write_atomic
 from .ros import is_bag
 
-__all__ = ["FORMATS", "encode", "output_paths", "trajectory_document", "write_atomic",
+__all__ = ["FORMATS", "SAMPLE_KEYS", "document_header", "encode", "output_paths",
+           "trajectory_document", "with_samples", "write_atomic",
            "write_output"]
 
 FORMATS = ("json", "csv", "npz", "mcap", "yaml")
@@ -33,10 +34,37 @@ FORMATS = ("json", "csv", "npz", "mcap", "yaml")
 FOLDER_FORMATS = ("mcap",)
 
 
+#: The keys of a trajectory document that hold its samples, one list entry per sample.
+SAMPLE_KEYS = ("t", "q", "qd", "qdd")
+
+
 def trajectory_document(result, *, measured: dict, declared: dict, cv: dict,
                         checks: dict | None = None, rate: float) -> dict:
     """The trajectory document (``aou-trajectory/1``) of a
     :class:`~.pipeline.CompileResult`."""
+    return with_samples(document_header(result, measured=measured, declared=declared, cv=cv,
+                                        checks=checks, rate=rate), result.trajectory)
+
+
+def with_samples(header: dict, tr) -> dict:
+    """The document ``header`` (:func:`document_header`) completed with the samples of
+    the trajectory ``tr`` as lists (:data:`SAMPLE_KEYS`, last)."""
+    import gc
+
+    # Hundreds of thousands of floats in lists, which cannot form cycles: the garbage
+    # collector, left on, would walk everything the process holds many times over.
+    collecting = gc.isenabled()
+    gc.disable()
+    try:
+        return header | {k: getattr(tr, k).tolist() for k in SAMPLE_KEYS}
+    finally:
+        if collecting:
+            gc.enable()
+
+
+def document_header(result, *, measured: dict, declared: dict, cv: dict,
+                    checks: dict | None = None, rate: float) -> dict:
+    """The trajectory document of a :class:`~.pipeline.CompileResult` but its samples."""
     tr = result.trajectory
     b = result.behaviour
     return {
@@ -54,10 +82,6 @@ def trajectory_document(result, *, measured: dict, declared: dict, cv: dict,
         "cv": cv,
         "episodes": [{"kind": k, "t_start": a, "t_end": e} for k, a, e in tr.episodes],
         "checks": checks or {},
-        "t": tr.t.tolist(),
-        "q": tr.q.tolist(),
-        "qd": tr.qd.tolist(),
-        "qdd": tr.qdd.tolist(),
     }
 
 
