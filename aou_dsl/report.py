@@ -136,7 +136,8 @@ def format_check(path: str, robot: str, t, report) -> str:
 def format_measured(path: str, robot: str, measured) -> str:
     """``aouc measure``: the eleven descriptors as a table, and the C-V point."""
     m = measured
-    lines = [f"{path}: {robot}, {m.duration:.2f} s, {len(m.episodes)} episodes"]
+    n = len(m.episodes)
+    lines = [f"{path}: {robot}, {m.duration:.2f} s, {n} episode{'' if n == 1 else 's'}"]
     from .descriptors import REGISTRY
 
     for k, v in m.descriptors.items():

@@ -135,7 +135,7 @@ XARM_SOURCE = "UFactory xarm_ros2, xarm_moveit_config/config/xarm7/joint_limits.
 #: sets has_acceleration_limits: false; the 8.6 rad/s^2 of ros2_kortex is the Gen3's,
 #: another arm.
 #: Unitree Z1 and Reach Robotics Bravo 7: no source found.
-NO_SOURCE = ("no source: the manufacturer publishes no joint acceleration limit; "
+NO_SOURCE = ("no source: the manufacturer publishes no such limit; "
              "aou's conservative default")
 
 LIMITS: dict[str, dict] = {

@@ -221,8 +221,9 @@ def _read_csv(path: str, text: str, robot: str | None,
     values = _csv_values(path, rows[1:], header)
     robot = robot or notes.get("robot")
     if not robot:
-        raise AouError(diag("I501", "a CSV recording needs `--robot NAME`",
-                            Span.whole_file(path)))
+        raise AouError(diag("I501", f"cannot read `{path}` as a recording without its robot: "
+                            "the CSV does not say which robot made it (no `# robot:` line)",
+                            Span.whole_file(path), hint="give --robot NAME|PATH"))
     if goal is None and notes.get("goal"):
         try:
             goal = tuple(float(x) for x in notes["goal"].split(","))  # type: ignore[assignment]
@@ -263,6 +264,13 @@ def _check_units(rec: Trajectory, angle_unit: str | None, time_unit: str | None,
             raise AouError(diag("R404", f"unknown {what} unit `{unit}`: expected one of "
                                 f"{', '.join(table)}", Span.whole_file(rec.path)))
     where = Span.whole_file(rec.path)
+    wrong = [f"--{flag} {unit}" for flag, unit, right in
+             (("angle-unit", angle_unit, "rad"), ("time-unit", time_unit, "s"))
+             if unit not in (None, right)]
+    if trusted and wrong:
+        raise AouError(diag("R404", f"aou wrote this file, in radians and seconds: "
+                            f"{' and '.join(wrong)} would misread it", where,
+                            hint="leave the units out for files aou wrote"))
     t = np.asarray(rec.t, float) * TIME_UNITS[time_unit or "s"]
     if time_unit is None and not trusted:
         step = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
