@@ -10,6 +10,7 @@ stays a margin inside the joint limits.
 from __future__ import annotations
 
 import enum
+import functools
 import math
 from dataclasses import dataclass
 
@@ -90,7 +91,7 @@ class _Solver:
         self.eye_n = np.eye(arm.n)
         # LAPACK's routines as numpy.linalg calls them (the same numbers), without the
         # checks of each call: its matrices here are small, finite and well formed.
-        self.lapack = _Lapack()
+        self.lapack = _lapack()
 
     def solve(self, p: np.ndarray, r: np.ndarray, q0: np.ndarray
               ) -> tuple[np.ndarray, float, float, float]:
@@ -132,6 +133,12 @@ class _Solver:
 
 _EYE6 = np.eye(6)
 _DAMPED = DAMPING * _EYE6
+
+
+@functools.cache
+def _lapack() -> _Lapack:
+    """The one :class:`_Lapack` of this process (its check runs once)."""
+    return _Lapack()
 
 
 class _Lapack:
