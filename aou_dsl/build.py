@@ -91,8 +91,7 @@ def _with_robot(lint: FileResult, robot: str | None) -> list[Diagnostic]:
 
         return [unknown_robot(robot, Span.whole_file(lint.path))]
     b = lint.behaviour
-    lint.behaviour = b.model_copy(update={"settings": b.settings.model_copy(
-        update={"robot": robot})})
+    lint.behaviour = b.replace(settings=b.settings.replace(robot=robot))
     return []
 
 

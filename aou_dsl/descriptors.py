@@ -22,7 +22,6 @@ Pure Python: no numerical imports.
 from __future__ import annotations
 
 import enum
-import statistics
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 
@@ -233,7 +232,9 @@ def _aggregate(d: Descriptor, episodes: list[EpisodeValues]) -> float | int | No
         return None
     if d.aggregate is Aggregate.MAX:
         return max(values)
-    return float(statistics.median(values))
+    values.sort()  # the median, without `statistics` (it brings random and fractions)
+    mid = len(values) // 2
+    return float(values[mid] if len(values) % 2 else (values[mid - 1] + values[mid]) / 2)
 
 
 def derive(episodes: Iterable[EpisodeValues]) -> Descriptors:

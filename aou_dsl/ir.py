@@ -2,22 +2,28 @@
 
 The primitive nodes live with their kinds in :mod:`aou_dsl.primitives`.
 
-All models are frozen pydantic v2 models that reject unknown fields. Angles are in
-radians, angular speeds in rad/s. Values a file leaves out are filled from
-:data:`DEFAULTS` by the validator, so later stages never guess.
+Every node is a frozen dataclass, built by keyword only: an unknown field is a TypeError,
+a value of the wrong type or out of range a TypeError or ValueError naming the field
+(numbers are stored as floats). The validator is what reports a file's mistakes, with
+their lines; these checks guard the Python API, where nodes are built or changed
+(:meth:`Node.replace`) by code. Angles are in radians, angular speeds in rad/s. Values a
+file leaves out are filled from :data:`DEFAULTS` by the validator, so later stages never
+guess.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import enum
 import math
+import types
+import typing
+from dataclasses import dataclass, field
 from typing import Any, Literal
-
-from pydantic import BaseModel, ConfigDict, Field
 
 from .diagnostics import Span
 
-__all__ = ["DEFAULTS", "Behaviour", "Effort", "Node", "Settings", "State"]
+__all__ = ["DEFAULTS", "Behaviour", "Effort", "Model", "Node", "Settings", "State"]
 
 
 class State(enum.StrEnum):
@@ -46,30 +52,85 @@ DEFAULTS = {
 }
 
 
-class Node(BaseModel):
-    """An IR node: frozen, unknown fields rejected, spanned. Primitive nodes (one per kind,
-    in :mod:`aou_dsl.primitives`) add ``kind`` and ``count``."""
+def _check(obj: Any, name: str, value: Any, hint: Any) -> Any:
+    """``value`` as field ``name`` of ``obj`` declared ``hint`` stores it, or an error."""
+    origin, args = typing.get_origin(hint), typing.get_args(hint)
+    if origin in (types.UnionType, typing.Union):
+        if value is None and type(None) in args:
+            return None
+        (hint,) = [a for a in args if a is not type(None)]
+        return _check(obj, name, value, hint)
+    if origin is Literal:
+        if value in args:
+            return value
+        raise ValueError(f"{type(obj).__name__}.{name}: {value!r} is not one of {args}")
+    if hint is float and isinstance(value, int | float) and not isinstance(value, bool):
+        return float(value)
+    if origin is tuple and isinstance(value, tuple | list):
+        each = args[:1] * len(value) if args[-1:] == (Ellipsis,) else args
+        if len(each) == len(value):
+            return tuple(_check(obj, name, v, h) for v, h in zip(value, each, strict=True))
+    if isinstance(hint, type) and issubclass(hint, enum.Enum) and value in set(hint):
+        return hint(value)
+    want = origin or hint
+    if isinstance(value, want) and not (want is int and isinstance(value, bool)):
+        return value
+    raise TypeError(f"{type(obj).__name__}.{name}: expected {getattr(hint, '__name__', hint)}"
+                    f", got {value!r}")
 
-    model_config = ConfigDict(frozen=True, extra="forbid", defer_build=True)
+
+_HINTS: dict[type, dict[str, Any]] = {}
+
+
+@dataclass(frozen=True, kw_only=True, slots=True)
+class Model:
+    """What every IR class shares: its fields checked when built, :meth:`replace`."""
+
+    def __post_init__(self) -> None:
+        cls = type(self)
+        if cls not in _HINTS:
+            _HINTS[cls] = typing.get_type_hints(cls)
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            checked = _check(self, f.name, value, _HINTS[cls][f.name])
+            if checked is not value:
+                object.__setattr__(self, f.name, checked)
+
+    def replace(self, **changes: Any) -> Any:
+        """A copy with ``changes``, checked like a new one (typed ``Any``: the copy is of
+        the object's own class)."""
+        return dataclasses.replace(self, **changes)
+
+
+@dataclass(frozen=True, kw_only=True, slots=True)
+class Node(Model):
+    """An IR node: frozen, built by keyword, spanned. Primitive nodes (one per kind, in
+    :mod:`aou_dsl.primitives`) add ``kind`` and ``count``."""
 
     span: Span
     kind: str = ""
     count: int = 1
 
 
+@dataclass(frozen=True, kw_only=True, slots=True)
 class Effort(Node):
     """The Laban Effort vector (docs/model.md), each factor in [-1, 1]."""
 
-    W: float = Field(ge=-1.0, le=1.0)
-    T: float = Field(ge=-1.0, le=1.0)
-    S: float = Field(ge=-1.0, le=1.0)
-    F: float = Field(ge=-1.0, le=1.0)
+    W: float
+    T: float
+    S: float
+    F: float
+
+    def __post_init__(self) -> None:
+        super(Effort, self).__post_init__()
+        for name in "WTSF":
+            if not -1.0 <= getattr(self, name) <= 1.0:
+                raise ValueError(f"Effort.{name}: {getattr(self, name)} is outside [-1, 1]")
 
 
-class Settings(BaseModel):
+@dataclass(frozen=True, kw_only=True, slots=True)
+class Settings(Model):
     """The file's settings with defaults filled in; ``spans`` holds the written ones."""
-
-    model_config = ConfigDict(frozen=True, extra="forbid", defer_build=True)
 
     robot: str = "panda"
     goal: tuple[float, float, float] | None = None  # None: the robot's default
@@ -77,13 +138,12 @@ class Settings(BaseModel):
     start: float = DEFAULTS["start"]
     standoff: float = DEFAULTS["standoff"]
     effort: Effort | None = None
-    spans: dict[str, Span] = Field(default_factory=dict)
+    spans: dict[str, Span] = field(default_factory=dict)
 
 
-class Behaviour(BaseModel):
+@dataclass(frozen=True, kw_only=True, slots=True)
+class Behaviour(Model):
     """One validated ``.aou`` file."""
-
-    model_config = ConfigDict(frozen=True, extra="forbid", defer_build=True)
 
     name: str
     state: State | None

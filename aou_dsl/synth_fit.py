@@ -118,7 +118,7 @@ def _cap_accel(r: Recipe, kind: str, lim: Limits) -> Recipe:
     name = descriptor(kind, "peak_acceleration").name
     note = (f"{r.notes.get(name, '')}; capped from {node.a:g} at {lim.accel:g} for "
             f"{lim.robot} (its joints reach about {lim.reached:.2g} m/s^2 here)")
-    return r.with_node(node.model_copy(update={"a": lim.accel})).noted(name, note)
+    return r.with_node(node.replace(a=lim.accel)).noted(name, note)
 
 
 def shiver_max_frequency(amplitude: float, duration: float, lim: Limits) -> float:
@@ -149,7 +149,7 @@ def _fit_shiver(r: Recipe, lim: Limits) -> Recipe:
         return r.noted(SHIVER_F, "the language default (the study gives none)")
     if f_max >= MIN_SHIVER_F:
         f = floor_sig(f_max)
-        return r.with_node(node.model_copy(update={"f": f})).noted(
+        return r.with_node(node.replace(f=f)).noted(
             SHIVER_F, f"the language default {node.f:g} Hz, lowered to {f:g} Hz for "
             f"{lim.robot}'s {lim.roll_joint} (the amplitude stays)")
     # the peaks are proportional to the amplitude at a fixed frequency
@@ -161,8 +161,7 @@ def _fit_shiver(r: Recipe, lim: Limits) -> Recipe:
     note = (f"{r.notes.get(name, '')}; reduced from {math.degrees(node.amplitude):g} to "
             f"{amp:g} deg: {lim.robot}'s {lim.roll_joint} cannot shiver wider at "
             f"{MIN_SHIVER_F:g} Hz")
-    return (r.with_node(node.model_copy(update={"f": MIN_SHIVER_F,
-                                                "amplitude": math.radians(amp)}))
+    return (r.with_node(node.replace(f=MIN_SHIVER_F, amplitude=math.radians(amp)))
             .noted(SHIVER_F, f"lowered to {MIN_SHIVER_F:g} Hz for {lim.robot}'s "
                    f"{lim.roll_joint}").noted(name, note))
 
@@ -178,7 +177,7 @@ def _fit_tilt(r: Recipe, lim: Limits) -> Recipe:
         return r.noted(name, "the language default (the study gives none; no clear effect "
                        "on curious)")
     v_deg = floor_sig(math.degrees(v_max))
-    return r.with_node(node.model_copy(update={"v": math.radians(v_deg)})).noted(
+    return r.with_node(node.replace(v=math.radians(v_deg))).noted(
         name, f"the language default {math.degrees(node.v):g} deg/s, lowered to {v_deg:g} "
         f"for {lim.robot}'s {lim.roll_joint} (no clear effect on curious)")
 

@@ -90,7 +90,7 @@ class Recipe:
         update: dict[str, Any] = {d.ir_field: int(value) if d.is_count else value * d.scale}
         if count is not None:
             update["count"] = count
-        out = self.with_node(node.model_copy(update=update))
+        out = self.with_node(node.replace(**update))
         return out.noted(d.name, note) if note is not None else out
 
     @classmethod
@@ -105,19 +105,19 @@ class Recipe:
             if not having or n < 1:
                 continue
             top = max(having, key=lambda s: w[s])
-            node = having[top].nodes[slot].model_copy(update={"count": n})
+            node = having[top].nodes[slot].replace(count=n)
             total = sum(w[s] for s in having)
             for d in REGISTRY.values():
                 if slot_of(d) == slot and not d.is_count:
                     v = sum(w[s] * r.value(d) for s, r in having.items()) / total
-                    node = node.model_copy(update={d.ir_field: sig(v) * d.scale})
+                    node = node.replace(**{d.ir_field: sig(v) * d.scale})
             nodes[slot] = node
         out = cls(nodes)
         need = (out.count("retreat") + 1 if out.count("retreat") else 0) + \
             (1 if out.count("gaze", "horizontal") or out.count("gaze", "vertical") else 0)
         pause = next(r.node("pause") for r in recipes.values() if r.count("pause"))
         if out.count("pause") < need:  # a retreat starts and ends at a pause
-            out = out.with_node((out.node("pause") or pause).model_copy(update={"count": need}))
+            out = out.with_node((out.node("pause") or pause).replace(count=need))
         shown = ", ".join(f"{s} {x:.2f}" for s, x in sorted(w.items(), key=lambda i: -i[1]))
         for d in REGISTRY.values():
             if out.present(d):

@@ -1,11 +1,11 @@
 """Stage 2: the IR holds SI values, defaults are filled, and the form is recorded."""
 
+import dataclasses
 import math
 
 import pytest
-from pydantic import ValidationError
 
-from aou_dsl.ir import DEFAULTS, State
+from aou_dsl.ir import DEFAULTS, Effort, State
 from aou_dsl.linter import load
 from aou_dsl.robots import ROBOTS
 
@@ -66,10 +66,28 @@ def test_x0_means_absent_but_valid():
 
 def test_ir_is_frozen_and_rejects_unknown_fields():
     b = _ok("pause 1s")
-    with pytest.raises(ValidationError):
-        b.primitives[0].duration = 2.0
-    with pytest.raises(ValidationError):
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        b.primitives[0].duration = 2.0  # type: ignore[misc]
+    with pytest.raises(TypeError, match="colour"):
         type(b.primitives[0])(span=b.span, duration=1.0, colour="red")
+
+
+def test_ir_checks_what_code_builds_or_changes():
+    """Nodes built or changed from Python get the types their fields declare, or an
+    error naming the field: the API cannot make a node the compiler would misread."""
+    b = _ok("approach a=0.1; pause 1s x2; gaze horizontal 20deg")
+    approach, gaze = b.first("approach"), b.first("gaze")
+    assert approach.replace(a=1).a == 1.0 and isinstance(approach.replace(a=1).a, float)
+    with pytest.raises(TypeError, match=r"Approach\.a"):
+        approach.replace(a="fast")
+    with pytest.raises(TypeError, match=r"Approach\.count"):
+        approach.replace(count=2.5)
+    with pytest.raises(ValueError, match=r"Gaze\.plane"):
+        gaze.replace(plane="diagonal")
+    with pytest.raises(ValueError, match="Effort.W"):
+        Effort(span=b.span, W=1.5, T=0, S=0, F=0)
+    assert b.replace(state="hesitant").state is State.HESITANT
+    assert b.replace(primitives=[gaze]).primitives == (gaze,)
 
 
 def test_all_errors_are_reported_not_just_the_first():

@@ -84,7 +84,7 @@ def make_variants(b: Behaviour, text: str, descriptor: str, low: float, high: fl
         if d.is_count and (value != int(value) or value < 0):
             raise AouError(diag("I501", f"{descriptor} is a count: expected a whole number, "
                                 f"found {value:g}", where))
-        new = prim.model_copy(update={d.ir_field: int(value) if d.is_count else value * d.scale})
+        new = prim.replace(**{d.ir_field: int(value) if d.is_count else value * d.scale})
         variant = Variant(label, value, _replace(text, prim.span, KINDS[d.kind].format(new)),
                           f"{prefix}-{label}.aou")
         lint = lint_source(variant.text, variant.path)

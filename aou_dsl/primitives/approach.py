@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Literal
 
 from ..ir import DEFAULTS, Node
@@ -12,6 +13,7 @@ from .base import Key, Kind, fmt, move
 __all__ = ["Approach", "ApproachKind", "translation"]
 
 
+@dataclass(frozen=True, kw_only=True, slots=True)
 class Approach(Node):
     """Translation toward the goal along the line of sight.
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 import math
 from typing import Literal
 
@@ -17,6 +18,7 @@ GAZE_ANGULAR_ACCEL = math.radians(45.0)
 _PLANES = ("horizontal", "vertical")
 
 
+@dataclass(frozen=True, kw_only=True, slots=True)
 class Gaze(Node):
     """An arc about the goal in the horizontal or vertical plane, gaze locked on it.
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Literal
 
 from ..ir import Node
@@ -12,6 +13,7 @@ from .base import MIN_PAUSE, Kind, fmt, repeat
 __all__ = ["Pause", "PauseKind"]
 
 
+@dataclass(frozen=True, kw_only=True, slots=True)
 class Pause(Node):
     """A hold: every joint velocity zero for ``duration`` [s]."""
 

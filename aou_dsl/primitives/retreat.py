@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Literal
 
 from ..ir import DEFAULTS, Node
@@ -13,6 +14,7 @@ from .base import MIN_RETREAT, Key, Kind, fmt, repeat
 __all__ = ["Retreat", "RetreatKind"]
 
 
+@dataclass(frozen=True, kw_only=True, slots=True)
 class Retreat(Node):
     """Translation away from the goal by ``length`` [m] with peak acceleration ``a``
     [m/s^2] and speed cap ``v`` [m/s]; negative in a sequence moves toward it."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 import math
 from typing import Literal
 
@@ -13,6 +14,7 @@ from .base import MIN_ANGLE, Key, Kind, fmt, repeat
 __all__ = ["Shiver", "ShiverKind", "shiver_duration"]
 
 
+@dataclass(frozen=True, kw_only=True, slots=True)
 class Shiver(Node):
     """Oscillation of the shiver joint: ``amplitude`` [rad] peak to peak, at ``f`` [Hz]
     for ``duration`` [s]."""

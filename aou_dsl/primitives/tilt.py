@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 import math
 from typing import Literal
 
@@ -13,6 +14,7 @@ from .base import MIN_ANGLE, Key, Kind, fmt, repeat
 __all__ = ["Tilt", "TiltKind"]
 
 
+@dataclass(frozen=True, kw_only=True, slots=True)
 class Tilt(Node):
     """A roll of ``angle`` [rad] about the forward axis at angular speed ``v`` [rad/s]:
     the episode lasts exactly ``|angle| / v`` (the tilt velocity descriptor)."""

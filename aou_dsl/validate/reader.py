@@ -7,7 +7,6 @@ positional arguments, the ``key=`` values (a bare value takes the key's unit) an
 
 from __future__ import annotations
 
-import difflib
 import math
 import re
 from collections.abc import Iterable, Mapping
@@ -24,6 +23,8 @@ _REPEAT = re.compile(r"^x(\d+)$")
 
 
 def did_you_mean(word: str, choices: Iterable[str]) -> str | None:
+    import difflib  # only for a misspelt word
+
     close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
     return f"did you mean `{close[0]}`?" if close else None
 
