@@ -191,14 +191,18 @@ def _cmd_check(args: argparse.Namespace) -> int:
 
 def _cmd_measure(args: argparse.Namespace) -> int:
     from .api import measure, read_trajectory
+    from .cv import missing_descriptors
     from .report import format_measured
 
     tr = read_trajectory(args.path, **_read_kw(args))
     m = measure(tr)
+    missing = missing_descriptors(tr.goal)  # what the C-V point could not use
     if args.format == "json":
-        print(format_json({"path": args.path, "robot": tr.robot, **m.to_json()}))
+        doc = m.to_json()
+        doc["cv"] = {**doc["cv"], "missing_descriptors": list(missing)}
+        print(format_json({"path": args.path, "robot": tr.robot, **doc}))
     else:
-        print(format_measured(args.path, tr.robot, m))
+        print(format_measured(args.path, tr.robot, m, missing))
         _print_diags(m.diagnostics)
     return EXIT_OK
 
@@ -223,7 +227,9 @@ def _cmd_plot(args: argparse.Namespace) -> int:
         return EXIT_USAGE
     else:
         tr = read_trajectory(args.paths[0], **_read_kw(args))
-        fig = profile_figure(profile_data(tr))
+        data = profile_data(tr)
+        _print_diags(list(data.diagnostics))  # R405: no goal, no goal-distance panel
+        fig = profile_figure(data)
     save(fig, args.output)
     print(f"wrote {args.output}", file=sys.stderr)
     return EXIT_OK
@@ -296,9 +302,6 @@ _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    # aou's models use no pydantic plugin: skip reading every installed package's entry
-    # points to look for one (a tenth of a cold `aouc lint`). A user's own setting wins.
-    os.environ.setdefault("PYDANTIC_DISABLE_PLUGINS", "__all__")
     parser, _ = build_parser()
     args = parser.parse_args(argv)
     if args.command is None:

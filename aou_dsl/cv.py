@@ -43,6 +43,7 @@ __all__ = [
     "composition",
     "effort_to_cv",
     "infer",
+    "missing_descriptors",
 ]
 
 #: Table I of the model: state -> (W, T, S, F), in the table's order.
@@ -212,3 +213,15 @@ def composition(episodes: Iterable) -> Composition:
             old = amounts.get(channel, 0.0)
             amounts[channel] = old + x if how == "sum" else max(old, x)
     return Composition(**amounts)
+
+
+def missing_descriptors(goal: object) -> tuple[str, ...]:
+    """The descriptors a C-V point inferred from measured motion could not use, given
+    the motion's ``goal`` (None: unknown): the gazes are bearings of the goal, so without
+    one they are unknown and their exploration is missing from the point. Empty for a
+    complete measurement."""
+    if goal is not None:
+        return ()
+    from .descriptors import REGISTRY
+
+    return tuple(name for name, d in REGISTRY.items() if d.kind == "gaze")

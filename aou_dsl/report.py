@@ -133,8 +133,9 @@ def format_check(path: str, robot: str, t, report) -> str:
     return "\n".join(lines)
 
 
-def format_measured(path: str, robot: str, measured) -> str:
-    """``aouc measure``: the eleven descriptors as a table, and the C-V point."""
+def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = ()) -> str:
+    """``aouc measure``: the eleven descriptors as a table, and the C-V point; ``missing``:
+    the descriptors the point could not use (:func:`aou_dsl.cv.missing_descriptors`)."""
     m = measured
     n = len(m.episodes)
     lines = [f"{path}: {robot}, {m.duration:.2f} s, {n} episode{'' if n == 1 else 's'}"]
@@ -148,5 +149,9 @@ def format_measured(path: str, robot: str, measured) -> str:
         # The model assumes the hand looks at the goal throughout: how far it did not.
         lines.append(f"  line of sight off the goal: median {los.median:.3g} deg, "
                      f"max {los.max:.3g} deg")
-    lines.append(f"  C-V: C={m.cv.C:+.2f} V={m.cv.V:+.2f} -> {m.cv.state}")
+    point = f"  C-V: C={m.cv.C:+.2f} V={m.cv.V:+.2f} -> {m.cv.state}"
+    if missing:
+        point += (f" (incomplete: read without the gaze descriptors {', '.join(missing)}, "
+                  "unknown without a goal)")
+    lines.append(point)
     return "\n".join(lines)

@@ -12,7 +12,7 @@ import math
 import os
 from typing import Any
 
-from ..robots import ROBOTS
+from ..robots import DEFAULT_JOINT_JERK, NO_SOURCE, ROBOTS, RobotSpec
 from .load import Robot, load_robot
 
 __all__ = ["describe_robot", "robot_toml"]
@@ -20,6 +20,9 @@ __all__ = ["describe_robot", "robot_toml"]
 _ORDER = ("arm_joints", "ee_frame", "forward", "ee_offset", "ee_roll", "shiver_joint",
           "goal", "start_direction", "posture", "joint_accel", "joint_jerk",
           "allowed_contacts")
+_LIMITS = ("joint_accel", "joint_jerk", "joint_velocity")
+_SCALES = ("velocity_scale", "accel_scale", "limit_margin")
+_DEFAULTS = RobotSpec("", "", (), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (), (), "")
 
 
 def _round(v: Any) -> Any:
@@ -129,28 +132,57 @@ def _toml_value(v: Any) -> str:
     return "[" + ", ".join(_toml_value(x) for x in v) + "]"
 
 
+def _builtin_of(r: Robot) -> str:
+    """The built-in arm ``r`` is, or its robot description extends ("" for neither)."""
+    if r.spec.name in ROBOTS:
+        return r.spec.name
+    if r.description:
+        from .description import read_description
+
+        return read_description(r.description).robot
+    return ""
+
+
 def robot_toml(r: Robot, urdf: str | None = None) -> str:
-    """A robot description that pins ``r`` as loaded. ``urdf``: the path to write in
-    it (default: the URDF's name, for a file saved beside it; a built-in arm is named
-    with ``robot = ...`` instead)."""
+    """A robot description that pins ``r`` as loaded: read back, it loads the same robot
+    (limits included). ``urdf``: the path to write in it (default: the URDF's name, for
+    a file saved beside it; a built-in arm, or a description extending one, is named
+    with ``robot = ...`` instead). A limit no source gives (aou's default) is written
+    commented out, with its value: it stays the default, with its warning (C313), until
+    a real number is pinned there."""
     spec = r.spec
-    if spec.name in ROBOTS and urdf is None:
-        lines = [f"robot = {_toml_value(spec.name)}"]
+    base = _builtin_of(r)
+    if base and urdf is None:
+        lines = [f"robot = {_toml_value(base)}"]
     else:
         lines = [f"urdf = {_toml_value(urdf or os.path.basename(r.urdf.path))}"]
-    pins = {
+    n = len(spec.arm_joints)
+    pins: dict[str, Any] = {
         "arm_joints": list(spec.arm_joints),
         "ee_frame": spec.ee_link or spec.ee_frame,
         "forward": spec.forward, "ee_offset": spec.ee_offset, "ee_roll": spec.ee_roll,
         "shiver_joint": spec.shiver_joint,
         "posture": list(spec.posture), "goal": list(spec.goal),
-        "from": list(spec.start_direction),
+        "from": list(spec.start_direction),  # the file's name for start_direction
         "joint_accel": list(spec.joint_accel),
+        "joint_jerk": list(spec.joint_jerk or (DEFAULT_JOINT_JERK,) * n),
     }
-    if spec.joint_jerk:
-        pins["joint_jerk"] = list(spec.joint_jerk)
     if spec.joint_velocity:
         pins["joint_velocity"] = list(spec.joint_velocity)
     pins["allowed_contacts"] = [list(p) for p in spec.allowed_contacts]
-    lines += [f"{k} = {_toml_value(v)}" for k, v in pins.items()]
+    for key in _SCALES:  # the compiler's margins, when not the defaults
+        if getattr(spec, key) != getattr(_DEFAULTS, key):
+            pins[key] = getattr(spec, key)
+    unsourced = {k for k in _LIMITS if spec.source(k) == NO_SOURCE or
+                 (k == "joint_jerk" and not spec.joint_jerk)}
+    for k, v in pins.items():
+        if k in unsourced:
+            lines.append(f"# {k} = {_toml_value(v)}  # no source: aou's conservative "
+                         "default; pin your arm's limits here")
+        else:
+            lines.append(f"{k} = {_toml_value(v)}")
+    sources = {k: spec.source(k) for k in _LIMITS if k in pins and k not in unsourced
+               and spec.source(k)}
+    if sources:
+        lines += ["[sources]", *(f"{k} = {_toml_value(v)}" for k, v in sources.items())]
     return "\n".join(lines) + "\n"

@@ -146,7 +146,13 @@ def _check_number(key: str, value: Any) -> tuple[Any, str | None]:
     return tuple(nums), None
 
 
+#: Names ``aouc robot`` shows (its text and JSON) for what the file calls otherwise.
+_FILE_NAMES = {"start_direction": "from", "ee_link": "ee_frame"}
+
+
 def _did_you_mean(key: str) -> str | None:
+    if key in _FILE_NAMES:
+        return f"a robot file calls it `{_FILE_NAMES[key]}`"
     close = difflib.get_close_matches(key, KEYS, n=1, cutoff=0.6)
     return f"did you mean `{close[0]}`?" if close else None
 

@@ -36,6 +36,8 @@ ANGLE_UNITS = {"rad": 1.0, "deg": math.pi / 180.0}
 TIME_UNITS = {"s": 1.0, "ms": 1e-3}
 #: A clock slower than this [s per sample] is taken for milliseconds read as seconds.
 SLOWEST_STEP = 0.2
+#: How far [rad] beyond its limits a joint may sit throughout under a unit given.
+BEYOND = math.radians(1.0)
 
 
 def _bad(path: str, message: str, hint: str | None = None, **fields) -> AouError:
@@ -252,10 +254,18 @@ def read_csv(path: str, text: str, robot: str | None = None,
     return rec
 
 
+def _at(rec: Trajectory, rows: list[int] | None, i: int) -> tuple[str, Span, dict]:
+    """Sample ``i``: its row in a text file (the span points there), else its index."""
+    if rows:
+        return f"row {rows[i]}", Span.point(rec.path, rows[i], 1), {"sample": i, "row": rows[i]}
+    return f"sample {i}", Span.whole_file(rec.path), {"sample": i}
+
+
 def _check_units(rec: Trajectory, angle_unit: str | None, time_unit: str | None,
-                 trusted: bool) -> Trajectory:
-    """Convert the units given; refuse values that look like degrees or milliseconds when
-    none is given (R404)."""
+                 trusted: bool, rows: list[int] | None = None) -> Trajectory:
+    """Convert the units given. R404 for values that look like degrees or milliseconds
+    when none is given, and for an angle unit that puts a joint outside its limits
+    throughout. ``rows``: each sample's line in a text file."""
     from ..kinematics import load_arm
 
     for unit, table, what in ((angle_unit, ANGLE_UNITS, "angle"),
@@ -263,21 +273,16 @@ def _check_units(rec: Trajectory, angle_unit: str | None, time_unit: str | None,
         if unit is not None and unit not in table:
             raise AouError(diag("R404", f"unknown {what} unit `{unit}`: expected one of "
                                 f"{', '.join(table)}", Span.whole_file(rec.path)))
-    where = Span.whole_file(rec.path)
     wrong = [f"--{flag} {unit}" for flag, unit, right in
              (("angle-unit", angle_unit, "rad"), ("time-unit", time_unit, "s"))
              if unit not in (None, right)]
     if trusted and wrong:
         raise AouError(diag("R404", f"aou wrote this file, in radians and seconds: "
-                            f"{' and '.join(wrong)} would misread it", where,
-                            hint="leave the units out for files aou wrote"))
+                            f"{' and '.join(wrong)} would misread it", Span.whole_file(
+                                rec.path), hint="leave the units out for files aou wrote"))
     t = np.asarray(rec.t, float) * TIME_UNITS[time_unit or "s"]
     if time_unit is None and not trusted:
-        step = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
-        if step >= SLOWEST_STEP:
-            raise AouError(diag("R404", f"the times look like milliseconds: one sample every "
-                                f"{step:g} s", where, hint="give --time-unit ms, or "
-                                "--time-unit s if the clock really is that slow"))
+        _plausible_clock(rec, t, rows)
     arm = load_arm(rec.robot, rec.ee_frame)
     q = np.asarray(rec.q, float).copy()
     revolute = [j for j, name in enumerate(arm.joint_names)
@@ -287,30 +292,68 @@ def _check_units(rec: Trajectory, angle_unit: str | None, time_unit: str | None,
         if name not in rec.joint_names:
             continue
         col = rec.joint_names.index(name)
+        limits = (float(arm.lower[j]), float(arm.upper[j]))
         if angle_unit is not None:
             q[:, col] *= ANGLE_UNITS[angle_unit]
+            _obeyed_limits(rec, q[:, col], name, limits, angle_unit, rows)
         elif not trusted:
-            _plausible_angles(rec, q[:, col], name, float(arm.lower[j]), float(arm.upper[j]))
+            _plausible_angles(rec, q[:, col], name, limits, rows)
     return rec.with_(t=t, q=q)
 
 
-def _plausible_angles(rec: Trajectory, col: np.ndarray, name: str, lo: float, hi: float
-                      ) -> None:
+def _plausible_clock(rec: Trajectory, t: np.ndarray, rows: list[int] | None) -> None:
+    """R404 when samples come slower than :data:`SLOWEST_STEP` (milliseconds as seconds)."""
+    step = np.diff(t)
+    if len(step) and float(np.median(step)) >= SLOWEST_STEP:
+        i = int(np.argmax(step >= SLOWEST_STEP)) + 1
+        at, span, fields = _at(rec, rows, i)
+        raise AouError(diag("R404", f"the times look like milliseconds: one sample every "
+                            f"{float(np.median(step)):g} s ({at} has t={t[i]:g} after "
+                            f"t={t[i - 1]:g})", span, hint="give --time-unit ms, or "
+                            "--time-unit s if the clock really is that slow", **fields))
+
+
+def _within(col: np.ndarray, lo: float, hi: float, slack: float | None = None) -> np.ndarray:
+    """Which values lie in [lo, hi] widened by ``slack`` (default a tenth of the range:
+    an offset is not a unit problem); +-2 turns for a joint without finite limits."""
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        lo, hi = -4 * math.pi, 4 * math.pi
+    slack = 0.1 * (hi - lo) if slack is None else slack
+    return (col >= lo - slack) & (col <= hi + slack)
+
+
+def _plausible_angles(rec: Trajectory, col: np.ndarray, name: str,
+                      limits: tuple[float, float], rows: list[int] | None) -> None:
     """R404 when a joint's values leave its limits and read as degrees they would not."""
-    lo, hi = (lo, hi) if math.isfinite(lo) and math.isfinite(hi) else (-4 * math.pi,
-                                                                        4 * math.pi)
-    slack = 0.1 * (hi - lo)
-    out = (col < lo - slack) | (col > hi + slack)
-    if not out.any():
+    inside = _within(col, *limits)
+    if inside.all() or not _within(np.radians(col), *limits).all():
         return
-    rad = np.radians(col)
-    if ((rad >= lo - slack) & (rad <= hi + slack)).all():
-        i = int(np.argmax(out))
-        raise AouError(diag(
-            "R404", f"joint `{name}` reads {col[i]:g} at sample {i}, outside its limits "
-            f"[{lo:.3g}, {hi:.3g}] rad: the angles look like degrees",
-            Span.whole_file(rec.path), hint="give --angle-unit deg, or --angle-unit rad "
-            "if they really are radians", joint=name, sample=i))
+    i = int(np.argmin(inside))
+    at, span, fields = _at(rec, rows, i)
+    raise AouError(diag(
+        "R404", f"joint `{name}` reads {col[i]:g} at {at}, outside its limits "
+        f"[{limits[0]:.3g}, {limits[1]:.3g}] rad: the angles look like degrees", span,
+        hint="give --angle-unit deg, or --angle-unit rad if they really are radians",
+        joint=name, **fields))
+
+
+def _obeyed_limits(rec: Trajectory, col: np.ndarray, name: str,
+                   limits: tuple[float, float], unit: str, rows: list[int] | None) -> None:
+    """R404 when the angle unit given leaves every sample of a joint beyond its limits
+    (by :data:`BEYOND`): the unit contradicts the robot."""
+    lo, hi = limits
+    if not (math.isfinite(lo) and math.isfinite(hi)) or _within(col, lo, hi, BEYOND).any():
+        return
+    other = "rad" if unit == "deg" else "deg"
+    fits = _within(col / ANGLE_UNITS[unit] * ANGLE_UNITS[other], lo, hi).all()
+    at, span, fields = _at(rec, rows, 0)
+    raise AouError(diag(
+        "R404", f"with --angle-unit {unit}, joint `{name}` reads {col[0]:.4g} rad at {at} "
+        f"and every one of its {len(col)} samples lies outside its limits [{lo:.3g}, "
+        f"{hi:.3g}] rad: the unit given contradicts the robot's limits", span,
+        hint=f"the values fit the limits in {other}: give --angle-unit {other}" if fits
+        else "check the unit, and that the recording is of this robot (--robot)",
+        joint=name, unit=unit, **fields))
 
 
 def final_goal(rec: Trajectory) -> tuple[float, float, float]:
@@ -338,7 +381,8 @@ def read_recording(path: str, *, robot: str | None = None,
             Without any goal, measuring warns (R405) and leaves the gazes unknown.
         angle_unit: ``"rad"`` or ``"deg"`` for the revolute joints; ``time_unit``:
             ``"s"`` or ``"ms"``. When not given, values that look like degrees or
-            milliseconds are refused (R404); files written by aou are trusted.
+            milliseconds are refused (R404); files written by aou are trusted. An angle
+            unit that leaves a joint outside its limits at every sample is refused too.
 
     Raises:
         AouError: I501 when the file cannot be read; R401 for a malformed trajectory
@@ -360,16 +404,12 @@ def read_recording(path: str, *, robot: str | None = None,
             trusted = _written_by_aou(json.loads(text or ""))
         except ValueError:
             trusted = False
-    changes: dict[str, Any] = {}
-    if robot:
-        changes["robot"] = robot
-    if ee_frame:
-        changes["ee_frame"] = ee_frame
+    changes: dict[str, Any] = {k: v for k, v in (("robot", robot), ("ee_frame", ee_frame))
+                               if v}
     if goal is not None and not isinstance(goal, str):
         changes["goal"] = tuple(float(x) for x in goal)
-    if changes:
-        rec = rec.with_(**changes)
-    rec = _check_units(rec, angle_unit, time_unit, trusted)
+    rec = rec.with_(**changes) if changes else rec
+    rec = _check_units(rec, angle_unit, time_unit, trusted, rows)
     _check_clock(path, rec.t, rows)
     if isinstance(goal, str):
         if goal != "final":

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..cv import CANONICAL, CVPoint
+from ..diagnostics import Diagnostic, Span, diag
 from ..trajectory import Trajectory
 
 __all__ = ["ProfileData", "cv_figure", "profile_data", "profile_figure", "save"]
@@ -34,6 +35,7 @@ class ProfileData:
             the ones ``aouc measure`` finds (``measured`` True).
         sight: for a recording with a goal, the line-of-sight angle [deg] over time
             (``sight_t`` [s]), else empty.
+        diagnostics: what the figure cannot show (R405: no goal, so no goal distance).
     """
 
     title: str
@@ -50,11 +52,18 @@ class ProfileData:
     measured: bool = False
     sight_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
     sight: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    diagnostics: tuple[Diagnostic, ...] = ()
+
+    @property
+    def has_goal(self) -> bool:
+        """Whether the goal distance is known (else its panel is left out)."""
+        return bool(np.isfinite(self.distance).any())
 
 
 def profile_data(rec: Trajectory) -> ProfileData:
     """From a trajectory: its compiler episodes are shaded, or, for a recording, the
-    episodes ``aouc measure`` finds (with the line of sight).
+    episodes ``aouc measure`` finds (with the line of sight). Without a goal there is no
+    goal distance, and R405 (a warning) says so.
 
     Raises:
         AouError: as :func:`aou_dsl.measuring.descriptors.measure` for a recording that
@@ -83,6 +92,11 @@ def profile_data(rec: Trajectory) -> ProfileData:
             extra["sight"] = m.line_of_sight.angle
     distance = (np.linalg.norm(np.asarray(rec.goal) - pos, axis=1) if rec.goal is not None
                 else np.full(len(t), np.nan))
+    if rec.goal is None:
+        extra["diagnostics"] = (diag(
+            "R405", "the trajectory has no goal: the plot leaves out the goal-distance "
+            "panel and the line of sight",
+            Span.whole_file(rec.path), hint="give it with --goal X,Y,Z, or --goal final"),)
     return ProfileData(rec.title, arm.joint_names, t, speed, distance, q, qd,
                        arm.lower, arm.upper, arm.vmax, tuple(episodes), **extra)
 
@@ -98,15 +112,21 @@ def _pyplot():
 
 def profile_figure(d: ProfileData):
     """Four panels over time: end-effector speed (episodes shaded and labelled, like the
-    paper's velocity profiles), goal distance, joint positions and joint velocities as
-    fractions of their limits; for a recording, a fifth: the line of sight (how far the
-    hand's forward axis points away from the goal)."""
+    paper's velocity profiles), goal distance (left out without a goal), joint positions
+    and joint velocities as fractions of their limits; for a recording, a fifth: the line
+    of sight (how far the hand's forward axis points away from the goal)."""
     plt = _pyplot()
     sight = len(d.sight) > 0
-    ratios = [2, 1, 1.3, 1.3] + ([1] if sight else [])
-    fig, axes = plt.subplots(len(ratios), 1, figsize=(10, 9 + 1.6 * sight), sharex=True,
-                             gridspec_kw={"height_ratios": ratios})
-    ax_v, ax_d, ax_q, ax_qd = axes[:4]
+    panels = {"v": 2, "d": 1, "q": 1.3, "qd": 1.3, "sight": 1}
+    if not d.has_goal:
+        del panels["d"]
+    if not sight:
+        del panels["sight"]
+    fig, axes = plt.subplots(len(panels), 1, sharex=True,
+                             figsize=(10, 9 + 1.6 * sight - 1.6 * (not d.has_goal)),
+                             gridspec_kw={"height_ratios": list(panels.values())})
+    panel = dict(zip(panels, axes, strict=True))
+    ax_v, ax_q, ax_qd = panel["v"], panel["q"], panel["qd"]
     ax_v.plot(d.t, d.speed, color="black", lw=1.2, label="end-effector speed")
     top = max(float(d.speed.max()), 1e-3) * 1.25
     for kind, a, b in d.episodes:
@@ -117,9 +137,11 @@ def profile_figure(d: ProfileData):
     ax_v.set_ylim(0, top)
     ax_v.set_ylabel("speed [m/s]")
     title = d.title or "velocity profile"
-    ax_v.set_title(f"{title} (episodes as measured)" if d.measured else title)
-    ax_d.plot(d.t, d.distance, color="#34495e", lw=1.2)
-    ax_d.set_ylabel("goal distance [m]")
+    ax_v.set_title((f"{title} (episodes as measured)" if d.measured else title)
+                   + ("" if d.has_goal else "; no goal: no goal distance"))
+    if "d" in panel:
+        panel["d"].plot(d.t, d.distance, color="#34495e", lw=1.2)
+        panel["d"].set_ylabel("goal distance [m]")
     mid = (d.upper + d.lower) / 2
     half = (d.upper - d.lower) / 2
     for j, name in enumerate(d.joint_names):
@@ -132,8 +154,8 @@ def profile_figure(d: ProfileData):
         ax.set_ylim(-1.1, 1.1)
     ax_q.legend(fontsize=6, ncol=4, loc="lower left")
     if sight:
-        axes[4].plot(d.sight_t, d.sight, color="#8e44ad", lw=1)
-        axes[4].set_ylabel("line of sight [deg]")
+        panel["sight"].plot(d.sight_t, d.sight, color="#8e44ad", lw=1)
+        panel["sight"].set_ylabel("line of sight [deg]")
     axes[-1].set_xlabel("time [s]")
     fig.tight_layout()
     return fig
