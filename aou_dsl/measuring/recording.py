@@ -28,6 +28,7 @@ import numpy as np
 from ..diagnostics import AouError, Severity, Span, diag
 from ..files import read_bytes, read_text
 from ..trajectory import Trajectory
+from .document import Header, read_header
 
 __all__ = ["ANGLE_UNITS", "TIME_UNITS", "read_csv", "read_json", "read_npz",
            "read_recording"]
@@ -92,27 +93,11 @@ def _optional(doc: dict, q: np.ndarray) -> dict:
     return out
 
 
-def _goal_of(path: str, doc: dict) -> tuple[float, ...] | None:
-    goal = doc.get("goal")
-    if goal is None:
-        return None
+def _from_document(path: str, doc: dict, header: Header, t: Any, q: Any) -> Trajectory:
+    """A trajectory from a document of the trajectory format, its validated header and
+    its arrays."""
+    names = tuple(header.joint_names)
     try:
-        pos = goal["position"] if isinstance(goal, dict) else goal
-        out = tuple(float(x) for x in pos)
-    except (TypeError, ValueError, KeyError):
-        raise _bad(path, "`goal.position` must be 3 numbers") from None
-    if len(out) != 3 or not all(math.isfinite(x) for x in out):
-        raise _bad(path, "`goal.position` must be 3 finite numbers")
-    return out
-
-
-def _from_document(path: str, doc: dict, t: Any, q: Any) -> Trajectory:
-    """A trajectory from a document of the trajectory format and its arrays."""
-    missing = [k for k in ("robot", "joint_names") if k not in doc]
-    if missing:
-        raise _bad(path, f"missing key(s): {', '.join(missing)}")
-    try:
-        names = tuple(str(n) for n in doc["joint_names"])
         t = np.asarray(t, dtype=float)
         rows = list(q)
         for i, row in enumerate(rows):
@@ -123,10 +108,9 @@ def _from_document(path: str, doc: dict, t: Any, q: Any) -> Trajectory:
     except (TypeError, ValueError) as exc:
         raise _bad(path, f"malformed trajectory: {exc}") from None
     _check_arrays(path, t, q, names)
-    title = str(doc.get("behaviour") or os.path.splitext(os.path.basename(path))[0])
-    ee = doc.get("ee_frame")
-    return Trajectory(t, q, names, str(doc["robot"]), None if ee is None else str(ee),
-                      _goal_of(path, doc), path=path, title=title, **_optional(doc, q))
+    title = header.behaviour or os.path.splitext(os.path.basename(path))[0]
+    return Trajectory(t, q, names, header.robot, header.ee_frame, header.goal_position,
+                      path=path, title=title, **_optional(doc, q))
 
 
 def _written_by_aou(doc: dict) -> bool:
@@ -140,17 +124,13 @@ def read_json(path: str, text: str) -> Trajectory:
     except json.JSONDecodeError as exc:
         raise AouError(diag("R401", f"not valid JSON: {exc.msg}",
                             Span.point(path, exc.lineno, exc.colno))) from None
-    if not isinstance(doc, dict):
-        raise _bad(path, "a trajectory file is a JSON object")
-    fmt = doc.get("format")
-    if fmt != "aou-trajectory/1":
-        raise _bad(path, f"expected format `aou-trajectory/1`, found {fmt!r}")
-    missing = [k for k in ("robot", "joint_names", "t", "q") if k not in doc]
+    header = read_header(path, doc)
+    missing = [k for k in ("t", "q") if k not in doc]
     if missing:
         raise _bad(path, f"missing key(s): {', '.join(missing)}")
     if not isinstance(doc["q"], list):
         raise _bad(path, "`q` must be a list of rows")
-    rec = _from_document(path, doc, doc["t"], doc["q"])
+    rec = _from_document(path, doc, header, doc["t"], doc["q"])
     _check_clock(path, rec.t)
     return rec
 
@@ -168,13 +148,14 @@ def read_npz(path: str, data: bytes) -> Trajectory:
     except (zipfile.BadZipFile, KeyError, ValueError, OSError) as exc:
         raise _bad(path, f"not an aou NPZ trajectory: {exc}",
                    hint="an NPZ of aou holds t.npy, q.npy and header.json") from None
-    if not isinstance(doc, dict) or "t" not in arrays or "q" not in arrays:
+    if "t" not in arrays or "q" not in arrays:
         raise _bad(path, "not an aou NPZ trajectory: `t.npy` or `q.npy` is missing")
+    header = read_header(path, doc)
     doc = {**doc, **{k: v for k, v in arrays.items() if k in ("qd", "qdd")}}
     q = arrays["q"]
     if q.ndim != 2:
         raise _bad(path, f"`q` has shape {q.shape}; expected (samples, joints)")
-    rec = _from_document(path, doc, arrays["t"], q)
+    rec = _from_document(path, doc, header, arrays["t"], q)
     _check_clock(path, rec.t)
     return rec
 
