@@ -6,7 +6,7 @@ Nothing here imports a heavy dependency: linting a folder in CI starts fast.
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from .cv import CANONICAL, DEFAULT_WEIGHTS, CVPoint, CVWeights, composition, effort_to_cv, infer
@@ -169,12 +169,24 @@ def read_source(path: str) -> str:
                             Span.whole_file(path))) from None
 
 
+#: Extensions of the trajectories aou writes and reads: given where a behaviour is
+#: expected, the file is almost surely one of them.
+TRAJECTORY_EXTENSIONS = (".json", ".csv", ".npz", ".yaml", ".mcap")
+
+
 def lint_file(path: str, *, weights: CVWeights = DEFAULT_WEIGHTS) -> FileResult:
     try:
         text = read_source(path)
     except AouError as err:
-        return FileResult(path, err.diagnostics)
-    return lint_source(text, path, weights=weights)
+        result = FileResult(path, err.diagnostics)
+    else:
+        result = lint_source(text, path, weights=weights)
+    first = result.diagnostics[0] if result.diagnostics else None
+    if first and first.code[0] in "SI" and path.lower().endswith(TRAJECTORY_EXTENSIONS):
+        result.diagnostics[0] = replace(first, hint=(
+            "this looks like a trajectory, not a behaviour: `aouc measure`, `check` and "
+            "`plot` read trajectories; `lint` and `compile` read `.aou` files"))
+    return result
 
 
 def collect_inputs(paths: list[str]) -> tuple[list[tuple[str, str | None]], list[Diagnostic]]:

@@ -18,6 +18,8 @@ __all__ = [
 ]
 
 
+#: The most characters of a source line an excerpt shows.
+EXCERPT = 120
 _LAST: tuple[str | None, list[str]] = (None, [])  # the last source formatted, its lines
 
 
@@ -38,9 +40,15 @@ def _source_excerpt(d: Diagnostic, source: str | None) -> list[str]:
         return []
     text = lines[d.span.line - 1].expandtabs(1)
     width = (d.span.end_col - d.span.col) if d.span.end_line == d.span.line else len(text)
-    width = max(1, min(width, len(text) - d.span.col + 2))
+    width = max(1, min(width, len(text) - d.span.col + 2, EXCERPT))
+    col = d.span.col
+    if len(text) > EXCERPT:  # a long line (a JSON file given as .aou): the part around col
+        start = max(0, min(col - 1 - EXCERPT // 4, len(text) - EXCERPT))
+        text = ("..." if start else "") + text[start:start + EXCERPT] + (
+            "..." if start + EXCERPT < len(text) else "")
+        col -= start - (3 if start else 0)
     gutter = f"{d.span.line:>4} | "
-    return [gutter + text, " " * (len(gutter) - 2) + "| " + " " * (d.span.col - 1) + "^" * width]
+    return [gutter + text, " " * (len(gutter) - 2) + "| " + " " * (col - 1) + "^" * width]
 
 
 def format_text(d: Diagnostic, source: str | None = None) -> str:
