@@ -273,3 +273,44 @@ def test_the_spec_names_aouc_robot_shows_are_pointed_to_the_file_s_names(tmp_pat
     bad.write_text('robot = "panda"\nstart_direction = [-0.6, 0.0, 0.8]\n')
     d = _fails("V109", read_description, str(bad))
     assert "`from`" in (d.hint or "") and d.span.line == 2
+
+
+# --- an aou CSV edited into degrees -------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def aou_csv(tmp_path_factory):
+    """A CSV written by `aouc compile` (comment lines say aou wrote it), and the same
+    file with its joint columns turned into degrees, as a spreadsheet edit would."""
+    from aou_dsl.build import build_source
+    from aou_dsl.compiler.output import encode
+
+    res = build_source("approach a=0.1\npause 1s x2\nretreat 0.05m a=0.1\n", "b.aou",
+                       check=False)
+    text = encode(res.document, "csv").decode()
+    edited = []
+    for line in text.splitlines():
+        if line.startswith("#") or line.startswith("t,"):
+            edited.append(line)
+        else:
+            t, *q = line.split(",")
+            edited.append(",".join([t, *(repr(float(v) / DEG) for v in q)]))
+    d = tmp_path_factory.mktemp("aou_csv")
+    (d / "rad.csv").write_text(text)
+    (d / "deg.csv").write_text("\n".join(edited) + "\n")
+    return str(d / "rad.csv"), str(d / "deg.csv")
+
+
+def test_an_aou_csv_edited_into_degrees_is_refused_then_read_with_the_unit(aou_csv):
+    rad, deg = aou_csv
+    d = _fails("R404", read_recording, deg)
+    assert "degrees" in d.message and "--angle-unit deg" in (d.hint or "")
+    want = measure(read_recording(rad)).descriptors
+    got = measure(read_recording(deg, angle_unit="deg")).descriptors
+    for key in ("approach_acceleration", "pause_count", "retreat_distance"):
+        assert got[key] == pytest.approx(want[key], rel=1e-6), key
+
+
+def test_a_unit_on_an_unedited_aou_csv_is_still_refused(aou_csv):
+    rad, _ = aou_csv
+    d = _fails("R404", read_recording, rad, angle_unit="deg")
+    assert "aou wrote this file" in d.message

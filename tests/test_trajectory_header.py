@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from aou_dsl.diagnostics import AouError
-from aou_dsl.measuring.recording import read_json, read_npz
+from aou_dsl.measuring.recording import read_json, read_npz, read_recording
 
 T = [0.0, 0.1, 0.2, 0.3]
 Q = [[0.1 * i] for i in range(4)]
@@ -33,23 +33,47 @@ def _refused(doc: dict) -> str:
 
 
 @pytest.mark.parametrize("changes,path", [
-    ({"goal": {"position": [0.5, 0.0]}}, "`goal.position.2`"),
-    ({"goal": {"position": [0.5, "far", 0.3]}}, "`goal.position.1`"),
-    ({"goal": {"where": [0.5, 0.0, 0.3]}}, "`goal.position`: field required"),
     ({"joint_names": ["panda_joint1", 7]}, "`joint_names.1`"),
     ({"joint_names": []}, "`joint_names`"),
     ({"robot": ""}, "`robot`"),
     ({"ee_frame": 3}, "`ee_frame`"),
+    ({"rate": "fast"}, "`rate`"),
+    ({"duration": -1}, "`duration`"),
 ])
 def test_a_wrong_field_is_named_by_its_path(changes, path):
     assert path in _refused(_doc(**changes))
+
+
+@pytest.mark.parametrize("goal", [{"position": [0.5, 0.0]}, {"position": [0.5, "far", 0.3]},
+                                  {"where": [0.5, 0.0, 0.3]}, "final", [1, 2, 3, 4]])
+def test_a_wrong_goal_says_what_a_goal_is_and_what_was_found(goal):
+    message = _refused(_doc(goal=goal))
+    assert '`goal` must be {"position": [x, y, z]}' in message
+    assert json.dumps(goal) in message
+
+
+def test_a_goal_given_replaces_a_wrong_one_in_the_file():
+    text = json.dumps(_doc(goal={"position": [1, 2]}))
+    with pytest.raises(AouError):
+        read_recording_text(text)
+    assert read_recording_text(text, goal=(0.5, 0.0, 0.3)).goal == (0.5, 0.0, 0.3)
 
 
 def test_an_infinite_goal_is_refused():
     text = json.dumps(_doc()).replace("[0.5, 0.0, 0.3]", "[0.5, Infinity, 0.3]")
     with pytest.raises(AouError) as info:
         read_json("x.json", text)
-    assert "`goal.position.1`" in info.value.diagnostics[0].message
+    assert "`goal` must be" in info.value.diagnostics[0].message
+
+
+def read_recording_text(text: str, **kw):
+    import tempfile
+    from pathlib import Path
+
+    with tempfile.TemporaryDirectory() as d:
+        path = Path(d) / "x.json"
+        path.write_text(text)
+        return read_recording(str(path), **kw)
 
 
 def test_missing_keys_are_listed_together():
@@ -58,8 +82,8 @@ def test_missing_keys_are_listed_together():
 
 
 def test_several_wrong_fields_are_all_named():
-    message = _refused(_doc(robot="", ee_frame=3))
-    assert "`robot`" in message and "`ee_frame`" in message
+    message = _refused(_doc(robot="", ee_frame=3, goal=[1]))
+    assert "`robot`" in message and "`ee_frame`" in message and "`goal`" in message
 
 
 def test_keys_the_format_does_not_name_and_a_bare_goal_are_read():
@@ -85,7 +109,7 @@ def test_an_npz_header_is_held_to_the_same_rules():
     assert read_npz("x.npz", _npz(header)).goal == (0.5, 0.0, 0.3)
     with pytest.raises(AouError) as info:
         read_npz("x.npz", _npz({**header, "goal": {"position": [1, 2]}}))
-    assert "`goal.position.2`" in info.value.diagnostics[0].message
+    assert "`goal` must be" in info.value.diagnostics[0].message
     with pytest.raises(AouError) as info:
         read_npz("x.npz", _npz(["not", "an", "object"]))  # type: ignore[arg-type]
     assert info.value.diagnostics[0].code == "R401"

@@ -9,6 +9,7 @@ checked as arrays by the reader, not here: a minute at 1 kHz is 60 000 rows.
 
 from __future__ import annotations
 
+import json
 from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
@@ -19,6 +20,7 @@ __all__ = ["FORMAT", "Goal", "Header", "read_header"]
 
 FORMAT = "aou-trajectory/1"
 Finite = Annotated[float, Field(allow_inf_nan=False)]
+Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
 
 
 class Goal(BaseModel):
@@ -38,9 +40,12 @@ class Header(BaseModel):
     robot: str = Field(min_length=1)
     joint_names: list[str] = Field(min_length=1)
     behaviour: str | None = None
+    state: str | None = None
     ee_frame: str | None = None
     goal: Goal | None = None
     generator: str = ""
+    rate: Positive | None = None  # Hz, of a compiled file
+    duration: Positive | None = None  # s
 
     @field_validator("goal", mode="before")
     @classmethod
@@ -62,17 +67,23 @@ def _message(errors: list[Any], doc: dict) -> str:
     if missing:
         return f"missing key(s): {', '.join(missing)}"
     parts = [f"`{'.'.join(str(x) for x in e['loc'])}`: {e['msg'].lower()}"
-             for e in errors[:3]]
-    more = f" (and {len(errors) - 3} more)" if len(errors) > 3 else ""
-    return "; ".join(parts) + more
+             for e in errors if e["loc"][0] != "goal"]
+    if any(e["loc"][0] == "goal" for e in errors):  # one part for the goal, in aou's words
+        found = json.dumps(doc.get("goal"))
+        parts.insert(0, "`goal` must be {\"position\": [x, y, z]}, three finite numbers "
+                        f"in metres; found {found[:60]}{'...' if len(found) > 60 else ''}")
+    more = f" (and {len(parts) - 3} more)" if len(parts) > 3 else ""
+    return "; ".join(parts[:3]) + more
 
 
-def read_header(path: str, doc: Any) -> Header:
-    """The validated header of ``doc``; R401 naming each wrong field."""
+def read_header(path: str, doc: Any, *, own_goal: bool = True) -> Header:
+    """The validated header of ``doc``; R401 naming each wrong field. ``own_goal``
+    False: the file's goal is not read (one given on the command line replaces it)."""
     if not isinstance(doc, dict):
         raise AouError(diag("R401", "a trajectory document is a JSON object",
                             Span.whole_file(path)))
-    fields = {k: v for k, v in doc.items() if k not in ("t", "q", "qd", "qdd")}
+    skip = ("t", "q", "qd", "qdd") if own_goal else ("t", "q", "qd", "qdd", "goal")
+    fields = {k: v for k, v in doc.items() if k not in skip}
     try:
         header = Header.model_validate(fields)
     except ValidationError as exc:

@@ -117,14 +117,15 @@ def _written_by_aou(doc: dict) -> bool:
     return str(doc.get("generator", "")).startswith("aouc")
 
 
-def read_json(path: str, text: str) -> Trajectory:
-    """An ``aou-trajectory/1`` document (the goal may be missing)."""
+def read_json(path: str, text: str, own_goal: bool = True) -> Trajectory:
+    """An ``aou-trajectory/1`` document (the goal may be missing; ``own_goal`` False:
+    not read, one given replaces it)."""
     try:
         doc = json.loads(text)
     except json.JSONDecodeError as exc:
         raise AouError(diag("R401", f"not valid JSON: {exc.msg}",
                             Span.point(path, exc.lineno, exc.colno))) from None
-    header = read_header(path, doc)
+    header = read_header(path, doc, own_goal=own_goal)
     missing = [k for k in ("t", "q") if k not in doc]
     if missing:
         raise _bad(path, f"missing key(s): {', '.join(missing)}")
@@ -135,7 +136,7 @@ def read_json(path: str, text: str) -> Trajectory:
     return rec
 
 
-def read_npz(path: str, data: bytes) -> Trajectory:
+def read_npz(path: str, data: bytes, own_goal: bool = True) -> Trajectory:
     """aou's NPZ: ``t.npy``, ``q.npy`` (and ``qd``, ``qdd``) with ``header.json``."""
     try:
         with zipfile.ZipFile(io.BytesIO(data)) as zf:
@@ -150,7 +151,7 @@ def read_npz(path: str, data: bytes) -> Trajectory:
                    hint="an NPZ of aou holds t.npy, q.npy and header.json") from None
     if "t" not in arrays or "q" not in arrays:
         raise _bad(path, "not an aou NPZ trajectory: `t.npy` or `q.npy` is missing")
-    header = read_header(path, doc)
+    header = read_header(path, doc, own_goal=own_goal)
     doc = {**doc, **{k: v for k, v in arrays.items() if k in ("qd", "qdd")}}
     q = arrays["q"]
     if q.ndim != 2:
@@ -257,18 +258,16 @@ def _check_units(rec: Trajectory, angle_unit: str | None, time_unit: str | None,
     wrong = [f"--{flag} {unit}" for flag, unit, right in
              (("angle-unit", angle_unit, "rad"), ("time-unit", time_unit, "s"))
              if unit not in (None, right)]
-    if trusted and wrong:
+    arm = load_arm(rec.robot, rec.ee_frame)
+    if trusted and wrong and _as_written(rec, arm, rows):
         raise AouError(diag("R404", f"aou wrote this file, in radians and seconds: "
                             f"{' and '.join(wrong)} would misread it", Span.whole_file(
                                 rec.path), hint="leave the units out for files aou wrote"))
     t = np.asarray(rec.t, float) * TIME_UNITS[time_unit or "s"]
-    if time_unit is None and not trusted:
+    if time_unit is None and not trusted:  # aou writes slow clocks too (--rate 1)
         _plausible_clock(rec, t, rows)
-    arm = load_arm(rec.robot, rec.ee_frame)
     q = np.asarray(rec.q, float).copy()
-    revolute = [j for j, name in enumerate(arm.joint_names)
-                if arm.model.joints[j + 1].shortname().startswith("JointModelR")]
-    for j in revolute:
+    for j in _revolute(arm):
         name = arm.joint_names[j]
         if name not in rec.joint_names:
             continue
@@ -277,9 +276,27 @@ def _check_units(rec: Trajectory, angle_unit: str | None, time_unit: str | None,
         if angle_unit is not None:
             q[:, col] *= ANGLE_UNITS[angle_unit]
             _obeyed_limits(rec, q[:, col], name, limits, angle_unit, rows)
-        elif not trusted:
+        else:  # aou's own files too: an edited one may no longer be in radians
             _plausible_angles(rec, q[:, col], name, limits, rows)
     return rec.with_(t=t, q=q)
+
+
+def _revolute(arm: Any) -> list[int]:
+    return [j for j in range(len(arm.joint_names))
+            if arm.model.joints[j + 1].shortname().startswith("JointModelR")]
+
+
+def _as_written(rec: Trajectory, arm: Any, rows: list[int] | None) -> bool:
+    """Whether the file's angles are plausible in radians as they stand."""
+    try:
+        for j in _revolute(arm):
+            if arm.joint_names[j] in rec.joint_names:
+                col = np.asarray(rec.q, float)[:, rec.joint_names.index(arm.joint_names[j])]
+                _plausible_angles(rec, col, arm.joint_names[j],
+                                  (float(arm.lower[j]), float(arm.upper[j])), rows)
+    except AouError:
+        return False
+    return True
 
 
 def _plausible_clock(rec: Trajectory, t: np.ndarray, rows: list[int] | None) -> None:
@@ -362,8 +379,10 @@ def read_recording(path: str, *, robot: str | None = None,
             Without any goal, measuring warns (R405) and leaves the gazes unknown.
         angle_unit: ``"rad"`` or ``"deg"`` for the revolute joints; ``time_unit``:
             ``"s"`` or ``"ms"``. When not given, values that look like degrees or
-            milliseconds are refused (R404); files written by aou are trusted. An angle
-            unit that leaves a joint outside its limits at every sample is refused too.
+            milliseconds are refused (R404), in files aou wrote too (they may have been
+            edited); a unit on a file aou wrote whose values look right as they stand is
+            refused. An angle unit that leaves a joint outside its limits at every sample
+            is refused too.
 
     Raises:
         AouError: I501 when the file cannot be read; R401 for a malformed trajectory
@@ -373,14 +392,14 @@ def read_recording(path: str, *, robot: str | None = None,
     text = None if path.endswith(".npz") else read_text(path)
     rows = None
     if path.endswith(".npz"):
-        rec = read_npz(path, data)
+        rec = read_npz(path, data, own_goal=goal is None)
         trusted = _written_by_aou(json.loads(zipfile.ZipFile(io.BytesIO(data))
                                              .read("header.json")))
     elif path.endswith(".csv"):
         rec, rows, trusted = _read_csv(path, text or "", robot,
                                        None if isinstance(goal, str) else goal, ee_frame)
     else:
-        rec = read_json(path, text or "")
+        rec = read_json(path, text or "", own_goal=goal is None)
         try:
             trusted = _written_by_aou(json.loads(text or ""))
         except ValueError:
