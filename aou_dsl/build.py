@@ -81,17 +81,20 @@ class BuildResult:
 
 
 def _with_robot(lint: FileResult, robot: str | None) -> list[Diagnostic]:
-    """Point the behaviour at another robot (``--robot``); V109 for an unknown one."""
+    """Point the behaviour at another robot (``--robot``); V109 for an unknown one. What
+    is said of the robot then points at the command line, not the file's ``robot`` line."""
     from .robots import ROBOTS, is_robot_file
 
     if robot is None or lint.behaviour is None:
         return []
+    where = Span.whole_file("<command line>")
     if robot not in ROBOTS and not is_robot_file(robot):
         from .arms.load import unknown_robot
 
-        return [unknown_robot(robot, Span.whole_file(lint.path))]
+        return [unknown_robot(robot, where)]
     b = lint.behaviour
-    lint.behaviour = b.replace(settings=b.settings.replace(robot=robot))
+    spans = {**b.settings.spans, "robot": where}
+    lint.behaviour = b.replace(settings=b.settings.replace(robot=robot, spans=spans))
     return []
 
 

@@ -14,7 +14,7 @@ from collections.abc import Callable, Sequence
 
 from .cli_args import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, build_parser
 from .cli_tools import cmd_robot, cmd_synth
-from .diagnostics import RULES, AouError, Diagnostic, Severity
+from .diagnostics import RULES, AouError, Diagnostic, Severity, Span
 from .report import format_github, format_json, format_suppressed, format_text
 
 __all__ = ["EXIT_ERRORS", "EXIT_OK", "EXIT_USAGE", "main"]
@@ -49,6 +49,11 @@ def _read_kw(args: argparse.Namespace) -> dict:
             "angle_unit": args.angle_unit, "time_unit": args.time_unit}
 
 
+def _count(n: int, noun: str) -> str:
+    """``1 error``, ``2 errors``."""
+    return f"{n} {noun}{'s' * (n != 1)}"
+
+
 # --- lint, rules, explain ---------------------------------------------------------------
 
 
@@ -71,10 +76,10 @@ def _cmd_lint(args: argparse.Namespace) -> int:
             if note:
                 print(note)
         if args.format == "text":
-            n = len(results)
-            print(f"{n} file{'s' * (n != 1)} checked: {counts[Severity.ERROR]} errors, "
-                  f"{counts[Severity.WARNING]} warnings, {counts[Severity.NOTE]} notes",
-                  file=sys.stderr)
+            print(f"{_count(len(results), 'file')} checked: "
+                  f"{_count(counts[Severity.ERROR], 'error')}, "
+                  f"{_count(counts[Severity.WARNING], 'warning')}, "
+                  f"{_count(counts[Severity.NOTE], 'note')}", file=sys.stderr)
     if io_errors:
         return EXIT_USAGE
     if counts[Severity.ERROR] or (args.strict and counts[Severity.WARNING]):
@@ -120,8 +125,9 @@ def _cmd_explain(args: argparse.Namespace) -> int:
 
 
 def _cmd_compile(args: argparse.Namespace) -> int:
-    from .compiler.output import output_paths
+    from .compiler.output import FORMATS, output_paths
     from .diagnostics import has_errors
+    from .files import check_format
     from .linter import collect_inputs
     from .parallel import build_many, default_jobs, write_result
     from .safety.scene import SceneOptions
@@ -132,6 +138,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
         return EXIT_USAGE
     try:
         dests, fmt = output_paths(inputs, args.output, args.format)
+        check_format(args.output, args.format, FORMATS)  # --format csv -o x.json
         for d in {os.path.dirname(d) for d in dests if os.path.dirname(d)}:
             os.makedirs(d, exist_ok=True)
     except AouError as err:
@@ -176,7 +183,9 @@ def _cmd_check(args: argparse.Namespace) -> int:
     tr = read_trajectory(args.path, **_read_kw(args))
     from .arms import robot_diagnostics
 
-    refused = robot_diagnostics(tr.robot, collision_check=not args.no_collision_check)
+    named = Span.whole_file("<command line>" if args.robot else args.path)  # the robot
+    refused = robot_diagnostics(tr.robot, collision_check=not args.no_collision_check,
+                                span=named)
     _print_diags(refused)
     if any(d.severity == Severity.ERROR for d in refused):
         return EXIT_ERRORS
@@ -257,8 +266,9 @@ def _render(paths: list[str], output: str, args: argparse.Namespace, read_kw: di
     info = render_video(motions, output, fps=args.fps, camera=camera,
                         scene_options=SceneOptions(**_scene_kw(args)), workers=workers)
     print(f"wrote {output}: {info['frames']} frames at {info['fps']:g} fps "
-          f"({info['duration']:.2f} s), {info['size'][0]}x{info['size'][1]}, rendered in "
-          f"{time.perf_counter() - start:.1f} s", file=sys.stderr)
+          f"({info['duration']:.2f} s), {info['size'][0]}x{info['size'][1]}, "
+          f"{_count(info['drawn'], 'image')} drawn (a frame where the arm holds still "
+          f"repeats one) in {time.perf_counter() - start:.1f} s", file=sys.stderr)
     return EXIT_OK
 
 

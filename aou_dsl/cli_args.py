@@ -13,7 +13,7 @@ from collections.abc import Callable
 
 from . import __version__
 
-__all__ = ["EXIT_ERRORS", "EXIT_OK", "EXIT_USAGE", "build_parser", "number"]
+__all__ = ["EXIT_ERRORS", "EXIT_OK", "EXIT_USAGE", "build_parser", "number", "usage_error"]
 
 EXIT_OK = 0
 EXIT_ERRORS = 1
@@ -27,6 +27,15 @@ class Parser(argparse.ArgumentParser):
         self.print_usage(sys.stderr)
         sys.stderr.write(f"aouc: error: {message}\n")
         raise SystemExit(EXIT_USAGE)
+
+
+def usage_error(command: str, message: str) -> int:
+    """A usage error found after parsing (options that only make sense together): the
+    command's usage line and ``aouc: error: message`` on stderr, as argparse prints its
+    own; returns :data:`EXIT_USAGE`."""
+    build_parser()[1][command].print_usage(sys.stderr)
+    sys.stderr.write(f"aouc: error: {message}\n")
+    return EXIT_USAGE
 
 
 def number(lo: float, hi: float, *, lo_open: bool = False, what: str = "a number"

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from .cli_args import EXIT_OK, EXIT_USAGE
+from .cli_args import EXIT_OK, EXIT_USAGE, usage_error
 from .report import format_json
 
 __all__ = ["cmd_robot", "cmd_synth"]
@@ -37,13 +37,14 @@ def cmd_synth(args: argparse.Namespace) -> int:
     """``aouc synth``: a behaviour file for a state or a C-V point, fitted to the arm."""
     import sys
 
-    from .diagnostics import AouError, Span, diag
     from .files import check_output, write_atomic
     from .synth import synthesize
 
-    if (args.C is None) != (args.V is None):
-        raise AouError(diag("I501", "a point of the C-V plane needs both --C and --V",
-                            Span.whole_file("<command line>")))
+    if args.V is not None and args.C is None:  # argparse requires --state or --C
+        return usage_error("synth", "--V goes with --C (a point of the C-V plane), not "
+                           "with --state")
+    if args.C is not None and args.V is None:
+        return usage_error("synth", "a point of the C-V plane needs --V too")
     if args.output is not None:
         check_output(args.output, ("aou",))
     text = synthesize(args.state, C=args.C, V=args.V, intensity=args.intensity,

@@ -2,7 +2,8 @@
 
 Every file aou writes (trajectories, figures, videos, behaviour files) appears whole or
 not at all: it is written to a temporary name beside the target and renamed over it
-when complete, and an input is never overwritten.
+when complete, and an input is never overwritten. The folders missing on the way to it
+are made first (and removed again if the write fails).
 """
 
 from __future__ import annotations
@@ -15,12 +16,14 @@ from typing import Any
 
 from .diagnostics import AouError, Span, diag
 
-__all__ = ["read_text", "atomic", "check_output", "write_atomic"]
+__all__ = ["read_text", "atomic", "check_format", "check_output", "write_atomic"]
 
 
 def check_output(path: str, formats: Sequence[str] = ()) -> str:
-    """Check, before any long work, that ``path`` can be written: its folder exists and
-    its extension is one of ``formats`` (when given). Returns the extension.
+    """Check, before any long work, that ``path`` can be written: its extension is one of
+    ``formats`` (when given), and its folder exists and is writable or can be made (the
+    folders missing on the way are made when the file is written, by :func:`atomic`).
+    Returns the extension.
 
     Raises:
         AouError: I502 naming what is wrong.
@@ -31,19 +34,41 @@ def check_output(path: str, formats: Sequence[str] = ()) -> str:
         raise AouError(diag("I502", f"cannot write `{path}`: expected a file ending in "
                             f"{', '.join('.' + f for f in formats)}", where))
     folder = os.path.dirname(os.path.abspath(path))
+    while not os.path.lexists(folder):  # the nearest folder that exists must take a new one
+        folder = os.path.dirname(folder)
     if not os.path.isdir(folder):
-        raise AouError(diag("I502", f"cannot write `{path}`: the folder `{folder}` does not "
-                            "exist", where, hint="create it first"))
+        raise AouError(diag("I502", f"cannot write `{path}`: `{folder}` is a file, not a "
+                            "folder", where))
     if not os.access(folder, os.W_OK):
-        raise AouError(diag("I502", f"cannot write `{path}`: the folder is not writable",
-                            where))
+        raise AouError(diag("I502", f"cannot write `{path}`: the folder `{folder}` is not "
+                            "writable", where))
     return ext
+
+
+def check_format(path: str | None, fmt: str | None, known: Sequence[str]) -> None:
+    """Refuse an output file whose extension names a known format other than ``fmt``
+    (``--format csv -o x.json`` would write CSV into a file every reader takes for JSON).
+    A folder, an unknown extension or no ``fmt`` pass.
+
+    Raises:
+        AouError: I502 naming both formats.
+    """
+    if not path or not fmt or path.endswith(os.sep) or os.path.isdir(path):
+        return
+    stem, ext = os.path.splitext(path)
+    ext = ext.lower().lstrip(".")
+    if ext in known and ext != fmt:
+        raise AouError(diag(
+            "I502", f"refusing to write {fmt} into `{path}`, whose extension names {ext}",
+            Span.whole_file(path), hint=f"name it `{stem}.{fmt}`, or leave out --format "
+            f"to write {ext}"))
 
 
 @contextlib.contextmanager
 def atomic(path: str, *, inputs: Sequence[str] = ()) -> Iterator[str]:
     """A temporary file name beside ``path`` to write to; renamed over ``path`` when the
-    block ends without an exception, removed otherwise.
+    block ends without an exception, removed otherwise. The folders missing on the way
+    to ``path`` are made first, and removed again when nothing was written.
 
     Raises:
         AouError: I502 when the file cannot be written or would overwrite an input.
@@ -54,21 +79,51 @@ def atomic(path: str, *, inputs: Sequence[str] = ()) -> Iterator[str]:
         raise AouError(diag("I502", f"refusing to overwrite the input `{path}`", where,
                             hint="choose another output with -o"))
     ext = os.path.splitext(path)[1]
+    made = _make_folders(os.path.dirname(target), where)
     try:
         fd, tmp = tempfile.mkstemp(prefix=".aouc-", suffix=ext or ".tmp",
                                    dir=os.path.dirname(target) or ".")
         os.close(fd)
     except OSError as exc:
+        _remove_folders(made)
         raise AouError(diag("I502", f"cannot write `{path}`: {exc.strerror}", where)) from None
+    done = False
     try:
         yield tmp
         os.chmod(tmp, 0o644)  # mkstemp makes files private; outputs are ordinary files
         os.replace(tmp, target)
+        done = True
     except OSError as exc:
         raise AouError(diag("I502", f"cannot write `{path}`: {exc.strerror}", where)) from None
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
+        if not done:
+            _remove_folders(made)
+
+
+def _make_folders(folder: str, where: Span) -> list[str]:
+    """Make ``folder`` and the folders missing above it; the ones made, deepest first."""
+    made = []
+    while folder and not os.path.lexists(folder):
+        made.append(folder)
+        folder = os.path.dirname(folder)
+    try:
+        for f in reversed(made):
+            os.mkdir(f)
+    except OSError as exc:
+        _remove_folders(made)
+        raise AouError(diag("I502", f"cannot write `{where.path}`: cannot make the folder "
+                            f"`{exc.filename}`: {exc.strerror}", where)) from None
+    return made
+
+
+def _remove_folders(made: list[str]) -> None:
+    """Remove the folders :func:`_make_folders` made (deepest first), if still empty:
+    a failed write leaves nothing behind."""
+    for f in made:
+        with contextlib.suppress(OSError):
+            os.rmdir(f)
 
 
 def write_atomic(path: str, data: bytes, *, inputs: Sequence[str] = ()) -> None:

@@ -2,10 +2,14 @@
 
 Compiles the study's hesitant behaviour (``behaviours/hesitant.aou``) to a CSV file with
 the command-line entry ``aou_dsl.cli.main`` (the same as ``aouc compile ... -o X.csv``).
-A CSV holds only sample times and joint positions, like a log recorded on a robot, so
-measuring it needs the robot and the goal to be named. ``aou_dsl.measure`` then finds the
-episodes and the eleven descriptors from the joint motion alone, and the script prints
-them beside the values the study used (Table II, hesitant column).
+Its rows hold only sample times and joint positions, like a log recorded on a robot.
+A CSV that aou writes also names its robot, end-effector frame and goal in ``#`` comment
+lines above the columns, so ``aouc measure hesitant.csv`` needs nothing more; a log from
+a real arm has no such lines, and measuring it needs the robot and the goal named
+(``--robot``, ``--goal``; ``robot=`` and ``goal=`` here). The script names them, as it
+would for such a log. ``aou_dsl.measure`` then finds the episodes and the eleven
+descriptors from the joint motion alone, and the script prints them beside the values
+the study used (Table II, hesitant column).
 
 Run from the repository root::
 
@@ -41,9 +45,13 @@ def main(argv: list[str]) -> int:
     if status != 0:
         print(f"aouc compile failed with exit status {status}")
         return status
-    header = csv_path.read_text().splitlines()[0]
+    lines = csv_path.read_text().splitlines()
+    comments = [ln for ln in lines if ln.startswith("#")]
+    header = next(ln for ln in lines if not ln.startswith("#"))
     print(f"wrote {csv_path}: columns {header}")
+    print(f"  and {len(comments)} comment lines: {'; '.join(c[2:] for c in comments)}")
 
+    # As for a log recorded on a robot, which has no comment lines: name robot and goal.
     m = aou_dsl.measure(csv_path, robot="panda", goal=GOAL)
     print(f"measured {m.duration:.2f} s of motion, {len(m.episodes)} episodes "
           f"(line of sight within {m.gaze_error:.4f} deg of the goal)")

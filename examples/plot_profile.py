@@ -4,8 +4,8 @@ Compiles a behaviour (by default the study's fearful one) with ``aou_dsl.compile
 draws its velocity profile with ``aou_dsl.media.plot``: the end-effector speed over time
 with the episodes shaded and labelled, the distance to the goal, and the joint positions
 and velocities as fractions of their limits. Then it draws the C-V plane with the five
-shipped behaviours, through the command-line entry (``aouc plot --cv``). Needs the media
-extra (matplotlib): ``pip install ".[media]"``.
+shipped behaviours from their lint results (what ``aouc plot --cv behaviours -o
+cv-map.png`` draws). Needs the media extra (matplotlib): ``pip install ".[media]"``.
 
 Run from the repository root::
 
@@ -22,8 +22,7 @@ import tempfile
 from pathlib import Path
 
 import aou_dsl
-from aou_dsl.cli import main as aouc
-from aou_dsl.media.plot import profile_data, profile_figure, save
+from aou_dsl.media.plot import cv_figure, profile_data, profile_figure, save
 
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT = ROOT / "behaviours" / "fearful.aou"
@@ -49,11 +48,14 @@ def main(argv: list[str]) -> int:
         print(f"  {t0:6.2f} - {t1:6.2f} s  {kind}")
 
     cv_map = out / "cv-map.png"
-    status = aouc(["plot", "--cv", str(ROOT / "behaviours"), "-o", str(cv_map)])
-    if status != 0:
-        print(f"aouc plot --cv failed with exit status {status}")
-        return status
-    print(f"wrote {cv_map}")
+    results, problems = aou_dsl.lint_paths([str(ROOT / "behaviours")])
+    points = [(r.behaviour.name, r.cv) for r in results
+              if r.behaviour is not None and r.cv is not None]
+    if problems or len(points) != len(results):
+        print("the shipped behaviours do not all lint")
+        return 1
+    save(cv_figure(points), str(cv_map))
+    print(f"wrote {cv_map}: {len(points)} behaviours on the C-V plane")
     return 0
 
 

@@ -199,7 +199,9 @@ def robot_diagnostics(robot: str, *, collision_check: bool = True,
                       span: Span | None = None) -> list[Diagnostic]:
     """What a build says about its robot: C313 warnings (limits from no source) and,
     unless ``collision_check`` is False, C312 when the arm has no collision geometry.
-    ``span`` (the ``robot`` line) replaces the robot file's own span when given.
+    They point at ``span`` (where the robot was named: the ``robot`` line, the command
+    line) when given, else at the file a user would edit: the robot description, the
+    user's URDF, or for a built-in arm ``<robot NAME>`` (its URDF is installed data).
 
     Raises:
         AouError: as :func:`load_robot`.
@@ -213,6 +215,8 @@ def robot_diagnostics(robot: str, *, collision_check: bool = True,
             Span.whole_file(r.urdf.path),
             hint="add <collision> shapes to the URDF, or compile with --no-collision-check "
                  "(the output then records that collisions were not checked)"))
+    if span is None and (r.description or robot in ROBOTS):
+        span = Span.whole_file(r.description or f"<robot {robot}>")
     if span is not None:
         out = [Diagnostic(d.code, d.severity, d.message, span, d.hint, d.fields)
                for d in out]

@@ -193,10 +193,11 @@ def cv_figure(points: list[tuple[str, CVPoint]]):
 
 
 def save(fig, path: str) -> None:
-    """Save atomically (a temporary file beside ``path``, then renamed).
+    """Save atomically (a temporary file beside ``path``, then renamed), making the
+    folders missing on the way.
 
     Raises:
-        AouError: I502 when the folder is missing or the extension unknown.
+        AouError: I502 when the extension is unknown or the folder cannot be written.
     """
     from ..files import atomic, check_output
 

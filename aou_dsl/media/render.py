@@ -335,7 +335,7 @@ def _pedestal(scene, goal, options) -> None:
 
 
 def _progress_bar(label: str):
-    """A progress bar on stderr: redrawn in place on a terminal, every 10 % otherwise."""
+    """A progress bar of the images drawn on stderr: in place on a terminal, else by 10 %."""
     tty = sys.stderr.isatty()
     state = {"shown": -1}
 
@@ -344,11 +344,11 @@ def _progress_bar(label: str):
         if tty:
             bar = "#" * (pct // 5) + "-" * (20 - pct // 5)
             end = "\n" if done == total else ""
-            print(f"\r{label} [{bar}] {pct:3d}% frame {done}/{total}", end=end,
+            print(f"\r{label} [{bar}] {pct:3d}% image {done}/{total}", end=end,
                   file=sys.stderr, flush=True)
         elif pct // 10 != state["shown"] // 10 or done == total:
             state["shown"] = pct
-            print(f"{label}: {pct}% ({done}/{total} frames)", file=sys.stderr, flush=True)
+            print(f"{label}: {pct}% ({done}/{total} images)", file=sys.stderr, flush=True)
 
     return show
 
@@ -363,7 +363,8 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
     (None: one per core), or by the ``workers`` of :func:`start_workers` (closed here).
 
     Returns:
-        ``{"frames": N, "fps": fps, "duration": seconds, "size": [w, h]}``.
+        ``{"frames": N, "drawn": D, "fps": fps, "duration": seconds, "size": [w, h]}``:
+        D of the N frames are drawn, the others repeat one (the arm holding still).
     """
     from ..safety.scene import SceneOptions
 
@@ -404,7 +405,8 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
                            duration=[10 * d for d in cs], loop=0, optimize=False)
     finally:
         drawer.close()
-    return {"frames": n, "fps": fps, "duration": n / fps, "size": [size[1], size[0]]}
+    return {"frames": n, "drawn": drawer.total, "fps": fps, "duration": n / fps,
+            "size": [size[1], size[0]]}
 
 
 def _cores() -> int:
@@ -414,5 +416,5 @@ def _cores() -> int:
 
 
 def check_output(path: str) -> str:
-    """Check a video path before rendering: .mp4 or .gif, in a folder that exists."""
+    """Check a video path before rendering: .mp4 or .gif, its folder writable or makeable."""
     return _check_output(path, ("mp4", "gif"))

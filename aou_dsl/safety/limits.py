@@ -63,13 +63,13 @@ def check_limits(arm: ArmModel, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
     names = arm.joint_names
     mid = (arm.upper + arm.lower) / 2.0
     pos = _worst("joint-position", t, q - mid, np.where(q >= mid, arm.upper, arm.lower) - mid,
-                 names, "within the URDF position limits")
+                 names, "against the URDF position limits")
     pos = Check(pos.name, pos.ok, pos.time, pos.joint,
                 pos.value + mid[names.index(pos.joint)], pos.limit + mid[names.index(pos.joint)],
                 pos.detail)
-    vel = _worst("joint-velocity", t, qd, arm.vmax, names, "within the URDF velocity limits")
+    vel = _worst("joint-velocity", t, qd, arm.vmax, names, "against the URDF velocity limits")
     acc = _worst("joint-acceleration", t, qdd, arm.amax, names,
-                 "within the robot table's acceleration limits")
+                 "against the robot table's acceleration limits")
     return [pos, vel, acc]
 
 
@@ -103,6 +103,6 @@ def check_rates(joints: tuple[str, ...], q: np.ndarray, rate: float, *, t0: floa
         d = np.diff(q, order, axis=0) / dt**order
         t = t0 + (np.arange(len(d)) + order) * dt
         checks.append(_worst(name, t, d, np.asarray(limit, dtype=float), joints,
-                             f"{what} from differences at {rate:g} Hz, within {source} "
+                             f"{what} from differences at {rate:g} Hz, against {source} "
                              "limits"))
     return checks
