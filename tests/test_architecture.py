@@ -26,6 +26,22 @@ def test_no_function_is_more_complex_than_twenty():
     assert out.returncode == 0, out.stdout
 
 
+def test_ruff_finds_nothing():
+    """The project's ruff rules (pyproject.toml) hold over the package, tests and benchmarks."""
+    out = subprocess.run([sys.executable, "-m", "ruff", "check", "--no-cache", str(PACKAGE),
+                          str(ROOT / "tests"), str(ROOT / "benchmarks")],
+                         capture_output=True, text=True, cwd=ROOT)
+    assert out.returncode == 0, out.stdout
+
+
+@pytest.mark.slow
+def test_mypy_finds_nothing():
+    """The package type-checks under the project's mypy settings (pyproject.toml)."""
+    out = subprocess.run([sys.executable, "-m", "mypy", str(PACKAGE)], capture_output=True,
+                         text=True, cwd=ROOT)
+    assert out.returncode == 0, out.stdout
+
+
 @pytest.mark.parametrize("path", sorted(PACKAGE.rglob("*.py")), ids=lambda p: p.name)
 def test_modules_stay_small(path):
     """No module of the package is over ~400 lines."""

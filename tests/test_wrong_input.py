@@ -42,3 +42,13 @@ def test_a_short_line_is_shown_whole():
     shown, caret = format_text(d, "approach; paws 1s").splitlines()[1:3]
     assert shown.endswith("approach; paws 1s")
     assert shown[caret.index("^"):caret.index("^") + 4] == "paws"
+
+
+def test_a_quantity_of_the_wrong_kind_is_named_with_its_article():
+    from aou_dsl.linter import load
+
+    _, diags = load("gaze horizontal 20m\npause 1s x2\napproach a=3deg\n", "t.aou")
+    messages = " / ".join(d.message for d in diags)
+    assert "must be an angle" in messages and "found an angle" in messages
+    assert "must be an acceleration" in messages and "found a length" in messages
+    assert " a angle" not in messages and " a acceleration" not in messages

@@ -22,6 +22,11 @@ __all__ = ["Ctx", "Reader", "did_you_mean", "si", "split_args"]
 _REPEAT = re.compile(r"^x(\d+)$")
 
 
+def _a(noun: str) -> str:
+    """The noun with its article: `a length`, `an angle`, `an acceleration`."""
+    return f"{'an' if str(noun)[:1] in ('a', 'e', 'i', 'o', 'u') else 'a'} {noun}"
+
+
 def did_you_mean(word: str, choices: Iterable[str]) -> str | None:
     import difflib  # only for a misspelt word
 
@@ -53,18 +58,18 @@ def si(ctx: Ctx, q: Quantity, dim: Dim, *, what: str, bare_unit: str | None) -> 
     fits = ", ".join(units_for(dim))
     if q.unit == "":
         if bare_unit is None:
-            ctx.error("V103", f"{what} `{q.text}` needs a unit: expected a {dim} ({fits})",
+            ctx.error("V103", f"{what} `{q.text}` needs a unit: expected {_a(dim)} ({fits})",
                       q.span, hint=f"write e.g. `{q.text}{units_for(dim)[0]}`",
                       expected=str(dim), found=q.text)
             return None
         return q.value * UNITS[bare_unit][1]
     if q.unit not in UNITS:
-        ctx.error("V104", f"unknown unit `{q.unit}` in `{q.text}`: expected a {dim} ({fits})",
+        ctx.error("V104", f"unknown unit `{q.unit}` in `{q.text}`: expected {_a(dim)} ({fits})",
                   q.span, hint=did_you_mean(q.unit, units_for(dim)), found=q.unit)
         return None
     found_dim, factor = UNITS[q.unit]
     if found_dim is not dim:
-        ctx.error("V102", f"{what} must be a {dim} ({fits}), found a {found_dim} `{q.text}`",
+        ctx.error("V102", f"{what} must be {_a(dim)} ({fits}), found {_a(found_dim)} `{q.text}`",
                   q.span, expected=str(dim), found=str(found_dim))
         return None
     value = q.value * factor
