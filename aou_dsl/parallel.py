@@ -10,7 +10,11 @@ order of the inputs, whatever order they finish in; each result is the one
   warm (the compiler, the checks and the measurement imported, the default robot
   loaded, before the first file). This process lints the files (a millisecond each)
   and hands them out a window at a time, the longest motions first, so that no worker
-  idles at the end while another builds a long one.
+  idles at the end while another builds a long one. Interrupting is this process's
+  alone: the workers ignore SIGINT (Ctrl-C); a ``KeyboardInterrupt`` or any exception
+  that leaves a pool's ``with`` block, or closing a ``build_many`` that started its own
+  pool, cancels the builds not started and stops the workers at once
+  (:meth:`BuildPool.terminate`).
 
 The parent's own share is what caps the speed-up, so it is kept small: a document's
 samples come back as the trajectory's arrays (one buffer each, not a float at a time),
@@ -26,6 +30,7 @@ Dask is imported only when a cluster is given (the optional extra ``cluster``).
 
 from __future__ import annotations
 
+import contextlib
 import os
 from collections.abc import Iterable, Iterator
 from typing import TYPE_CHECKING, Any
@@ -44,6 +49,8 @@ __all__ = ["BuildPool", "build_many", "build_text", "default_jobs", "encoded", "
 _WINDOW = 8
 #: How long a pool waits for its workers to warm up before it hands out files [s].
 _START_TIMEOUT = 120.0
+#: How long stopping a pool waits for a worker to end after it was told to [s].
+_STOP_TIMEOUT = 2.0
 
 
 def default_jobs() -> int:
@@ -176,10 +183,35 @@ def warm(robots: tuple[str, ...] = ("panda",)) -> None:
 
 
 def _start(robots: tuple[str, ...], ready) -> None:
+    """A worker's initializer: SIGINT ignored (the parent stops its workers itself; a
+    terminal's Ctrl-C reaches every process of the group), warm, then wait for the
+    others, though not for ever: the parent may have gone on or stopped the pool."""
+    import signal
+    import threading
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         warm(robots)
     finally:
-        ready.wait()
+        with contextlib.suppress(threading.BrokenBarrierError):
+            ready.wait(timeout=_START_TIMEOUT)
+
+
+@contextlib.contextmanager
+def _sigint_held() -> Iterator[None]:
+    """SIGINT held back in this thread, so also in the processes it starts meanwhile
+    (they inherit the mask: a worker cannot be interrupted before its initializer
+    ignores SIGINT); one that arrives meanwhile is delivered here at the end."""
+    import signal
+
+    if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - not POSIX
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 def _cost(lint: FileResult) -> float:
@@ -194,6 +226,10 @@ class BuildPool:
     robot before it takes a file; :meth:`map` can be called again and again (a sweep
     that compiles in rounds pays the start once). Scripts that make a pool need the
     ``if __name__ == "__main__":`` guard: each worker is a fresh interpreter.
+
+    The workers ignore SIGINT: a ``KeyboardInterrupt`` is this process's, and leaving
+    the ``with`` block by one (or by any exception) stops the workers at once
+    (:meth:`terminate`); leaving it normally waits for the builds handed out.
     """
 
     def __init__(self, jobs: int | None = None, *, robots: tuple[str, ...] = ("panda",)):
@@ -208,12 +244,24 @@ class BuildPool:
         ready = ctx.Barrier(self.jobs + 1)
         self._pool = ProcessPoolExecutor(max_workers=self.jobs, mp_context=ctx,
                                          initializer=_start, initargs=(robots, ready))
-        for _ in range(self.jobs):  # one task each makes the pool start every worker
-            self._pool.submit(os.getpid)
-        try:  # until every worker has built its warm-up behaviour
-            ready.wait(timeout=_START_TIMEOUT)
-        except threading.BrokenBarrierError:  # a slow or failed start: go on regardless
-            pass
+        # Once the workers are stopped, the pool's thread may still put an end-of-work
+        # sentinel into the queue that hands out the builds, which nobody reads any more:
+        # a pipe that cannot be written then is nothing to report (by default its feeder
+        # thread prints a traceback; it takes this setting when it starts, at a submit).
+        calls = getattr(self._pool, "_call_queue", None)
+        if calls is not None and hasattr(calls, "_ignore_epipe"):
+            calls._ignore_epipe = True
+        try:
+            with _sigint_held():  # one task each makes the pool start every worker
+                for _ in range(self.jobs):
+                    self._pool.submit(os.getpid)
+            # until every worker has built its warm-up behaviour; a slow or failed start
+            # goes on regardless
+            with contextlib.suppress(threading.BrokenBarrierError):
+                ready.wait(timeout=_START_TIMEOUT)
+        except BaseException:  # interrupted while the workers warm up
+            self.terminate()
+            raise
 
     def map(self, paths: Iterable[str], options: dict[str, Any] | None = None, *,
             encode: str | None = None) -> Iterator[BuildResult]:
@@ -257,13 +305,48 @@ class BuildPool:
         return sorted(self._pool._processes or {})  # type: ignore[attr-defined]
 
     def close(self) -> None:
-        self._pool.shutdown(wait=True, cancel_futures=True)
+        """Wait for the builds handed out, then end the workers."""
+        try:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+        except BaseException:  # interrupted while waiting
+            self.terminate()
+            raise
+
+    def terminate(self) -> None:
+        """Stop now: the builds not started are cancelled, the workers are ended even
+        in the middle of a build (whose result is lost), and this returns once they
+        have (within a few seconds)."""
+        pool = self._pool
+        procs = list((getattr(pool, "_processes", None) or {}).values())
+        manager = getattr(pool, "_executor_manager_thread", None)
+        results = getattr(pool, "_result_queue", None)
+        pool.shutdown(wait=False, cancel_futures=True)
+        for p in procs:
+            with contextlib.suppress(OSError, ValueError):  # already ended
+                p.terminate()
+        for p in procs:
+            with contextlib.suppress(ValueError):
+                p.join(_STOP_TIMEOUT)
+                if p.is_alive():
+                    p.kill()
+                    p.join(_STOP_TIMEOUT)
+        # The pool's thread may be reading a result a worker was writing when it ended:
+        # with this process's copy of the pipe's writing end closed, it reads the end of
+        # the pipe instead of waiting for ever (and so does not hold up this process's exit).
+        writer = getattr(results, "_writer", None)
+        if writer is not None:
+            writer.close()
+        if manager is not None:
+            manager.join(_STOP_TIMEOUT)
 
     def __enter__(self) -> BuildPool:
         return self
 
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+    def __exit__(self, kind: type[BaseException] | None, *exc: object) -> None:
+        if kind is None:
+            self.close()
+        else:  # an interruption or an error: the builds still running are not wanted
+            self.terminate()
 
 
 def _on_cluster(paths: list[str], options: dict[str, Any], cluster: Any,
