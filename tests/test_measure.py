@@ -516,3 +516,98 @@ def test_an_acceleration_the_joints_cannot_produce_is_an_error(synths):
     with pytest.raises(AouError) as info:
         E._self_check(ctx, 10 * peak, at, 51, u, 0.0)
     assert info.value.diagnostics[0].code == "R406"
+
+
+# --- peak accelerations of any smooth profile, and pauses beside a shiver --------------------
+
+
+class _MinJerk(Synth):
+    """Moves along the minimum-jerk law: s = L (10 u^3 - 15 u^4 + 6 u^5), u = t / T. Its
+    acceleration is a bell that peaks at 10 sqrt(3) / 3 L / T^2, not a plateau."""
+
+    @staticmethod
+    def _bang(length: float, a: float, rate: float) -> np.ndarray:
+        length = abs(length)
+        duration = math.sqrt(10 * math.sqrt(3) / 3 * length / a)
+        u = np.minimum(np.arange(1, int(math.ceil(duration * rate)) + 1) / rate / duration, 1)
+        return length * (10 * u**3 - 15 * u**4 + 6 * u**5)
+
+
+class _Cycloid(Synth):
+    """Moves along the cycloidal law: s = L (u - sin(2 pi u) / (2 pi)), whose acceleration
+    is one period of a sine, peaking at 2 pi L / T^2."""
+
+    @staticmethod
+    def _bang(length: float, a: float, rate: float) -> np.ndarray:
+        length = abs(length)
+        duration = math.sqrt(2 * math.pi * length / a)
+        u = np.minimum(np.arange(1, int(math.ceil(duration * rate)) + 1) / rate / duration, 1)
+        return length * (u - np.sin(2 * math.pi * u) / (2 * math.pi))
+
+
+@pytest.mark.parametrize("law", [_MinJerk, _Cycloid], ids=["minimum-jerk", "cycloidal"])
+@pytest.mark.parametrize("noise", [0.0, 1e-4], ids=["clean", "noisy"])
+def test_a_bell_shaped_acceleration_reads_its_peak(law, noise):
+    """A profile that holds no level (its acceleration a bell) peaks above any mean of it:
+    its peak is read as the peak, within 1.5 % clean and 3 % under 1e-4 rad of noise."""
+    s = law()
+    s.line(-0.10, 0.05).hold(1.0).line(+0.05, 0.2).hold(1.0)
+    m = measure(s.recording(noise, seed=3))
+    peaks = [e.values["peak_acceleration"] for e in m.episodes if e.kind != "pause"]
+    assert peaks == pytest.approx([0.05, 0.2], rel=0.03 if noise else 0.015)
+
+
+def test_the_joints_path_takes_the_noise_across_it_out_of_the_travel():
+    """Joints that move along one path (each a smooth function of the travel s) carry
+    noise across that path too; moved back onto the path, the travel keeps only the
+    noise along it, and says how much that is."""
+    from aou_dsl.measuring.peaks import path_travel
+
+    rng = np.random.default_rng(5)
+    s = 0.03 * (1 - np.cos(np.linspace(0, math.pi, 120))) / 2  # the true travel [m]
+    g = np.array([3.0, -2.0, 1.0, 4.0, -1.0, 2.0, 0.5])  # d(joint)/ds at s = 0 [rad/m]
+    # The hand's travel is s + a . noise: a . g = 1 (it moves with the path), and it takes
+    # noise across the path as well (a component orthogonal to g, twice as large).
+    across = np.array([1.0, 1.0, 0.0, -0.5, 0.0, 0.0, 0.0])
+    across -= (across @ g) / (g @ g) * g
+    a = g / (g @ g) + 2.0 / np.linalg.norm(g) * across / np.linalg.norm(across)
+    k = np.array([1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0])  # curvature across the hand's axis
+    k = k - (a @ k) / (a @ a) * a
+    q = np.outer(s, g) + np.outer(s**2, 20 * k)
+    sigma = np.full(7, 1e-4)
+    noise = rng.normal(0.0, 1e-4, q.shape)
+    hand = s + (noise @ a)
+    got = path_travel(hand, q + noise, sigma)
+    assert got is not None
+    travel, left = got
+    assert left == pytest.approx(1e-4 / np.linalg.norm(g), rel=0.2)
+    assert np.std(travel - s) == pytest.approx(left, rel=0.25)
+    assert np.std(travel - s) < 0.6 * np.std(hand - s)
+    # joints that do not follow one path are left alone
+    assert path_travel(hand, q + rng.normal(0.0, 1e-3, q.shape), sigma) is None
+
+
+class _SoftShiver(Synth):
+    """A shiver whose envelope fades in and out linearly over its first and last cycle
+    (not the compiler's sin^2)."""
+
+    def shiver(self, amplitude: float, f: float, cycles: int) -> Synth:
+        duration = cycles / f
+        t = np.arange(1, int(round(duration * self.rate)) + 1) / self.rate
+        env = np.minimum(np.minimum(t, duration - t) * f, 1.0)
+        for x in amplitude / 2 * np.sin(2 * math.pi * f * t) * env:
+            self._add(self._pose(), float(x))
+        return self
+
+
+@pytest.mark.parametrize("law", [Synth, _SoftShiver], ids=["sin2-envelope", "linear-envelope"])
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_pause_beside_a_shiver_ends_where_the_shiver_starts(law, seed):
+    """A shiver's soft start and end hide under the noise (100 Hz, 1.5e-4 rad); the pauses
+    on either side still measure within 50 ms."""
+    s = law(rate=100.0)
+    s.line(-0.05, 0.1).hold(1.0).shiver(2 * DEG, 1.2, 3).hold(1.2)
+    m = measure(s.recording(1.5e-4, seed=seed))
+    pauses = [e.t_end - e.t_start for e in m.episodes if e.kind == "pause"]
+    assert len(pauses) == 2
+    assert pauses == pytest.approx([1.0, 1.2], abs=0.05)

@@ -8,8 +8,9 @@
 - The hand stayed in place and turned: a roll piece, made into tilts and shivers by
   :mod:`.roll`.
 
-Peak accelerations are read over a window set by the motion and the noise (see
-:func:`peak_acceleration`), and checked against what the joints can produce.
+Peak accelerations are read phase by phase (:mod:`.peaks`, from the hand's travel with
+the joints' noise across their path removed), and checked against what the joints can
+produce.
 """
 
 from __future__ import annotations
@@ -24,7 +25,8 @@ from ..diagnostics import AouError, Span, diag
 from ..kinematics import ArmModel
 from .fk import classical_acceleration, linear_jacobian
 from .holds import Boundary, Rest
-from .signal import curvature_gain, filter_at, odd, smooth
+from .peaks import episode_peak, path_travel, phase_peak
+from .signal import curvature_gain, filter_at, smooth
 
 __all__ = ["STILL_TRANSLATION", "Context", "Piece", "peak_acceleration", "pieces",
            "translation"]
@@ -33,8 +35,6 @@ __all__ = ["STILL_TRANSLATION", "Context", "Piece", "peak_acceleration", "pieces
 STILL_TRANSLATION = 2e-3
 #: A gaze moved in a plane when its bearing there changed by more than this [deg].
 MIN_GAZE_SWEEP = 0.25
-#: Relative std of a peak acceleration that the noise may cause.
-ACCEL_NOISE = 0.01
 #: How long an arm's own tracking transients last after each switch of the acceleration
 #: [s]: the acceleration is averaged over at least this long (never longer than the
 #: phase it is read in).
@@ -189,14 +189,9 @@ def _phases(c: Context, p: Piece, speed: np.ndarray) -> list[tuple[int, int, flo
 
 def peak_acceleration(c: Context, p: Piece, u: np.ndarray) -> tuple[float, float]:
     """Peak acceleration of the hand along the direction of travel ``u`` [m/s^2], and
-    the std the joints' noise gives it.
-
-    The acceleration is a Savitzky-Golay second derivative: a weighted mean of the
-    true acceleration with positive weights, so it never overshoots a plateau and equals
-    it when the window fits inside. The window is half of the speeding-up (or
-    slowing-down) phase, and at least :data:`TRANSIENT`, so that the arm's own
-    transients at each switch average out; longer when the noise needs it (relative
-    std :data:`ACCEL_NOISE`); never longer than the phase.
+    the std the joints' noise gives it: each speeding-up and slowing-down phase read as
+    :mod:`.peaks` explains, over the whole phase and never shorter than :data:`TRANSIENT`
+    where the phase allows (so that the arm's own transients at each switch average out).
 
     Raises:
         AouError: R406 when the joints' own accelerations cannot produce the peak.
@@ -206,35 +201,27 @@ def peak_acceleration(c: Context, p: Piece, u: np.ndarray) -> tuple[float, float
     speed = np.abs(smooth(x, r.window, 1, h, order=2))
     jac = linear_jacobian(c.arm, c.q[(p.i0 + p.i1) // 2])
     sigma_x = float(np.sqrt(np.sum(((u @ jac) * c.noise) ** 2)))
-    best, at, win = 0.0, p.i0, 3
-    for a, b, dur in _phases(c, p, speed):
-        steps = max(dur / h, 1.0)
-        a_est = 0.95 * float(speed.max()) / max(dur, h)
-        w = odd(max(0.5 * steps, TRANSIENT / h))
-        while w < steps and sigma_x * curvature_gain(w, h) > ACCEL_NOISE * a_est:
-            w += 2
-        w = min(w, max(3, odd(steps) - 2), len(x) if len(x) % 2 else len(x) - 1)
-        if w < 3:
-            continue
-        half = w // 2
-        # Only where the window stays inside the piece.
-        k0, k1 = max(a, half), min(b, len(x) - 1 - half)
-        if k1 < k0:
-            k0 = k1 = min(max((a + b) // 2, half), len(x) - 1 - half)
-        acc = np.abs(filter_at(x, w, 2, h, k0, k1))
-        k = int(np.argmax(acc))
-        if acc[k] > best:
-            best, at, win = float(acc[k]), p.i0 + k0 + k, w
-    if best > 0:
-        _self_check(c, best, at, win, u, sigma_x)
-    return best, sigma_x * curvature_gain(win, h)
+    q = c.q[p.i0:p.i1 + 1]
+
+    def travel(j0: int, j1: int) -> tuple[np.ndarray, float] | None:
+        return path_travel(x[j0:j1 + 1], q[j0:j1 + 1], c.noise)
+
+    found = [f for a, b, _ in _phases(c, p, speed)
+             if (f := phase_peak(x, a, b, h, sigma_x, r.sparse[p.i0:p.i1 + 1], TRANSIENT,
+                                 travel if c.noise.max() > 0 else None)) is not None]
+    if not found:
+        return 0.0, 0.0
+    peak = episode_peak(found)
+    if peak.value > 0:
+        _self_check(c, peak.value, p.i0 + peak.at, peak.window, u, sigma_x, peak.sd)
+    return peak.value, peak.sd
 
 
 def _self_check(c: Context, peak: float, at: int, window: int, u: np.ndarray,
-                sigma_x: float) -> None:
-    """R406 when the joint motion around sample ``at`` cannot produce ``peak``: the
-    hand's acceleration there is ``J qdd + Jdot qd`` from the joints' filtered
-    velocities and accelerations over the same window."""
+                sigma_x: float, sd: float = 0.0) -> None:
+    """R406 when the joint motion around sample ``at`` cannot produce ``peak`` (whose
+    std from the noise is ``sd``): the hand's acceleration there is ``J qdd + Jdot qd``
+    from the joints' filtered velocities and accelerations over the same window."""
     n, h = len(c.rest.t), c.rest.h
     half = window // 2
     near = np.unique(np.clip(np.linspace(at - half, at + half, 5).round().astype(int),
@@ -244,7 +231,8 @@ def _self_check(c: Context, peak: float, at: int, window: int, u: np.ndarray,
     qd = filter_at(c.q, window, 1, h, lo, hi)[near - lo]
     qdd = filter_at(c.q, window, 2, h, lo, hi)[near - lo]
     joint_side = classical_acceleration(c.arm, q, qd, qdd) @ u
-    bound = 1.25 * float(np.abs(joint_side).max()) + 4.0 * sigma_x * curvature_gain(window, h)
+    noise = max(sd, sigma_x * curvature_gain(window, h))
+    bound = 1.25 * float(np.abs(joint_side).max()) + 4.0 * noise
     if peak > bound + 1e-6:
         raise AouError(diag(
             "R406", f"the hand's peak acceleration {peak:.4g} m/s^2 at t={c.rest.t[at]:.3f}s "

@@ -10,6 +10,8 @@ deceleration, so its velocity is a straight line there). A rest whose refined sp
 for most of it, is a pause; a shorter one is the boundary between two episodes (a
 rest-to-rest boundary, or a reversal). Motion that reverses or stops without ever
 looking still (a fast shiver, coarse sampling) is found from the speed's dips to zero.
+A pause beside an oscillation, whose envelope fades in and out, has its edges placed by
+:mod:`.onset`.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .onset import soft_pause
 from .signal import NOISE_SIGMAS, odd, runs, sg_coefficients, slope_gain, smooth
 
 __all__ = ["MIN_PAUSE", "REST_SPEED", "Boundary", "Rest", "boundaries", "rest_at_end",
@@ -326,7 +329,8 @@ def boundaries(r: Rest) -> list[Boundary]:
         if h1 - h0 >= max(MIN_PAUSE, 0.5 * (t1 - t0)):
             # Motion too slow to see in the speed but not in the positions (the soft
             # start of a shiver) is no part of the hold.
-            out.append(Boundary(max(t0, h0), min(t1, h1), i0, i1, True))
+            a, b = soft_pause(r.t, r.q, r.noise, (max(t0, h0), min(t1, h1)), MIN_PAUSE)
+            out.append(Boundary(a, b, i0, i1, True))
         elif 0 < i0 and i1 < n - 1:
             # The instant between two episodes; when motion too slow to see fills the
             # gap between where one stops and the next starts, that gap belongs to

@@ -1,0 +1,134 @@
+"""Where an oscillation beside a hold leaves (or reaches) the held position.
+
+An oscillation (a shiver) starts and ends with an envelope that fades in and out: near
+its start it grows as a power of the time since it started (the cube for an envelope
+that rises as sin^2, the square or the cube for most smooth starts from rest). Its first
+part hides under the noise, and its velocity has no straight ramp to follow back to
+zero, so the rest test sees it tens of milliseconds late. The hold's edge is found
+instead by fitting the deviation of the leading joint from the held position, from
+inside the hold to :data:`ONSET_TOP` of the oscillation's first lobe, with ``c * (t - t0)^p``
+after ``t0`` and 0 before it: ``t0`` on a grid a quarter step (at most 1 ms) fine, ``p`` from
+:data:`POWERS`, ``c`` by least squares. Under noise the data hardly tell a higher power
+with an earlier start from a lower one with a later start, so the powers are those of
+smooth starts from rest: from finite acceleration (2) to a little past finite jerk (3).
+The fit reaches well up the first lobe, where the oscillation's growth has begun to
+slow, so that enough samples stand above the noise; the free power absorbs that. A
+motion that does not swing to both sides of the hold (an approach, a tilt, the ringing
+of an arm that stops) is left to its velocity ramp, and a fit that misses the data by
+more than the noise leaves the edge where it was.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["soft_edge", "soft_pause"]
+
+#: The powers of time a soft start is fitted with.
+POWERS = (2.0, 2.5, 3.0, 3.5)
+#: The fit covers the motion until its deviation reaches this fraction of its first lobe.
+ONSET_TOP = 0.8
+#: Longest stretch of a hold [s] and of the motion [s] the fit looks at.
+HOLD_SPAN = 0.4
+MOTION_SPAN = 1.5
+#: A fit whose residual is more than this many times the noise's, and more than this
+#: fraction of the first lobe (a power of time is not the lobe's exact shape), leaves the
+#: edge alone.
+FIT_SIGMAS = 1.5
+FIT_SHAPE = 0.05
+#: An oscillation swings to either side of the held position, twice at least, by this
+#: fraction of its first lobe.
+SWING = 0.3
+#: Its first lobe is this fraction of its largest at least (a fade-in over one cycle
+#: makes it about 0.15; the ringing of an arm that stops is far smaller than its stop).
+LOBE = 0.05
+#: A deviation is clearly motion past this many noise stds.
+CLEAR = 6.0
+
+
+def soft_edge(t: np.ndarray, q: np.ndarray, noise: np.ndarray, hold: tuple[int, int],
+              step: int) -> float | None:
+    """The instant the motion after the hold ``hold`` (grid samples, inclusive; ``step``
+    +1), or before it (``step`` -1), leaves the held position; None when no joint with
+    noise moves clearly beside it, or when the fit misses.
+
+    ``t`` (N,) and ``q`` (N, n) are the grid's times and joint positions; ``noise`` (n,)
+    each joint's noise std (0: a still or clean joint, not used)."""
+    n = len(t)
+    h0, h1 = hold
+    if h1 - h0 < 4 or not np.any(noise > 0):
+        return None
+    h = float(t[1] - t[0])
+    third = (h1 - h0 + 1) // 3
+    ref = np.median(q[h0 + third:h1 - third + 1], axis=0)
+    edge = h1 if step > 0 else h0
+    reach = int(round(MOTION_SPAN / h))
+    far = int(np.clip(edge + step * reach, 0, n - 1))
+    side = np.arange(edge, far + step, step)
+    if len(side) < 4:
+        return None
+    sig = np.where(noise > 0, noise, np.inf)
+    z = np.abs(q[side] - ref) / sig
+    j = int(np.argmax(z.max(axis=0)))
+    clear = np.flatnonzero(z[:, j] > CLEAR)
+    if not np.isfinite(sig[j]) or len(clear) == 0:
+        return None
+    d = (q[side, j] - ref[j]) * np.sign(q[side[clear[0]], j] - ref[j])
+    # The first lobe: up to where the deviation first swings back through the hold; the
+    # onset is the part of it under ONSET_TOP of its top.
+    back = np.flatnonzero(d[clear[0]:] < 0.0)
+    top = float(d[clear[0]:clear[0] + (back[0] if len(back) else len(d))].max())
+    if top < LOBE * float(np.abs(d).max()) or _swings(d[clear[0]:], SWING * top) < 2:
+        return None  # no oscillation: a motion's velocity ramp gives its edge
+    end = clear[0] + int(np.argmax(d[clear[0]:] >= ONSET_TOP * top))
+    end = max(end, clear[0])
+    inside = int(min(round(HOLD_SPAN / h), h1 - h0))
+    idx = np.arange(edge - step * inside, side[end] + step, step)
+    y = (q[idx, j] - ref[j]) * np.sign(q[side[clear[0]], j] - ref[j])
+    tau = (t[idx] - t[edge]) * step  # time away from the hold, 0 at its edge
+    # Candidate starts: from inside the hold to the first clear sample, a quarter step
+    # (at most a millisecond) apart.
+    starts = np.arange(tau[0], (t[side[clear[0]]] - t[edge]) * step, max(h / 4.0, 1e-3))
+    if len(starts) == 0:
+        return None
+    lag = np.clip(tau[None, :] - starts[:, None], 0.0, None)  # (S, K)
+    best = (np.inf, 0.0)
+    for p in POWERS:
+        g = lag ** p
+        gg = np.einsum("sk,sk->s", g, g)
+        c = np.where(gg > 0, (g @ y) / np.where(gg > 0, gg, 1.0), 0.0)
+        sse = np.einsum("sk,sk->s", y[None, :] - c[:, None] * g, y[None, :] - c[:, None] * g)
+        k = int(np.argmin(sse))
+        if sse[k] < best[0]:
+            best = (float(sse[k]), float(starts[k]))
+    if best[0] > len(y) * max(FIT_SIGMAS * float(sig[j]), FIT_SHAPE * top) ** 2:
+        return None
+    return float(t[edge]) + step * best[1]
+
+
+def _swings(d: np.ndarray, level: float) -> int:
+    """How many times ``d`` crosses from beyond ``level`` on one side to beyond it on
+    the other."""
+    side = np.sign(d) * (np.abs(d) > level)
+    side = side[side != 0]
+    return int(np.count_nonzero(np.diff(side)))
+
+
+def soft_pause(t: np.ndarray, q: np.ndarray, noise: np.ndarray, span: tuple[float, float],
+               shortest: float) -> tuple[float, float]:
+    """A pause from ``span[0]`` to ``span[1]`` [s] with each edge that borders an
+    oscillation moved to where the oscillation leaves or reaches the held position
+    (:func:`soft_edge`); an edge that would leave the pause shorter than ``shortest``
+    [s] stays."""
+    a, b = span
+    k0 = int(np.searchsorted(t, a, "left"))
+    k1 = int(np.searchsorted(t, b, "right")) - 1
+    if k1 - k0 < 4:
+        return a, b
+    if k0 > 0:
+        edge = soft_edge(t, q, noise, (k0, k1), -1)
+        a = edge if edge is not None and edge < b - shortest else a
+    if k1 < len(t) - 1:
+        edge = soft_edge(t, q, noise, (k0, k1), +1)
+        b = edge if edge is not None and edge > a + shortest else b
+    return a, b
