@@ -294,7 +294,6 @@ def _cmd_variants(args: argparse.Namespace) -> int:
     folder = args.output or "."
     variants = make_variants(base.behaviour, base.source, name, low, high,
                              os.path.join(folder, f"{stem}-{name}"))
-    os.makedirs(folder, exist_ok=True)
     for v in variants:
         write_atomic(v.path, v.text.encode(), inputs=[args.path])
         print(f"wrote {v.path} ({name}={v.value:g})", file=sys.stderr)

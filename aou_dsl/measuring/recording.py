@@ -113,13 +113,18 @@ def _from_document(path: str, doc: dict, header: Header, t: Any, q: Any) -> Traj
                       path=path, title=title, **_optional(doc, q))
 
 
-def _written_by_aou(doc: dict) -> bool:
-    return str(doc.get("generator", "")).startswith("aouc")
-
-
 def read_json(path: str, text: str, own_goal: bool = True) -> Trajectory:
     """An ``aou-trajectory/1`` document (the goal may be missing; ``own_goal`` False:
     not read, one given replaces it)."""
+    return _json(path, text, own_goal)[0]
+
+
+def read_npz(path: str, data: bytes, own_goal: bool = True) -> Trajectory:
+    """aou's NPZ: ``t.npy``, ``q.npy`` (and ``qd``, ``qdd``) with ``header.json``."""
+    return _npz(path, data, own_goal)[0]
+
+
+def _json(path: str, text: str, own_goal: bool) -> tuple[Trajectory, Header]:
     try:
         doc = json.loads(text)
     except json.JSONDecodeError as exc:
@@ -133,11 +138,10 @@ def read_json(path: str, text: str, own_goal: bool = True) -> Trajectory:
         raise _bad(path, "`q` must be a list of rows")
     rec = _from_document(path, doc, header, doc["t"], doc["q"])
     _check_clock(path, rec.t)
-    return rec
+    return rec, header
 
 
-def read_npz(path: str, data: bytes, own_goal: bool = True) -> Trajectory:
-    """aou's NPZ: ``t.npy``, ``q.npy`` (and ``qd``, ``qdd``) with ``header.json``."""
+def _npz(path: str, data: bytes, own_goal: bool) -> tuple[Trajectory, Header]:
     try:
         with zipfile.ZipFile(io.BytesIO(data)) as zf:
             doc = json.loads(zf.read("header.json"))
@@ -158,7 +162,7 @@ def read_npz(path: str, data: bytes, own_goal: bool = True) -> Trajectory:
         raise _bad(path, f"`q` has shape {q.shape}; expected (samples, joints)")
     rec = _from_document(path, doc, header, arrays["t"], q)
     _check_clock(path, rec.t)
-    return rec
+    return rec, header
 
 
 def _comments(lines: list[str]) -> dict[str, str]:
@@ -391,19 +395,13 @@ def read_recording(path: str, *, robot: str | None = None,
     data = read_bytes(path) if path.endswith(".npz") else b""
     text = None if path.endswith(".npz") else read_text(path)
     rows = None
-    if path.endswith(".npz"):
-        rec = read_npz(path, data, own_goal=goal is None)
-        trusted = _written_by_aou(json.loads(zipfile.ZipFile(io.BytesIO(data))
-                                             .read("header.json")))
-    elif path.endswith(".csv"):
+    if path.endswith(".csv"):
         rec, rows, trusted = _read_csv(path, text or "", robot,
                                        None if isinstance(goal, str) else goal, ee_frame)
     else:
-        rec = read_json(path, text or "", own_goal=goal is None)
-        try:
-            trusted = _written_by_aou(json.loads(text or ""))
-        except ValueError:
-            trusted = False
+        rec, header = (_npz(path, data, goal is None) if path.endswith(".npz")
+                       else _json(path, text or "", goal is None))
+        trusted = header.generator.startswith("aouc")
     changes: dict[str, Any] = {k: v for k, v in (("robot", robot), ("ee_frame", ee_frame))
                                if v}
     if goal is not None and not isinstance(goal, str):
