@@ -61,12 +61,14 @@ def default_limits_warning(spec: RobotSpec, urdf: Urdf, description: str, *, acc
     if description:
         hint = f"add {keys} to `{description}`"
     elif spec.name == os.path.basename(spec.name) and not spec.name.endswith(".urdf"):
-        hint = (f"write `{spec.name}.toml` with `robot = \"{spec.name}\"` and {keys} from "
-                f"your controller's documentation, then use `robot \"{spec.name}.toml\"`")
+        toml = f"{spec.name}.toml"
+        hint = (f"write `{toml}` with `robot = \"{spec.name}\"` and {keys} from your "
+                f"controller's documentation, then use it: `robot \"{toml}\"` in the file "
+                f"or `--robot {toml}`")
     else:
         toml = os.path.splitext(spec.name)[0] + ".toml"
         hint = (f"write `{toml}` with `urdf = \"{os.path.basename(urdf.path)}\"` and "
-                f"{keys}, then use `robot \"{toml}\"`")
+                f"{keys}, then use it: `robot \"{toml}\"` in the file or `--robot {toml}`")
     return diag("C313", f"robot `{spec.name}`: no sourced {' or '.join(what)} limit; aou "
                 "plans with its conservative default", Span.whole_file(urdf.path),
                 hint=hint, defaults=[k for k in keys.split(" and ")])
