@@ -139,13 +139,8 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     try:
         dests, fmt = output_paths(inputs, args.output, args.format)
         check_format(args.output, args.format, FORMATS)  # --format csv -o x.json
-        for d in {os.path.dirname(d) for d in dests if os.path.dirname(d)}:
-            os.makedirs(d, exist_ok=True)
     except AouError as err:
         return _fail(err)
-    except OSError as exc:
-        print(f"aouc: cannot create the output folder: {exc.strerror}", file=sys.stderr)
-        return EXIT_USAGE
     sources = [src for src, _ in inputs]
     options = {"robot": args.robot, "rate": args.rate, "check": not args.no_check,
                "scene": SceneOptions(**_scene_kw(args)),
@@ -311,8 +306,11 @@ _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser, _ = build_parser()
-    args = parser.parse_args(argv)
+    parser, commands = build_parser()
+    args, extra = parser.parse_known_args(argv)
+    if extra:  # said with the usage of the command they were given to
+        (commands.get(args.command) or parser).error(
+            f"unrecognized arguments: {' '.join(extra)}")
     if args.command is None:
         parser.print_help(sys.stderr)
         return EXIT_USAGE
@@ -327,7 +325,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except ImportError as exc:
         if args.command in ("plot", "render", "variants") and exc.name:
             print(f"aouc: this command needs the media extra ({exc.name} is missing): "
-                  "pip install 'aou-dsl[media]'", file=sys.stderr)
+                  "pip install '.[media]' in aou's folder (the one with pyproject.toml)",
+                  file=sys.stderr)
             return EXIT_USAGE
         return _internal(exc, args.debug)
     except KeyboardInterrupt:

@@ -244,6 +244,8 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     rob.add_argument("--list", action="store_true", help="list the built-in robots")
     rob.add_argument("--format", choices=("text", "json", "toml"), default="text",
                      help="toml: a robot description pinning every value")
+    rob.add_argument("-o", "--output", metavar="FILE",
+                     help="write to FILE instead of standard output (e.g. -o arm.toml)")
     _package_dir(rob)
     c["synth"] = syn = sub.add_parser(
         "synth", help="write a .aou file for a state, or a point of the C-V plane, at an "

@@ -4,8 +4,9 @@ file for a state or a point of the C-V plane, fitted to the arm)."""
 from __future__ import annotations
 
 import argparse
+import sys
 
-from .cli_args import EXIT_OK, EXIT_USAGE, usage_error
+from .cli_args import EXIT_OK, usage_error
 from .report import format_json
 
 __all__ = ["cmd_robot", "cmd_synth"]
@@ -16,26 +17,33 @@ def cmd_robot(args: argparse.Namespace) -> int:
 
     if args.list or args.robot is None:
         if args.robot is None and not args.list:
-            print("aouc robot: give a robot name or path, or --list")
-            return EXIT_USAGE
+            return usage_error("robot", "give a robot name or path, or --list")
         for name, spec in ROBOTS.items():
             print(f"{name:14s} {len(spec.arm_joints)} joints, end-effector {spec.ee_frame}")
         return EXIT_OK
     from .arms import describe_robot
+    from .files import check_output, write_atomic
 
+    if args.output:
+        check_output(args.output)
     doc, text = describe_robot(args.robot)
     if args.format == "json":
-        print(format_json(doc))
+        out = format_json(doc)
     elif args.format == "toml":
-        print(doc["toml"], end="" if doc["toml"].endswith("\n") else "\n")
+        out = doc["toml"]
     else:
-        print(text)
+        out = text
+    out = out if out.endswith("\n") else out + "\n"
+    if args.output:
+        write_atomic(args.output, out.encode(), inputs=[args.robot])
+        print(f"{args.robot} -> {args.output}", file=sys.stderr)
+    else:
+        sys.stdout.write(out)
     return EXIT_OK
 
 
 def cmd_synth(args: argparse.Namespace) -> int:
     """``aouc synth``: a behaviour file for a state or a C-V point, fitted to the arm."""
-    import sys
 
     from .files import check_output, write_atomic
     from .synth import synthesize

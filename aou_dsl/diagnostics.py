@@ -382,6 +382,17 @@ _RULE_LIST = [
          "A folder given on the command line holds no `.aou` files.",
          "Probably the wrong folder.",
          "aouc lint empty/"),
+    Rule("I504", "bad-argument", _E,
+         "A value given on the command line or to the Python API is not one aou can use "
+         "(a malformed `--vary`, a state it does not know, a number outside its range, a "
+         "recording measured without its robot).",
+         "The command cannot start; the message says what the value should be.",
+         "aouc variants a.aou --vary speed=1,2"),
+    Rule("I505", "cannot-connect", _E,
+         "The scheduler given with `--cluster` cannot be reached, or its address is not "
+         "one (`tcp://HOST:PORT`).",
+         "Nothing is built: the files would have had no workers.",
+         "aouc compile a.aou --cluster tcp://127.0.0.1:9"),
 ]
 
 RULES: dict[str, Rule] = {r.code: r for r in _RULE_LIST}

@@ -355,11 +355,12 @@ def _on_cluster(paths: list[str], options: dict[str, Any], cluster: Any,
         from distributed import Client, Future
     except ImportError:  # pragma: no cover - the extra is installed with the tests
         raise ImportError("building on a cluster needs Dask distributed: "
-                          "pip install 'aou-dsl[cluster]'") from None
+                          "pip install '.[cluster]' in aou's folder (the one with "
+                          "pyproject.toml)") from None
     from .build import build_lint
     from .linter import FileResult, read_source
 
-    client = cluster if isinstance(cluster, Client) else Client(cluster)
+    client = cluster if isinstance(cluster, Client) else _connect(Client, cluster)
     try:
         futures: list = []
         for p in paths:
@@ -374,3 +375,38 @@ def _on_cluster(paths: list[str], options: dict[str, Any], cluster: Any,
     finally:
         if client is not cluster:
             client.close()
+
+
+def _connect(client: Any, address: str) -> Any:
+    """A Dask client of the scheduler at ``address``, or an I505 saying why not. A TCP
+    address is tried first with a plain socket, so that a port nobody listens on is
+    said at once rather than after Dask's connection timeout."""
+    import socket
+    from urllib.parse import urlsplit
+
+    from .diagnostics import Span, diag
+
+    def fail(why: str) -> AouError:
+        return AouError(diag("I505", f"cannot connect to the cluster `{address}`: {why}",
+                             Span.whole_file("<command line>"),
+                             hint="give the scheduler's address, e.g. --cluster "
+                                  "tcp://scheduler-host:8786 (`dask scheduler` prints it)"))
+
+    text = str(address)
+    parts = urlsplit(text if "://" in text else f"tcp://{text}")
+    try:
+        port = parts.port
+    except ValueError:
+        port = None
+    if parts.scheme == "tcp":
+        if not parts.hostname or port is None:
+            raise fail("expected tcp://HOST:PORT")
+        try:
+            socket.create_connection((parts.hostname, port), timeout=5).close()
+        except OSError as exc:
+            raise fail(exc.strerror or str(exc) or type(exc).__name__) from None
+    try:
+        return client(text)
+    except (OSError, ValueError, TypeError) as exc:
+        raise fail(str(exc)) from None
+

@@ -89,7 +89,7 @@ _MIN_COUNT = {"retreat": 1, "pause": 1}
 
 def _check_intensity(intensity: float) -> float:
     if not (isinstance(intensity, int | float) and 0.0 <= intensity <= 1.0):
-        raise AouError(diag("I501", f"the intensity must be a number in [0, 1], found "
+        raise AouError(diag("I504", f"the intensity must be a number in [0, 1], found "
                             f"{intensity!r}", _WHERE))
     return float(intensity)
 
@@ -204,7 +204,7 @@ def _floor(state: State, limits: Limits) -> float:
         return 0.0
     lo, hi = 0.0, 1.0
     if not ok(hi):
-        raise AouError(diag("I501", f"no intensity of `{state}` reads as {state} on "
+        raise AouError(diag("I504", f"no intensity of `{state}` reads as {state} on "
                             f"{limits.robot}", _WHERE))
     while hi - lo > 0.01:
         mid = (lo + hi) / 2
@@ -233,12 +233,12 @@ def synthesize(state: State | str | None = None, C: float | None = None,
     """
     intensity = _check_intensity(intensity)
     if state is not None and (C is not None or V is not None):
-        raise AouError(diag("I501", "give a state or a C-V point, not both", _WHERE))
+        raise AouError(diag("I504", "give a state or a C-V point, not both", _WHERE))
     if state is None and (C is None or V is None):
-        raise AouError(diag("I501", "give a state, or both C and V", _WHERE))
+        raise AouError(diag("I504", "give a state, or both C and V", _WHERE))
     for name, x in (("C", C), ("V", V)):
         if x is not None and not (isinstance(x, int | float) and -1.0 <= x <= 1.0):
-            raise AouError(diag("I501", f"{name} must be a number in [-1, 1], found {x!r}",
+            raise AouError(diag("I504", f"{name} must be a number in [-1, 1], found {x!r}",
                                 _WHERE))
     limits = fit_limits(robot or "panda", _goal(goal))
     st = _state(state) if state is not None else None
@@ -342,10 +342,10 @@ def _goal(goal) -> tuple[float, float, float] | None:
     try:
         x, y, z = (float(v) for v in goal)
     except (TypeError, ValueError):
-        raise AouError(diag("I501", f"the goal must be three numbers (x, y, z) [m], found "
+        raise AouError(diag("I504", f"the goal must be three numbers (x, y, z) [m], found "
                             f"{goal!r}", _WHERE)) from None
     if not all(math.isfinite(v) for v in (x, y, z)):
-        raise AouError(diag("I501", f"the goal must be finite, found {goal!r}", _WHERE))
+        raise AouError(diag("I504", f"the goal must be finite, found {goal!r}", _WHERE))
     return x, y, z
 
 
@@ -353,7 +353,7 @@ def _state(state: State | str) -> State:
     try:
         return State(state)
     except ValueError:
-        raise AouError(diag("I501", f"unknown state `{state}`: expected one of "
+        raise AouError(diag("I504", f"unknown state `{state}`: expected one of "
                             f"{', '.join(s.value for s in State)}", _WHERE)) from None
 
 

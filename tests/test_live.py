@@ -214,18 +214,18 @@ def test_uncertainty_mapping_is_continuous_and_classified(a, b):
     {"uncertainty": 1.2}, {"uncertainty": 0.5, "C": 0.1}, {"C": 0.1},
     {"C": 2.0, "V": 0.0}, {"C": 0.0, "V": 0.0, "intensity": -0.1}])
 def test_bad_estimates_are_diagnostics(reg, kwargs):
-    """A bad estimate is an AouError (I501), never a crash."""
+    """A bad estimate is an AouError (I504), never a crash."""
     with pytest.raises(AouError) as err:
         reg.update(np.zeros(reg.arm.n), **kwargs)
-    assert err.value.diagnostics[0].code == "I501"
+    assert err.value.diagnostics[0].code == "I504"
 
 
 @pytest.mark.parametrize("q", [np.zeros(3), "home", [np.nan] * 7, None])
 def test_bad_arm_state_is_a_diagnostic(reg, q):
-    """A joint state of the wrong size, or not numbers, is an I501, never a crash."""
+    """A joint state of the wrong size, or not numbers, is an I504, never a crash."""
     with pytest.raises(AouError) as err:
         reg.update(q, uncertainty=0.1, restart=True)
-    assert err.value.diagnostics[0].code == "I501"
+    assert err.value.diagnostics[0].code == "I504"
 
 
 @pytest.mark.slow

@@ -171,12 +171,12 @@ def test_deterministic():
 
 
 @pytest.mark.parametrize("kwargs, code", [
-    ({"state": "curious", "intensity": 1.5}, "I501"),
-    ({"state": "curious", "intensity": math.nan}, "I501"),
-    ({"state": "bored"}, "I501"),
-    ({"C": 1.2, "V": 0.0}, "I501"),
-    ({"C": 0.2}, "I501"),
-    ({"state": "curious", "C": 0.2, "V": 0.1}, "I501"),
+    ({"state": "curious", "intensity": 1.5}, "I504"),
+    ({"state": "curious", "intensity": math.nan}, "I504"),
+    ({"state": "bored"}, "I504"),
+    ({"C": 1.2, "V": 0.0}, "I504"),
+    ({"C": 0.2}, "I504"),
+    ({"state": "curious", "C": 0.2, "V": 0.1}, "I504"),
     ({"state": "curious", "robot": "r2d2"}, "V109"),
 ])
 def test_bad_requests_are_diagnostics(kwargs, code):
@@ -200,7 +200,7 @@ def test_goal_is_written_and_fitted():
     assert err.value.diagnostics[0].code.startswith("C3")
     with pytest.raises(AouError) as err:
         fitted(State.CURIOUS, goal="above the table")  # type: ignore[arg-type]
-    assert err.value.diagnostics[0].code == "I501"
+    assert err.value.diagnostics[0].code == "I504"
 
 
 def _compiles(text: str, robot: str, *, round_trip: bool = True) -> None:

@@ -10,7 +10,7 @@ lint without errors, or neither is returned.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..declared import source_of
 from ..descriptors import REGISTRY
@@ -43,13 +43,13 @@ def parse_vary(text: str) -> tuple[str, float, float]:
         name, values = text.split("=", 1)
         low, high = (float(v) for v in values.split(","))
     except ValueError:
-        raise AouError(diag("I501", f"--vary takes NAME=LOW,HIGH, e.g. "
+        raise AouError(diag("I504", f"--vary takes NAME=LOW,HIGH, e.g. "
                             f"pause_duration=1.0,2.5; found `{text}`", where)) from None
     if name not in REGISTRY:
-        raise AouError(diag("I501", f"unknown descriptor `{name}`: expected one of "
+        raise AouError(diag("I504", f"unknown descriptor `{name}`: expected one of "
                             f"{', '.join(REGISTRY)}", where))
     if not (math.isfinite(low) and math.isfinite(high)):
-        raise AouError(diag("I501", f"--vary values must be finite numbers, found `{text}`",
+        raise AouError(diag("I504", f"--vary values must be finite numbers, found `{text}`",
                             where))
     return name, low, high
 
@@ -73,22 +73,26 @@ def make_variants(b: Behaviour, text: str, descriptor: str, low: float, high: fl
     where = b.span
     d = REGISTRY[descriptor]
     if b.form != "descriptor":
-        raise AouError(diag("I501", "variants are made from descriptor-form files, where "
+        raise AouError(diag("I504", "variants are made from descriptor-form files, where "
                             "each descriptor is set by one statement", where))
     prim = source_of(b, descriptor)
     if prim is None:
-        raise AouError(diag("I501", f"`{b.name}` has no `{d.kind}` statement to vary; "
+        raise AouError(diag("I504", f"`{b.name}` has no `{d.kind}` statement to vary; "
                             f"add one to the base first", where))
     out = []
     for label, value in (("low", low), ("high", high)):
         if d.is_count and (value != int(value) or value < 0):
-            raise AouError(diag("I501", f"{descriptor} is a count: expected a whole number, "
+            raise AouError(diag("I504", f"{descriptor} is a count: expected a whole number, "
                                 f"found {value:g}", where))
         new = prim.replace(**{d.ir_field: int(value) if d.is_count else value * d.scale})
         variant = Variant(label, value, _replace(text, prim.span, KINDS[d.kind].format(new)),
                           f"{prefix}-{label}.aou")
         lint = lint_source(variant.text, variant.path)
-        if not lint.ok:  # the file's own errors (exit 1): nothing is written
-            raise AouError(lint.diagnostics)
+        if not lint.ok:  # the variant's own errors (exit 1): nothing is written
+            statement = KINDS[d.kind].format(new)
+            raise AouError([  # said at the statement varied, in the file that exists
+                replace(e, message=f"the {label} variant (`{statement}`, for "
+                        f"{variant.path}) would not lint: {e.message}", span=prim.span)
+                for e in lint.diagnostics if e.severity == "error"])
         out.append(variant)
     return out
