@@ -96,7 +96,8 @@ def _text(doc: dict[str, Any]) -> str:
     lines.append("  joints:")
     for j in doc["joints"]:
         effort = "none" if j["effort"] is None else f"{j['effort']:g} N m"
-        jerk = "default" if j["jerk"] is None else f"{j['jerk']:g} rad/s^3"
+        jerk = (f"{DEFAULT_JOINT_JERK:g} rad/s^3 (aou's default)" if j["jerk"] is None
+                else f"{j['jerk']:g} rad/s^3")
         lines.append(
             f"    {j['name']} ({j['type']}): [{j['lower']:.4g}, {j['upper']:.4g}] rad, "
             f"{j['velocity']:.4g} rad/s ({j['velocity_source']}), "
