@@ -178,9 +178,11 @@ def cv_figure(points: list[tuple[str, CVPoint]]):
     xs = [p.C for _, p in points]
     ys = [p.V for _, p in points]
     ax.scatter(xs, ys, s=40, color="#c0392b", zorder=3)
-    for (label, p) in points:
-        ax.annotate(f"{label} ({p.state.value})", (p.C, p.V), xytext=(6, 4),
-                    textcoords="offset points", fontsize=8)
+    for (label, p) in points:  # labelled on the side toward the centre, clear of the
+        right = p.C > 0.3  # canonical squares' labels and of the plot's edges
+        ax.annotate(f"{label} ({p.state.value})", (p.C, p.V),
+                    xytext=(-6 if right else 6, -12 if p.V > 0.3 else 5),
+                    textcoords="offset points", fontsize=8, ha="right" if right else "left")
     ax.set_xlim(-1.25, 1.25)
     ax.set_ylim(-1.25, 1.25)
     ax.set_aspect("equal")
