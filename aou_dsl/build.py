@@ -180,7 +180,12 @@ def build_lint(lint: FileResult, *, robot: str | None = None, rate: float | None
         if has_errors(res.diagnostics):
             res.seconds = time.perf_counter() - start
             return res
-    res.measured = m = measure(tr.with_(path=lint.path))
+    try:
+        res.measured = m = measure(tr.with_(path=lint.path))
+    except AouError as err:  # measure refuses to report: this file fails, not the batch
+        res.diagnostics += err.diagnostics
+        res.seconds = time.perf_counter() - start
+        return res
     res.declared = want = declared(b, tl)
     for mm in compare(want, m.descriptors):
         res.diagnostics.append(diag(

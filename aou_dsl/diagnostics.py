@@ -124,6 +124,11 @@ class AouError(Exception):
         self.diagnostics = [diagnostics] if isinstance(diagnostics, Diagnostic) else diagnostics
         super().__init__("; ".join(f"{d.span}: {d.code} {d.message}" for d in self.diagnostics))
 
+    def __reduce__(self) -> tuple[type[AouError], tuple[list[Diagnostic]]]:
+        """Pickled by its diagnostics (the message is made from them): an error raised in
+        a worker process reaches the parent whole."""
+        return (type(self), (self.diagnostics,))
+
 
 def has_errors(diagnostics: list[Diagnostic]) -> bool:
     return any(d.severity is Severity.ERROR for d in diagnostics)

@@ -96,3 +96,39 @@ def test_a_variant_that_would_not_lint_is_said_at_the_statement_of_the_base(tmp_
     assert line.startswith(f"{base}:2:1:") and "low variant" in line
     assert "scared-pause_count-low.aou" in line
     assert not out.exists()
+
+
+def test_an_error_pickles_whole_so_a_worker_can_send_it():
+    import pickle
+
+    from aou_dsl.diagnostics import AouError, Span, diag
+
+    err = AouError([diag("R406", "a peak the joints cannot make", Span.whole_file("a.json")),
+                    diag("I501", "cannot read `b`", Span.whole_file("b"))])
+    back = pickle.loads(pickle.dumps(err))
+    assert isinstance(back, AouError) and back.diagnostics == err.diagnostics
+    assert str(back) == str(err)
+
+
+def test_a_file_whose_measurement_fails_fails_alone(tmp_path, capsys, monkeypatch):
+    """When measure refuses to report on one file's motion, that file fails with measure's
+    diagnostic and nothing written for it; the files after it are still built."""
+    import aou_dsl.measuring.descriptors as descriptors
+    from aou_dsl.diagnostics import AouError, Span, diag
+
+    real = descriptors.measure
+
+    def refuse_long(tr, *a, **kw):
+        if tr.duration > 10.0:
+            raise AouError(diag("R406", "refused for the test", Span.whole_file(tr.path)))
+        return real(tr, *a, **kw)
+
+    monkeypatch.setattr(descriptors, "measure", refuse_long)
+    names = ["confident", "hesitant", "fearful"]  # 4.5 s, 22 s, 12 s of motion
+    out = tmp_path / "out"
+    argv = ["compile", *(str(BEHAVIOURS / f"{n}.aou") for n in names), "-o", f"{out}/",
+            "--jobs", "1"]
+    assert main(argv) == EXIT_ERRORS
+    err = capsys.readouterr().err
+    assert err.count(" R406 ") == 2 and "[3/3]" in err
+    assert sorted(p.name for p in out.iterdir()) == ["confident.json"]
