@@ -68,6 +68,8 @@ def describe_robot(robot: str) -> tuple[dict[str, Any], str]:
     kind = ("built-in" if robot in ROBOTS else
             "robot description" if r.description else "URDF")
     values = {k: _round(getattr(spec, k)) for k in _ORDER}
+    if not spec.joint_jerk:  # the limit planned with, said to be aou's by its source
+        values["joint_jerk"] = [DEFAULT_JOINT_JERK] * len(spec.arm_joints)
     doc: dict[str, Any] = {
         "robot": robot, "kind": kind, "urdf": r.urdf.path,
         "description": r.description or None,
