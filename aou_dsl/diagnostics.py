@@ -356,7 +356,7 @@ _RULE_LIST = [
          "two retreats of 4 cm and 8 cm"),
     Rule("R404", "implausible-units", _E,
          "The columns of a recording look like degrees (or its times like milliseconds), "
-         "not radians and seconds.",
+         "not radians and seconds; or a unit given contradicts the robot's joint limits.",
          "Descriptors measured from wrong units are nonsense; say the unit "
          "(--angle-unit deg, --time-unit ms) if the file really uses it.",
          "t,panda_joint1\n0,45\n1,90"),

@@ -16,7 +16,8 @@ from typing import Any
 
 from .diagnostics import AouError, Span, diag
 
-__all__ = ["read_text", "atomic", "check_format", "check_output", "write_atomic"]
+__all__ = ["atomic", "check_format", "check_output", "decode", "read_bytes", "read_text",
+           "write_atomic"]
 
 
 def check_output(path: str, formats: Sequence[str] = ()) -> str:
@@ -133,7 +134,8 @@ def write_atomic(path: str, data: bytes, *, inputs: Sequence[str] = ()) -> None:
 
 
 def read_text(path: str, what: str = "") -> str:
-    """The text of an input file (UTF-8).
+    """The text of an input file (UTF-8; a leading byte-order mark, as Windows editors
+    save one, is dropped, so the first line's columns count from its first character).
 
     Raises:
         AouError: I501 naming the file (and ``what`` it is) and the reason.
@@ -150,12 +152,42 @@ def read_bytes(path: str, what: str = "") -> bytes:
     return _read(path, what, text=False)
 
 
+#: Byte-order marks of encodings other than UTF-8: a file saved as "Unicode" by Notepad.
+_OTHER_BOMS = {b"\xff\xfe\x00\x00": "UTF-32", b"\x00\x00\xfe\xff": "UTF-32",
+               b"\xff\xfe": "UTF-16", b"\xfe\xff": "UTF-16"}
+
+
+def decode(data: bytes, path: str, what: str = "") -> str:
+    """``data`` as UTF-8 text without a leading byte-order mark.
+
+    Raises:
+        AouError: I501 for text in another encoding, saying where it stops being UTF-8.
+    """
+    name = f"{what + ' ' if what else ''}`{path}`"
+    for bom, encoding in _OTHER_BOMS.items():
+        if data.startswith(bom):
+            raise AouError(diag("I501", f"cannot read {name}: it is saved as {encoding}, "
+                                "not UTF-8", Span.whole_file(path),
+                                hint="save it as UTF-8 (in Notepad: Save as, Encoding UTF-8)"))
+    try:
+        return data.decode("utf-8").removeprefix("\ufeff")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        start = data.rfind(b"\n", 0, exc.start) + 1
+        col = len(data[start:exc.start].decode("utf-8", "replace").removeprefix("\ufeff")) + 1
+        raise AouError(diag("I501", f"cannot read {name}: not UTF-8 text (byte "
+                            f"0x{data[exc.start]:02x} at line {line})",
+                            Span.point(path, line, col),
+                            hint="save it as UTF-8, or check that it is a text file"),
+                       ) from None
+
+
 def _read(path: str, what: str, text: bool) -> Any:
     try:
         with open(path, "rb") as fh:
             data = fh.read()
-        return data.decode("utf-8") if text else data
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+    except OSError as exc:
+        reason = exc.strerror or str(exc)
         raise AouError(diag("I501", f"cannot read {what + ' ' if what else ''}`{path}`: "
                             f"{reason}", Span.whole_file(path))) from None
+    return decode(data, path, what) if text else data

@@ -12,6 +12,7 @@ from pathlib import Path
 from .cv import CANONICAL, DEFAULT_WEIGHTS, CVPoint, CVWeights, composition, effort_to_cv, infer
 from .descriptors import REGISTRY
 from .diagnostics import AouError, Diagnostic, Severity, Span, diag, has_errors
+from .files import read_text
 from .ir import Behaviour
 from .layout import episode_values, nominal_values
 from .parse import parse
@@ -146,7 +147,8 @@ def load(text: str, path: str = "<string>") -> tuple[Behaviour | None, list[Diag
 
 def lint_source(text: str, path: str = "<string>", *,
                 weights: CVWeights = DEFAULT_WEIGHTS) -> FileResult:
-    """Lint ``.aou`` source text."""
+    """Lint ``.aou`` source text (a leading byte-order mark is not part of it)."""
+    text = text.removeprefix("\ufeff")
     v = load_validated(text, path)
     result = FileResult(path, list(v.diagnostics), source=text)
     b = v.behaviour
@@ -159,14 +161,9 @@ def lint_source(text: str, path: str = "<string>", *,
 
 
 def read_source(path: str) -> str:
-    """Read a source file as UTF-8, or raise an :class:`AouError` with an I501."""
-    try:
-        with open(path, encoding="utf-8") as fh:
-            return fh.read()
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise AouError(diag("I501", f"cannot read `{path}`: {reason}",
-                            Span.whole_file(path))) from None
+    """Read a source file as UTF-8 (a leading byte-order mark dropped), or raise an
+    :class:`AouError` with an I501."""
+    return read_text(path)
 
 
 #: Extensions of the trajectories aou writes and reads: given where a behaviour is

@@ -10,6 +10,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import os
+import re
 import sys
 import threading
 from dataclasses import dataclass
@@ -263,7 +264,26 @@ _TERMINAL_TEXT = {
     "EQUAL": "`=`",
     "COLON": "`:`",
     "SEQUENCE": "`sequence`",
+    "STRING": "a quoted text",
     "$END": "the end of the file",
+}
+
+#: Characters that look right in an editor but are not the language's, and what to
+#: write instead ("{n}" is the number before the character, when there is one).
+_MINUS, _QUOTES, _SPACE = ("write the minus sign as `-`",
+                           'quote a text with straight double quotes: `"..."`',
+                           "use an ordinary space")
+_LOOKALIKES = {
+    "°": ("a degree sign", "write `{n}deg`: the unit is a word after the number"),
+    "º": ("an ordinal sign", "write `{n}deg`: the unit is a word after the number"),
+    "×": ("a multiplication sign", "write a repeat count with the letter x: `x3`"),
+    "−": ("a typographic minus", _MINUS), "–": ("a dash", _MINUS), "—": ("a dash", _MINUS),
+    "“": ("a curly quote", _QUOTES), "”": ("a curly quote", _QUOTES),
+    "‘": ("a curly quote", _QUOTES), "’": ("a curly quote", _QUOTES),
+    "'": ("a single quote", _QUOTES), "\u00a0": ("a non-breaking space", _SPACE),
+    "\u202f": ("a narrow non-breaking space", _SPACE), "\u2009": ("a thin space", _SPACE),
+    "\ufeff": ("a byte-order mark", "delete it: an invisible character, often left where "
+                "two files were joined"),
 }
 
 
@@ -289,18 +309,72 @@ def _found_text(tok: Token) -> str:
     return f"`{tok}`"
 
 
+def _number_before(text: str, at: int) -> str:
+    """The number that ends at ``at`` in ``text`` (`20` in `tilt 20°`), or ``""``."""
+    m = re.search(r"[+-]?(\d+(\.\d*)?|\.\d+)\s*$", text[max(0, at - 40):at])
+    return m.group(0).strip() if m else ""
+
+
+def _unexpected_character(path: str, text: str, err: lark.exceptions.UnexpectedCharacters
+                          ) -> AouError:
+    at = err.pos_in_stream
+    ch = text[at] if at is not None and at < len(text) else "?"
+    span = Span.point(path, err.line, err.column)
+    hint = None
+    shown = f"`{ch}`"
+    if ch == "{":
+        hint = "a `{` only opens a `sequence { ... }` block"
+    elif ch in _LOOKALIKES:
+        what, hint = _LOOKALIKES[ch]
+        shown = f"`{ch}` ({what}, U+{ord(ch):04X})"
+        hint = hint.format(n=_number_before(text, at or 0) or "20")
+    elif not ch.isprintable() or ch.isspace():
+        shown = f"U+{ord(ch):04X} (an invisible character)"
+        hint = "delete it, or replace it with an ordinary space"
+    return AouError(diag("S003", f"unexpected character {shown}", span, hint=hint, found=ch))
+
+
+#: `1,5s`: a comma between the digits of a number, with what follows it up to its unit.
+_DECIMAL_COMMA = re.compile(r"([+-]?\d+),(\d+([eE][+-]?\d+)?[A-Za-z][A-Za-z0-9]*(/[A-Za-z0-9]+)?"
+                            r"(\^[0-9]+)?|\d+([eE][+-]?\d+)?)")
+
+
+def _comma(path: str, text: str, tok: Token) -> AouError | None:
+    """A comma outside a vector: a decimal comma (`1,5s`), or a vector without its
+    parentheses (`goal 0.5, 0, 0.3`)."""
+    at = tok.start_pos or 0
+    line_start = text.rfind("\n", 0, at) + 1
+    if text.rfind("(", line_start, at) > text.rfind(")", line_start, at):  # in a vector
+        return AouError(diag(
+            "S001", "a vector has three numbers, `(X, Y, Z)`; this one has more",
+            _tok_span(path, tok), found=",",
+            hint="the decimal mark is a point: `0.5`, not `0,5`"
+            if re.search(r"\d,\d", text[line_start:at + 2]) else None))
+    start = at
+    while start > 0 and (text[start - 1].isdigit() or text[start - 1] in "+-"):
+        start -= 1
+    m = _DECIMAL_COMMA.match(text, start)
+    if m and m.start(0) == start and text[at - 1:at].isdigit():
+        written, meant = m.group(0), f"{m.group(1)}.{m.group(2)}"
+        return AouError(diag(
+            "S001", f"unexpected `,` in `{written}`: the decimal mark is a point",
+            Span(path, tok.line or 1, (tok.column or 1) - (at - start), tok.line or 1,
+                 (tok.column or 1) + len(written) - (at - start)),
+            hint=f"write `{meant}`", found=","))
+    if _number_before(text, at):
+        return AouError(diag("S001", "unexpected `,` after a number", _tok_span(path, tok),
+                             hint="commas separate the numbers of a vector, written in "
+                             "parentheses: `goal (0.5, 0, 0.3)`", found=","))
+    return None
+
+
 def _syntax_error(path: str, text: str, err: lark.exceptions.UnexpectedInput) -> AouError:
     if isinstance(err, lark.exceptions.UnexpectedCharacters):
-        at = err.pos_in_stream
-        ch = text[at] if at is not None and at < len(text) else "?"
-        span = Span.point(path, err.line, err.column)
-        hint = None
-        if ch == "{":
-            hint = "a `{` only opens a `sequence { ... }` block"
-        return AouError(diag("S003", f"unexpected character `{ch}`", span, hint=hint,
-                             found=ch))
+        return _unexpected_character(path, text, err)
     if isinstance(err, lark.exceptions.UnexpectedToken) and err.token.type != "$END":
         tok = err.token
+        if tok.type == "COMMA" and (comma := _comma(path, text, tok)) is not None:
+            return comma
         span = _tok_span(path, tok)
         expected = _expected_text(set(err.expected))
         hint = None
@@ -325,6 +399,7 @@ def parse(text: str, path: str = "<string>") -> SyntaxTree:
     Raises:
         AouError: with one ``S`` diagnostic for the first syntax error.
     """
+    text = text.removeprefix("\ufeff")  # a byte-order mark (Windows editors) is no text
     parser = _parser()
     _CURRENT.path, _CURRENT.text = path, text
     try:

@@ -76,8 +76,34 @@ def _message(errors: list[Any], doc: dict) -> str:
     return "; ".join(parts[:3]) + more
 
 
-def read_header(path: str, doc: Any, *, own_goal: bool = True) -> Header:
-    """The validated header of ``doc``; R401 naming each wrong field. ``own_goal``
+def _first(errors: list[Any]) -> tuple:
+    """The path of the field the message leads with (:func:`_message`'s order); ``()``
+    for missing keys."""
+    if any(e["loc"] == ("format",) for e in errors):
+        return ("format",)
+    if any(e["type"] == "missing" and len(e["loc"]) == 1 for e in errors):
+        return ()
+    goal = [e for e in errors if e["loc"][0] == "goal"]
+    return tuple((goal or errors)[0]["loc"])
+
+
+def _span(path: str, text: str | None, loc: tuple) -> Span:
+    """Where the field at ``loc`` is in the document ``text`` (its nearest enclosing
+    field that is there; a missing key: the document's start)."""
+    from .locate import json_span
+
+    if text is not None:
+        for n in range(len(loc), 0, -1):
+            span = json_span(path, text, loc[:n])
+            if span is not None:
+                return span
+    return Span.whole_file(path)
+
+
+def read_header(path: str, doc: Any, *, own_goal: bool = True, text: str | None = None
+                ) -> Header:
+    """The validated header of ``doc``; R401 naming each wrong field (the diagnostic
+    points at the first in ``text``, the document's JSON, when given). ``own_goal``
     False: the file's goal is not read (one given on the command line replaces it)."""
     if not isinstance(doc, dict):
         raise AouError(diag("R401", "a trajectory document is a JSON object",
@@ -88,7 +114,7 @@ def read_header(path: str, doc: Any, *, own_goal: bool = True) -> Header:
         header = Header.model_validate(fields)
     except ValidationError as exc:
         errors = exc.errors(include_url=False)
-        raise AouError(diag("R401", _message(errors, doc), Span.whole_file(path),
+        raise AouError(diag("R401", _message(errors, doc), _span(path, text, _first(errors)),
                             fields=[".".join(str(x) for x in e["loc"]) for e in errors])
                        ) from None
     return header

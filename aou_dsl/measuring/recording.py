@@ -10,7 +10,10 @@ Every format aou writes reads back with its robot, frame and goal: the JSON and 
 carry them in the document, the CSV in comment lines before its header
 (``# robot: NAME``, ``# ee_frame: F``, ``# goal: X,Y,Z``). Options given to
 :func:`read_recording` override the file. A recording whose units look wrong (angles in
-degrees, times in milliseconds) is refused unless the unit is given.
+degrees, times in milliseconds) is refused unless the unit is given, and so is a unit
+given that contradicts the robot (:mod:`.plausible`). A file of another extension is
+read by its content; ROS bags and YAML, which aou writes for ROS, are not read back.
+Errors point at the row, the sample or the header field where they are (:mod:`.locate`).
 """
 
 from __future__ import annotations
@@ -18,7 +21,6 @@ from __future__ import annotations
 import csv
 import io
 import json
-import math
 import os
 import zipfile
 from typing import Any
@@ -26,30 +28,29 @@ from typing import Any
 import numpy as np
 
 from ..diagnostics import AouError, Severity, Span, diag
-from ..files import read_bytes, read_text
+from ..files import decode, read_bytes
 from ..trajectory import Trajectory
 from .document import Header, read_header
+from .locate import Where, json_span
+from .plausible import ANGLE_UNITS, TIME_UNITS, check_units
 
-__all__ = ["ANGLE_UNITS", "TIME_UNITS", "read_csv", "read_json", "read_npz",
+__all__ = ["ANGLE_UNITS", "FORMATS", "TIME_UNITS", "read_csv", "read_json", "read_npz",
            "read_recording"]
 
-ANGLE_UNITS = {"rad": 1.0, "deg": math.pi / 180.0}
-TIME_UNITS = {"s": 1.0, "ms": 1e-3}
-#: A clock slower than this [s per sample] is taken for milliseconds read as seconds.
-SLOWEST_STEP = 0.2
-#: How far [rad] beyond its limits a joint may sit throughout under a unit given.
-BEYOND = math.radians(1.0)
+#: The trajectory formats read, by extension.
+FORMATS = ("json", "csv", "npz")
 
 
-def _bad(path: str, message: str, hint: str | None = None, **fields) -> AouError:
-    return AouError(diag("R401", message, Span.whole_file(path), hint=hint, **fields))
+def _bad(path: str, message: str, hint: str | None = None, span: Span | None = None,
+         **fields) -> AouError:
+    return AouError(diag("R401", message, span or Span.whole_file(path), hint=hint, **fields))
 
 
-def _check_arrays(path: str, t: np.ndarray, q: np.ndarray, names: tuple[str, ...],
-                  rows: list[int] | None = None) -> None:
-    """Shapes, finite values and distinct names; ``rows`` gives each sample's line in a
-    text file (for the messages)."""
-    where = (lambda i: f"row {rows[i]}") if rows else (lambda i: f"sample {i}")
+def _check_arrays(t: np.ndarray, q: np.ndarray, names: tuple[str, ...], where: Where
+                  ) -> None:
+    """Shapes, finite values and distinct names; ``where`` places each sample in its
+    file (for the messages and spans)."""
+    path = where.path
     if t.ndim != 1 or len(t) < 3:
         raise _bad(path, f"a trajectory needs at least 3 samples, found {t.size}")
     if q.shape != (len(t), len(names)):
@@ -60,22 +61,22 @@ def _check_arrays(path: str, t: np.ndarray, q: np.ndarray, names: tuple[str, ...
     bad = ~np.isfinite(t)
     if bad.any():
         i = int(np.argmax(bad))
-        raise _bad(path, f"{where(i)}: the time is not a finite number", sample=i)
+        raise _bad(path, f"{where.label(i)}: the time is not a finite number",
+                   span=where.span(i, "t"), sample=i)
     bad_rows = ~np.isfinite(q).all(axis=1)
     if bad_rows.any():
         i = int(np.argmax(bad_rows))
-        j = names[int(np.argmax(~np.isfinite(q[i])))]
-        raise _bad(path, f"{where(i)} (t={t[i]:g}): joint `{j}` is not a finite number",
-                   sample=i, joint=j)
+        k = int(np.argmax(~np.isfinite(q[i])))
+        raise _bad(path, f"{where.label(i)} (t={t[i]:g}): joint `{names[k]}` is not a finite "
+                   "number", span=where.span(i, "q", k), sample=i, joint=names[k])
 
 
-def _check_clock(path: str, t: np.ndarray, rows: list[int] | None = None) -> None:
+def _check_clock(t: np.ndarray, where: Where) -> None:
     step = np.diff(t)
     if (step <= 0).any():
         i = int(np.argmax(step <= 0)) + 1
-        at = f"row {rows[i]}" if rows else f"sample {i}"
-        raise _bad(path, f"time must increase strictly: {at} has t={t[i]:g} after "
-                   f"t={t[i - 1]:g}", sample=i)
+        raise _bad(where.path, f"time must increase strictly: {where.label(i)} has "
+                   f"t={t[i]:g} after t={t[i - 1]:g}", span=where.span(i, "t"), sample=i)
 
 
 def _optional(doc: dict, q: np.ndarray) -> dict:
@@ -93,21 +94,44 @@ def _optional(doc: dict, q: np.ndarray) -> dict:
     return out
 
 
-def _from_document(path: str, doc: dict, header: Header, t: Any, q: Any) -> Trajectory:
+def _number_at(values: Any, where: Where, key: str, i: int) -> AouError:
+    """R401 at the first value of row (or time) ``i`` onwards that is not a number."""
+    for k in range(i, len(values)):
+        row = values[k] if key == "q" else [values[k]]
+        if not isinstance(row, list | tuple):
+            return _bad(where.path, f"{where.label(k)} of `q` is not a list of joint values",
+                        span=where.span(k, key), sample=k)
+        for j, v in enumerate(row):
+            try:
+                float(v)
+            except (TypeError, ValueError):
+                what = f"joint column {j}" if key == "q" else "the time"
+                return _bad(where.path, f"{where.label(k)}: {what} is {json.dumps(v)[:40]}, "
+                            "not a number", span=where.span(k, key, j if key == "q" else None),
+                            sample=k)
+    return _bad(where.path, f"malformed `{key}`")
+
+
+def _from_document(doc: dict, header: Header, t: Any, q: Any, where: Where) -> Trajectory:
     """A trajectory from a document of the trajectory format, its validated header and
-    its arrays."""
-    names = tuple(header.joint_names)
+    its arrays; ``where`` places its samples in the file."""
+    path, names = where.path, tuple(header.joint_names)
+    rows = list(q)
+    for i, row in enumerate(rows):
+        if not hasattr(row, "__len__"):
+            raise _number_at(rows, where, "q", i)
+        if len(row) != len(names):
+            raise _bad(path, f"{where.label(i)} has {len(row)} values; `joint_names` has "
+                       f"{len(names)}", span=where.span(i), sample=i)
     try:
         t = np.asarray(t, dtype=float)
-        rows = list(q)
-        for i, row in enumerate(rows):
-            if len(row) != len(names):
-                raise _bad(path, f"sample {i} has {len(row)} values; `joint_names` has "
-                           f"{len(names)}", sample=i)
+    except (TypeError, ValueError):
+        raise _number_at(list(t) if isinstance(t, list) else [t], where, "t", 0) from None
+    try:
         q = np.asarray(rows, dtype=float).reshape(len(rows), len(names))
-    except (TypeError, ValueError) as exc:
-        raise _bad(path, f"malformed trajectory: {exc}") from None
-    _check_arrays(path, t, q, names)
+    except (TypeError, ValueError):
+        raise _number_at(rows, where, "q", 0) from None
+    _check_arrays(t, q, names, where)
     title = header.behaviour or os.path.splitext(os.path.basename(path))[0]
     return Trajectory(t, q, names, header.robot, header.ee_frame, header.goal_position,
                       path=path, title=title, **_optional(doc, q))
@@ -125,19 +149,23 @@ def read_npz(path: str, data: bytes, own_goal: bool = True) -> Trajectory:
 
 
 def _json(path: str, text: str, own_goal: bool) -> tuple[Trajectory, Header]:
+    text = text.removeprefix("\ufeff")
     try:
         doc = json.loads(text)
     except json.JSONDecodeError as exc:
         raise AouError(diag("R401", f"not valid JSON: {exc.msg}",
                             Span.point(path, exc.lineno, exc.colno))) from None
-    header = read_header(path, doc, own_goal=own_goal)
+    header = read_header(path, doc, own_goal=own_goal, text=text)
     missing = [k for k in ("t", "q") if k not in doc]
     if missing:
         raise _bad(path, f"missing key(s): {', '.join(missing)}")
-    if not isinstance(doc["q"], list):
-        raise _bad(path, "`q` must be a list of rows")
-    rec = _from_document(path, doc, header, doc["t"], doc["q"])
-    _check_clock(path, rec.t)
+    where = Where(path, text=text)
+    for key in ("t", "q"):
+        if not isinstance(doc[key], list):
+            raise _bad(path, f"`{key}` must be a list of {'times' if key == 't' else 'rows'}",
+                       span=json_span(path, text, (key,)))
+    rec = _from_document(doc, header, doc["t"], doc["q"], where)
+    _check_clock(rec.t, where)
     return rec, header
 
 
@@ -160,8 +188,9 @@ def _npz(path: str, data: bytes, own_goal: bool) -> tuple[Trajectory, Header]:
     q = arrays["q"]
     if q.ndim != 2:
         raise _bad(path, f"`q` has shape {q.shape}; expected (samples, joints)")
-    rec = _from_document(path, doc, header, arrays["t"], q)
-    _check_clock(path, rec.t)
+    where = Where(path)
+    rec = _from_document(doc, header, arrays["t"], q, where)
+    _check_clock(rec.t, where)
     return rec, header
 
 
@@ -176,28 +205,29 @@ def _comments(lines: list[str]) -> dict[str, str]:
     return out
 
 
-def _csv_values(path: str, rows: list[tuple[int, list[str]]], header: list[str]
-                ) -> np.ndarray:
-    values = np.full((len(rows), len(header)), math.nan)
+def _csv_values(path: str, rows: list[tuple[int, list[str]]], header: list[str],
+                lines: list[str]) -> np.ndarray:
+    values = np.full((len(rows), len(header)), np.nan)
     for i, (line, r) in enumerate(rows):
         if len(r) != len(header):
             raise _bad(path, f"row {line} has {len(r)} columns; the header has "
-                       f"{len(header)}", row=line)
+                       f"{len(header)}", span=Span.point(path, line, 1), row=line)
         for j, cell in enumerate(r):
             try:
                 values[i, j] = float(cell)
             except ValueError:
+                col = 1 if '"' in lines[line - 1] else len(",".join(r[:j] + [""])) + 1
                 raise _bad(path, f"row {line}, column `{header[j]}`: `{cell}` is not a "
-                           "number", row=line) from None
+                           "number", span=Span.point(path, line, col), row=line) from None
     return values
 
 
 def _read_csv(path: str, text: str, robot: str | None,
               goal: tuple[float, float, float] | None, ee_frame: str | None
-              ) -> tuple[Trajectory, list[int], bool]:
-    """:func:`read_csv` without the clock check; also each sample's line in the file and
-    whether aou wrote the file."""
-    lines = text.splitlines()
+              ) -> tuple[Trajectory, Where, bool]:
+    """:func:`read_csv` without the clock check; also where each sample is in the file
+    and whether aou wrote the file."""
+    lines = text.removeprefix("\ufeff").splitlines()
     notes = _comments([ln for ln in lines if ln.startswith("#")])
     rows = [(k + 1, r) for k, r in enumerate(csv.reader(lines)) if r and not r[0].startswith("#")]
     if not rows:
@@ -205,8 +235,9 @@ def _read_csv(path: str, text: str, robot: str | None,
     header = [h.strip() for h in rows[0][1]]
     if header[0] != "t":
         raise _bad(path, f"the first column must be `t`, found `{header[0]}`",
-                   hint="a header row `t,joint_a,joint_b,...` names the columns")
-    values = _csv_values(path, rows[1:], header)
+                   hint="a header row `t,joint_a,joint_b,...` names the columns",
+                   span=Span.point(path, rows[0][0], 1))
+    values = _csv_values(path, rows[1:], header, lines)
     robot = robot or notes.get("robot")
     if not robot:
         raise AouError(diag("I501", f"cannot read `{path}` as a recording without its robot: "
@@ -221,12 +252,12 @@ def _read_csv(path: str, text: str, robot: str | None,
     ee = ee_frame or (notes.get("ee_frame") if notes.get("ee_frame") not in (None, "None")
                       else None)
     names = tuple(header[1:])
-    line_of = [line for line, _ in rows[1:]]
-    _check_arrays(path, values[:, 0], values[:, 1:], names, line_of)
+    where = Where(path, lines=[line for line, _ in rows[1:]])
+    _check_arrays(values[:, 0], values[:, 1:], names, where)
     title = os.path.splitext(os.path.basename(path))[0]
     rec = Trajectory(values[:, 0], values[:, 1:], names, robot, ee,
                      tuple(goal) if goal is not None else None, path=path, title=title)
-    return rec, line_of, "aou-trajectory/1" in notes.get("format", "")
+    return rec, where, "aou-trajectory/1" in notes.get("format", "")
 
 
 def read_csv(path: str, text: str, robot: str | None = None,
@@ -235,127 +266,63 @@ def read_csv(path: str, text: str, robot: str | None = None,
     """A CSV with a header row ``t,JOINT,...``, after optional ``# key: value`` comment
     lines (aou writes ``robot``, ``ee_frame`` and ``goal`` there). ``robot``, ``goal``
     and ``ee_frame`` override the comments."""
-    rec, rows, _ = _read_csv(path, text, robot, goal, ee_frame)
-    _check_clock(path, rec.t, rows)
+    rec, where, _ = _read_csv(path, text, robot, goal, ee_frame)
+    _check_clock(rec.t, where)
     return rec
 
 
-def _at(rec: Trajectory, rows: list[int] | None, i: int) -> tuple[str, Span, dict]:
-    """Sample ``i``: its row in a text file (the span points there), else its index."""
-    if rows:
-        return f"row {rows[i]}", Span.point(rec.path, rows[i], 1), {"sample": i, "row": rows[i]}
-    return f"sample {i}", Span.whole_file(rec.path), {"sample": i}
+#: Files aou writes, or meets beside its own, but does not read as trajectories.
+_NOT_READ = {".mcap": "a ROS 2 bag", ".db3": "a ROS 2 bag", ".bag": "a ROS bag",
+             ".yaml": "YAML", ".yml": "YAML"}
 
 
-def _check_units(rec: Trajectory, angle_unit: str | None, time_unit: str | None,
-                 trusted: bool, rows: list[int] | None = None) -> Trajectory:
-    """Convert the units given. R404 for values that look like degrees or milliseconds
-    when none is given, and for an angle unit that puts a joint outside its limits
-    throughout. ``rows``: each sample's line in a text file."""
-    from ..kinematics import load_arm
-
-    for unit, table, what in ((angle_unit, ANGLE_UNITS, "angle"),
-                              (time_unit, TIME_UNITS, "time")):
-        if unit is not None and unit not in table:
-            raise AouError(diag("R404", f"unknown {what} unit `{unit}`: expected one of "
-                                f"{', '.join(table)}", Span.whole_file(rec.path)))
-    wrong = [f"--{flag} {unit}" for flag, unit, right in
-             (("angle-unit", angle_unit, "rad"), ("time-unit", time_unit, "s"))
-             if unit not in (None, right)]
-    arm = load_arm(rec.robot, rec.ee_frame)
-    if trusted and wrong and _as_written(rec, arm, rows):
-        raise AouError(diag("R404", f"aou wrote this file, in radians and seconds: "
-                            f"{' and '.join(wrong)} would misread it", Span.whole_file(
-                                rec.path), hint="leave the units out for files aou wrote"))
-    t = np.asarray(rec.t, float) * TIME_UNITS[time_unit or "s"]
-    if time_unit is None and not trusted:  # aou writes slow clocks too (--rate 1)
-        _plausible_clock(rec, t, rows)
-    q = np.asarray(rec.q, float).copy()
-    for j in _revolute(arm):
-        name = arm.joint_names[j]
-        if name not in rec.joint_names:
-            continue
-        col = rec.joint_names.index(name)
-        limits = (float(arm.lower[j]), float(arm.upper[j]))
-        if angle_unit is not None:
-            q[:, col] *= ANGLE_UNITS[angle_unit]
-            _obeyed_limits(rec, q[:, col], name, limits, angle_unit, rows)
-        else:  # aou's own files too: an edited one may no longer be in radians
-            _plausible_angles(rec, q[:, col], name, limits, rows)
-    return rec.with_(t=t, q=q)
+def _unread(path: str, what: str) -> AouError:
+    """I501: ``path`` (``what`` it is) is in none of :data:`FORMATS`."""
+    bag = "bag" in what or what == "YAML"
+    return AouError(diag(
+        "I501", f"cannot read `{path}`: it is {what}, not a trajectory aou reads; aou "
+        "reads trajectories from JSON, CSV and NPZ files (and compiles `.aou` files)",
+        Span.whole_file(path), hint=(
+            "aou writes ROS 2 bags and YAML for ROS (--format mcap|yaml) but does not read "
+            "them back: measure the same trajectory as JSON, CSV or NPZ (aouc compile "
+            "--format json), or export the recorded joint states to a CSV" if bag else
+            "a CSV recording starts with a header row `t,JOINT,JOINT,...`; a JSON "
+            "trajectory is an object with `format`, `robot`, `joint_names`, `t` and `q`")))
 
 
-def _revolute(arm: Any) -> list[int]:
-    return [j for j in range(len(arm.joint_names))
-            if arm.model.joints[j + 1].shortname().startswith("JointModelR")]
+def _sniff(data: bytes) -> str | None:
+    """The format of a file of no known extension, by its first bytes: a zip (NPZ), a
+    JSON object, or a CSV whose header's first column is ``t``; None for none."""
+    if data.startswith(b"PK\x03\x04"):
+        return "npz"
+    head = data[:4096].decode("utf-8-sig", "ignore").lstrip()
+    if head.startswith("{"):
+        return "json"
+    for line in head.splitlines():
+        if line.strip() and not line.startswith("#"):
+            return "csv" if "," in line and line.split(",")[0].strip() == "t" else None
+    return None
 
 
-def _as_written(rec: Trajectory, arm: Any, rows: list[int] | None) -> bool:
-    """Whether the file's angles are plausible in radians as they stand."""
-    try:
-        for j in _revolute(arm):
-            if arm.joint_names[j] in rec.joint_names:
-                col = np.asarray(rec.q, float)[:, rec.joint_names.index(arm.joint_names[j])]
-                _plausible_angles(rec, col, arm.joint_names[j],
-                                  (float(arm.lower[j]), float(arm.upper[j])), rows)
-    except AouError:
-        return False
-    return True
+def _format(path: str) -> tuple[str, bytes]:
+    """The format of ``path`` (by its extension, else by its content) and its bytes.
 
-
-def _plausible_clock(rec: Trajectory, t: np.ndarray, rows: list[int] | None) -> None:
-    """R404 when samples come slower than :data:`SLOWEST_STEP` (milliseconds as seconds)."""
-    step = np.diff(t)
-    if len(step) and float(np.median(step)) >= SLOWEST_STEP:
-        i = int(np.argmax(step >= SLOWEST_STEP)) + 1
-        at, span, fields = _at(rec, rows, i)
-        raise AouError(diag("R404", f"the times look like milliseconds: one sample every "
-                            f"{float(np.median(step)):g} s ({at} has t={t[i]:g} after "
-                            f"t={t[i - 1]:g})", span, hint="give --time-unit ms, or "
-                            "--time-unit s if the clock really is that slow", **fields))
-
-
-def _within(col: np.ndarray, lo: float, hi: float, slack: float | None = None) -> np.ndarray:
-    """Which values lie in [lo, hi] widened by ``slack`` (default a tenth of the range:
-    an offset is not a unit problem); +-2 turns for a joint without finite limits."""
-    if not (math.isfinite(lo) and math.isfinite(hi)):
-        lo, hi = -4 * math.pi, 4 * math.pi
-    slack = 0.1 * (hi - lo) if slack is None else slack
-    return (col >= lo - slack) & (col <= hi + slack)
-
-
-def _plausible_angles(rec: Trajectory, col: np.ndarray, name: str,
-                      limits: tuple[float, float], rows: list[int] | None) -> None:
-    """R404 when a joint's values leave its limits and read as degrees they would not."""
-    inside = _within(col, *limits)
-    if inside.all() or not _within(np.radians(col), *limits).all():
-        return
-    i = int(np.argmin(inside))
-    at, span, fields = _at(rec, rows, i)
-    raise AouError(diag(
-        "R404", f"joint `{name}` reads {col[i]:g} at {at}, outside its limits "
-        f"[{limits[0]:.3g}, {limits[1]:.3g}] rad: the angles look like degrees", span,
-        hint="give --angle-unit deg, or --angle-unit rad if they really are radians",
-        joint=name, **fields))
-
-
-def _obeyed_limits(rec: Trajectory, col: np.ndarray, name: str,
-                   limits: tuple[float, float], unit: str, rows: list[int] | None) -> None:
-    """R404 when the angle unit given leaves every sample of a joint beyond its limits
-    (by :data:`BEYOND`): the unit contradicts the robot."""
-    lo, hi = limits
-    if not (math.isfinite(lo) and math.isfinite(hi)) or _within(col, lo, hi, BEYOND).any():
-        return
-    other = "rad" if unit == "deg" else "deg"
-    fits = _within(col / ANGLE_UNITS[unit] * ANGLE_UNITS[other], lo, hi).all()
-    at, span, fields = _at(rec, rows, 0)
-    raise AouError(diag(
-        "R404", f"with --angle-unit {unit}, joint `{name}` reads {col[0]:.4g} rad at {at} "
-        f"and every one of its {len(col)} samples lies outside its limits [{lo:.3g}, "
-        f"{hi:.3g}] rad: the unit given contradicts the robot's limits", span,
-        hint=f"the values fit the limits in {other}: give --angle-unit {other}" if fits
-        else "check the unit, and that the recording is of this robot (--robot)",
-        joint=name, unit=unit, **fields))
+    Raises:
+        AouError: I501 for a folder, a ROS bag or YAML, or content of no format read.
+    """
+    ext = os.path.splitext(path)[1].lower()
+    if os.path.isdir(path):
+        bag = os.path.exists(os.path.join(path, "metadata.yaml"))
+        raise _unread(path, "a ROS 2 bag (a folder)" if bag else "a folder")
+    if ext in _NOT_READ:
+        raise _unread(path, _NOT_READ[ext])
+    data = read_bytes(path)
+    if ext.lstrip(".") in FORMATS:
+        return ext.lstrip("."), data
+    fmt = _sniff(data)
+    if fmt is None:
+        raise _unread(path, f"a `{ext}` file" if ext else "a file without an extension")
+    return fmt, data
 
 
 def final_goal(rec: Trajectory) -> tuple[float, float, float]:
@@ -373,7 +340,9 @@ def read_recording(path: str, *, robot: str | None = None,
                    goal: tuple[float, float, float] | str | None = None,
                    ee_frame: str | None = None, angle_unit: str | None = None,
                    time_unit: str | None = None) -> Trajectory:
-    """Read a ``.json`` or ``.npz`` trajectory or a ``.csv`` recording.
+    """Read a ``.json`` or ``.npz`` trajectory or a ``.csv`` recording (a file of another
+    extension by its content: a JSON object, a zip, or a CSV whose header starts with
+    ``t``).
 
     Args:
         robot, ee_frame: override the file's (a CSV without a ``# robot:`` line needs
@@ -386,29 +355,32 @@ def read_recording(path: str, *, robot: str | None = None,
             milliseconds are refused (R404), in files aou wrote too (they may have been
             edited); a unit on a file aou wrote whose values look right as they stand is
             refused. An angle unit that leaves a joint outside its limits at every sample
-            is refused too.
+            is refused too, and so are times on which the joints move more than ten times
+            faster than their velocity limits (seconds read as milliseconds).
 
     Raises:
-        AouError: I501 when the file cannot be read; R401 for a malformed trajectory
+        AouError: I501 when the file cannot be read or is in a format aou does not read
+            (a ROS 2 bag, a YAML message, any text that is no trajectory); R401 for a
+            malformed trajectory
             (with the row or sample); R404 for implausible units.
     """
-    data = read_bytes(path) if path.endswith(".npz") else b""
-    text = None if path.endswith(".npz") else read_text(path)
-    rows = None
-    if path.endswith(".csv"):
-        rec, rows, trusted = _read_csv(path, text or "", robot,
-                                       None if isinstance(goal, str) else goal, ee_frame)
+    fmt, data = _format(path)
+    text = "" if fmt == "npz" else decode(data, path)
+    if fmt == "csv":
+        rec, where, trusted = _read_csv(path, text, robot,
+                                        None if isinstance(goal, str) else goal, ee_frame)
     else:
-        rec, header = (_npz(path, data, goal is None) if path.endswith(".npz")
-                       else _json(path, text or "", goal is None))
+        rec, header = (_npz(path, data, goal is None) if fmt == "npz"
+                       else _json(path, text, goal is None))
         trusted = header.generator.startswith("aouc")
+        where = Where(path, text=text if fmt == "json" else None)
     changes: dict[str, Any] = {k: v for k, v in (("robot", robot), ("ee_frame", ee_frame))
                                if v}
     if goal is not None and not isinstance(goal, str):
         changes["goal"] = tuple(float(x) for x in goal)
     rec = rec.with_(**changes) if changes else rec
-    rec = _check_units(rec, angle_unit, time_unit, trusted, rows)
-    _check_clock(path, rec.t, rows)
+    rec = check_units(rec, angle_unit, time_unit, trusted, where)
+    _check_clock(rec.t, where)
     if isinstance(goal, str):
         if goal != "final":
             raise AouError(diag("R405", f"unknown goal `{goal}`: give X,Y,Z or `final`",

@@ -15,7 +15,7 @@ from typing import Any
 
 from ..diagnostics import Diagnostic, Span, diag
 from ..parse import Colon, KeyVal, Quantity, Statement, Vector, Word
-from ..units import UNITS, Dim, units_for
+from ..units import UNITS, Dim, as_unit, suggest_unit, units_for
 
 __all__ = ["Ctx", "Reader", "did_you_mean", "si", "split_args"]
 
@@ -64,8 +64,10 @@ def si(ctx: Ctx, q: Quantity, dim: Dim, *, what: str, bare_unit: str | None) -> 
             return None
         return q.value * UNITS[bare_unit][1]
     if q.unit not in UNITS:
+        meant = suggest_unit(q.unit, dim)
         ctx.error("V104", f"unknown unit `{q.unit}` in `{q.text}`: expected {_a(dim)} ({fits})",
-                  q.span, hint=did_you_mean(q.unit, units_for(dim)), found=q.unit)
+                  q.span, hint=f"did you mean `{q.text[:-len(q.unit)]}{meant}`?" if meant
+                  else None, found=q.unit)
         return None
     found_dim, factor = UNITS[q.unit]
     if found_dim is not dim:
@@ -127,8 +129,12 @@ def split_args(ctx: Ctx, st: Statement, allowed: Iterable[str], repeat: bool) ->
 def _key(ctx: Ctx, st: Statement, a: KeyVal, allowed: list[str], out: Args) -> None:
     if a.key not in allowed:
         keys = ", ".join(f"{k}=" for k in allowed) or "no keys"
+        hint = did_you_mean(a.key, allowed)
+        if a.key == "for" and st.keyword == "shiver":  # `for` is a word, not a key
+            keys += " and `for DURATION`"
+            hint = f"write `for {a.value.text}`, with a space, not `=`"
         ctx.error("V112", f"`{st.keyword}` takes {keys}; found `{a.key}=`", a.span,
-                  hint=did_you_mean(a.key, allowed), found=a.key)
+                  hint=hint, found=a.key)
     elif a.key in out.keys:
         ctx.error("V111", f"`{a.key}=` is given twice", a.span)
     else:
@@ -191,8 +197,23 @@ class Reader:
             self.pos.pop(0)
         return None
 
+    def _after(self, a: object) -> object | None:
+        """The argument written after ``a`` in the statement."""
+        args = self.st.args
+        i = next((k for k, b in enumerate(args) if b is a), len(args))
+        return args[i + 1] if i + 1 < len(args) else None
+
     def si(self, q: Quantity | None, dim: Dim, what: str) -> float | None:
-        return None if q is None else si(self.ctx, q, dim, what=what, bare_unit=None)
+        if q is None:
+            return None
+        unit = self._after(q) if q.unit == "" else None
+        if isinstance(unit, Word) and as_unit(unit.text) and unit in self.pos:
+            self.pos.remove(unit)  # `1.25 s`: one slip, one diagnostic
+            self.error("V103", f"{what} `{q.text}` needs a unit glued to it: found "
+                       f"`{q.text} {unit.text}`", q.span.to(unit.span),
+                       hint=f"write `{q.text}{as_unit(unit.text)}`, without a space")
+            return None
+        return si(self.ctx, q, dim, what=what, bare_unit=None)
 
     def positive(self, q: Quantity | None, value: float | None, what: str) -> float | None:
         return None if q is None else positive(self.ctx, value, q, what)
@@ -230,8 +251,31 @@ class Reader:
 
     def done(self) -> bool:
         """Report arguments left over; True when this statement added no diagnostic."""
+        skip: list[object] = []
         for a in self.pos:
+            if any(a is b for b in skip):
+                continue
             text = getattr(a, "text", None) or ":"
+            hint = self._slip(a)
+            if hint and "repeat count" in hint:  # `x 3`: one slip, one diagnostic
+                skip.append(self._after(a))
             self.error("V113", f"unexpected argument `{text}` to `{self.st.keyword}`; "
-                       f"usage: {self.kind.usage}", a.span)
+                       f"usage: {self.kind.usage}", a.span, hint=hint)
         return len(self.ctx.diags) == self.n_before
+
+    def _slip(self, a: object) -> str | None:
+        """What a left-over argument most likely meant: a unit written apart from its
+        number (`f=3 Hz`), a repeat count apart from its x (`x 3`)."""
+        args = list(self.st.args)
+        i = next((k for k, b in enumerate(args) if b is a), 0)
+        before, after = args[i - 1] if i else None, self._after(a)
+        key = f"{before.key}=" if isinstance(before, KeyVal) else ""
+        if isinstance(before, KeyVal):
+            before = before.value
+        if isinstance(a, Word) and as_unit(a.text) and isinstance(before, Quantity) \
+                and before.unit == "":
+            return f"write `{key}{before.text}{as_unit(a.text)}`, without a space"
+        if isinstance(a, Word) and a.text == "x" and isinstance(after, Quantity) \
+                and after.unit == "":
+            return f"write the repeat count as `x{after.text}`, without a space"
+        return None
