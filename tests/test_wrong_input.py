@@ -49,6 +49,6 @@ def test_a_quantity_of_the_wrong_kind_is_named_with_its_article():
 
     _, diags = load("gaze horizontal 20m\npause 1s x2\napproach a=3deg\n", "t.aou")
     messages = " / ".join(d.message for d in diags)
-    assert "must be an angle" in messages and "found an angle" in messages
-    assert "must be an acceleration" in messages and "found a length" in messages
+    assert "expected an angle" in messages and "found an angle" in messages
+    assert "expected an acceleration" in messages and "found a length" in messages
     assert " a angle" not in messages and " a acceleration" not in messages

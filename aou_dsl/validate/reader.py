@@ -71,7 +71,8 @@ def si(ctx: Ctx, q: Quantity, dim: Dim, *, what: str, bare_unit: str | None) -> 
         return None
     found_dim, factor = UNITS[q.unit]
     if found_dim is not dim:
-        ctx.error("V102", f"{what} must be {_a(dim)} ({fits}), found {_a(found_dim)} `{q.text}`",
+        ctx.error("V102", f"{what}: expected {_a(dim)} ({fits}), found {_a(found_dim)} "
+                  f"`{q.text}`",
                   q.span, expected=str(dim), found=str(found_dim))
         return None
     value = q.value * factor
@@ -229,7 +230,8 @@ class Reader:
             self.error("V113", f"`{kv.key}=` takes a {spec.dim}, found `{kv.value.text}`",
                        kv.value.span)
             return None
-        value = si(self.ctx, kv.value, spec.dim, what=spec.what, bare_unit=spec.bare_unit)
+        value = si(self.ctx, kv.value, spec.dim, what=f"`{kv.key}=` ({spec.what})",
+                   bare_unit=spec.bare_unit)
         return positive(self.ctx, value, kv.value, spec.what)
 
     def amplitude(self, q: Quantity | None, value: float | None, what: str) -> float | None:
