@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 from .diagnostics import AouError, has_errors
 from .ir import DEFAULTS
+from .primitives import MIN_SHIVER_F, shiver_duration
 from .synth_recipe import Recipe, descriptor
 
 __all__ = ["SHIVER_F", "Limits", "fit", "fit_limits", "floor_sig", "goal_line", "robot_line",
@@ -27,8 +28,6 @@ MARGIN = 0.8
 #: Tilts plan up to this fraction of the rolling joint's acceleration limit: a tilt has a
 #: fixed duration, and a smoother time law over it needs a higher peak than bang-bang.
 TILT_MARGIN = 0.5
-#: A shiver is not slowed below this frequency [Hz]; its amplitude shrinks instead.
-MIN_SHIVER_F = 1.0
 #: The probe asks for this end-effector acceleration [m/s^2]: more than any arm reaches.
 PROBE_ACCEL = 20.0
 #: Shivers plan up to this fraction of the rolling joint's acceleration limit: their
@@ -149,7 +148,7 @@ def _fit_shiver(r: Recipe, lim: Limits) -> Recipe:
         return r.noted(SHIVER_F, "the language default (the study gives none)")
     if f_max >= MIN_SHIVER_F:
         f = floor_sig(f_max)
-        return r.with_node(node.replace(f=f)).noted(
+        return r.with_node(node.replace(f=f, duration=_whole(node.duration, f))).noted(
             SHIVER_F, f"the language default {node.f:g} Hz, lowered to {f:g} Hz for "
             f"{lim.robot}'s {lim.roll_joint} (the amplitude stays)")
     # the peaks are proportional to the amplitude at a fixed frequency
@@ -161,9 +160,16 @@ def _fit_shiver(r: Recipe, lim: Limits) -> Recipe:
     note = (f"{r.notes.get(name, '')}; reduced from {math.degrees(node.amplitude):g} to "
             f"{amp:g} deg: {lim.robot}'s {lim.roll_joint} cannot shiver wider at "
             f"{MIN_SHIVER_F:g} Hz")
-    return (r.with_node(node.replace(f=MIN_SHIVER_F, amplitude=math.radians(amp)))
+    return (r.with_node(node.replace(f=MIN_SHIVER_F, amplitude=math.radians(amp),
+                                     duration=_whole(node.duration, MIN_SHIVER_F)))
             .noted(SHIVER_F, f"lowered to {MIN_SHIVER_F:g} Hz for {lim.robot}'s "
                    f"{lim.roll_joint}").noted(name, note))
+
+
+def _whole(duration: float, f: float) -> float:
+    """The duration a shiver asked to last ``duration`` [s] runs at ``f`` [Hz] (whole
+    cycles, at least 3), to 3 significant digits that read back as the same cycles."""
+    return float(f"{shiver_duration(duration, f):.3g}")
 
 
 def _fit_tilt(r: Recipe, lim: Limits) -> Recipe:

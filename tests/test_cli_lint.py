@@ -20,8 +20,8 @@ def test_shipped_behaviours_lint_clean_even_strict(capsys):
 def test_text_form_has_location_code_source_line_and_caret(capsys):
     assert main(["lint", str(INVALID / "invalid_wrong_dimension.aou")]) == EXIT_ERRORS
     out = capsys.readouterr().out.splitlines()
-    assert out[0].endswith("invalid_wrong_dimension.aou:2:7: V102 [error] pause duration must "
-                           "be a duration (s, ms), found a length `3m`")
+    assert out[0].endswith("invalid_wrong_dimension.aou:2:7: V102 [error] pause duration: "
+                           "expected a duration (s, ms), found a length `3m`")
     assert out[1].endswith("| pause 3m")
     assert out[2].index("^") == out[1].index("3m")
 

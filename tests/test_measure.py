@@ -454,7 +454,7 @@ def test_rolls_measure_as_declared(text):
     assert kinds.count("shiver") == sum(k == "shiver" for k, _, _ in res.trajectory.episodes)
 
 
-@pytest.mark.parametrize("f", [0.3, 0.8, 1.5, 3.0, 5.0, 7.0])
+@pytest.mark.parametrize("f", [1.0, 1.5, 3.0, 5.0, 7.0])
 def test_every_shiver_frequency_the_compiler_accepts_is_seen(f):
     res = _built(f"shiver 1deg f={f}Hz for 2s\n")
     assert res.measured.descriptors["shiver_amplitude"] == pytest.approx(1.0, abs=0.5)

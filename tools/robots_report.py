@@ -36,10 +36,13 @@ def _advice(d, arm) -> tuple[str, str]:
     """(the binding limit, what the user can change) for one diagnostic."""
     f = d.fields
     if d.code == "C308":
-        return (f"{f['joint']} acceleration ({_limit(arm, f['joint'])})",
-                f"shiver at most {f['max_frequency']:.2g} Hz at this amplitude (or a smaller "
-                f"amplitude at 2.5 Hz), or pin a higher `joint_accel` in a robot description "
-                f"if the controller allows it")
+        limit = f.get("limit", "acceleration")
+        fits = (f"shiver at most {f['max_frequency']:g} Hz at this amplitude (or a smaller "
+                "amplitude at 2.5 Hz)" if f.get("max_frequency") else "a smaller shiver")
+        return (f"{f['joint']} {limit}" + (f" ({_limit(arm, f['joint'])})"
+                                           if limit == "acceleration" else ""),
+                f"{fits}, or pin a higher `joint_{'accel' if limit == 'acceleration' else limit}`"
+                " in a robot description if the controller allows it")
     if d.code == "C304":
         joint = f.get("joint")
         limit = f"{joint} acceleration ({_limit(arm, joint)})" if joint in arm.joint_names \
@@ -47,7 +50,9 @@ def _advice(d, arm) -> tuple[str, str]:
         return (limit, f"declare at most {math.floor(f['achieved'] * 100) / 100:g} "
                        "(the arm's peak here), or move the goal (`goal`, `from`)")
     if d.code == "C309":
-        return (f"{f.get('joint')} velocity and acceleration", "a smaller or slower tilt")
+        return (f"{f.get('joint')} {f.get('limit', 'velocity and acceleration')}",
+                f"at most {f['max_velocity']:g} deg/s" if f.get("max_velocity")
+                else "a smaller or slower tilt")
     if d.code in ("C301", "C302", "C303"):
         joint = f.get("joint")
         return (f"{joint} position limit" if joint else "the workspace",

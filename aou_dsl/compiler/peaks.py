@@ -19,9 +19,11 @@ from .timelaw import SmoothLaw
 if TYPE_CHECKING:
     from .timing import PathSegment
 
-__all__ = ["JERK_SCALE", "PEAK_RATE", "binding_joint", "cartesian_peak", "jerk_ratio",
-           "limit_ratios", "within_limits"]
+__all__ = ["JERK_SCALE", "LIMIT_SLACK", "PEAK_RATE", "binding_joint", "cartesian_peak",
+           "jerk_ratio", "jerk_ratios", "limit_ratios", "within_limits"]
 
+#: Relative slack when checking a result against a limit.
+LIMIT_SLACK = 1e-3
 #: Fraction of the joint jerk limits the time laws are planned with (the checks hold the
 #: trajectory to the full limits).
 JERK_SCALE = 0.9
@@ -80,13 +82,32 @@ def limit_ratios(arm: ArmModel, seg: PathSegment, samples: int = 1500
     return (np.abs(qd).max(axis=0) / arm.plan_vmax, np.abs(qdd).max(axis=0) / arm.plan_amax)
 
 
-def jerk_ratio(arm: ArmModel, seg: PathSegment) -> float:
-    """The largest joint jerk over the planned jerk limits (``JERK_SCALE`` of the
-    robot's) on a segment, seen at every piece of its smoothed law."""
+#: A dense look at a segment's jerk samples it this often [Hz] (a controller's rate)...
+JERK_RATE = 1000.0
+#: ... at least this many times, at most this many.
+JERK_SAMPLES = (1500, 20000)
+
+
+def jerk_ratios(arm: ArmModel, seg: PathSegment, dense: bool = False) -> np.ndarray:
+    """Per joint, the largest jerk over the planned jerk limits (``JERK_SCALE`` of the
+    robot's) on a segment, seen at every piece of its smoothed law; shape (n,).
+
+    With ``dense``, also at :data:`JERK_RATE`: where the joint path itself bends sharply
+    (an arm turning its null space), its jerk ``q_sss s'^3`` peaks inside a piece of the
+    law, not at its ends; a controller's check of the trajectory sees it there."""
     law = seg.law
     tau = (law.probe_times() if isinstance(law, SmoothLaw)
            else np.linspace(0.0, seg.duration, 1500))
-    return float(np.max(np.abs(seg.jerk(tau)) / (arm.jmax * JERK_SCALE)))
+    if dense:
+        lo, hi = JERK_SAMPLES
+        n = min(hi, max(lo, math.ceil(seg.duration * JERK_RATE) + 1))
+        tau = np.concatenate([tau, np.linspace(0.0, seg.duration, n)])
+    return np.abs(seg.jerk(tau)).max(axis=0) / (arm.jmax * JERK_SCALE)
+
+
+def jerk_ratio(arm: ArmModel, seg: PathSegment) -> float:
+    """The largest joint jerk over the planned jerk limits on a segment."""
+    return float(np.max(jerk_ratios(arm, seg)))
 
 
 def within_limits(arm: ArmModel, seg: PathSegment) -> bool:

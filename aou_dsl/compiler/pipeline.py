@@ -8,6 +8,7 @@ compiled gives a result with error diagnostics and no trajectory.
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from dataclasses import dataclass, field
@@ -18,19 +19,17 @@ from ..diagnostics import AouError, Diagnostic, diag, has_errors
 from ..ir import Behaviour
 from ..kinematics import ArmModel, load_arm
 from ..layout import layout
-from ..primitives import KINDS
+from ..primitives import KINDS, MIN_SHIVER_F
 from ..timeline import Episode, Pose, Timeline
 from ..trajectory import Trajectory
 from .geometry import ReachFrame, reach_frame
 from .ik import IKStatus, solve_path
 from .timing import (
-    LIMIT_SLACK,
     JointSegment,
     PathSegment,
-    binding_joint,
-    fixed_segment,
-    jerk_ratio,
+    TimingFailure,
     shiver_segment,
+    tilt_segment,
     time_path,
 )
 
@@ -118,6 +117,36 @@ def _ik_diag(ep: Episode, status: IKStatus, t: float, joint: str | None, b: Beha
                 "shorten the motion", reason=status.name.lower(), time=t, joint=joint)
 
 
+def _siblings(arm: ArmModel, frame: ReachFrame, episodes: tuple[Episode, ...],
+              q: np.ndarray, options: CompileOptions) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The joint paths of the later episodes (``episodes[1:]``) that the statement of the
+    first makes, following the reach from ``q`` (the end of the first): joint paths do not
+    depend on timing, so a value that times them all can be checked before any is timed."""
+    ep, later = episodes[0], episodes[1:]
+    if not any(e.span == ep.span and e.kind == ep.kind for e in later):
+        return []
+    out = []
+    for e in later:
+        if KINDS[e.kind].timing in ("hold", "oscillation"):
+            continue
+        s, targets = _waypoints(e, frame, options)
+        ik = solve_path(arm, targets, q)
+        if ik.failure is not None:
+            break
+        q = ik.q[-1]
+        if e.span == ep.span and e.kind == ep.kind:
+            out.append((s, ik.q))
+    return out
+
+
+def _too_fast(code: str, fail: TimingFailure, ep: Episode, edit: str | None,
+              **fields) -> Diagnostic:
+    """C308 or C309: the limit a shiver or a tilt exceeds; the hint is the edit that
+    fits (the value the message gives), when there is one."""
+    return diag(code, fail.reason, ep.span, hint=f"write `{edit}`" if edit else None,
+                joint=fail.joint, limit=fail.limit, **fields)
+
+
 def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
                       timeline: Timeline | None = None) -> CompileResult:
     """Compile a validated behaviour into a joint trajectory.
@@ -155,7 +184,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
     q = first.q[0]
     worst_p, worst_r = first.worst_position_error, first.worst_rotation_error
     lap("ik")
-    for ep in tl.episodes:
+    for i, ep in enumerate(tl.episodes):
         seg: PathSegment | JointSegment | None
         timing = KINDS[ep.kind].timing
         if timing == "hold":
@@ -163,9 +192,10 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
         elif timing == "oscillation":
             seg, shiver_fail = shiver_segment(arm, q, ep.amplitude, ep.f, ep.duration)
             if shiver_fail is not None:
-                res.diagnostics.append(diag("C308", shiver_fail.reason, ep.span,
-                                            joint=shiver_fail.joint,
-                                            max_frequency=shiver_fail.wanted))
+                f_ok = shiver_fail.wanted
+                edit = f"f={f_ok:g}Hz" if f_ok and f_ok >= MIN_SHIVER_F else None
+                res.diagnostics.append(_too_fast("C308", shiver_fail, ep, edit,
+                                                 max_frequency=f_ok))
                 return res
             segments.append(seg)
         else:
@@ -180,15 +210,13 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
             worst_p = max(worst_p, ik.worst_position_error)
             worst_r = max(worst_r, ik.worst_rotation_error)
             if timing == "fixed":
-                seg = fixed_segment(arm, s, ik.q, ep.duration)
-                j, over = binding_joint(arm, seg)
-                over_jerk = jerk_ratio(arm, seg)
-                if max(over, over_jerk) > 1.0 + LIMIT_SLACK:
-                    what = (f"{over:.1f}x the limits of {j}" if over >= over_jerk else
-                            f"{over_jerk:.1f}x the planned jerk limits")
-                    res.diagnostics.append(diag(
-                        "C309", f"tilt of {math.degrees(ep.path_length):g} deg in "
-                        f"{ep.duration:.2f}s needs {what}", ep.span, joint=j))
+                seg, tilt_fail = tilt_segment(arm, s, ik.q, ep.duration, functools.partial(
+                    _siblings, arm, frame, tl.episodes[i:], ik.q[-1], options))
+                if tilt_fail is not None:
+                    v_ok = tilt_fail.wanted
+                    edit = f"v={v_ok:g}deg/s" if v_ok else None
+                    res.diagnostics.append(_too_fast("C309", tilt_fail, ep, edit,
+                                                     max_velocity=v_ok))
                     return res
             else:
                 seg, fail = time_path(arm, s, ik.q, ep.a, ep.vmax,

@@ -26,17 +26,20 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..kinematics import ArmModel
+from .fits import TimingFailure, largest_fitting, times
+from .oscillation import JointSegment, shiver_ratios, shiver_segment
 from .peaks import (
     JERK_SCALE,
+    LIMIT_SLACK,
     PEAK_RATE,
     binding_joint,
     cartesian_peak,
     jerk_ratio,
+    jerk_ratios,
     limit_ratios,
     within_limits,
 )
@@ -45,6 +48,7 @@ from .topp import parametrize
 
 __all__ = [
     "JERK_SCALE",
+    "LIMIT_SLACK",
     "PEAK_RATE",
     "JointSegment",
     "PathSegment",
@@ -56,12 +60,12 @@ __all__ = [
     "fixed_segment",
     "jerk_ratio",
     "limit_ratios",
+    "shiver_ratios",
     "shiver_segment",
+    "tilt_segment",
     "time_path",
 ]
 
-#: Relative slack when checking a result against a limit.
-LIMIT_SLACK = 1e-3
 #: Shortest smoothing window [s]: two periods of a 1 kHz controller.
 MIN_WINDOW = 2e-3
 #: A time law reaches its declared acceleration when its peak is at least this fraction
@@ -128,94 +132,32 @@ class PathSegment:
                 + self.d1(s) * sddd[:, None])
 
 
-class JointSegment:
-    """A hold or a shiver: the held configuration plus an analytic offset on one joint."""
-
-    def __init__(self, q_hold: np.ndarray, duration: float, joint: int = 0,
-                 amplitude: float = 0.0, f: float = 0.0):
-        self.q_hold, self._duration = np.asarray(q_hold, dtype=float), duration
-        self.joint, self.amplitude, self.f = joint, amplitude, f
-
-    @property
-    def duration(self) -> float:
-        return self._duration
-
-    def sample(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        n = len(tau)
-        q = np.tile(self.q_hold, (n, 1))
-        qd = np.zeros_like(q)
-        qdd = np.zeros_like(q)
-        if self.amplitude:
-            x, xd, xdd, _ = _shiver_offset(tau, self.amplitude, self.f, self.duration)
-            q[:, self.joint] += x
-            qd[:, self.joint] = xd
-            qdd[:, self.joint] = xdd
-        return q, qd, qdd
-
-    def positions(self, tau: np.ndarray) -> np.ndarray:
-        """Joint positions at local times, (len(tau), n): :meth:`sample`'s first."""
-        q = np.tile(self.q_hold, (len(tau), 1))
-        if self.amplitude:
-            q[:, self.joint] += _shiver_offset(tau, self.amplitude, self.f, self.duration)[0]
-        return q
-
-
-def _shiver_offset(tau: np.ndarray, amplitude: float, f: float, duration: float
-                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``(A/2) sin(2 pi f t) e(t)`` and its first three derivatives: a sine whose envelope
-    ``e`` rises as sin^2 over the first cycle and falls over the last, so it starts and
-    ends at rest with zero acceleration; the middle cycles have the full peak-to-peak
-    amplitude ``A``."""
-    w = 2.0 * math.pi * f
-    ramp = 1.0 / f
-    tau = np.clip(tau, 0.0, duration)
-    edge = np.minimum(tau, duration - tau)  # time from the nearer end
-    sign = np.where(tau <= duration - tau, 1.0, -1.0)  # d(edge)/dt
-    inside = edge < ramp
-    k = math.pi / (2.0 * ramp)
-    e = np.where(inside, np.sin(k * edge) ** 2, 1.0)
-    ed = np.where(inside, k * np.sin(2.0 * k * edge) * sign, 0.0)
-    edd = np.where(inside, 2.0 * k * k * np.cos(2.0 * k * edge), 0.0)
-    eddd = np.where(inside, -4.0 * k**3 * np.sin(2.0 * k * edge) * sign, 0.0)
-    a = amplitude / 2.0
-    s, c = np.sin(w * tau), np.cos(w * tau)
-    x = a * s * e
-    xd = a * (w * c * e + s * ed)
-    xdd = a * (-w * w * s * e + 2.0 * w * c * ed + s * edd)
-    xddd = a * (-w**3 * c * e - 3.0 * w * w * s * ed + 3.0 * w * c * edd + s * eddd)
-    return x, xd, xdd, xddd
-
-
-@dataclass(frozen=True)
-class TimingFailure:
-    """Why an episode could not be timed as declared: ``reason`` names the binding
-    constraint in words, ``joint`` the binding joint when it is one."""
-
-    reason: str
-    joint: str | None
-    achieved: float | None = None
-    wanted: float | None = None
-
-
 def _smoothed(arm: ArmModel, make: Callable[[float], PathSegment], first: float,
-              longest: float) -> PathSegment:
+              longest: float, keep_best: bool = False) -> PathSegment:
     """The segment ``make(window)`` with the shortest window (from ``first``, at least
     :data:`MIN_WINDOW`, at most ``longest``) whose joint jerks stay within the planned
-    limits. Jerk falls as 1 / window, so each try scales the window by the jerk ratio."""
+    limits. Jerk falls as 1 / window, so each try scales the window by the jerk ratio.
+
+    When no window keeps the jerk within the limits, the last one tried is returned; with
+    ``keep_best``, the one of least jerk. (On a path whose own bends set the jerk, a longer
+    window does not lower it: it shortens the rest of a fixed-duration law and raises the
+    speed, acceleration and jerk there.)"""
     w = min(max(MIN_WINDOW, first), longest)
     seg = make(w)
     r = jerk_ratio(arm, seg)
+    best = (r, seg)
     for _ in range(6):
         if r <= 1.0 or w >= longest:
             break
         w = min(longest, w * r * 1.05)
         seg = make(w)
         r = jerk_ratio(arm, seg)
+        best = min(best, (r, seg), key=lambda x: x[0])
     if r < 0.8 and w > MIN_WINDOW:  # the first guess was generous: try a shorter window
         shorter = make(max(MIN_WINDOW, w * r * 1.05))
         if jerk_ratio(arm, shorter) <= 1.0:
             return shorter
-    return seg
+    return best[1] if keep_best and r > 1.0 else seg
 
 
 def _window_guess(arm: ArmModel, seg: PathSegment, base: TimeLaw) -> float:
@@ -245,7 +187,7 @@ def fixed_segment(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, duration:
     assert isinstance(base, TimeLaw)
     return _smoothed(arm, lambda w: probe.with_law(
         SmoothLaw(TimeLaw.bang_bang(length, duration - w), w)),
-        _window_guess(arm, probe, base), duration / 2.0)
+        _window_guess(arm, probe, base), duration / 2.0, keep_best=True)
 
 
 def time_path(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, a: float, vmax: float,
@@ -341,24 +283,49 @@ def _shortfall(arm: ArmModel, seg: PathSegment, a: float, a_virtual: float, vmax
     return TimingFailure(reason, None, achieved, a)
 
 
-def shiver_segment(arm: ArmModel, q_hold: np.ndarray, amplitude: float, f: float,
-                   duration: float) -> tuple[JointSegment, TimingFailure | None]:
-    """An oscillation of the robot's shiver joint about ``q_hold``; checked against that
-    joint's velocity, acceleration and jerk limits (planned fractions)."""
-    j = arm.joint_names.index(arm.spec.shiver_joint)
-    seg = JointSegment(q_hold, duration, j, amplitude, f)
-    tau = np.linspace(0.0, duration, max(400, int(duration * f * 80)))
-    _, xd, xdd, xddd = _shiver_offset(tau, amplitude, f, duration)
-    r_v = float(np.max(np.abs(xd))) / arm.plan_vmax[j]  # scales with f
-    r_a = float(np.max(np.abs(xdd))) / arm.plan_amax[j]  # scales with f^2
-    r_j = float(np.max(np.abs(xddd))) / (arm.jmax[j] * JERK_SCALE)  # scales with f^3
-    worst = max(r_v, r_a, r_j)
-    if worst > 1.0 + LIMIT_SLACK:
-        f_ok = f * min(1.0 / max(r_v, 1e-12), 1.0 / math.sqrt(max(r_a, 1e-12)),
-                       1.0 / math.cbrt(max(r_j, 1e-12)))
-        which = ("velocity", "acceleration", "jerk")[int(np.argmax([r_v, r_a, r_j]))]
-        return seg, TimingFailure(
-            f"a {math.degrees(amplitude):g} deg shiver at {f:g} Hz needs "
-            f"{worst:.1f}x {arm.spec.shiver_joint}'s {which} limit; at most about "
-            f"{f_ok:.2g} Hz at this amplitude", arm.spec.shiver_joint, f, f_ok)
-    return seg, None
+def _fixed_excess(arm: ArmModel, seg: PathSegment) -> tuple[str, int, float, float] | None:
+    """The limit a fixed-duration segment exceeds most, as ``(kind, joint, ratio, need)``
+    (``need``: how much slower it must run, velocity scaling with the speed, acceleration
+    with its square, jerk with its cube); None when it is within every limit."""
+    rv, ra = limit_ratios(arm, seg)
+    rj = jerk_ratios(arm, seg, dense=True)
+    if max(rv.max(), ra.max(), rj.max()) <= 1.0 + LIMIT_SLACK:
+        return None
+    excess = []
+    for kind, ratios, p in (("velocity", rv, 1), ("acceleration", ra, 2), ("jerk", rj, 3)):
+        j = int(np.argmax(ratios))
+        excess.append((kind, j, float(ratios[j]), float(ratios[j]) ** (1.0 / p)))
+    return max(excess, key=lambda e: e[3])
+
+
+def tilt_segment(arm: ArmModel, s_way: np.ndarray, q_way: np.ndarray, duration: float,
+                 siblings: Callable[[], list[tuple[np.ndarray, np.ndarray]]] | None = None
+                 ) -> tuple[PathSegment, TimingFailure | None]:
+    """A tilt's segment (:func:`fixed_segment`), checked against every joint's velocity,
+    acceleration and jerk limits. On failure the reason names the limit and the joint and
+    gives the highest tilt velocity [deg/s] that fits (``wanted``), rounded down and
+    checked on this path and on those of the statement's other episodes (``siblings``:
+    ``(s_way, q_way)`` of each, asked for only on failure), since `v=` times them all."""
+    seg = fixed_segment(arm, s_way, q_way, duration)
+    over = _fixed_excess(arm, seg)
+    if over is None:
+        return seg, None
+    kind, j, ratio, need = over
+    angle = math.degrees(float(s_way[-1]))
+    v = angle / duration
+    paths = [(s_way, q_way), *(siblings() if siblings is not None else [])]
+
+    def excess(vc: float, sw: np.ndarray, qw: np.ndarray) -> tuple[str, int, float, float] | None:
+        return _fixed_excess(arm, fixed_segment(arm, sw, qw, math.degrees(sw[-1]) / vc))
+
+    for sw, qw in paths[1:]:  # the estimate: the slowest any of them needs
+        need = max(need, (excess(v, sw, qw) or ("", 0, 1.0, 1.0))[3])
+    v_ok = largest_fitting(v / need, lambda vc: all(
+        excess(vc, sw, qw) is None for sw, qw in paths), below=v)
+    joint = arm.joint_names[j]
+    reason = (f"a {angle:g} deg tilt at {v:.3g} deg/s ({duration:.2f} s) needs "
+              f"{times(ratio)}x {joint}'s {kind} limit")
+    if v_ok is not None:
+        where = f"all {len(paths)} tilts of this statement" if len(paths) > 1 else "here"
+        reason += f"; at most {v_ok:g} deg/s fits {where}"
+    return seg, TimingFailure(reason, joint, v, v_ok, kind)

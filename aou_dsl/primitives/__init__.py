@@ -11,7 +11,7 @@ from .base import MIN_ANGLE, MIN_PAUSE, MIN_RETREAT, Kind
 from .gaze import GAZE_ANGULAR_ACCEL, Gaze, GazeKind
 from .pause import Pause, PauseKind
 from .retreat import Retreat, RetreatKind
-from .shiver import Shiver, ShiverKind, shiver_duration
+from .shiver import MIN_SHIVER_F, Shiver, ShiverKind, shiver_duration
 from .tilt import Tilt, TiltKind
 
 __all__ = [
@@ -20,6 +20,7 @@ __all__ = [
     "MIN_ANGLE",
     "MIN_PAUSE",
     "MIN_RETREAT",
+    "MIN_SHIVER_F",
     "Approach",
     "Gaze",
     "Kind",

@@ -2,15 +2,19 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from typing import Literal
 
 from ..ir import DEFAULTS, Node
+from ..parse import Word
 from ..timeline import Episode, Pose
 from ..units import Dim
 from .base import Key, Kind, fmt, move
 
 __all__ = ["Approach", "ApproachKind", "translation"]
+
+_REPEAT = re.compile(r"^x\d+$")
 
 
 @dataclass(frozen=True, kw_only=True, slots=True)
@@ -36,6 +40,27 @@ def translation(node, span, pose: Pose, d: float) -> Episode:
     return move(kind, span, pose, Pose(d, pose.h, pose.v, pose.roll), node.a, node.v)
 
 
+def _check_repeat(r, length: float | None) -> None:
+    """An approach repeats only in a sequence, and only with a length (V113): in the
+    descriptor form it runs once, from start to standoff; without a length it already
+    runs the rest of the way, so a repeat would have nowhere left to go."""
+    if r.args.count is None or (r.in_sequence and (length is not None or r.count <= 1)):
+        return
+    word = next((a for a in r.st.args if isinstance(a, Word) and _REPEAT.match(a.text)),
+                None)
+    span = word.span if word is not None else r.st.keyword_span
+    text = word.text if word is not None else f"x{r.count}"
+    if not r.in_sequence:
+        r.error("V113", f"an approach takes no `{text}` in the descriptor form: it runs "
+                "once, from start to standoff", span,
+                hint="for an approach in steps, write them in a `sequence { }` block, "
+                "e.g. `approach 0.05m x3`")
+    else:
+        r.error("V113", f"an approach without a length runs the rest of the way to the "
+                f"standoff: `{text}` would repeat it with nothing left to approach", span,
+                hint="give it a length to approach in steps, e.g. `approach 0.05m x3`")
+
+
 class ApproachKind(Kind):
     name = "approach"
     node = Approach
@@ -56,6 +81,7 @@ class ApproachKind(Kind):
                         q.span)
             elif length == 0:
                 r.error("V105", "an approach length must not be zero", q.span)
+        _check_repeat(r, length)
         a, v = r.key("a"), r.key("v")
         if r.done():
             return Approach(span=r.st.span, length=length, a=a or DEFAULTS["approach_a"],
