@@ -7,7 +7,8 @@ A sequence is laid out as written. The descriptor form is laid out in three step
    +angle, -angle (horizontal first, then vertical), tilts join gaze stops (before the
    gaze) and shivers retreat stops; retreats form clusters (``R R`` when pauses are
    scarce), and pauses left over after the end's hold become stops of their own. The
-   stops are ordered by the state's composition.
+   stops are ordered by the state's composition; then the tilts alternate +angle, -angle
+   in the order they run, so the roll stays between the start's and one angle from it.
 2. *Motion*: an approach piece leads to each stop and a last one to the standoff; each
    wins back the last withdrawal and makes an equal share of the net progress, so the
    reach never gets closer than the standoff and ends there.
@@ -122,12 +123,11 @@ def _plan(b: Behaviour, has_approach: bool) -> _Plan:
     gaze_stops = list(stops)
     for size in _split(n_r, clusters) if clusters else []:
         stops.append(_Stop("retreat", [(retreat, None)] * size))
-    for i in range(_count(tilt)):
-        delta = tilt.angle if i % 2 == 0 else -tilt.angle
+    for i in range(_count(tilt)):  # the signs are set in time order, once stops are sorted
         if gaze_stops:
-            gaze_stops[i % len(gaze_stops)].items.insert(0, (tilt, delta))
+            gaze_stops[i % len(gaze_stops)].items.insert(0, (tilt, tilt.angle))
         else:
-            stops.append(_Stop("tilt", [(tilt, delta)]))
+            stops.append(_Stop("tilt", [(tilt, tilt.angle)]))
     retreat_stops = [s for s in stops if s.kind == "retreat"]
     _share_pauses(stops, gaze_stops, retreat_stops, n_p - need_r - (clusters - 1))
     for i in range(_count(shiver)):
@@ -154,6 +154,17 @@ def _share_pauses(stops: list[_Stop], gaze_stops: list[_Stop], retreat_stops: li
                         strict=False):
         stops.remove(st)
         host.items[:0] = st.items
+
+
+def _alternate_tilts(stops: list[_Stop]) -> None:
+    """Tilts alternate +angle, -angle in the order they run, so the roll goes back and
+    forth between the start's and one angle away, whichever stops they join."""
+    n = 0
+    for st in stops:
+        for k, (node, arg) in enumerate(st.items):
+            if node.kind == "tilt" and arg is not None:
+                st.items[k] = (node, abs(arg) if n % 2 == 0 else -abs(arg))
+                n += 1
 
 
 def _motion(b: Behaviour, approach: Any, stops: list[_Stop]
@@ -204,6 +215,7 @@ def _descriptor(b: Behaviour, state: State) -> list[Episode]:
     plan = _plan(b, approach is not None)
     order = STOP_ORDER[state]
     plan.stops.sort(key=lambda st: order.index(st.kind))  # stable: keeps alternation
+    _alternate_tilts(plan.stops)
     motion, required, preferred = _motion(b, approach, plan.stops)
     n = len(motion)
     wanted = sorted(required) + preferred + ([n] if plan.end_hold else [])

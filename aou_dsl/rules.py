@@ -155,8 +155,10 @@ _RULE_LIST = [
          "No arm aou knows reaches that far; such a value is almost always a typo.",
          "goal (30, 0, 0.3)"),
     Rule("V123", "below-resolution", _E,
-         "An angle under 1 deg, a retreat under 5 mm, or a gaze whose arc around the goal "
-         "moves the end-effector less than 5 mm: too small to be seen, or measured.",
+         "An angle under 1 deg; a move along the line of sight under 5 mm (an approach or "
+         "a retreat of either sign, the rest of the way to the standoff, or a piece of a "
+         "descriptor-form approach); or a gaze whose arc around the goal moves the "
+         "end-effector less than 5 mm: too small to be seen, or measured.",
          "The descriptors are measured to 0.5 deg and 1 mm; a smaller motion cannot be told "
          "from a pause, and the compiled motion would not show what the file declares.",
          "shiver 0.1deg"),

@@ -24,6 +24,7 @@ from ..timeline import Episode, Pose, Timeline
 from ..trajectory import Trajectory
 from .geometry import ReachFrame, reach_frame
 from .ik import IKStatus, solve_path
+from .start import CODES, start_diagnostic
 from .timing import (
     JointSegment,
     PathSegment,
@@ -108,13 +109,36 @@ def _start_configuration(arm: ArmModel, frame: ReachFrame, pose: Pose):
 
 
 def _ik_diag(ep: Episode, status: IKStatus, t: float, joint: str | None, b: Behaviour,
-             ) -> Diagnostic:
-    code = {IKStatus.UNREACHABLE: "C301", IKStatus.JOINT_LIMIT: "C302"}.get(status, "C303")
+             d: float) -> Diagnostic:
+    """C301-C303 at the episode whose pose at ``d`` [m] from the goal failed; when that
+    pose is no closer than the start, the hint names `start` too."""
     where = f" ({joint})" if joint else ""
-    robot = b.settings.robot
-    return diag(code, f"{ep.kind} at t={t:.2f}s: {status.value}{where} on {robot}",
-                ep.span, hint="move the goal (`goal`), the start direction (`from`) or "
-                "shorten the motion", reason=status.name.lower(), time=t, joint=joint)
+    s = b.settings
+    hint = "move the goal (`goal`), the start direction (`from`) or shorten the motion"
+    if d >= s.start - 1e-9:
+        line = f"line {s.spans['start'].line}" if "start" in s.spans else \
+            f"the default {s.start:g} m"
+        hint = (f"this pose is {d:.3g} m from the goal, no closer than the start ({line}): "
+                f"a smaller `start`, or {hint[0].lower()}{hint[1:]}")
+    return diag(CODES.get(status, "C303"),
+                f"{ep.kind} at t={t:.2f}s: {status.value}{where} on {s.robot}", ep.span,
+                hint=hint, reason=status.name.lower(), time=t, joint=joint)
+
+
+def _follows(arm: ArmModel, frame: ReachFrame, options: CompileOptions, tl: Timeline
+             ) -> bool:
+    """Whether IK follows every pose of ``tl``, from its start pose on (no timing)."""
+    ik = solve_path(arm, [frame.target(tl.episodes[0].start)]) if tl.episodes else None
+    if ik is None or ik.failure is not None:
+        return False
+    q = ik.q[0]
+    for ep in tl.episodes:
+        if KINDS[ep.kind].timing not in ("hold", "oscillation"):
+            ik = solve_path(arm, _waypoints(ep, frame, options)[1], q)
+            if ik.failure is not None:
+                return False
+            q = ik.q[-1]
+    return True
 
 
 def _siblings(arm: ArmModel, frame: ReachFrame, episodes: tuple[Episode, ...],
@@ -177,9 +201,8 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
     start_pose = tl.episodes[0].start if tl.episodes else Pose(b.settings.start)
     first = _start_configuration(arm, frame, start_pose)
     if first.failure is not None:
-        ep0 = tl.episodes[0] if tl.episodes else Episode("pause", b.span, Pose(0), Pose(0), 0)
-        res.diagnostics.append(_ik_diag(ep0, first.failure.status, 0.0, first.failure.joint,
-                                        b))
+        res.diagnostics.append(start_diagnostic(
+            arm, frame, b, first.failure, functools.partial(_follows, arm, frame, options)))
         return res
     q = first.q[0]
     worst_p, worst_r = first.worst_position_error, first.worst_rotation_error
@@ -204,8 +227,10 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
             lap("ik")
             if ik.failure is not None:
                 f = ik.failure
-                t_fail = t_planned + ep.duration * f.index / max(1, len(targets) - 1)
-                res.diagnostics.append(_ik_diag(ep, f.status, t_fail, f.joint, b))
+                frac = f.index / max(1, len(targets) - 1)
+                t_fail = t_planned + ep.duration * frac
+                d_fail = ep.start.lerp(ep.end, frac).d
+                res.diagnostics.append(_ik_diag(ep, f.status, t_fail, f.joint, b, d_fail))
                 return res
             worst_p = max(worst_p, ik.worst_position_error)
             worst_r = max(worst_r, ik.worst_rotation_error)

@@ -10,7 +10,7 @@ from ..ir import DEFAULTS, Node
 from ..parse import Word
 from ..timeline import Episode, Pose
 from ..units import Dim
-from .base import Key, Kind, fmt, move
+from .base import MIN_RETREAT, Key, Kind, fmt, move
 
 __all__ = ["Approach", "ApproachKind", "translation"]
 
@@ -81,6 +81,8 @@ class ApproachKind(Kind):
                         q.span)
             elif length == 0:
                 r.error("V105", "an approach length must not be zero", q.span)
+            else:  # a move along the line of sight, either way: by its magnitude
+                r.visible(q, length, MIN_RETREAT, "an approach of", "m")
         _check_repeat(r, length)
         a, v = r.key("a"), r.key("v")
         if r.done():

@@ -20,6 +20,9 @@ from ..units import UNITS, Dim, as_unit, suggest_unit, units_for
 __all__ = ["Ctx", "Reader", "did_you_mean", "si", "split_args"]
 
 _REPEAT = re.compile(r"^x(\d+)$")
+#: What looks like a repeat count but is not a whole number >= 0: `x-1`, `x2b`, and
+#: `x1.5`, `x+2` (read as the word `x1` or `x` with the number `.5` or `+2` glued on).
+_COUNTLIKE = re.compile(r"^x[-+]?\d")
 
 
 def _a(noun: str) -> str:
@@ -107,7 +110,11 @@ def split_args(ctx: Ctx, st: Statement, allowed: Iterable[str], repeat: bool) ->
     i = 0
     while i < len(args):
         a = args[i]
-        if isinstance(a, Word) and repeat and _REPEAT.match(a.text):
+        bad = _malformed_count(args, i) if repeat and isinstance(a, Word) else None
+        if bad is not None:
+            _bad_count(ctx, *bad)
+            i += bad[2]
+        elif isinstance(a, Word) and repeat and _REPEAT.match(a.text):
             if out.count is not None:
                 ctx.error("V116", f"`{st.keyword}` has two repeat counts", a.span)
             out.count = int(a.text[1:])
@@ -125,6 +132,49 @@ def split_args(ctx: Ctx, st: Statement, allowed: Iterable[str], repeat: bool) ->
             out.positional.append(a)
         i += 1
     return out
+
+
+def _glued(a: object, b: object) -> bool:
+    """``b`` is written right after ``a``, with no space between them."""
+    sa, sb = getattr(a, "span", None), getattr(b, "span", None)
+    return sa is not None and sb is not None and (sa.end_line, sa.end_col) == \
+        (sb.line, sb.col)
+
+
+def _malformed_count(args: list, i: int) -> tuple[str, Span, int] | None:
+    """A repeat count that is not a whole number >= 0 starting at ``args[i]`` (a word):
+    its text as written, its span and how many arguments after ``args[i]`` it takes."""
+    a = args[i]
+    nxt = args[i + 1] if i + 1 < len(args) else None
+    if not isinstance(nxt, Quantity):
+        nxt = None
+    glued = nxt is not None and _glued(a, nxt)
+    if a.text == "x" and nxt is not None and nxt.unit == "" and \
+            (glued or not nxt.text.isdigit()):
+        gap = "" if glued else " "
+        return f"{a.text}{gap}{nxt.text}", a.span.to(nxt.span), 1  # `x+2`, `x.5`, `x -1`
+    if not _COUNTLIKE.match(a.text):
+        return None
+    if nxt is not None and glued:
+        return f"{a.text}{nxt.text}", a.span.to(nxt.span), 1  # `x1.5`, `x-1.5`
+    return None if _REPEAT.match(a.text) else (a.text, a.span, 0)  # `x-1`, `x2b`
+
+
+def _bad_count(ctx: Ctx, text: str, span: Span, _: int) -> None:
+    try:
+        n = float(text[1:].strip())
+    except ValueError:
+        n = math.nan
+    if n < 0:
+        hint = "a count cannot be negative; `x0` leaves the statement out"
+    elif math.isfinite(n) and n != int(n):
+        hint = f"write `x{math.floor(n)}` or `x{math.ceil(n)}`" if n > 1 else "write `x1`"
+    elif math.isfinite(n):
+        hint = f"write `x{int(n)}`"
+    else:
+        hint = "write e.g. `x2`"
+    ctx.error("V116", f"a repeat count is a whole number of episodes, 0 or more: found "
+              f"`{text}`", span, hint=hint, found=text)
 
 
 def _key(ctx: Ctx, st: Statement, a: KeyVal, allowed: list[str], out: Args) -> None:

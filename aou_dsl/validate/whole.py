@@ -7,10 +7,10 @@ import math
 from typing import Any
 
 from ..declared import source_of, written
-from ..descriptors import compare, derive
+from ..descriptors import REGISTRY, compare, derive
 from ..ir import Behaviour
 from ..layout import episode_values, layout
-from ..primitives import MIN_RETREAT
+from ..primitives import KINDS, MIN_RETREAT
 from ..timeline import Timeline
 from .reader import Ctx
 
@@ -96,6 +96,47 @@ def _swept(ctx: Ctx, tl: Timeline) -> None:
             return
 
 
+def _short_moves(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
+    """V123: a move along the line of sight shorter than the smallest visible motion. A
+    written length is checked where it is read; here, the moves the layout makes: an
+    approach without a length (the rest of the way to the standoff) and, in the
+    descriptor form, the pieces the approach is split into between the stops."""
+    short = [e for e in tl.episodes if KINDS[e.kind].translation
+             and 0.0 < e.path_length < MIN_RETREAT - 1e-12]
+    if not short:
+        return
+    e = min(short, key=lambda x: x.path_length)
+    mm = f"{e.path_length * 1e3:.2g} mm"
+    least_mm = f"{MIN_RETREAT * 1e3:g} mm"
+    least = f"at least {least_mm}"
+    if b.form == "sequence":
+        ctx.error("V123", f"this approach runs the rest of the way to the standoff: "
+                  f"{mm}, too little to be seen or measured; {least}", e.span,
+                  hint=f"the moves before it end {mm} from the standoff: end them at "
+                  f"least {least_mm} from it, or leave this approach out",
+                  moved=e.path_length, least=MIN_RETREAT)
+        return
+    pieces = sum(1 for x in tl.episodes if x.kind == "approach")
+    ctx.error("V123", f"the layout splits the approach into {pieces} pieces (one to each "
+              f"stop, the last to the standoff) and the shortest moves {mm}, too little to "
+              f"be seen or measured; {least}", e.span,
+              hint=_further_start(b, pieces), moved=e.path_length, least=MIN_RETREAT)
+
+
+def _further_start(b: Behaviour, pieces: int) -> str:
+    """A hint for approach pieces too short: a start far enough for every piece (checked
+    on the layout), or fewer stops."""
+    s = b.settings
+    fewer = "fewer pauses, gazes, tilts or retreats to stop at"
+    first = max(s.start + 0.01, s.standoff + MIN_RETREAT * pieces)  # equal shares at best
+    for cm in range(math.ceil(first * 100 - 1e-9), round(MAX_REACH_DISTANCE * 100) + 1):
+        tl = layout(b.replace(settings=s.replace(start=cm / 100)))
+        if all(e.path_length >= MIN_RETREAT for e in tl.episodes
+               if e.kind == "approach"):
+            return f"start further from the goal, e.g. `start {cm}cm`, or {fewer}"
+    return f"{fewer}, or a start further from the goal (`start`)"
+
+
 def _touching(ctx: Ctx, tl: Timeline) -> None:
     """V125: two pauses in a row are one hold."""
     for a, b in zip(tl.episodes, tl.episodes[1:], strict=False):
@@ -106,12 +147,45 @@ def _touching(ctx: Ctx, tl: Timeline) -> None:
                        hint="put a motion between them, or write one longer pause")
 
 
+_NEEDS = {"retreat": "a retreat counts only between two pauses, one before and one after it",
+          "gaze": "a gaze counts only when a pause ends it"}
+
+
+def _none_shown(kind: str, n_pauses: int) -> str:
+    """Why no episode of ``kind`` counts in the layout, in words."""
+    article = "an" if kind[0] in "aeiou" else "a"
+    why = _NEEDS.get(kind, f"no {kind} of its layout counts")
+    if kind in _NEEDS and n_pauses < (2 if kind == "retreat" else 1):
+        why += f", and this file has {('no pause', 'only one pause')[n_pauses]}"
+    return f"no layout of this file can show {article} {kind}: {why}"
+
+
+def _shown(name: str, value: float | int | None) -> str:
+    """A descriptor's value with its unit, as the file would write it."""
+    unit = REGISTRY[name].unit
+    return f"{value:.3g} {unit}" if isinstance(value, float) and unit else f"{value}"
+
+
 def _realisable(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
-    """V121: the laid-out descriptor form must show the values the file writes."""
+    """V121: the laid-out descriptor form must show the values the file writes. When no
+    episode of a statement counts, one diagnostic says why: its values are absent for
+    that one reason."""
+    pause = b.first("pause")
+    n_pauses = pause.count if pause is not None else 0
+    said: set[int] = set()
     for m in compare(written(b), derive(episode_values(tl.episodes))):
         node = source_of(b, m.name)
-        ctx.error("V121", f"{m.name} is declared {m.declared} but no layout of this file "
-                  f"can show more than {m.measured}", node.span if node else b.span,
+        if m.measured is None and id(node) in said:
+            continue  # its statement is already said to show no episode that counts
+        said.add(id(node))
+        kind = REGISTRY[m.name].kind
+        none = m.measured is None or (REGISTRY[m.name].is_count and m.measured == 0)
+        shows = _none_shown(kind, n_pauses) if none else \
+            f"no layout of this file can show more than {_shown(m.name, m.measured)}" \
+            if REGISTRY[m.name].is_count else \
+            f"its layout shows {_shown(m.name, m.measured)}"
+        ctx.error("V121", f"{m.name} is declared {_shown(m.name, m.declared)} but {shows}",
+                  node.span if node else b.span,
                   hint="pauses need motion between them (an approach, a retreat, a gaze...); "
                   "a retreat needs a pause before and after it, a gaze one after it",
                   descriptor=m.name, declared=m.declared, realised=m.measured)
@@ -132,6 +206,7 @@ def check_whole(ctx: Ctx, b: Behaviour) -> Timeline | None:
         return tl
     _reach(ctx, b, tl)
     _swept(ctx, tl)
+    _short_moves(ctx, b, tl)
     _touching(ctx, tl)
     if b.form == "descriptor":
         _realisable(ctx, b, tl)
