@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 
 from aou_dsl.cli import EXIT_ERRORS, EXIT_OK, main
-from aou_dsl.diagnostics import AouError
 from aou_dsl.kinematics import load_arm
 from aou_dsl.measuring.descriptors import measure
 from aou_dsl.measuring.recording import read_recording
 
+from .conftest import fails_with
 from .synth import Synth
 
 DEG = math.pi / 180
@@ -40,14 +40,6 @@ def _json(tmp_path, rec, goal: bool, name="r.json") -> str:
     path = tmp_path / name
     path.write_text(json.dumps(doc))
     return str(path)
-
-
-def _fails(code, fn, *args, **kw):
-    with pytest.raises(AouError) as err:
-        fn(*args, **kw)
-    (d,) = err.value.diagnostics
-    assert d.code == code, d.message
-    return d
 
 
 # --- 1. a C-V point read without the gazes -----------------------------------------------
@@ -108,7 +100,7 @@ def test_an_angle_unit_that_puts_a_joint_outside_its_limits_throughout_is_refuse
     """Degrees read as radians (the user said rad): a joint at about -126 deg sits at
     -126 rad, nowhere near its limits, at every sample."""
     path = _csv(tmp_path, short, "deg.csv", scale_q=1 / DEG)
-    d = _fails("R404", read_recording, path, goal=short.goal, angle_unit="rad")
+    d = fails_with("R404", read_recording, path, goal=short.goal, angle_unit="rad")
     arm = load_arm("panda")
     j = arm.joint_names.index(d.fields["joint"])
     col = short.q[:, j] / DEG
@@ -135,7 +127,7 @@ def test_radians_read_as_degrees_are_refused_where_a_joint_s_range_excludes_zero
     j = arm.joint_names.index("panda_joint4")
     assert arm.upper[j] < -math.radians(3) and (short.q[:, j] * DEG > arm.upper[j]).all()
     path = _csv(tmp_path, short, "rad.csv")
-    d = _fails("R404", read_recording, path, goal=short.goal, angle_unit="deg")
+    d = fails_with("R404", read_recording, path, goal=short.goal, angle_unit="deg")
     assert d.fields["joint"] == "panda_joint4" and "--angle-unit deg" in d.message
     assert "--angle-unit rad" in (d.hint or "")
 
@@ -158,7 +150,7 @@ def _degrees_csv(tmp_path) -> tuple[str, int]:
 
 def test_implausible_degrees_point_at_the_row_where_they_are_seen(tmp_path):
     path, line = _degrees_csv(tmp_path)
-    d = _fails("R404", read_recording, path)
+    d = fails_with("R404", read_recording, path)
     assert d.span.path == path and d.span.line == line
     assert f"row {line}" in d.message and "panda_joint1" in d.message
 
@@ -166,7 +158,7 @@ def test_implausible_degrees_point_at_the_row_where_they_are_seen(tmp_path):
 def test_implausible_milliseconds_point_at_a_row_of_the_file(tmp_path, short):
     path = _csv(tmp_path, short, "ms.csv", scale_t=1000.0,
                 header=("# robot: panda", "# goal: 0.55,0,0.25"))
-    d = _fails("R404", read_recording, path)
+    d = fails_with("R404", read_recording, path)
     lines = open(path).read().splitlines()
     assert "milliseconds" in d.message and d.span.line > 3  # past the comments, header
     row = lines[d.span.line - 1].split(",")
@@ -271,7 +263,7 @@ def test_the_spec_names_aouc_robot_shows_are_pointed_to_the_file_s_names(tmp_pat
 
     bad = tmp_path / "b.toml"
     bad.write_text('robot = "panda"\nstart_direction = [-0.6, 0.0, 0.8]\n')
-    d = _fails("V109", read_description, str(bad))
+    d = fails_with("V109", read_description, str(bad))
     assert "`from`" in (d.hint or "") and d.span.line == 2
 
 
@@ -302,7 +294,7 @@ def aou_csv(tmp_path_factory):
 
 def test_an_aou_csv_edited_into_degrees_is_refused_then_read_with_the_unit(aou_csv):
     rad, deg = aou_csv
-    d = _fails("R404", read_recording, deg)
+    d = fails_with("R404", read_recording, deg)
     assert "degrees" in d.message and "--angle-unit deg" in (d.hint or "")
     want = measure(read_recording(rad)).descriptors
     got = measure(read_recording(deg, angle_unit="deg")).descriptors
@@ -312,5 +304,5 @@ def test_an_aou_csv_edited_into_degrees_is_refused_then_read_with_the_unit(aou_c
 
 def test_a_unit_on_an_unedited_aou_csv_is_still_refused(aou_csv):
     rad, _ = aou_csv
-    d = _fails("R404", read_recording, rad, angle_unit="deg")
+    d = fails_with("R404", read_recording, rad, angle_unit="deg")
     assert "aou wrote this file" in d.message

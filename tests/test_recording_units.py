@@ -15,13 +15,12 @@ import numpy as np
 import pytest
 
 from aou_dsl.cli import EXIT_ERRORS, main
-from aou_dsl.diagnostics import AouError
 from aou_dsl.kinematics import load_arm
 from aou_dsl.measuring.descriptors import measure
 from aou_dsl.measuring.plausible import FASTEST
 from aou_dsl.measuring.recording import read_recording
 
-from .conftest import BEHAVIOURS
+from .conftest import BEHAVIOURS, fails_with
 from .recsim import PRESETS, record, to_csv_text, to_json_doc
 
 COUNTS = ("pause_count", "retreat_count")
@@ -45,14 +44,6 @@ def _csv(tmp_path, rec: dict, name: str) -> str:
     return str(path)
 
 
-def _fails(code, fn, *args, **kw):
-    with pytest.raises(AouError) as err:
-        fn(*args, **kw)
-    (d,) = err.value.diagnostics
-    assert d.code == code, d.message
-    return d
-
-
 def _goal(rec: dict) -> tuple[float, float, float]:
     return tuple(rec["goal"]["position"])
 
@@ -63,7 +54,7 @@ def test_seconds_read_as_milliseconds_are_refused_by_every_logger(hesitant, tmp_
     doc, declared = hesitant
     rec = record(doc, PRESETS[logger], dynamic=False)
     path = _csv(tmp_path, rec, f"{logger}.csv")
-    d = _fails("R404", read_recording, path, robot="panda", goal=_goal(rec), time_unit="ms")
+    d = fails_with("R404", read_recording, path, robot="panda", goal=_goal(rec), time_unit="ms")
     assert "--time-unit ms" in d.message and "seconds" in d.message
     assert "leave out --time-unit ms" in (d.hint or "")
     # The joint named really moves beyond its limit on that reading: even its mean speed
@@ -100,7 +91,7 @@ def test_a_json_recording_points_at_the_time_it_misreads(hesitant, tmp_path):
     path = tmp_path / "rec.json"
     text = json.dumps(to_json_doc(rec), indent=1)
     path.write_text(text)
-    d = _fails("R404", read_recording, str(path), time_unit="ms")
+    d = fails_with("R404", read_recording, str(path), time_unit="ms")
     i = d.fields["sample"]
     lines = text.splitlines()
     first = lines.index(' "t": [') + 2  # the line of t[0] (1-based)
@@ -116,7 +107,7 @@ def test_milliseconds_read_as_milliseconds_measure_as_seconds_do(hesitant, tmp_p
     in_s, in_ms = record(doc, log, dynamic=False), record(doc, log.with_(time_unit="ms"),
                                                           dynamic=False)
     s_path, ms_path = _csv(tmp_path, in_s, "s.csv"), _csv(tmp_path, in_ms, "ms.csv")
-    d = _fails("R404", read_recording, ms_path, robot="panda", goal=_goal(in_s))
+    d = fails_with("R404", read_recording, ms_path, robot="panda", goal=_goal(in_s))
     assert "milliseconds" in d.message
     a = measure(read_recording(s_path, robot="panda", goal=_goal(in_s))).descriptors
     b = measure(read_recording(ms_path, robot="panda", goal=_goal(in_s),
@@ -159,5 +150,5 @@ def test_a_file_aou_wrote_with_a_time_unit_is_still_refused(hesitant, tmp_path):
     doc, _ = hesitant
     path = tmp_path / "h.json"
     path.write_bytes(encode(doc, "json"))
-    d = _fails("R404", read_recording, str(path), time_unit="ms")
+    d = fails_with("R404", read_recording, str(path), time_unit="ms")
     assert "aou wrote this file" in d.message
