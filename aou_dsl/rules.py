@@ -292,6 +292,11 @@ _RULE_LIST = [
          "aou reports an internal inconsistency instead of a wrong number.",
          "a recording whose measured peak exceeds what its joint accelerations allow"),
     # --- I: input/output and usage -----------------------------------------------------
+    Rule("R407", "undersampled-oscillation", _W,
+         "A roll back and forth is sampled too few times per cycle (under about 5) to "
+         "tell a shiver from tilts by its speed profile; it is reported as neither.",
+         "Sample the recording, or compile, at 6 samples per cycle or more.",
+         "a 5 Hz shiver in a trajectory sampled at 20 Hz"),
     Rule("I501", "cannot-read", _E,
          "An input file or folder cannot be read (missing, a directory, permissions, encoding).",
          "Nothing can be checked or compiled.",

@@ -29,10 +29,18 @@ from ..descriptors import REGISTRY, Descriptors, EpisodeValues, derive, qualify,
 from ..diagnostics import AouError, Diagnostic, Span, diag
 from ..kinematics import load_arm
 from ..trajectory import Trajectory
-from .episodes import STILL_TRANSLATION, Context, Piece, pieces, translation
+from .episodes import (
+    COMPUTED_NOISE,
+    STILL_TRANSLATION,
+    Context,
+    Piece,
+    Samples,
+    pieces,
+    translation,
+)
 from .fk import batch_fk
 from .holds import MIN_PAUSE, REST_SPEED, Boundary, Rest, boundaries, rest_at_end, rest_signals
-from .roll import MIN_TILT, Lobe, lobe, roll_angle, rotations
+from .roll import MIN_TILT, SHAPED_CYCLE, Lobe, lobe, roll_angle, rotations
 from .signal import Grid, joint_noise, short_window, smooth, to_grid, unwrap
 
 __all__ = ["MIN_PAUSE", "MIN_TILT", "STILL_TRANSLATION", "LineOfSight", "Measured",
@@ -140,13 +148,16 @@ def _context(rec: Trajectory) -> tuple[Context, list[Boundary], np.ndarray, np.n
     h0 = float(np.median(np.diff(t)))
     window = short_window(float(noise.max()), h0)
     grid = to_grid(t, q, window * h0)
+    carried = _carried(rec, cols, grid)
     rest = rest_signals(grid.t, grid.h, grid.q, noise, jn.quantum, grid.density, window,
-                        grid.t_last, _carried(rec, cols, grid))
+                        grid.t_last, carried)
     pos, rot = batch_fk(arm, grid.q)
     pos_s = smooth(pos, window, 0, grid.h) if window > 3 else pos
     goal = None if rec.goal is None else np.asarray(rec.goal, float)
+    raw = Samples(t - t[0], q, batch_fk(arm, q)[0]) if grid.resampled else None
     ctx = Context(arm, rec.path, rest, grid.q, noise, pos, pos_s, rot, roll_angle(rot),
-                  goal, rot[0][:, 1].copy(), rot[0][:, 0].copy(), _edge_rest(rec, rest))
+                  goal, rot[0][:, 1].copy(), rot[0][:, 0].copy(), _edge_rest(rec, rest),
+                  raw, _computed(noise, grid, carried))
     return ctx, boundaries(rest), jn.sigma, jn.quantum
 
 
@@ -166,6 +177,25 @@ def _carried(rec: Trajectory, cols: np.ndarray, grid: Grid
     return qd, qdd
 
 
+def _computed(noise: np.ndarray, grid: Grid,
+              carried: tuple[np.ndarray, np.ndarray] | None) -> bool:
+    """Whether the trajectory was computed (aou's own, a planner's), not recorded on an
+    arm: its joints carry no noise, or the velocities and accelerations it carries are
+    the derivatives of its positions (each step is their trapezoid with its end
+    correction, within :data:`COMPUTED_NOISE` for most samples). A logger's velocities
+    are an estimate: they miss its positions by about their noise."""
+    if float(noise.max()) <= COMPUTED_NOISE:
+        return True
+    if carried is None or len(grid.t) < 3:
+        return False
+    qd, qdd = carried
+    h = np.diff(grid.t)[:, None]
+    step = np.diff(grid.q, axis=0)
+    miss = step - h * (qd[1:] + qd[:-1]) / 2 + h * h * (qdd[1:] - qdd[:-1]) / 12
+    moving = step != 0
+    return bool(moving.any() and np.median(np.abs(miss[moving])) <= COMPUTED_NOISE)
+
+
 def _edge_rest(rec: Trajectory, rest: Rest) -> tuple[bool, bool]:
     """Whether the arm is at rest at the first and last sample: from the velocities the
     file carries, else from the rest test."""
@@ -176,8 +206,10 @@ def _edge_rest(rec: Trajectory, rest: Rest) -> tuple[bool, bool]:
     return bool(speed[0].max() <= REST_SPEED), bool(speed[-1].max() <= REST_SPEED)
 
 
-def _episodes(ctx: Context, parts: list[Piece | Boundary]) -> list[EpisodeValues]:
-    """Pauses, translations and rolls in time order."""
+def _episodes(ctx: Context, parts: list[Piece | Boundary],
+              coarse: list[tuple[float, float, float]] | None = None) -> list[EpisodeValues]:
+    """Pauses, translations and rolls in time order; oscillations sampled too coarsely
+    to tell a shiver from tilts are added to ``coarse`` (see :func:`.roll.rotations`)."""
     out: list[EpisodeValues] = []
     lobes: list[Lobe] = []
     g0 = None
@@ -190,7 +222,7 @@ def _episodes(ctx: Context, parts: list[Piece | Boundary]) -> list[EpisodeValues
         g0 = ctx.goal - p0
 
     def flush() -> None:
-        out.extend(rotations(ctx, lobes))
+        out.extend(rotations(ctx, lobes, coarse))
         lobes.clear()
 
     for part in parts:
@@ -223,6 +255,18 @@ def _line_of_sight(ctx: Context) -> LineOfSight | None:
     return LineOfSight(ctx.rest.t[ok], np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0))))
 
 
+def _undersampled(where: Span, t0: float, t1: float, per_cycle: float, h: float
+                  ) -> Diagnostic:
+    """R407: an oscillation sampled too coarsely to tell a shiver from tilts."""
+    f = 1.0 / (per_cycle * h)
+    return diag("R407", f"the hand rolls back and forth at about {f:.2g} Hz from t={t0:.3f}s to "
+                f"t={t1:.3f}s, sampled {per_cycle:.2g} times per cycle: too few to tell a "
+                "shiver from tilts by its speed profile, so it is reported as neither",
+                where, hint=f"sample it at {math.ceil(SHAPED_CYCLE * f)} Hz or more "
+                f"({SHAPED_CYCLE} samples per cycle)", start=t0, end=t1,
+                frequency=f, samples_per_cycle=per_cycle)
+
+
 def _unequal(name: str, vals: list[float]) -> bool:
     return max(vals) - min(vals) > REGISTRY[name].tolerance(float(np.median(vals)))
 
@@ -239,10 +283,12 @@ def measure(rec: Trajectory) -> Measured:
             measured value contradicts the joint motion it came from.
     """
     ctx, bounds, sigma, quantum = _context(rec)
-    episodes = _episodes(ctx, pieces(ctx, bounds))
+    coarse: list[tuple[float, float, float]] = []
+    episodes = _episodes(ctx, pieces(ctx, bounds), coarse)
     descriptors = derive(episodes)
     where = Span.whole_file(rec.path)
-    diags = []
+    diags = [_undersampled(where, t0 + float(rec.t[0]), t1 + float(rec.t[0]), per_cycle,
+                           ctx.rest.h) for t0, t1, per_cycle in coarse]
     if ctx.goal is None:
         diags.append(diag("R405", "the trajectory has no goal: gaze descriptors and the line "
                           "of sight are not measured; approach and retreat are read along "

@@ -26,19 +26,34 @@ from ..kinematics import ArmModel
 from .fk import classical_acceleration, linear_jacobian
 from .holds import Boundary, Rest
 from .peaks import episode_peak, path_travel, phase_peak
-from .signal import curvature_gain, filter_at, smooth
+from .signal import curvature_gain, filter_at, odd, smooth
 
-__all__ = ["STILL_TRANSLATION", "Context", "Piece", "peak_acceleration", "pieces",
-           "translation"]
+__all__ = ["COMPUTED_NOISE", "STILL_TRANSLATION", "Context", "Piece", "Samples",
+           "peak_acceleration", "pieces", "translation"]
 
 #: Translation under which an episode has not moved the hand [m].
 STILL_TRANSLATION = 2e-3
 #: A gaze moved in a plane when its bearing there changed by more than this [deg].
 MIN_GAZE_SWEEP = 0.25
 #: How long an arm's own tracking transients last after each switch of the acceleration
-#: [s]: the acceleration is averaged over at least this long (never longer than the
-#: phase it is read in).
-TRANSIENT = 0.1
+#: [s]: a recording's acceleration is read over at least this long (never longer than
+#: the phase it is read in).
+TRANSIENT = 0.06
+#: Joint noise [rad] up to which a trajectory was computed (aou's own, a planner's,
+#: written at full precision), not recorded on an arm: it has no tracking transients.
+#: Also how closely a computed trajectory's carried velocities match its positions.
+COMPUTED_NOISE = 1e-7
+
+
+@dataclass(frozen=True)
+class Samples:
+    """A recording's own samples, where its clock is not the grid's: times from its
+    first sample [s] (K,), joint positions (K, n) and the hand's positions [m] (K, 3).
+    Accelerations are read from them at their own times."""
+
+    t: np.ndarray
+    q: np.ndarray
+    pos: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -60,6 +75,10 @@ class Context:
             file that carries its joint velocities says so exactly (a jerk-limited start
             barely moves in its first samples, so a fit there would call it moving);
             otherwise the rest test decides.
+        raw: the recording's own samples when it was put on the grid by interpolation
+            (None: the grid is its own clock).
+        computed: whether the trajectory was computed (aou's own, a planner's), not
+            recorded on an arm: it has no tracking transients.
     """
 
     arm: ArmModel
@@ -75,6 +94,8 @@ class Context:
     y0: np.ndarray
     x0: np.ndarray
     edge_rest: tuple[bool, bool]
+    raw: Samples | None = None
+    computed: bool = False
 
 
 @dataclass(frozen=True)
@@ -92,6 +113,8 @@ class Piece:
     roll1: float
     at_rest0: bool  # starts where the arm was at rest (not at the recording's first sample)
     at_rest1: bool
+    held0: bool = False  # starts at the end of a pause (a hold, not an instant)
+    held1: bool = False
 
 
 def _anchor(c: Context, b: Boundary, side: int) -> tuple[np.ndarray, float]:
@@ -129,7 +152,8 @@ def pieces(c: Context, bounds: list[Boundary]) -> list[Piece | Boundary]:
         p1, r1 = _anchor(c, b, -1) if b is not last else (c.pos_s[-1], float(c.roll[-1]))
         rest0 = a is not first or c.edge_rest[0]
         rest1 = b is not last or c.edge_rest[1]
-        out.append(Piece(ta, tb, i0, i1, p0, p1, r0, r1, rest0, rest1))
+        out.append(Piece(ta, tb, i0, i1, p0, p1, r0, r1, rest0, rest1,
+                         a.pause and a is not first, b.pause and b is not last))
     return out
 
 
@@ -171,49 +195,73 @@ def translation(c: Context, p: Piece, g0: np.ndarray | None) -> EpisodeValues | 
     return EpisodeValues("gaze", p.t0, p.t1, values)
 
 
-def _phases(c: Context, p: Piece, speed: np.ndarray) -> list[tuple[int, int, float]]:
-    """The speeding-up and slowing-down phases of a piece: (first, last sample,
-    duration [s]); a phase cut by the recording's start or end is left out, unless
-    nothing else is left."""
-    t = c.rest.t[p.i0:p.i1 + 1]
-    top = speed.max()
-    fast = np.flatnonzero(speed >= 0.95 * top)
-    out = []
+def _phases(c: Context, p: Piece, speed: np.ndarray) -> list[tuple[int, int, int, int]]:
+    """The speeding-up and slowing-down phases of a piece: the samples of each (from
+    rest to 95 % of the top speed, and back), and those up to or from the top speed
+    (where a peak that grows to the top speed is: a bang-bang law's switch); a phase
+    cut by the recording's start or end is left out, unless nothing else is left."""
+    n = len(speed)
+    fast = np.flatnonzero(speed >= 0.95 * speed.max())
     a, b = int(fast[0]), int(fast[-1])
+    top = a + int(np.argmax(speed[a:b + 1]))
+    out = []
     if p.at_rest0:
-        out.append((0, a, float(t[a] - p.t0)))
+        out.append((0, a, 0, top))
     if p.at_rest1:
-        out.append((b, len(t) - 1, float(p.t1 - t[b])))
-    return out or [(0, len(t) - 1, float(p.t1 - p.t0))]
+        out.append((b, n - 1, top, n - 1))
+    return out or [(0, n - 1, 0, n - 1)]
 
 
 def peak_acceleration(c: Context, p: Piece, u: np.ndarray) -> tuple[float, float]:
     """Peak acceleration of the hand along the direction of travel ``u`` [m/s^2], and
     the std the joints' noise gives it: each speeding-up and slowing-down phase read as
-    :mod:`.peaks` explains, over the whole phase and never shorter than :data:`TRANSIENT`
-    where the phase allows (so that the arm's own transients at each switch average out).
+    :mod:`.peaks` explains, from the recording's own samples at their own times; in a
+    recording never over less than :data:`TRANSIENT` where the phase allows (so that
+    the arm's own transients at each switch average out).
 
     Raises:
         AouError: R406 when the joints' own accelerations cannot produce the peak.
     """
     r, h = c.rest, c.rest.h
-    x = c.pos[p.i0:p.i1 + 1] @ u
-    speed = np.abs(smooth(x, r.window, 1, h, order=2))
+    speed = np.abs(smooth(c.pos[p.i0:p.i1 + 1] @ u, r.window, 1, h, order=2))
     jac = linear_jacobian(c.arm, c.q[(p.i0 + p.i1) // 2])
     sigma_x = float(np.sqrt(np.sum(((u @ jac) * c.noise) ** 2)))
-    q = c.q[p.i0:p.i1 + 1]
+    src = c.raw if c.raw is not None else Samples(r.t, c.q, c.pos)
+    k0 = int(np.searchsorted(src.t, p.t0 - 1e-9 * max(h, 1.0), "left"))
+    k1 = int(np.searchsorted(src.t, p.t1 + 1e-9 * max(h, 1.0), "right")) - 1
+    # The held sample just before a start from a pause (after a stop at one) belongs to
+    # the motion's readings: at a low rate the first moving sample's acceleration needs it.
+    k0 -= int(p.held0 and k0 > 0)
+    k1 += int(p.held1 and k1 < len(src.t) - 1)
+    t, x, q = src.t[k0:k1 + 1], src.pos[k0:k1 + 1] @ u, src.q[k0:k1 + 1]
+    grid = r.t[p.i0:p.i1 + 1]
+
+    def own(i: int, side: int) -> int:  # grid sample i of the piece, in its own samples
+        if i == (0 if side < 0 else len(grid) - 1):
+            return 0 if side < 0 else len(t) - 1
+        at = int(np.searchsorted(t, grid[i], "left" if side < 0 else "right"))
+        return at if side < 0 else at - 1
 
     def travel(j0: int, j1: int) -> tuple[np.ndarray, float] | None:
         return path_travel(x[j0:j1 + 1], q[j0:j1 + 1], c.noise)
 
-    found = [f for a, b, _ in _phases(c, p, speed)
-             if (f := phase_peak(x, a, b, h, sigma_x, r.sparse[p.i0:p.i1 + 1], TRANSIENT,
-                                 travel if c.noise.max() > 0 else None)) is not None]
+    transient = 0.0 if c.computed else TRANSIENT
+    # An arm's transients grow with the step of its acceleration: from rest by the
+    # level, where one motion reverses into the next by up to twice it.
+    steps = (2.0 if p.at_rest0 and not p.held0 else 1.0,
+             2.0 if p.at_rest1 and not p.held1 else 1.0)
+    found = [f for a, b, lo, hi in _phases(c, p, speed)
+             if (f := phase_peak(t, x, own(a, -1), own(b, +1), sigma_x, transient,
+                                 travel if c.noise.max() > 0 else None,
+                                 steps[0] if a == 0 else steps[1] if b == len(grid) - 1
+                                 else 1.0, (own(lo, -1), own(hi, +1)))) is not None]
     if not found:
         return 0.0, 0.0
     peak = episode_peak(found)
     if peak.value > 0:
-        _self_check(c, peak.value, p.i0 + peak.at, peak.window, u, sigma_x, peak.sd)
+        at = int(np.clip(np.searchsorted(r.t, peak.at), 0, len(r.t) - 1))
+        window = min(odd(peak.span / h), len(r.t) - (1 - len(r.t) % 2))
+        _self_check(c, peak.value, at, max(window, 3), u, sigma_x, peak.sd)
     return peak.value, peak.sd
 
 

@@ -9,7 +9,9 @@ deceleration, so its velocity is a straight line there). A rest whose refined sp
 :data:`MIN_PAUSE` or more, and in which the joints hold one position within their noise
 for most of it, is a pause; a shorter one is the boundary between two episodes (a
 rest-to-rest boundary, or a reversal). Motion that reverses or stops without ever
-looking still (a fast shiver, coarse sampling) is found from the speed's dips to zero.
+looking still (a fast shiver, coarse sampling) is found from the speed's dips to zero,
+also between two samples: sampled a few times per cycle, a shiver's samples can all
+miss its reversals, where its leading joint's velocity changes sign.
 A pause beside an oscillation, whose envelope fades in and out, has its edges placed by
 :mod:`.onset`.
 """
@@ -21,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .onset import soft_pause
+from .onset import REST_SPEED, carried_edge, soft_pause
 from .signal import NOISE_SIGMAS, odd, runs, sg_coefficients, slope_gain, smooth
 
 __all__ = ["MIN_PAUSE", "REST_SPEED", "Boundary", "Rest", "boundaries", "rest_at_end",
@@ -29,8 +31,6 @@ __all__ = ["MIN_PAUSE", "REST_SPEED", "Boundary", "Rest", "boundaries", "rest_at
 
 #: Shortest rest that counts as a pause [s] (the language's shortest pause is 0.2 s).
 MIN_PAUSE = 0.15
-#: Joint speed under which clean data are at rest [rad/s].
-REST_SPEED = 1e-4
 #: Window of the slow-motion check inside long rests [s].
 LONG_WINDOW = 0.3
 #: A held joint stays within this many times its filtered noise of one position.
@@ -189,7 +189,7 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False
     first clearly moving sample; motion too weak to follow leaves the edge where it is.
     Also whether a straight ramp was followed (a firm edge)."""
     if r.carried is not None:
-        exact = _carried_edge(r, i, step)
+        exact = carried_edge(r.t, r.q, *r.carried, i, step)
         if exact is not None:
             return exact, True
     t, n = r.t, len(r.t)
@@ -232,42 +232,6 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False
     return float(min(max(t0, bounds[0]), bounds[1])), True
 
 
-def _carried_edge(r: Rest, i: int, step: int) -> float | None:
-    """Where the motion beside sample ``i`` (after it for ``step`` +1, before it for -1)
-    leaves rest, from the positions, velocities and accelerations the file carries.
-
-    Near its start a motion from rest goes as a power of the time since it started,
-    ``dq ~ tau^k`` (k = 2 at constant acceleration, 3 under a jerk limit), so at its first
-    moving sample ``qd/qdd = tau/(k-1)`` and ``dq/qd = tau/k``: both give ``k`` and
-    ``tau`` without assuming either. The first sample near ``i`` whose start falls
-    between it and its neighbour on the rest side gives the edge; None when none does.
-    """
-    assert r.carried is not None
-    qd, qdd = r.carried
-    n = len(r.t)
-    j = int(np.argmax(np.abs(qd[min(max(i + 3 * step, 0), n - 1)])))
-    for b in range(i - 2 * step, i + 5 * step, step):
-        a = b - step
-        if not (0 <= a < n and 0 <= b < n):
-            continue
-        dq = float(r.q[b, j] - r.q[a, j])
-        v, acc = float(qd[b, j]) * step, float(qdd[b, j])
-        if abs(v) <= REST_SPEED or dq == 0.0:
-            continue
-        sign = math.copysign(1.0, dq)
-        v, acc, dq = v * sign, acc * sign, abs(dq)
-        if v <= 0 or acc <= 0:
-            continue
-        r1, r2 = v / acc, dq / v
-        if r1 <= r2:
-            continue
-        k = r1 / (r1 - r2)
-        tau = k * r2
-        if 1.0 <= k <= 8.0 and tau <= abs(float(r.t[b] - r.t[a])) * (1 + 1e-9):
-            return float(r.t[b]) - step * tau
-    return None
-
-
 def _zero(t: np.ndarray, v: np.ndarray, straight: bool = False) -> float | None:
     """Where the velocity ``v`` (positive, over the ramp ``t``) reached zero: the line
     through it followed back. With ``straight``, None unless the ramp is a straight line
@@ -286,22 +250,59 @@ def _zero(t: np.ndarray, v: np.ndarray, straight: bool = False) -> float | None:
     return float(t[0] - icpt / slope)
 
 
+def _crossings(r: Rest) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where the leading joint's velocity changes sign between two samples ``i`` and
+    ``i + 1``: those ``i``, the leading joint, and the speed level there (every joint's
+    velocity interpolated to the crossing). Sampled a few times per cycle, an
+    oscillation's samples can all miss its reversals; the level between them does not."""
+    ratio = np.abs(r.v) / r.thr
+    j = np.argmax(ratio[:-1] + ratio[1:], axis=1)
+    rows = np.arange(len(j))
+    va, vb = r.v[rows, j], r.v[rows + 1, j]
+    idx = np.flatnonzero(va * vb < 0)
+    j = j[idx]
+    frac = (va[idx] / (va[idx] - vb[idx]))[:, None]
+    v = r.v[idx] + frac * (r.v[idx + 1] - r.v[idx])
+    thr = r.thr[idx] + frac * (r.thr[idx + 1] - r.thr[idx])
+    return idx, j, np.max(np.abs(v) / thr, axis=1)
+
+
 def _dips(r: Rest, taken: np.ndarray) -> list[tuple[float, float, int]]:
     """Where the motion passes through zero speed without a rest sample: local minima of
-    the speed level that fall under 30 % of the peaks on both sides. Where the leading
-    joint reverses, the instant is its velocity's zero crossing; else the motion on each
-    side is followed to zero as beside a rest. (stop, start, sample) each."""
+    the speed level, at the samples or where the leading joint reverses between two of
+    them, that fall under 30 % of the peaks on both sides. Where the leading joint
+    reverses, the instant is its velocity's zero crossing; else the motion on each side
+    is followed to zero as beside a rest. (stop, start, sample) each."""
     from scipy.signal import find_peaks
 
-    lv = r.level
-    idx, props = find_peaks(-lv, prominence=0.0)
+    n = len(r.level)
+    # The level at the samples (even places) and between them (odd places): at a
+    # reversal the level there, else the larger of the two (never a minimum).
+    seq = np.empty(2 * n - 1)
+    seq[0::2] = r.level
+    seq[1::2] = np.maximum(r.level[:-1], r.level[1:])
+    cross, lead, between = _crossings(r)
+    seq[2 * cross + 1] = np.minimum(between, seq[2 * cross + 1])
+    joint = dict(zip(cross.tolist(), lead.tolist(), strict=True))
+    idx, props = find_peaks(-seq, prominence=0.0)
     out = []
-    for k, prom in zip(idx.tolist(), props["prominences"].tolist(), strict=True):
-        if taken[k] or lv[k] > 0.3 * (lv[k] + prom):
+    v = r.v if r.carried is None else r.carried[0]
+    for m, prom in zip(idx.tolist(), props["prominences"].tolist(), strict=True):
+        k = m // 2
+        if taken[k] or (m % 2 and taken[k + 1]) or seq[m] > 0.3 * (seq[m] + prom):
             continue
-        j = int(np.argmax(np.abs(r.v[k - 1]) / r.thr[k - 1] + np.abs(r.v[k + 1]) / r.thr[k + 1]))
-        v = r.v if r.carried is None else r.carried[0]
-        a, b = (k - 1, k) if v[k - 1, j] * v[k, j] <= 0 else (k, k + 1)
+        if m % 2 and seq[m] + prom < 2.0 * CLEARLY:  # noise flips a slow joint's sign
+            continue
+        if m % 2:  # a reversal between samples k and k + 1
+            j = joint[k]
+            pairs = [(k, k + 1), (k - 1, k), (k + 1, k + 2)]
+            k = k if abs(r.v[k, j]) <= abs(r.v[k + 1, j]) else k + 1
+        else:
+            j = int(np.argmax(np.abs(r.v[k - 1]) / r.thr[k - 1]
+                              + np.abs(r.v[k + 1]) / r.thr[k + 1]))
+            pairs = [(k - 1, k), (k, k + 1)]
+        a, b = next(((a, b) for a, b in pairs if 0 <= a and b < n and v[a, j] * v[b, j] <= 0),
+                    pairs[-1 if m % 2 == 0 else 0])
         va, vb = v[a, j], v[b, j]
         if va * vb <= 0 and va != vb:
             tk = float(r.t[a] + (r.t[b] - r.t[a]) * va / (va - vb))

@@ -16,13 +16,21 @@ slow, so that enough samples stand above the noise; the free power absorbs that.
 motion that does not swing to both sides of the hold (an approach, a tilt, the ringing
 of an arm that stops) is left to its velocity ramp, and a fit that misses the data by
 more than the noise leaves the edge where it was.
+
+A file that carries its joints' velocities and accelerations (a compiled trajectory)
+says exactly where any motion leaves rest: :func:`carried_edge`.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-__all__ = ["soft_edge", "soft_pause"]
+__all__ = ["REST_SPEED", "carried_edge", "soft_edge", "soft_pause"]
+
+#: Joint speed under which clean data are at rest [rad/s].
+REST_SPEED = 1e-4
 
 #: The powers of time a soft start is fitted with.
 POWERS = (2.0, 2.5, 3.0, 3.5)
@@ -132,3 +140,39 @@ def soft_pause(t: np.ndarray, q: np.ndarray, noise: np.ndarray, span: tuple[floa
         edge = soft_edge(t, q, noise, (k0, k1), +1)
         b = edge if edge is not None and edge > a + shortest else b
     return a, b
+
+
+def carried_edge(t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, i: int,
+                 step: int) -> float | None:
+    """Where the motion beside sample ``i`` (after it for ``step`` +1, before it for -1)
+    leaves rest, from the positions ``q``, velocities ``qd`` and accelerations ``qdd``
+    (N, n) a file carries at times ``t`` (N,).
+
+    Near its start a motion from rest goes as a power of the time since it started,
+    ``dq ~ tau^k`` (k = 2 at constant acceleration, 3 under a jerk limit), so at its first
+    moving sample ``qd/qdd = tau/(k-1)`` and ``dq/qd = tau/k``: both give ``k`` and
+    ``tau`` without assuming either. The first sample near ``i`` whose start falls
+    between it and its neighbour on the rest side gives the edge; None when none does.
+    """
+    n = len(t)
+    j = int(np.argmax(np.abs(qd[min(max(i + 3 * step, 0), n - 1)])))
+    for b in range(i - 2 * step, i + 5 * step, step):
+        a = b - step
+        if not (0 <= a < n and 0 <= b < n):
+            continue
+        dq = float(q[b, j] - q[a, j])
+        v, acc = float(qd[b, j]) * step, float(qdd[b, j])
+        if abs(v) <= REST_SPEED or dq == 0.0:
+            continue
+        sign = math.copysign(1.0, dq)
+        v, acc, dq = v * sign, acc * sign, abs(dq)
+        if v <= 0 or acc <= 0:
+            continue
+        r1, r2 = v / acc, dq / v
+        if r1 <= r2:
+            continue
+        k = r1 / (r1 - r2)
+        tau = k * r2
+        if 1.0 <= k <= 8.0 and tau <= abs(float(t[b] - t[a])) * (1 + 1e-9):
+            return float(t[b]) - step * tau
+    return None

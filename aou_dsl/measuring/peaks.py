@@ -1,7 +1,9 @@
 """The peak acceleration of an approach or a retreat, read phase by phase.
 
 An episode speeds up from rest and slows down to rest; the peak of each phase is read as
-follows (docs/measure.md explains the choices):
+follows (docs/measure.md explains the choices). Every reading is a quadratic in time
+fitted by least squares to the samples at their own times: a log's jittered clock and
+its gaps are no curvature (a straight line drawn across a gap would be).
 
 1. **The hand's travel, with the joints' noise across their path removed.** The hand's
    position along its direction of travel, ``s = u . p``, takes noise from every joint,
@@ -16,14 +18,25 @@ follows (docs/measure.md explains the choices):
    derivative is a mean of the acceleration with positive weights, equal to it where the
    acceleration holds a level, and the least noisy reading of one. It is one reading at
    one place: no maximum over noisy values, which the noise would bias up.
-3. **A curved phase.** A bell-shaped acceleration peaks above any mean of it. A quartic
-   fitted over the phase, centred where the phase's acceleration is concentrated (the
-   centroid of its square), reads a curved peak without that bias. Where the two
-   readings differ by more than :data:`CURVED_SIGMAS` stds of their difference and by
-   :data:`CURVED` of the level, the phase is curved and the quartic's reading is its
-   peak. A quartic resolves finer detail than a quadratic over the same span, so it is
-   used over :data:`QUARTIC_SPAN` times the arm's transients at least: an arm's
-   tracking transients after a switch are no peak.
+3. **The phase's profile.** Not every phase holds a level: a joint at its acceleration
+   limit gives a peak at the phase's start that falls off after it (or one that builds
+   up to its end), a minimum-jerk law a bell. The acceleration is also read over every
+   run of samples of one length inside the phase and up to the top speed beside it
+   (where a bang-bang law switches), as the level of a quadratic over the run. The runs
+   are first long enough that their noise is :data:`DETECTION` of the level (at most
+   half the phase): their largest reading is a peak when it exceeds the level by more
+   than the largest of that many readings of a level would (:data:`SIGNIFICANT` stds
+   more than ``sqrt(2 ln M)`` for ``M`` runs, stds of the hand's own noise) and, in a
+   recording of an arm, by more than :data:`TRANSIENT_EXCESS` of the step of the
+   acceleration at the phase's ends (what an arm's tracking transients add: a start
+   from rest steps by the level, a switch from speeding up to slowing down by twice
+   that). Otherwise the phase holds its level, and the level is its peak. A peak is
+   then read finely: at the motion's start or stop, where the acceleration trends to
+   it, by the cubic through the run that found it, at the shortest span an arm's
+   transients allow (the end itself for a computed trajectory), when that cubic's
+   noise is within :data:`RESOLUTION` of the peak; elsewhere as the largest reading,
+   within that run, of the shortest runs whose noise is :data:`RESOLUTION` of the
+   peak. A recording's runs never last less than its arm's transients.
 4. **The episode's peak** is the larger of its two phases'. When they differ by no more
    than their noise, the larger of two noisy readings is biased up (by half a std for
    equal ones); the estimate is then their weighted mean, plus half the part of their
@@ -32,38 +45,43 @@ follows (docs/measure.md explains the choices):
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from .signal import filter_at, odd, sg_coefficients
-
-__all__ = ["PhasePeak", "episode_peak", "path_travel", "phase_peak"]
+__all__ = ["PhasePeak", "curvatures", "episode_peak", "path_travel", "phase_peak"]
 
 #: Largest mean squared residual of the joints from their fitted path, in noise variances.
 PATH_FIT = 1.5
 #: Noise that moves a phase's level by less than this fraction of it is left as it is.
 NEGLIGIBLE = 1e-3
-#: A quartic's reading replaces the quadratic's when they differ by this many stds of
-#: their difference...
-CURVED_SIGMAS = 4.0
-#: ... and by this fraction of the level.
-CURVED = 0.03
-#: The quartic is used over this many times the arm's transients at least.
-QUARTIC_SPAN = 1.7
+#: A peak is read over runs whose noise std is at most this fraction of it.
+RESOLUTION = 0.015
+#: The profile's peak is found over runs whose noise std is at most this fraction of the
+#: level (then read over runs of :data:`RESOLUTION`).
+DETECTION = 0.005
+#: The largest reading of the profile is a peak when it exceeds the level by this many
+#: stds of its noise, plus what the largest of that many readings of a level exceeds it
+#: by (``sqrt(2 ln M)`` stds for ``M`` independent runs in the phase)...
+SIGNIFICANT = 3.5
+#: ... and, in a recording of an arm, by this fraction of the level (of the step at
+#: the phase's ends): an arm's tracking transients after a step of its acceleration add
+#: up to about that to a reading as short as they are.
+TRANSIENT_EXCESS = 0.03
 
 
 @dataclass(frozen=True)
 class PhasePeak:
-    """A phase's peak acceleration [m/s^2], its std from the noise, the sample (of the
-    piece) and the window [samples] it was read at."""
+    """A phase's peak acceleration [m/s^2], its std from the noise, and the time [s] and
+    span [s] of the samples it was read from."""
 
     value: float
     sd: float
-    at: int
-    window: int
+    at: float
+    span: float
 
 
 def path_travel(s: np.ndarray, q: np.ndarray, noise: np.ndarray
@@ -92,72 +110,143 @@ def path_travel(s: np.ndarray, q: np.ndarray, noise: np.ndarray
     return None
 
 
-def _centroid(x: np.ndarray, a: int, b: int, window: int, h: float) -> tuple[int, float]:
-    """Where the acceleration of phase ``a``..``b`` is concentrated (the centroid of its
-    square, from a quadratic over ``window`` samples), and its sign."""
-    n, half = len(x), window // 2
-    k0, k1 = max(a, half), min(b, n - 1 - half)
-    if k1 < k0:
-        k0 = k1 = min(max((a + b) // 2, half), n - 1 - half)
-    acc = filter_at(x, window, 2, h, k0, k1, order=2)
-    sign = 1.0 if acc.sum() >= 0 else -1.0
-    weight = np.clip(acc * sign, 0.0, None) ** 2
-    if weight.sum() <= 0:
-        return (k0 + k1) // 2, sign
-    return int(round(k0 + float(np.arange(len(acc)) @ weight) / float(weight.sum()))), sign
+@functools.lru_cache(maxsize=512)
+def _uniform_weights(w: int, h: float) -> np.ndarray:
+    """The second-derivative weights of a least-squares quadratic through ``w`` samples
+    ``h`` [s] apart (any ``w`` >= 3, odd or even)."""
+    k = np.arange(w) - 0.5 * (w - 1)
+    d = k * k - float(np.mean(k * k))
+    return 2.0 * d / (float(d @ d) * h * h)
 
 
-def _weights(n: int, centre: int, window: int, order: int, h: float) -> np.ndarray:
-    """A fit's second-derivative weights at ``centre``, over ``n`` samples."""
-    out = np.zeros(n)
-    half = window // 2
-    out[centre - half:centre + half + 1] = sg_coefficients(window, order, 2, h)
-    return out
+def curvatures(t: np.ndarray, x: np.ndarray, w: int) -> tuple[np.ndarray, np.ndarray]:
+    """Over every run of ``w`` (>= 3) consecutive samples of ``x`` at times ``t``: the
+    second derivative of the least-squares quadratic in time, and its std per unit of
+    white noise on ``x``. Run ``k`` covers samples ``k``..``k + w - 1``."""
+    xw = np.lib.stride_tricks.sliding_window_view(x, w)
+    steps = np.diff(t)
+    if len(steps) and float(np.ptp(steps)) <= 1e-9 * float(steps.mean()):  # one clock
+        c = _uniform_weights(w, float(steps.mean()))
+        return xw @ c, np.full(len(xw), float(np.linalg.norm(c)))
+    tw = np.lib.stride_tricks.sliding_window_view(t, w)
+    centre = tw.mean(axis=1, keepdims=True)
+    half = np.maximum(0.5 * (tw[:, -1] - tw[:, 0]), 1e-300)[:, None]
+    z = (tw - centre) / half  # in [-1, 1]: well conditioned at any clock
+    z2 = z * z
+    m = np.empty((len(tw), 3, 3))
+    m[:, 0, 0] = w
+    m[:, 0, 1] = m[:, 1, 0] = z.sum(axis=1)
+    m[:, 0, 2] = m[:, 2, 0] = m[:, 1, 1] = z2.sum(axis=1)
+    m[:, 1, 2] = m[:, 2, 1] = (z2 * z).sum(axis=1)
+    m[:, 2, 2] = (z2 * z2).sum(axis=1)
+    xm = xw - xw.mean(axis=1, keepdims=True)  # the constant term takes the offset
+    rhs = np.stack([xm.sum(axis=1), (xm * z).sum(axis=1), (xm * z2).sum(axis=1)], axis=1)
+    inv = np.linalg.inv(m)
+    scale = 2.0 / half[:, 0] ** 2
+    return (np.einsum("kj,kj->k", inv[:, 2], rhs) * scale,
+            np.sqrt(np.maximum(inv[:, 2, 2], 0.0)) * scale)
+
+
+def _run(t: np.ndarray, a: int, b: int, level: float, noise: float, shortest: float,
+         resolution: float) -> int:
+    """The profile's run [samples] within phase ``a``..``b``: the shortest of at least 3
+    samples, lasting at least ``shortest`` [s], whose reading has a noise std (``noise``
+    on the travel) within ``resolution`` of ``level``; the whole phase when none is."""
+    length = b - a + 1
+    step = float(t[b] - t[a]) / max(length - 1, 1)
+    w = min(max(3, int(math.ceil(shortest / step - 1e-9)) + 1), length)
+    while w < length:
+        # The gain of a run on an even clock of the phase's mean step.
+        gain = float(np.linalg.norm(_uniform_weights(w, step)))
+        if noise * gain <= resolution * level:
+            break
+        w = min(w + max(1, w // 8), length)
+    return w
 
 
 Travel = Callable[[int, int], "tuple[np.ndarray, float] | None"]
 
 
-def phase_peak(x: np.ndarray, a: int, b: int, h: float, sigma: float, sparse: np.ndarray,
-               shortest: float, travel: Travel | None = None) -> PhasePeak | None:
+def phase_peak(t: np.ndarray, x: np.ndarray, a: int, b: int, sigma: float,
+               transient: float, travel: Travel | None = None, step: float = 1.0,
+               around: tuple[int, int] | None = None) -> PhasePeak | None:
     """The peak acceleration of phase ``a``..``b`` (samples of ``x``, the hand's travel
-    [m] over its piece); ``sigma`` the travel's noise std [m]; ``sparse`` (per sample)
-    how much noisier a value is across a logging gap; ``shortest`` [s] the arm's
-    transients; ``travel(j0, j1)`` the travel over samples ``j0``..``j1`` with the
-    joints' noise across their path removed, and its noise (:func:`path_travel`)."""
+    [m] over its piece, at times ``t`` [s]); ``sigma`` the travel's noise std [m];
+    ``transient`` [s] how long the arm's tracking transients last (0 for a computed
+    trajectory, which has none); ``travel(j0, j1)`` the travel over samples
+    ``j0``..``j1`` with the joints' noise across their path removed, and its noise
+    (:func:`path_travel`); ``step`` the largest step of the acceleration at the phase's
+    ends, in levels (1 from rest, up to 2 where one motion reverses into the next): an
+    arm's transients grow with it; ``around`` the samples its peak is looked for in
+    (``a``..``b`` and up to the top speed beside it)."""
     n, length = len(x), b - a + 1
-    w1 = min(odd(shortest / h, least=5), length if length % 2 else length - 1,
-             n if n % 2 else n - 1)
-    if w1 < 3:
+    if length < 3:
         return None
-    ctr, sign = _centroid(x, a, b, w1, h)
-    mid = (a + b) // 2
-    w2 = max(3, min(2 * min(mid - a, b - mid) + 1, 2 * min(mid, n - 1 - mid) + 1))
-    f2 = _weights(n, mid, w2, 2, h)
-    level = float(f2 @ x) * sign
+    acc, gain = curvatures(t[a:b + 1], x[a:b + 1], length)
+    level, g2 = float(acc[0]), float(gain[0])
     reach = length // 2 + 1
     j0, j1 = max(0, a - reach), min(n - 1, b + reach)
     # Noise that moves the level by less than NEGLIGIBLE of it is not worth the path.
-    noisy = sigma * float(np.linalg.norm(f2)) > NEGLIGIBLE * abs(level)
-    better = travel(j0, j1) if travel is not None and noisy else None
+    better = (travel(j0, j1) if travel is not None and sigma * g2 > NEGLIGIBLE * abs(level)
+              else None)
+    # The path's noise is what a fit of it says is left; but the fitted path bends with
+    # the noise across it over a short stretch, so a peak must stand out of the hand's.
+    raw = sigma
     if better is not None and better[1] < sigma:
         x = x.copy()
         x[j0:j1 + 1], sigma = better
-        level = float(f2 @ x) * sign
-    sigma *= float(sparse[ctr])
-    out = PhasePeak(abs(level), sigma * float(np.linalg.norm(f2)), mid, w2)
-    w4 = max(w1, min(2 * min(ctr - a, b - ctr) + 1, 2 * min(ctr, n - 1 - ctr) + 1))
-    c4 = ctr
-    if w4 * h < QUARTIC_SPAN * shortest:
-        w4, c4 = w2, mid
-    if w4 * h < QUARTIC_SPAN * shortest or w4 < 7:
+        level = float(curvatures(t[a:b + 1], x[a:b + 1], length)[0][0])
+    sign = 1.0 if level >= 0 else -1.0
+    level *= sign
+    out = PhasePeak(level, sigma * g2, 0.5 * float(t[a] + t[b]), float(t[b] - t[a]))
+    w = _run(t, a, b, level, sigma, transient, RESOLUTION)
+    if w >= length:
         return out
-    f4 = _weights(n, c4, w4, 4, h)
-    curved = float(f4 @ x) * sign
-    if abs(curved - level) > max(CURVED_SIGMAS * sigma * float(np.linalg.norm(f4 - f2)),
-                                 CURVED * abs(level)):
-        return PhasePeak(abs(curved), sigma * float(np.linalg.norm(f4)), c4, w4)
-    return out
+    # The peak is found over longer runs (less noisy: a smaller excess stands out of
+    # the noise) and then read over the shortest run the noise allows, where it was found.
+    lo, hi = around if around is not None else (a, b)
+    lo, hi = min(lo, a), max(hi, b)
+    if lo < a or hi > b:  # up to the top speed: a bang-bang law's switch steps by 2 levels
+        step = max(step, 2.0)
+    ws = max(w, min(_run(t, a, b, level, sigma, transient, DETECTION), (length + 1) // 2))
+    reads, gains = curvatures(t[lo:hi + 1], x[lo:hi + 1], ws)
+    best = int(np.argmax(reads * sign))
+    found, sd = float(reads[best]) * sign, sigma * float(gains[best])
+    runs = max(1.0, (hi - lo + 1) / ws)
+    allowed = max((SIGNIFICANT + math.sqrt(2.0 * math.log(runs))) * raw * float(gains[best]),
+                  TRANSIENT_EXCESS * step * level if transient > 0 else 0.0)
+    if found - level <= allowed:
+        return out
+    k0, k1 = lo + best, lo + best + ws - 1
+    start, end = best == 0 and lo == a, best == len(reads) - 1 and hi == b
+    if (start or end) and ws >= 6:
+        # At the motion's start or stop the acceleration trends to its peak: a cubic over
+        # the run follows the trend to the shortest span an arm's transients allow there
+        # (when the noise lets it: its reading is noisier than the run's).
+        at = t[k0] + 0.5 * transient if start else t[k1] - 0.5 * transient
+        edge, edge_gain = _cubic_curvature(t[k0:k1 + 1], x[k0:k1 + 1], float(at))
+        if edge * sign > found and sigma * edge_gain <= RESOLUTION * edge * sign:
+            return PhasePeak(edge * sign, sigma * edge_gain, float(at), transient)
+    fine = _run(t, a, b, found, sigma, transient, RESOLUTION)
+    if fine < ws:
+        acc_f, gain_f = curvatures(t[k0:k1 + 1], x[k0:k1 + 1], fine)
+        k = int(np.argmax(acc_f * sign))
+        if float(acc_f[k]) * sign > found:
+            k0, k1 = k0 + k, k0 + k + fine - 1
+            found, sd = float(acc_f[k]) * sign, sigma * float(gain_f[k])
+    return PhasePeak(found, sd, 0.5 * float(t[k0] + t[k1]), float(t[k1] - t[k0]))
+
+
+def _cubic_curvature(t: np.ndarray, x: np.ndarray, at: float) -> tuple[float, float]:
+    """The second derivative at time ``at`` of the least-squares cubic in time through
+    ``x``, and its std per unit of white noise on ``x``."""
+    centre, half = 0.5 * float(t[0] + t[-1]), max(0.5 * float(t[-1] - t[0]), 1e-300)
+    z = (t - centre) / half
+    v = np.vander(z, 4, increasing=True)
+    inv = np.linalg.inv(v.T @ v)
+    za = (at - centre) / half
+    g = np.array([0.0, 0.0, 2.0, 6.0 * za]) / half ** 2
+    return float(g @ inv @ (v.T @ x)), float(np.sqrt(max(float(g @ inv @ g), 0.0)))
 
 
 def episode_peak(phases: list[PhasePeak]) -> PhasePeak:
@@ -170,7 +259,7 @@ def episode_peak(phases: list[PhasePeak]) -> PhasePeak:
     beyond = (p.value - r.value) ** 2 - (p.sd ** 2 + r.sd ** 2)
     if beyond > 0:
         value = min(p.value, 0.5 * (p.value + r.value) + 0.5 * math.sqrt(beyond))
-        return PhasePeak(value, p.sd, p.at, p.window)
+        return PhasePeak(value, p.sd, p.at, p.span)
     wp, wr = 1.0 / max(p.sd, 1e-300) ** 2, 1.0 / max(r.sd, 1e-300) ** 2
     return PhasePeak((wp * p.value + wr * r.value) / (wp + wr), 1.0 / math.sqrt(wp + wr),
-                     p.at, p.window)
+                     p.at, p.span)

@@ -14,14 +14,14 @@ swallow them.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..descriptors import EpisodeValues
 from .episodes import Context, Piece
 
-__all__ = ["MIN_TILT", "Lobe", "lobe", "roll_angle", "rotations"]
+__all__ = ["MIN_TILT", "SHAPED_CYCLE", "Lobe", "lobe", "roll_angle", "rotations"]
 
 #: Smallest roll reported as a tilt [deg] (the tilt tolerance is 0.5 deg).
 MIN_TILT = 0.5
@@ -29,6 +29,18 @@ MIN_TILT = 0.5
 MIN_LOBE = 0.05
 #: Lobes of one shiver last within this factor of their median.
 SAME_FREQUENCY = 1.8
+#: Fewest samples of a lobe whose velocity shows its shape; shorter lobes are judged by
+#: their positions, together with their neighbours (:func:`_block_shapes`).
+SHAPED = 5
+#: A lobe shorter than this many sample steps is too coarsely sampled to show its
+#: shape: three or more in a row that are no shiver are reported as neither (R407).
+COARSE = 2.5
+#: Samples per cycle from which an oscillation's shape is told (its lobes' positions
+#: judged together); a coarser one is reported as neither a shiver nor tilts (R407).
+SHAPED_CYCLE = 6
+#: The shape of a pure sine lobe's speed (a triangle's is minus that): the residual of
+#: fitting one of the two to the other, relative to its norm.
+SINE_SHAPE = 0.12
 
 
 def roll_angle(rot: np.ndarray) -> np.ndarray:
@@ -66,10 +78,11 @@ class Lobe:
 
 def _shape(c: Context, p: Piece, j: int) -> float:
     """Residual of the best triangle minus that of the best half sine, fitted to the
-    joint's velocity over the lobe (each relative to the velocity's norm)."""
+    joint's velocity over the lobe (each relative to the velocity's norm); 0 for a lobe
+    of fewer than :data:`SHAPED` samples (:func:`_block_shapes` judges those)."""
     t = c.rest.t[p.i0:p.i1 + 1]
     v = c.rest.v[p.i0:p.i1 + 1, j]
-    if len(t) < 5 or p.t1 <= p.t0:
+    if len(t) < SHAPED or p.t1 <= p.t0:
         return 0.0
     u = np.clip((t - p.t0) / (p.t1 - p.t0), 0.0, 1.0)
     norm = float(np.linalg.norm(v))
@@ -80,6 +93,54 @@ def _shape(c: Context, p: Piece, j: int) -> float:
         k = float(v @ tmpl) / float(tmpl @ tmpl)
         out.append(float(np.linalg.norm(v - k * tmpl)) / norm)
     return out[0] - out[1]
+
+
+def _rise(u: np.ndarray, sine: bool) -> np.ndarray:
+    """A lobe's position from 0 to 1 over ``u`` in [0, 1]: at a sine's speed, or at a
+    triangle's (a rest-to-rest tilt: constant acceleration, then deceleration)."""
+    if sine:
+        return 0.5 * (1.0 - np.cos(math.pi * u))
+    return np.where(u <= 0.5, 2.0 * u * u, 1.0 - 2.0 * (1.0 - u) ** 2)
+
+
+def _block_shapes(c: Context, lobes: list[Lobe]) -> list[float]:
+    """The shapes of consecutive lobes too short for a velocity's shape, from their
+    positions: the joint passes through one extreme at each reversal, and between two it
+    rises as a sine's or a triangle's speed would take it. Both models are fitted to all
+    the lobes at once (the extremes shared by neighbours; a lobe of a few samples alone
+    could not tell them apart); each lobe's shape is its two residuals' difference over
+    their sum and the noise's, scaled like a velocity's shape (a sine's is
+    +:data:`SINE_SHAPE`, a triangle's minus that). Lobes under 3 samples get 0."""
+    j = max(lobes, key=lambda lb: lb.swing).joint
+    r = c.rest
+    edges: list[float] = []
+    rows, cols, ends, owner = [], [], [], []
+    for k, lb in enumerate(lobes):
+        p = lb.piece
+        if not edges or p.t0 > edges[-1] + 1e-9:
+            edges.append(p.t0)
+        e0 = len(edges) - 1
+        edges.append(p.t1)
+        idx = np.arange(p.i0, p.i1 + 1)
+        rows.append(idx)
+        cols.append((r.t[idx] - p.t0) / max(p.t1 - p.t0, 1e-12))
+        ends.append(e0)
+        owner.append(np.full(len(idx), k))
+    idx, u, who = np.concatenate(rows), np.clip(np.concatenate(cols), 0, 1), np.concatenate(owner)
+    e0 = np.asarray(ends)[who]
+    y = r.q[idx, j]
+    res = []
+    for sine in (False, True):
+        rise = _rise(u, sine)
+        a = np.zeros((len(idx), len(edges)))
+        a[np.arange(len(idx)), e0] = 1.0 - rise
+        a[np.arange(len(idx)), e0 + 1] = rise
+        miss = y - a @ np.linalg.lstsq(a, y, rcond=None)[0]
+        res.append(np.bincount(who, miss * miss, minlength=len(lobes)))
+    count = np.bincount(who, minlength=len(lobes))
+    total = res[0] + res[1] + 9.0 * float(c.noise[j]) ** 2 * count
+    return [SINE_SHAPE * float((res[0][k] - res[1][k]) / total[k])
+            if count[k] >= 3 and total[k] > 0 else 0.0 for k in range(len(lobes))]
 
 
 def lobe(c: Context, p: Piece) -> Lobe | None:
@@ -139,13 +200,34 @@ def _same_beat(lb: Lobe, median: float) -> bool:
             and lb.shape > -0.08)
 
 
+def _extreme(y: np.ndarray, k: int, sign: float, most: float) -> float:
+    """The extreme of ``y`` at sample ``k`` (``sign`` +1 a maximum, -1 a minimum), with
+    the part its samples missed: the parabola through it and its neighbours peaks
+    between them. The correction is at most ``most`` (what samples this far apart can
+    miss of a sine), so that noise on finely sampled data adds nothing."""
+    if k == 0 or k == len(y) - 1:
+        return float(y[k])
+    a = 0.5 * (y[k + 1] - 2.0 * y[k] + y[k - 1]) * sign
+    b = 0.5 * (y[k + 1] - y[k - 1])
+    miss = -b * b / (4.0 * a) if a < 0 else 0.0
+    return float(y[k]) + sign * min(max(miss, 0.0), most)
+
+
 def _shiver(c: Context, lobes: list[Lobe]) -> EpisodeValues:
+    """A shiver: the peak-to-peak range of the joint that moved most, its extremes read
+    between the samples when they are a few per cycle."""
     t0, t1 = lobes[0].piece.t0, lobes[-1].piece.t1
     i0, i1 = lobes[0].piece.i0, lobes[-1].piece.i1
-    rng = np.ptp(c.q[i0:i1 + 1], axis=0)
+    seg = c.q[i0:i1 + 1]
+    rng = np.ptp(seg, axis=0)
     j = int(np.argmax(rng))
+    per_cycle = 2.0 * float(np.median([lb.duration for lb in lobes])) / c.rest.h
+    most = 0.5 * float(rng[j]) * (1.0 - math.cos(math.pi / max(per_cycle, 2.0)))
+    y = seg[:, j]
+    top = _extreme(y, int(np.argmax(y)), 1.0, most)
+    bottom = _extreme(y, int(np.argmin(y)), -1.0, most)
     return EpisodeValues("shiver", t0, t1, {
-        "amplitude": math.degrees(float(rng[j])), "joint": float(j),
+        "amplitude": math.degrees(top - bottom), "joint": float(j),
         "cycles": len(lobes) / 2.0})
 
 
@@ -158,18 +240,64 @@ def _tilt(lb: Lobe) -> EpisodeValues | None:
         "joint": float(lb.joint)})
 
 
-def rotations(c: Context, lobes: list[Lobe]) -> list[EpisodeValues]:
-    """Consecutive lobes (no pause or translation between them) as tilts and shivers."""
-    out: list[EpisodeValues] = []
+def _coarse(lobes: list[Lobe], taken: set[int], h: float) -> list[tuple[int, int]]:
+    """Runs of lobes sampled too coarsely to tell a shiver from tilts: three or more in a
+    row (outside the shivers ``taken``), each lasting under :data:`COARSE` sample steps
+    ``h`` [s]. Sampled that coarsely an oscillation's swings lose their reversals between
+    samples, so they need not alternate or last alike."""
+    out: list[tuple[int, int]] = []
+    few = [k not in taken and lb.duration < COARSE * h for k, lb in enumerate(lobes)]
     k = 0
-    blocks = []
+    while k < len(lobes):
+        end = k
+        while few[k] and end + 1 < len(lobes) and few[end + 1]:
+            end += 1
+        if few[k] and end - k >= 2:
+            out.append((k, end))
+        k = end + 1
+    return out
+
+
+def _oscillation(c: Context, lobes: list[Lobe]) -> tuple[float, float, float]:
+    """Start, end [s] and samples per cycle of coarsely sampled lobes: the joint that
+    swung most turns back once per half cycle (its steps change sign), whichever
+    reversals fell between samples."""
+    t0, t1 = lobes[0].piece.t0, lobes[-1].piece.t1
+    j = max(lobes, key=lambda lb: lb.swing).joint
+    steps = np.sign(np.diff(c.q[lobes[0].piece.i0:lobes[-1].piece.i1 + 1, j]))
+    steps = steps[steps != 0]
+    turns = int(np.count_nonzero(steps[1:] != steps[:-1]))
+    cycle = 2.0 * (t1 - t0) / turns if turns else 2.0 * (t1 - t0) / len(lobes)
+    return t0, t1, cycle / c.rest.h
+
+
+def rotations(c: Context, lobes: list[Lobe],
+              coarse: list[tuple[float, float, float]] | None = None) -> list[EpisodeValues]:
+    """Consecutive lobes (no pause or translation between them) as tilts and shivers.
+    An oscillation sampled too coarsely to tell which is neither: it is added to
+    ``coarse`` as (start, end [s], samples per cycle)."""
+    lobes = list(lobes)
+    out: list[EpisodeValues] = []
+    blocks: list[tuple[int, int]] = []
     for a, b in _alternating(lobes):
+        short = [k for k in range(a, b + 1) if lobes[k].piece.i1 - lobes[k].piece.i0 + 1 < SHAPED]
+        if short and b > a:
+            shapes = _block_shapes(c, lobes[a:b + 1])
+            for k in short:
+                lobes[k] = replace(lobes[k], shape=shapes[k - a])
         blk = _shiver_block(lobes, a, b)
         if blk is not None:
             blocks.append(blk)
+    skip: set[int] = set()
+    taken = {k for first, end in blocks for k in range(first, end + 1)}
+    for lo, hi in _coarse(lobes, taken, c.rest.h):
+        skip.update(range(lo, hi + 1))
+        if coarse is not None:
+            coarse.append(_oscillation(c, lobes[lo:hi + 1]))
+    k = 0
     for lo, hi in blocks:
-        out += [e for e in (_tilt(lb) for lb in lobes[k:lo]) if e is not None]
+        out += [e for i in range(k, lo) if i not in skip and (e := _tilt(lobes[i])) is not None]
         out.append(_shiver(c, lobes[lo:hi + 1]))
         k = hi + 1
-    out += [e for e in (_tilt(lb) for lb in lobes[k:]) if e is not None]
+    out += [e for i in range(k, len(lobes)) if i not in skip and (e := _tilt(lobes[i])) is not None]
     return out
