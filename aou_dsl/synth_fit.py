@@ -15,6 +15,7 @@ import functools
 import math
 from dataclasses import dataclass
 
+from .compiler.fits import floor_sig
 from .diagnostics import AouError, has_errors
 from .ir import DEFAULTS
 from .primitives import MIN_SHIVER_F, shiver_duration
@@ -99,14 +100,6 @@ def fit_limits(robot: str, goal: tuple[float, float, float] | None = None) -> Li
     j = arm.joint_names.index(arm.spec.shiver_joint)
     return Limits(robot, goal, reached, floor_sig(MARGIN * reached), arm.spec.shiver_joint,
                   MARGIN * float(arm.plan_vmax[j]), MARGIN * float(arm.plan_amax[j]))
-
-
-def floor_sig(x: float, digits: int = 2) -> float:
-    """``x`` rounded down to ``digits`` significant digits."""
-    if x <= 0:
-        return 0.0
-    scale = 10.0 ** (math.floor(math.log10(x)) - digits + 1)
-    return math.floor(x / scale + 1e-9) * scale
 
 
 def _cap_accel(r: Recipe, kind: str, lim: Limits) -> Recipe:

@@ -26,6 +26,7 @@ import numpy as np
 from ..diagnostics import AouError, Span, diag
 from ..trajectory import Trajectory
 from .locate import Where
+from .signal import joint_noise
 
 __all__ = ["ANGLE_UNITS", "BEYOND", "FASTEST", "SLOWEST_STEP", "TIME_UNITS", "check_units"]
 
@@ -162,8 +163,7 @@ def moving_speed(t: np.ndarray, col: np.ndarray) -> tuple[float, int] | None:
     of :data:`_WINDOW` samples whose displacement stands out of the joint's noise, the
     speed a tenth of them reach (at least :data:`_MOVING` of them: a few glitches cannot
     set it). None when the joint moves in fewer than :data:`_MOVING` windows."""
-    d2 = np.diff(col, 2)
-    noise = 1.4826 * float(np.median(np.abs(d2))) / math.sqrt(6.0) if len(d2) else 0.0
+    noise = float(joint_noise(t, col[:, None]).effective[0])  # white noise and rounding
     at = np.arange(0, len(t), _WINDOW)
     dq, dt = np.abs(np.diff(col[at])), np.diff(t[at])
     moving = (dq > max(6 * math.sqrt(2) * noise, 1e-5)) & (dt > 0)
