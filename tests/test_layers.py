@@ -1,0 +1,198 @@
+"""The package's layers: each imports only from the layers below it, no import cycle, a
+small package root and no two modules with one name.
+
+Every import counts: at the top of a module, inside a function, and under
+``TYPE_CHECKING`` (a type that needs a higher layer is a design that does too).
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+from collections import defaultdict
+from pathlib import Path
+
+import pytest
+
+from .conftest import ROOT
+
+PACKAGE = ROOT / "aou_dsl"
+
+#: Each layer, lowest first. A module may import from its own layer and any layer before it.
+#: The package root's modules are placed where they sit: ``version`` at the bottom, the API
+#: facade just under the command line.
+LAYERS = [
+    ("version", "core"),
+    ("lang",),
+    ("robot",),
+    ("compiler",),
+    ("measuring",),
+    ("safety",),
+    ("build",),
+    ("synth",),
+    ("live",),
+    ("media", "dmp", "editor"),
+    ("studio",),
+    ("api",),
+    ("cli",),
+    ("__main__", ""),
+]
+RANK = {name: i for i, names in enumerate(LAYERS) for name in names}
+ROOT_MODULES_MAX = 6
+
+
+def _module_name(path: Path) -> str:
+    parts = list(path.relative_to(PACKAGE).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    return ".".join(parts)
+
+
+MODULES = {_module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
+
+
+def _targets(module: str, path: Path) -> set[str]:
+    """The package's modules that ``module`` imports, anywhere in its text."""
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    found: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".") if package else []
+                base = base[: len(base) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            elif node.module and (node.module + ".").startswith("aou_dsl."):
+                target = node.module.removeprefix("aou_dsl").lstrip(".")
+            else:
+                continue
+            names = [f"{target}.{a.name}".lstrip(".") for a in node.names]
+            found.update(n for n in names if n in MODULES)
+            found.add(target)
+        elif isinstance(node, ast.Import):
+            for a in node.names:
+                if (a.name + ".").startswith("aou_dsl."):
+                    found.add(a.name.removeprefix("aou_dsl").lstrip("."))
+    found.discard(module)
+    # importing a.b.c runs a/__init__ and a/b/__init__ first
+    return {t for t in found if t in MODULES or t == ""}
+
+
+GRAPH = {m: _targets(m, p) for m, p in MODULES.items()}
+
+
+def _layer(module: str) -> str:
+    return module.split(".")[0]
+
+
+def test_every_module_belongs_to_a_layer():
+    """Each top-level module or subpackage of aou_dsl has a place in the table of layers."""
+    assert {_layer(m) for m in MODULES} <= set(RANK), {_layer(m) for m in MODULES} - set(RANK)
+
+
+@pytest.mark.parametrize("module", sorted(m for m in MODULES if m))
+def test_no_upward_import(module):
+    """A module imports nothing from a layer above its own (the package facade, which
+    imports its names on first use by name only, is above everything)."""
+    mine = RANK[_layer(module)]
+    upward = [t for t in GRAPH[module] if RANK[_layer(t)] > mine]
+    assert not upward, (f"{MODULES[module].relative_to(ROOT)} imports "
+                        + ", ".join(str(MODULES[t].relative_to(ROOT)) for t in upward))
+
+
+def _cycles() -> list[list[str]]:
+    """Every strongly connected component with more than one module (Tarjan)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    out: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in GRAPH[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(sorted(comp))
+
+    for v in sorted(GRAPH):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_no_import_cycle():
+    """No set of modules imports itself round, counting imports inside functions."""
+    assert _cycles() == [], [[str(MODULES[m].relative_to(ROOT)) for m in c] for c in _cycles()]
+
+
+def test_cycle_finder_finds_a_planted_cycle(monkeypatch):
+    """The cycle check is not vacuous: an edge from the lowest module back up to one that
+    imports it is reported."""
+    planted = {m: set(t) for m, t in GRAPH.items()}
+    planted["core.diagnostics"] = planted["core.diagnostics"] | {"lang.parse"}
+    monkeypatch.setattr(__import__(__name__, fromlist=["GRAPH"]), "GRAPH", planted)
+    assert any({"core.diagnostics", "lang.parse"} <= set(c) for c in _cycles())
+
+
+def test_package_root_is_small():
+    """The package root holds the facade, the API, ``__main__`` and the version only."""
+    root = sorted(p.name for p in PACKAGE.glob("*.py"))
+    assert len(root) <= ROOT_MODULES_MAX, root
+
+
+def test_no_two_modules_share_a_name():
+    """A module's file name says what it holds, once in the package (``__init__`` aside)."""
+    by_name = defaultdict(list)
+    for p in PACKAGE.rglob("*.py"):
+        if p.name != "__init__.py":
+            by_name[p.name].append(str(p.relative_to(ROOT)))
+    assert not {n: ps for n, ps in by_name.items() if len(ps) > 1}
+
+
+def test_each_layer_states_its_public_face():
+    """Each layer's ``__init__`` has a docstring saying what it holds."""
+    for init in sorted(PACKAGE.glob("*/__init__.py")):
+        tree = ast.parse(init.read_text())
+        assert ast.get_docstring(tree), init.relative_to(ROOT)
+
+
+def test_no_module_level_mutable_state():
+    """No ``global`` statement, and no module-level dict, list or set that the module then
+    changes (caches belong to ``functools.cache`` or to a session object)."""
+    offenders = []
+    for p in PACKAGE.rglob("*.py"):
+        text = p.read_text()
+        tree = ast.parse(text)
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Global):
+                offenders.append(f"{p.relative_to(ROOT)}:{node.lineno}: global")
+        module_level = set()
+        for node in tree.body:
+            targets = [node.target] if isinstance(node, ast.AnnAssign) else (
+                node.targets if isinstance(node, ast.Assign) else [])
+            value = getattr(node, "value", None)
+            if isinstance(value, (ast.Dict, ast.List, ast.Set)) or (
+                    isinstance(value, ast.Call) and getattr(value.func, "id", "") in
+                    ("dict", "list", "set", "defaultdict", "OrderedDict")):
+                module_level.update(t.id for t in targets if isinstance(t, ast.Name))
+        for name in module_level:
+            mutated = re.search(rf"\b{name}\s*\[[^\]]*\]\s*=(?!=)|\b{name}\.(append|add|update|"
+                                rf"setdefault|pop|clear|extend|insert|remove)\(", text)
+            if mutated:
+                line = text[: mutated.start()].count("\n") + 1
+                offenders.append(f"{p.relative_to(ROOT)}:{line}: {name} is changed")
+    assert not offenders, offenders
