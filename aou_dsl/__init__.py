@@ -20,12 +20,14 @@ from .version import __version__ as __version__
 __all__ = [
     "REGISTRY",
     "AouError",
+    "BuildOptions",
     "BuildResult",
     "CheckReport",
     "Descriptors",
     "Diagnostic",
     "FileResult",
     "Measured",
+    "Session",
     "Trajectory",
     "check",
     "compile",
@@ -37,11 +39,11 @@ __all__ = [
 
 #: name -> module that defines it, imported on first use.
 _LAZY = {
-    "REGISTRY": "descriptors", "Descriptors": "descriptors",
-    "AouError": "diagnostics", "Diagnostic": "diagnostics",
-    "BuildResult": "build", "FileResult": "linter",
-    "CheckReport": "safety.replay", "Measured": "measuring.descriptors",
-    "Trajectory": "trajectory",
+    "REGISTRY": "lang.descriptors", "Descriptors": "lang.descriptors",
+    "AouError": "core.diagnostics", "Diagnostic": "core.diagnostics",
+    "BuildOptions": "core.options", "Trajectory": "core.trajectory",
+    "BuildResult": "build.builder", "Session": "build.session", "FileResult": "lang.linter",
+    "CheckReport": "safety.replay", "Measured": "measuring.measured",
     "check": "api", "compile": "api", "lint": "api", "lint_paths": "api",
     "measure": "api", "read_trajectory": "api",
 }

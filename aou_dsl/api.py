@@ -19,9 +19,12 @@ Example::
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 from .build.builder import BuildResult, build_file, build_source
+from .core.options import BuildOptions, SceneOptions
+from .core.options import package_dirs as package_dirs_of
 from .lang.linter import FileResult, lint_file, lint_paths, lint_source
 
 if TYPE_CHECKING:
@@ -47,7 +50,9 @@ def lint(path: Source | None = None, *, source: str | None = None) -> FileResult
 def compile(path: Source | None = None, *, source: str | None = None,  # noqa: A001
             robot: str | None = None, rate: float | None = None, check: bool = True,
             target_size: float = 0.05, table_height: float | None = 0.0,
-            collision_check: bool = True, controller: str | None = None) -> BuildResult:
+            collision_check: bool = True, controller: str | None = None,
+            package_dirs: Sequence[Source] = (),
+            options: BuildOptions | None = None) -> BuildResult:
     """Lint, compile, check and measure one behaviour.
 
     Args:
@@ -60,36 +65,42 @@ def compile(path: Source | None = None, *, source: str | None = None,  # noqa: A
             document's ``checks.collision_checked`` then says so.
         controller: ``"franka"`` or ``"ur"``: also check that motion generator's rate and
             published limits (joint jerk at 1 kHz against the robot's is always checked).
+        package_dirs: folders searched first for the robot's ``package://`` meshes.
+        options: all of the above in one :class:`~aou_dsl.core.options.BuildOptions`
+            (when given, the other keywords are not read).
 
     Returns:
         A :class:`~aou_dsl.build.builder.BuildResult`: ``ok``, ``diagnostics``, ``trajectory``,
         ``declared`` and ``measured`` descriptors, the output ``document``.
     """
-    from .robot.scene import SceneOptions
-
-    scene = SceneOptions(target_size=target_size, table_height=table_height)
-    options: dict[str, Any] = {"robot": robot, "rate": rate, "check": check, "scene": scene,
-                               "collision_check": collision_check, "controller": controller}
+    if options is None:
+        options = BuildOptions(
+            robot=robot, rate=rate, check=check, collision_check=collision_check,
+            controller=controller, package_dirs=package_dirs_of(package_dirs),
+            scene=SceneOptions(target_size=target_size, table_height=table_height))
     if source is not None:
         return build_source(source, os.fspath(path) if path is not None else "<string>",
-                            **options)
+                            options)
     if path is None:
         raise TypeError("compile() needs a path or source=")
-    return build_file(os.fspath(path), **options)
+    return build_file(os.fspath(path), options)
 
 
 def read_trajectory(path: Source, *, robot: str | None = None,
                     goal: tuple[float, float, float] | str | None = None,
                     ee_frame: str | None = None, angle_unit: str | None = None,
-                    time_unit: str | None = None) -> Trajectory:
+                    time_unit: str | None = None,
+                    package_dirs: Sequence[Source] = ()) -> Trajectory:
     """A trajectory from a file: aou's JSON or NPZ, or a CSV recording (which needs
     ``robot``); a ``.aou`` file is compiled. ``goal`` (or ``"final"``: the end-effector's
     last position) and ``ee_frame`` override the file's; ``angle_unit="deg"`` and
-    ``time_unit="ms"`` read a recording in those units (docs/measure.md)."""
+    ``time_unit="ms"`` read a recording in those units (docs/measure.md); ``package_dirs``
+    are the folders of the robot's ``package://`` meshes, kept with the trajectory."""
     from .build.builder import load_motion
 
     return load_motion(os.fspath(path), robot=robot, goal=goal, ee_frame=ee_frame,
-                       angle_unit=angle_unit, time_unit=time_unit)
+                       angle_unit=angle_unit, time_unit=time_unit,
+                       package_dirs=package_dirs_of(package_dirs))
 
 
 def _trajectory(what: Trajectory | Source, **options: Any) -> Trajectory:
@@ -116,12 +127,12 @@ def check(what: Trajectory | Source, *, dynamic: bool = True, target_size: float
     samples as a ``joint_trajectory_controller`` does) is checked too when ``controller``
     is named, or when the trajectory carries velocities (a compiled one); a recording of
     positions alone is too noisy for a third derivative unless asked."""
-    from .robot.scene import SceneOptions
     from .safety.controllers import controller_checks
     from .safety.replay import replay
 
-    scene = SceneOptions(target_size=target_size, table_height=table_height)
     tr = _trajectory(what, **options)
+    scene = SceneOptions(target_size=target_size, table_height=table_height,
+                         package_dirs=tr.package_dirs)
     report = replay(tr, options=scene, dynamic=dynamic)
     if controller is not None or tr.qd is not None:
         report.checks += controller_checks(tr, controller)

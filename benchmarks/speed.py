@@ -341,14 +341,14 @@ def bench_jobs(copies: int = 3, rounds: int = 5) -> None:
                 dst = Path(tmp, f"{src.stem}{i}.aou")
                 shutil.copy(src, dst)
                 paths.append(str(dst))
-        list(build_many(paths[:5], {}, 1))  # this process warm too
+        list(build_many(paths[:5], None, 1))  # this process warm too
         t = time.perf_counter()
         with BuildPool(cores) as pool:
             start = time.perf_counter() - t
             walls, cpus, ceilings = [], [], []
             for _ in range(rounds):  # interleaved: the machine's load changes
                 c, t = time.process_time(), time.perf_counter()
-                one = list(build_many(paths, {}, 1))
+                one = list(build_many(paths, None, 1))
                 t1, c1 = time.perf_counter() - t, time.process_time() - c
                 before, t = _cpu_seconds(pool.pids), time.perf_counter()
                 many = list(pool.map(paths))

@@ -118,8 +118,9 @@ def test_a_frame_is_pybullets_own_picture_of_the_whole_scene():
     them by depth: each frame is, pixel for pixel, the image PyBullet draws of everything
     together, at the start, with the hand at its nearest to the target, and with the
     hand pushed through the table (which must hide it)."""
+    from aou_dsl.core.options import SceneOptions
     from aou_dsl.media.render import Camera, _Clip, _pedestal, _stage, render_configurations
-    from aou_dsl.robot.scene import Scene, SceneOptions
+    from aou_dsl.robot.scene import Scene
 
     tr = build_file(str(BEHAVIOURS / "hesitant.aou"), check=False).trajectory
     clip, cam, opts = _Clip.of(tr, 30.0), Camera(width=160, height=120), SceneOptions()

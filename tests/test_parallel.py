@@ -6,6 +6,7 @@ import pytest
 from aou_dsl.build.builder import build_file
 from aou_dsl.build.parallel import BuildPool, build_many, encoded, write_result
 from aou_dsl.compiler.output import encode
+from aou_dsl.core.options import BuildOptions
 
 from .conftest import BEHAVIOURS, INVALID
 
@@ -14,7 +15,7 @@ from .conftest import BEHAVIOURS, INVALID
 INPUTS = [str(BEHAVIOURS / "hesitant.aou"), str(BEHAVIOURS / "confident.aou"),
           "no/such/file.aou", str(INVALID / "invalid_bad_character.aou"),
           str(BEHAVIOURS / "inactive.aou")]
-OPTIONS = {"rate": 100.0}
+OPTIONS = BuildOptions(rate=100.0)
 
 
 def _same(got, want) -> None:
@@ -31,7 +32,7 @@ def _same(got, want) -> None:
 @pytest.fixture(scope="module")
 def alone():
     """Each input built on its own, in this process."""
-    return [build_file(p, **OPTIONS) for p in INPUTS]
+    return [build_file(p, OPTIONS) for p in INPUTS]
 
 
 @pytest.mark.slow

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from ..core.diagnostics import AouError, Diagnostic, Span, diag, has_errors
+from ..core.options import BuildOptions, SceneOptions
 from ..lang.linter import FileResult, lint_file, lint_source
 
 if TYPE_CHECKING:  # the numerical stages load only when a build runs
@@ -21,7 +22,6 @@ if TYPE_CHECKING:  # the numerical stages load only when a build runs
     from ..core.trajectory import Trajectory
     from ..lang.descriptors import Descriptors
     from ..measuring.measured import Measured
-    from ..robot.scene import SceneOptions
 
 __all__ = ["CHECK_RATE", "BuildResult", "build_file", "build_source", "load_motion"]
 
@@ -98,12 +98,11 @@ def _with_robot(lint: FileResult, robot: str | None) -> list[Diagnostic]:
     return []
 
 
-def _check(res: BuildResult, rate: float, scene: SceneOptions | None,
+def _check(res: BuildResult, rate: float, scene: SceneOptions,
            controller: str | None = None) -> dict:
     """The kinematic replay and the controller's view of the motion (joint jerk at its
     rate), as C306/C311 diagnostics and the document's ``checks``."""
     from ..compiler.pipeline import sample
-    from ..robot.scene import SceneOptions
     from ..safety.controllers import controller_checks, describe
     from ..safety.replay import replay
 
@@ -111,7 +110,7 @@ def _check(res: BuildResult, rate: float, scene: SceneOptions | None,
     tr = res.compiled.trajectory
     assert tr is not None
     dense = tr if rate >= CHECK_RATE else sample(res.compiled, CHECK_RATE)
-    report = replay(dense, options=scene or SceneOptions())
+    report = replay(dense, options=scene)
     motion = controller_checks(res.compiled, controller)
     report.checks += motion
     res.checks = report.checks
@@ -129,22 +128,25 @@ def _check(res: BuildResult, rate: float, scene: SceneOptions | None,
     return {"kinematic": report.to_json()}
 
 
-def _robot_diagnostics(b, check: bool, collision_check: bool) -> list[Diagnostic]:
+def _robot_diagnostics(b, opts: BuildOptions) -> list[Diagnostic]:
     """What the build says of its robot (limits from no source, no collision shapes)."""
     from ..robot import robot_diagnostics
 
     try:
-        return robot_diagnostics(b.settings.robot, collision_check=check and collision_check,
-                                 span=b.settings.spans.get("robot", b.span))
+        return robot_diagnostics(b.settings.robot,
+                                 collision_check=opts.check and opts.collision_check,
+                                 span=b.settings.spans.get("robot", b.span),
+                                 package_dirs=opts.package_dirs)
     except AouError as err:
         return list(err.diagnostics)
 
 
-def build_lint(lint: FileResult, *, robot: str | None = None, rate: float | None = None,
-               check: bool = True, scene: SceneOptions | None = None,
-               collision_check: bool = True, controller: str | None = None) -> BuildResult:
+def build_lint(lint: FileResult, options: BuildOptions | None = None,
+               **changes: Any) -> BuildResult:
     """Compile, check and measure a linted file (see the module's docstring).
 
+    ``options`` (:class:`~aou_dsl.core.options.BuildOptions`) says how; keyword
+    ``changes`` replace some of its fields (``robot="ur5"``, ``check=False``).
     ``collision_check=False`` lets a robot without collision shapes compile; the
     document's ``checks`` then records that self-collision was not checked.
     ``controller`` (``franka``, ``ur``) adds that motion generator's rate and limits to
@@ -155,28 +157,32 @@ def build_lint(lint: FileResult, *, robot: str | None = None, rate: float | None
     from ..lang.descriptors import compare
     from ..measuring.measured import measure
 
+    opts = (options or BuildOptions()).replace(**changes) if changes else (
+        options or BuildOptions())
     start = time.perf_counter()
     res = BuildResult(lint.path, lint, list(lint.diagnostics))
-    res.diagnostics += _with_robot(lint, robot)
+    res.diagnostics += _with_robot(lint, opts.robot)
     b, tl = lint.behaviour, lint.timeline
     if has_errors(res.diagnostics) or b is None or tl is None or lint.cv is None:
         return res
-    res.diagnostics += _robot_diagnostics(b, check, collision_check)
+    res.diagnostics += _robot_diagnostics(b, opts)
     if has_errors(res.diagnostics):
         return res
-    opts = CompileOptions() if rate is None else CompileOptions(rate=rate)
-    res.compiled = compiled = compile_behaviour(b, opts, tl)
+    copts = CompileOptions(package_dirs=opts.package_dirs) if opts.rate is None else \
+        CompileOptions(rate=opts.rate, package_dirs=opts.package_dirs)
+    res.compiled = compiled = compile_behaviour(b, copts, tl)
     res.diagnostics += compiled.diagnostics
     tr = compiled.trajectory
     if not compiled.ok or tr is None:
         res.seconds = time.perf_counter() - start
         return res
     checks_json: dict[str, Any] = {"kinematic": "skipped (--no-check)"}
-    if check:
+    if opts.check:
         from ..robot import load_robot
 
-        checks_json["collision_checked"] = load_robot(b.settings.robot).collision
-        checks_json |= _check(res, opts.rate, scene, controller)
+        checks_json["collision_checked"] = load_robot(b.settings.robot,
+                                                      opts.package_dirs).collision
+        checks_json |= _check(res, copts.rate, opts.scene, opts.controller)
         if has_errors(res.diagnostics):
             res.seconds = time.perf_counter() - start
             return res
@@ -195,19 +201,20 @@ def build_lint(lint: FileResult, *, robot: str | None = None, rate: float | None
     res.header = document_header(
         compiled, measured=m.descriptors.to_json(), declared=want.to_json(),
         cv=lint.cv.to_json(), checks=checks_json | {"gaze_error_deg": round(m.gaze_error, 6)},
-        rate=opts.rate)
+        rate=copts.rate)
     res.seconds = time.perf_counter() - start
     return res
 
 
-def build_source(text: str, path: str = "<string>", **options: Any) -> BuildResult:
-    """:func:`build_lint` of source text; ``options`` as there."""
-    return build_lint(lint_source(text, path), **options)
+def build_source(text: str, path: str = "<string>", options: BuildOptions | None = None,
+                 **changes: Any) -> BuildResult:
+    """:func:`build_lint` of source text; ``options`` and ``changes`` as there."""
+    return build_lint(lint_source(text, path), options, **changes)
 
 
-def build_file(path: str, **options: Any) -> BuildResult:
-    """:func:`build_lint` of a file; ``options`` as there."""
-    return build_lint(lint_file(path), **options)
+def build_file(path: str, options: BuildOptions | None = None, **changes: Any) -> BuildResult:
+    """:func:`build_lint` of a file; ``options`` and ``changes`` as there."""
+    return build_lint(lint_file(path), options, **changes)
 
 
 def _what(c) -> str:
@@ -244,19 +251,23 @@ def _span_at(compiled, t: float | None) -> Span:
 def load_motion(path: str, *, robot: str | None = None,
                 goal: tuple[float, float, float] | str | None = None,
                 ee_frame: str | None = None, angle_unit: str | None = None,
-                time_unit: str | None = None) -> Trajectory:
+                time_unit: str | None = None, package_dirs: tuple[str, ...] = ()
+                ) -> Trajectory:
     """A ``.aou`` file compiled (without the safety checks), or a trajectory file read
     (a CSV recording needs ``robot``; ``goal`` and ``ee_frame`` override the file's).
 
     Raises:
         AouError: the file's diagnostics when it cannot be compiled or read.
     """
+    from ..core.options import package_dirs as absolute
     from ..measuring.recording import read_recording
 
+    package_dirs = absolute(package_dirs)
     if path.endswith(".aou"):
-        res = build_file(path, robot=robot, check=False)
+        res = build_file(path, robot=robot, check=False, package_dirs=package_dirs)
         if not res.ok:
             raise AouError(res.diagnostics)
         return res.trajectory.with_(path=path)
     return read_recording(path, robot=robot, goal=goal, ee_frame=ee_frame,
-                          angle_unit=angle_unit, time_unit=time_unit)
+                          angle_unit=angle_unit, time_unit=time_unit,
+                          package_dirs=package_dirs)

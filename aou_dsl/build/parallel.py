@@ -36,6 +36,7 @@ from collections.abc import Iterable, Iterator
 from typing import TYPE_CHECKING, Any
 
 from ..core.diagnostics import AouError
+from ..core.options import BuildOptions
 
 if TYPE_CHECKING:
     from ..lang.linter import FileResult
@@ -61,15 +62,15 @@ def default_jobs() -> int:
         return max(1, os.cpu_count() or 1)
 
 
-def build_many(paths: Iterable[str], options: dict[str, Any] | None = None, jobs: int = 1,
+def build_many(paths: Iterable[str], options: BuildOptions | None = None, jobs: int = 1,
                *, cluster: Any = None, pool: BuildPool | None = None,
                encode: str | None = None) -> Iterator[BuildResult]:
-    """Build every path with ``build_file(path, **options)``; results in input order.
+    """Build every path with ``build_file(path, options)``; results in input order.
 
     Args:
         paths: ``.aou`` files.
-        options: keyword options of :func:`aou_dsl.build.builder.build_lint` (``robot``,
-            ``rate``, ``check``, ``scene``).
+        options: how to build (:class:`~aou_dsl.core.options.BuildOptions`); it travels
+            to the workers whole, ``package_dirs`` included.
         jobs: worker processes on this machine (1: none, build here).
         cluster: a ``distributed.Client`` or a scheduler address; then ``jobs`` is
             ignored and the cluster's workers build.
@@ -79,37 +80,38 @@ def build_many(paths: Iterable[str], options: dict[str, Any] | None = None, jobs
             left to this process is then copying bytes).
     """
     paths = list(paths)
-    opts = dict(options or {})
+    opts = options or BuildOptions()
     if cluster is not None:
         yield from _on_cluster(paths, opts, cluster, encode)
     elif pool is not None:
         yield from pool.map(paths, opts, encode=encode)
     elif jobs <= 1 or len(paths) <= 1:
-        from .builder import build_file
+        from .session import Session
 
+        session = Session(opts)
         for p in paths:
-            yield build_file(p, **opts)
+            yield session.build_file(p)
     else:
-        robot = opts.get("robot")
-        with BuildPool(min(jobs, len(paths)), robots=(robot or "panda",)) as own:
+        with BuildPool(min(jobs, len(paths)), robots=(opts.robot or "panda",),
+                       options=opts) as own:
             yield from own.map(paths, opts, encode=encode)
 
 
-def build_text(text: str, path: str, options: dict[str, Any], encode: str | None = None
+def build_text(text: str, path: str, options: BuildOptions, encode: str | None = None
                ) -> BuildResult:
     """One build, in a worker: the same as ``build_file(path)`` of a file holding
     ``text`` (and its document encoded in ``encode``, see :func:`encoded`)."""
     from .builder import build_source
 
-    return _pack(build_source(text, path, **options), encode)
+    return _pack(build_source(text, path, options), encode)
 
 
-def _build_linted(lint: FileResult, options: dict[str, Any], encode: str | None
+def _build_linted(lint: FileResult, options: BuildOptions, encode: str | None
                   ) -> BuildResult:
     """One build of a file the parent has linted (``build_lint`` of it)."""
     from .builder import build_lint
 
-    return _pack(build_lint(lint, **options), encode)
+    return _pack(build_lint(lint, options), encode)
 
 
 # --- what goes back to the parent --------------------------------------------------------
@@ -171,18 +173,18 @@ def write_result(path: str, res: BuildResult, fmt: str, *, inputs: list[str] | t
 _WARM = "approach\npause 1.25s x2\nretreat 0.06m a=0.12\n"
 
 
-def warm(robots: tuple[str, ...] = ("panda",)) -> None:
+def warm(robots: tuple[str, ...] = ("panda",), options: BuildOptions | None = None) -> None:
     """A worker's start: one thread for numerical libraries (the pool already uses every
-    core), then a small behaviour built for each of ``robots``."""
+    core), then a small behaviour built for each of ``robots`` with ``options``."""
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(var, "1")
     from .builder import build_source
 
     for r in robots:  # a robot this behaviour does not suit is simply less warm
-        build_source(_WARM, "<warm-up>", robot=r)
+        build_source(_WARM, "<warm-up>", options, robot=r)
 
 
-def _start(robots: tuple[str, ...], ready) -> None:
+def _start(robots: tuple[str, ...], options: BuildOptions | None, ready) -> None:
     """A worker's initializer: SIGINT ignored (the parent stops its workers itself; a
     terminal's Ctrl-C reaches every process of the group), warm, then wait for the
     others, though not for ever: the parent may have gone on or stopped the pool."""
@@ -191,7 +193,7 @@ def _start(robots: tuple[str, ...], ready) -> None:
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
-        warm(robots)
+        warm(robots, options)
     finally:
         with contextlib.suppress(threading.BrokenBarrierError):
             ready.wait(timeout=_START_TIMEOUT)
@@ -232,7 +234,8 @@ class BuildPool:
     (:meth:`terminate`); leaving it normally waits for the builds handed out.
     """
 
-    def __init__(self, jobs: int | None = None, *, robots: tuple[str, ...] = ("panda",)):
+    def __init__(self, jobs: int | None = None, *, robots: tuple[str, ...] = ("panda",),
+                 options: BuildOptions | None = None):
         import multiprocessing
         import threading
         from concurrent.futures import ProcessPoolExecutor
@@ -243,7 +246,7 @@ class BuildPool:
         ctx = multiprocessing.get_context("spawn")
         ready = ctx.Barrier(self.jobs + 1)
         self._pool = ProcessPoolExecutor(max_workers=self.jobs, mp_context=ctx,
-                                         initializer=_start, initargs=(robots, ready))
+                                         initializer=_start, initargs=(robots, options, ready))
         # Once the workers are stopped, the pool's thread may still put an end-of-work
         # sentinel into the queue that hands out the builds, which nobody reads any more:
         # a pipe that cannot be written then is nothing to report (by default its feeder
@@ -263,9 +266,9 @@ class BuildPool:
             self.terminate()
             raise
 
-    def map(self, paths: Iterable[str], options: dict[str, Any] | None = None, *,
+    def map(self, paths: Iterable[str], options: BuildOptions | None = None, *,
             encode: str | None = None) -> Iterator[BuildResult]:
-        """``build_file(path, **options)`` of every path, in input order.
+        """``build_file(path, options)`` of every path, in input order.
 
         The files are linted here (a millisecond each), a window at a time; a file lint
         refuses is finished here, the others are handed out longest motion first, the
@@ -273,7 +276,7 @@ class BuildPool:
         """
         from concurrent.futures import Future
 
-        opts = dict(options or {})
+        opts = options or BuildOptions()
         todo = iter(paths)
         size = _WINDOW * self.jobs
         current = self._window(todo, size, opts, encode)
@@ -283,7 +286,7 @@ class BuildPool:
                 yield got.result() if isinstance(got, Future) else got
             current = upcoming
 
-    def _window(self, todo: Iterator[str], size: int, options: dict[str, Any],
+    def _window(self, todo: Iterator[str], size: int, options: BuildOptions,
                 encode: str | None) -> list:
         """The next ``size`` paths, each a finished result or a submitted build."""
         from ..lang.linter import lint_file
@@ -294,7 +297,7 @@ class BuildPool:
         for k in sorted(range(len(lints)), key=lambda k: -_cost(lints[k])):
             lint = lints[k]
             if lint.behaviour is None or lint.timeline is None or lint.cv is None:
-                out[k] = build_lint(lint, **options)  # refused: nothing to compile
+                out[k] = build_lint(lint, options)  # refused: nothing to compile
             else:
                 out[k] = self._pool.submit(_build_linted, lint, options, encode)
         return out
@@ -349,7 +352,7 @@ class BuildPool:
             self.terminate()
 
 
-def _on_cluster(paths: list[str], options: dict[str, Any], cluster: Any,
+def _on_cluster(paths: list[str], options: BuildOptions, cluster: Any,
                 encode: str | None) -> Iterator[BuildResult]:
     try:
         from distributed import Client, Future

@@ -44,9 +44,16 @@ def _scene_kw(args: argparse.Namespace) -> dict:
             "table_height": None if args.no_table else args.table_height}
 
 
+def _package_dirs(args: argparse.Namespace) -> tuple[str, ...]:
+    from ..core.options import package_dirs
+
+    return package_dirs(getattr(args, "package_dir", None))
+
+
 def _read_kw(args: argparse.Namespace) -> dict:
     return {"robot": args.robot, "goal": args.goal, "ee_frame": args.ee_frame,
-            "angle_unit": args.angle_unit, "time_unit": args.time_unit}
+            "angle_unit": args.angle_unit, "time_unit": args.time_unit,
+            "package_dirs": _package_dirs(args)}
 
 
 def _count(n: int, noun: str) -> str:
@@ -129,8 +136,8 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     from ..compiler.output import FORMATS, output_paths
     from ..core.diagnostics import has_errors
     from ..core.files import check_format
+    from ..core.options import BuildOptions, SceneOptions
     from ..lang.linter import collect_inputs
-    from ..robot.scene import SceneOptions
 
     inputs, problems = collect_inputs(args.paths)
     if problems:
@@ -142,9 +149,10 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     except AouError as err:
         return _fail(err)
     sources = [src for src, _ in inputs]
-    options = {"robot": args.robot, "rate": args.rate, "check": not args.no_check,
-               "scene": SceneOptions(**_scene_kw(args)),
-               "collision_check": not args.no_collision_check, "controller": args.controller}
+    options = BuildOptions(robot=args.robot, rate=args.rate, check=not args.no_check,
+                           scene=SceneOptions(**_scene_kw(args)),
+                           collision_check=not args.no_collision_check,
+                           controller=args.controller, package_dirs=_package_dirs(args))
     results = build_many(sources, options, args.jobs or default_jobs(), cluster=args.cluster,
                          encode=fmt)  # the workers encode; this process writes bytes
     worst = EXIT_OK
@@ -180,7 +188,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
 
     named = Span.whole_file("<command line>" if args.robot else args.path)  # the robot
     refused = robot_diagnostics(tr.robot, collision_check=not args.no_collision_check,
-                                span=named)
+                                span=named, package_dirs=tr.package_dirs)
     _print_diags(refused)
     if any(d.severity == Severity.ERROR for d in refused):
         return EXIT_ERRORS
@@ -243,8 +251,8 @@ def _render(paths: list[str], output: str, args: argparse.Namespace, read_kw: di
     import time
 
     from ..api import read_trajectory
+    from ..core.options import SceneOptions
     from ..media.render import Camera, check_output, render_video, start_workers
-    from ..robot.scene import SceneOptions
 
     check_output(output)
     w, h = args.size
@@ -259,7 +267,9 @@ def _render(paths: list[str], output: str, args: argparse.Namespace, read_kw: di
         raise
     start = time.perf_counter()
     info = render_video(motions, output, fps=args.fps, camera=camera,
-                        scene_options=SceneOptions(**_scene_kw(args)), workers=workers)
+                        scene_options=SceneOptions(**_scene_kw(args),
+                                                   package_dirs=_package_dirs(args)),
+                        workers=workers)
     print(f"wrote {output}: {info['frames']} frames at {info['fps']:g} fps "
           f"({info['duration']:.2f} s), {info['size'][0]}x{info['size'][1]}, "
           f"{_count(info['drawn'], 'image')} drawn (a frame where the arm holds still "
@@ -315,10 +325,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help(sys.stderr)
         return EXIT_USAGE
     try:
-        if getattr(args, "package_dir", None):
-            from ..robot import set_package_dirs
-
-            set_package_dirs(args.package_dir)
         return _COMMANDS[args.command](args)
     except AouError as err:
         return _fail(err)

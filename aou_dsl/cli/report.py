@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 
@@ -20,16 +21,10 @@ __all__ = [
 
 #: The most characters of a source line an excerpt shows.
 EXCERPT = 120
-_LAST: tuple[str | None, list[str]] = (None, [])  # the last source formatted, its lines
-
-
+@functools.lru_cache(maxsize=2)
 def _lines(source: str) -> list[str]:
     """The lines of ``source``, split once however many diagnostics point into it."""
-    global _LAST
-    last = _LAST
-    if last[0] is not source:
-        last = _LAST = (source, source.splitlines())
-    return last[1]
+    return source.splitlines()
 
 
 def _source_excerpt(d: Diagnostic, source: str | None) -> list[str]:

@@ -22,11 +22,12 @@ def cmd_robot(args: argparse.Namespace) -> int:
             print(f"{name:14s} {len(spec.arm_joints)} joints, end-effector {spec.ee_frame}")
         return EXIT_OK
     from ..core.files import check_output, write_atomic
+    from ..core.options import package_dirs
     from ..robot import describe_robot
 
     if args.output:
         check_output(args.output)
-    doc, text = describe_robot(args.robot)
+    doc, text = describe_robot(args.robot, package_dirs(args.package_dir))
     if args.format == "json":
         out = format_json(doc)
     elif args.format == "toml":

@@ -17,7 +17,7 @@ from ..robot.kinematics import ArmModel
 from .timelaw import SmoothLaw
 
 if TYPE_CHECKING:
-    from .timing import PathSegment
+    from .segment import PathSegment
 
 __all__ = ["JERK_SCALE", "LIMIT_SLACK", "PEAK_RATE", "binding_joint", "cartesian_peak",
            "jerk_ratio", "jerk_ratios", "limit_ratios", "within_limits"]

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.diagnostics import AouError, Diagnostic, diag, has_errors
+from ..core.memo import Keyed
 from ..core.trajectory import Trajectory
 from ..lang.ir import Behaviour
 from ..lang.layout import layout
@@ -54,11 +55,13 @@ DEFAULT_RATE = 250.0  # Hz
 
 @dataclass(frozen=True)
 class CompileOptions:
-    """Options of ``aouc compile``: sample ``rate`` [Hz], IK ``step_*`` sizes."""
+    """Options of ``aouc compile``: sample ``rate`` [Hz], IK ``step_*`` sizes, the folders
+    of the robot's ``package://`` meshes."""
 
     rate: float = DEFAULT_RATE
     step_length: float = STEP_LENGTH
     step_angle: float = STEP_ANGLE
+    package_dirs: tuple[str, ...] = ()
 
 
 @dataclass
@@ -95,18 +98,17 @@ def _waypoints(ep: Episode, frame: ReachFrame, opts: CompileOptions
     return s, targets
 
 
-_START_CACHE: dict = {}
-
-
 def _start_configuration(arm: ArmModel, frame: ReachFrame, pose: Pose):
     """IK of the start pose, by continuation from the robot's posture. The same reach
     always starts the same way, so the result is kept for recompilations."""
     key = (arm.spec.name, arm.frame_id, frame.goal.tobytes(), frame.R0.tobytes(), pose)
-    if key not in _START_CACHE:
-        if len(_START_CACHE) > 64:
-            _START_CACHE.clear()
-        _START_CACHE[key] = solve_path(arm, [frame.target(pose)])
-    return _START_CACHE[key]
+    return _solved_start(Keyed(key, (arm, frame.target(pose))))
+
+
+@functools.lru_cache(maxsize=64)
+def _solved_start(probe: Keyed):
+    arm, target = probe.value
+    return solve_path(arm, [target])
 
 
 def _ik_diag(ep: Episode, status: IKStatus, t: float, joint: str | None, b: Behaviour,
@@ -191,7 +193,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
     tl = timeline if timeline is not None else layout(b)
     res.timeline = tl
     lap("layout")
-    arm: ArmModel = load_arm(b.settings.robot)
+    arm: ArmModel = load_arm(b.settings.robot, None, options.package_dirs)
     spec = arm.spec
     frame = reach_frame(b.settings.goal or spec.goal,
                         b.settings.start_direction or spec.start_direction)
@@ -264,7 +266,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
         t_planned += segments[-1].duration
     res.ik_position_error, res.ik_rotation_error = worst_p, worst_r
     res.frame, res.segments = frame, segments
-    res.trajectory = _sample(arm, b, tl, segments, options.rate)
+    res.trajectory = _sample(arm, b, tl, segments, options.rate, options.package_dirs)
     lap("sample")
     return res
 
@@ -299,8 +301,9 @@ def sample(res: CompileResult, rate: float) -> Trajectory:
     if res.trajectory is None or res.timeline is None:
         raise AouError(diag("C305", "the compilation failed: there is nothing to sample",
                             res.behaviour.span))
-    arm = load_arm(res.behaviour.settings.robot)
-    return _sample(arm, res.behaviour, res.timeline, res.segments, rate)
+    dirs = res.trajectory.package_dirs
+    arm = load_arm(res.behaviour.settings.robot, None, dirs)
+    return _sample(arm, res.behaviour, res.timeline, res.segments, rate, dirs)
 
 
 def _clock(total: float, rate: float) -> np.ndarray:
@@ -361,7 +364,8 @@ def _evaluate(segments: list[PathSegment | JointSegment], t: np.ndarray,
 
 
 def _sample(arm: ArmModel, b: Behaviour, tl: Timeline,
-            segments: list[PathSegment | JointSegment], rate: float) -> Trajectory:
+            segments: list[PathSegment | JointSegment], rate: float,
+            package_dirs: tuple[str, ...] = ()) -> Trajectory:
     """Sample the segments on one clock at ``rate``; the last sample is the end."""
     if not segments:
         raise AouError(diag("V124", "the behaviour has nothing to move or hold", b.span))
@@ -373,4 +377,4 @@ def _sample(arm: ArmModel, b: Behaviour, tl: Timeline,
     episodes = tuple((e.kind, float(bounds[i]), float(bounds[i + 1]))
                      for i, e in enumerate(tl.episodes))
     return Trajectory(t, q, arm.joint_names, spec.name, spec.ee_frame, goal, qd, qdd,
-                      episodes, title=b.name)
+                      episodes, title=b.name, package_dirs=package_dirs)

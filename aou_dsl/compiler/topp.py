@@ -29,6 +29,7 @@ class _LazyModule(types.ModuleType):
         return getattr(importlib.import_module(self.__name__), attr)
 
 
+@functools.cache
 def _import_toppra():
     """toppra, imported without matplotlib.
 
@@ -38,8 +39,6 @@ def _import_toppra():
     are removed right after, so a later ``import matplotlib`` (``aouc plot``) is the real
     one, and toppra's own reference imports it only if it is ever used.
     """
-    if _READY:
-        return _READY[0]
     stubs: dict[str, types.ModuleType] = {}
     if "matplotlib" not in sys.modules:
         stubs["matplotlib"] = _LazyModule("matplotlib")
@@ -61,11 +60,7 @@ def _import_toppra():
     wrappers = toppra.solverwrapper
     available = wrappers.available_solvers(output_msg=False)
     wrappers.available_solvers = lambda output_msg=True: available
-    _READY.append(toppra)
     return toppra
-
-
-_READY: list = []  # toppra, once imported and prepared
 
 
 @functools.lru_cache(maxsize=256)

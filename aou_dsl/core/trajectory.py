@@ -32,6 +32,8 @@ class Trajectory:
             (compiled trajectories have them; recordings usually not).
         episodes: ``(kind, t_start, t_end)`` from the compiler's timeline, when known.
         path: where it was read from, for diagnostics; title: a name for figures.
+        package_dirs: folders that hold the robot's ``package://`` meshes, when its URDF
+            needs them (absolute paths).
     """
 
     t: np.ndarray
@@ -45,6 +47,7 @@ class Trajectory:
     episodes: tuple[tuple[str, float, float], ...] = ()
     path: str = "<memory>"
     title: str = ""
+    package_dirs: tuple[str, ...] = ()
 
     @property
     def duration(self) -> float:

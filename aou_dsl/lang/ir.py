@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import enum
+import functools
 import math
 import types
 import typing
@@ -79,7 +80,9 @@ def _check(obj: Any, name: str, value: Any, hint: Any) -> Any:
                     f", got {value!r}")
 
 
-_HINTS: dict[type, dict[str, Any]] = {}
+@functools.cache
+def _hints(cls: type) -> dict[str, Any]:
+    return typing.get_type_hints(cls)
 
 
 @dataclass(frozen=True, kw_only=True, slots=True)
@@ -88,11 +91,10 @@ class Model:
 
     def __post_init__(self) -> None:
         cls = type(self)
-        if cls not in _HINTS:
-            _HINTS[cls] = typing.get_type_hints(cls)
+        hints = _hints(cls)
         for f in dataclasses.fields(self):
             value = getattr(self, f.name)
-            checked = _check(self, f.name, value, _HINTS[cls][f.name])
+            checked = _check(self, f.name, value, hints[f.name])
             if checked is not value:
                 object.__setattr__(self, f.name, checked)
 

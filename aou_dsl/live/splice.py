@@ -14,7 +14,7 @@ next candidate.
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
@@ -22,7 +22,7 @@ from ..core.diagnostics import AouError, Span, diag
 
 if TYPE_CHECKING:
     from ..core.trajectory import Trajectory
-    from .regulator import Regulator
+    from ..robot.kinematics import ArmModel
 
 __all__ = ["LEAD", "PHASE_WEIGHT", "VELOCITY_WEIGHT", "brake_and_hold", "join_plan", "phase_in",
            "transition"]
@@ -41,6 +41,15 @@ PHASE_WEIGHT = 1.0
 _WHERE = Span.whole_file("<live>")
 
 State3 = tuple[np.ndarray, np.ndarray, np.ndarray]
+
+
+class Regulator(Protocol):
+    """What a splice reads of the regulator that runs it (:class:`.regulator.Regulator`)."""
+
+    arm: ArmModel
+    robot: str
+    goal: tuple[float, float, float] | None
+    transition_scale: float
 
 
 def _limits(reg: Regulator, x: State3, v: np.ndarray, a: np.ndarray
@@ -147,14 +156,17 @@ def phase_in(last: Trajectory, join_time: float, transition: float, plan_duratio
 
 
 def _checked(reg: Regulator, t, q, qd, qdd, goal) -> bool:
-    from ..api import check
     from ..core.trajectory import Trajectory
+    from ..safety.controllers import controller_checks
+    from ..safety.replay import replay
 
     if len(t) < 2:
         return True
     tr = Trajectory(t, q, reg.arm.joint_names, reg.arm.spec.name, reg.arm.spec.ee_frame,
                     goal, qd, qdd)
-    return check(tr, dynamic=False).ok
+    report = replay(tr, dynamic=False)
+    report.checks += controller_checks(tr, None)
+    return report.ok
 
 
 def _rate(plan: Trajectory) -> float:

@@ -330,7 +330,7 @@ def final_goal(rec: Trajectory) -> tuple[float, float, float]:
     from ..robot.batch_fk import batch_fk
     from ..robot.load import load_arm
 
-    arm = load_arm(rec.robot, rec.ee_frame)
+    arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs)
     cols = rec.columns(arm.joint_names)
     pos, _ = batch_fk(arm, np.asarray(rec.q, float)[-1:, cols])
     return (float(pos[0, 0]), float(pos[0, 1]), float(pos[0, 2]))
@@ -339,7 +339,8 @@ def final_goal(rec: Trajectory) -> tuple[float, float, float]:
 def read_recording(path: str, *, robot: str | None = None,
                    goal: tuple[float, float, float] | str | None = None,
                    ee_frame: str | None = None, angle_unit: str | None = None,
-                   time_unit: str | None = None) -> Trajectory:
+                   time_unit: str | None = None,
+                   package_dirs: tuple[str, ...] = ()) -> Trajectory:
     """Read a ``.json`` or ``.npz`` trajectory or a ``.csv`` recording (a file of another
     extension by its content: a JSON object, a zip, or a CSV whose header starts with
     ``t``).
@@ -357,6 +358,7 @@ def read_recording(path: str, *, robot: str | None = None,
             refused. An angle unit that leaves a joint outside its limits at every sample
             is refused too, and so are times on which the joints move more than ten times
             faster than their velocity limits (seconds read as milliseconds).
+        package_dirs: folders of the robot's ``package://`` meshes, kept with the motion.
 
     Raises:
         AouError: I501 when the file cannot be read or is in a format aou does not read
@@ -374,8 +376,8 @@ def read_recording(path: str, *, robot: str | None = None,
                        else _json(path, text, goal is None))
         trusted = header.generator.startswith("aouc")
         where = Where(path, text=text if fmt == "json" else None)
-    changes: dict[str, Any] = {k: v for k, v in (("robot", robot), ("ee_frame", ee_frame))
-                               if v}
+    changes: dict[str, Any] = {k: v for k, v in (("robot", robot), ("ee_frame", ee_frame),
+                                                 ("package_dirs", tuple(package_dirs))) if v}
     if goal is not None and not isinstance(goal, str):
         changes["goal"] = tuple(float(x) for x in goal)
     rec = rec.with_(**changes) if changes else rec

@@ -15,6 +15,7 @@ display.
 
 from __future__ import annotations
 
+import functools
 import math
 import sys
 from dataclasses import dataclass
@@ -55,12 +56,12 @@ def frame_configurations(traj, fps: float) -> np.ndarray:
     from ..robot.load import load_robot
 
     t = np.asarray(traj.t, float)
-    q = np.asarray(traj.q, float)[:, traj.columns(load_robot(traj.robot).spec.arm_joints)]
+    joints = load_robot(traj.robot, traj.package_dirs).spec.arm_joints
+    q = np.asarray(traj.q, float)[:, traj.columns(joints)]
     times = frame_times(float(t[-1] - t[0]), fps) + t[0]
     return np.column_stack([np.interp(times, t, q[:, j]) for j in range(q.shape[1])])
 
 
-_STAGES: dict = {}
 
 
 @dataclass
@@ -77,42 +78,38 @@ class _Stage:
     depth: np.ndarray  # (h * w) their depth (1: nothing there)
 
 
+@functools.lru_cache(maxsize=4)
 def _stage(robot: str, goal: tuple, options, camera: Camera) -> _Stage:
     """The stage of a video, kept for the next one: loading the meshes takes a second."""
-    from ..robot.scene import Scene, SceneOptions
+    from ..core.options import SceneOptions
+    from ..robot.scene import Scene
 
-    key = (robot, goal, options, repr(camera))
-    if key not in _STAGES:
-        if len(_STAGES) >= 4:
-            for old in _STAGES.values():
-                old.scene.close()  # type: ignore[attr-defined]
-            _STAGES.clear()
-        arm = Scene(robot, None, SceneOptions(target_size=0, table_height=None))
-        pb, c = arm.pb, arm.client
-        target = camera.target or (goal[0] / 2, goal[1] / 2, goal[2])
-        view = pb.computeViewMatrixFromYawPitchRoll(
-            cameraTargetPosition=list(target), distance=camera.distance, yaw=camera.yaw,
-            pitch=camera.pitch, roll=0, upAxisIndex=2, physicsClientId=c)
-        proj = pb.computeProjectionMatrixFOV(
-            fov=camera.fov, aspect=camera.width / camera.height, nearVal=0.05, farVal=10.0,
-            physicsClientId=c)
-        # The still things: the target, its pedestal, the table and the links no arm
-        # joint moves (the base), drawn once; the arm's scene hides those links.
-        try:
-            still = Scene(robot, goal, options)
-        except BaseException:
-            arm.close()
-            raise
-        try:
-            _pedestal(still, goal, options)
-            moving = _moving_links(still)
-            _hide(still, moving)
-            rgb, depth = _draw(still, camera, view, proj)
-        finally:
-            still.close()
-        _hide(arm, _drawn_links(arm) - moving)
-        _STAGES[key] = _Stage(arm, view, proj, rgb.copy(), depth.copy())
-    return _STAGES[key]
+    arm = Scene(robot, None, SceneOptions(target_size=0, table_height=None,
+                                            package_dirs=options.package_dirs))
+    pb, c = arm.pb, arm.client
+    target = camera.target or (goal[0] / 2, goal[1] / 2, goal[2])
+    view = pb.computeViewMatrixFromYawPitchRoll(
+        cameraTargetPosition=list(target), distance=camera.distance, yaw=camera.yaw,
+        pitch=camera.pitch, roll=0, upAxisIndex=2, physicsClientId=c)
+    proj = pb.computeProjectionMatrixFOV(
+        fov=camera.fov, aspect=camera.width / camera.height, nearVal=0.05, farVal=10.0,
+        physicsClientId=c)
+    # The still things: the target, its pedestal, the table and the links no arm
+    # joint moves (the base), drawn once; the arm's scene hides those links.
+    try:
+        still = Scene(robot, goal, options)
+    except BaseException:
+        arm.close()
+        raise
+    try:
+        _pedestal(still, goal, options)
+        moving = _moving_links(still)
+        _hide(still, moving)
+        rgb, depth = _draw(still, camera, view, proj)
+    finally:
+        still.close()
+    _hide(arm, _drawn_links(arm) - moving)
+    return _Stage(arm, view, proj, rgb.copy(), depth.copy())
 
 
 def _drawn_links(scene) -> set[int]:
@@ -365,7 +362,7 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
         ``{"frames": N, "drawn": D, "fps": fps, "duration": seconds, "size": [w, h]}``:
         D of the N frames are drawn, the others repeat one (the arm holding still).
     """
-    from ..robot.scene import SceneOptions
+    from ..core.options import SceneOptions
 
     try:
         fmt = check_output(path)
@@ -375,7 +372,7 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
             import imageio_ffmpeg  # noqa: F401  (imageio's ffmpeg plugin needs it)
         else:
             from PIL import Image
-        opts = scene_options or SceneOptions()
+        opts = scene_options or SceneOptions(package_dirs=trajs[0].package_dirs)
         clips = [_Clip.of(tr, fps) for tr in trajs]
     except BaseException:
         if workers is not None:

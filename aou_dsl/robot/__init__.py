@@ -1,26 +1,31 @@
-"""Robots from files: URDFs as vendors ship them, robot description files (TOML), and the
-derivation of what they do not say.
+"""The robot layer: any arm, from a built-in name, a URDF as vendors ship it or a robot
+description file (TOML), to a kinematic model, IK and a PyBullet scene.
 
-The modules, lightest first: :mod:`.table` (the built-in arms' geometry, plain data),
-:mod:`.urdf` (reading and rewriting URDFs), :mod:`.chain` (the arm inside a URDF),
-:mod:`.description` (robot description files), :mod:`.derive` (forward axis, shiver
-joint, default reach; Pinocchio), :mod:`.load` (a robot name or path -> a loaded robot,
-once per process), :mod:`.describe` (what ``aouc robot`` prints). Importing this package
-imports none of them.
+The modules, lightest first: :mod:`.urdf` (reading and rewriting URDFs), :mod:`.chain`
+(the arm inside a URDF), :mod:`.description` (robot description files),
+:mod:`.kinematics` (the arm's Pinocchio model), :mod:`.batch_fk` (forward kinematics of
+many samples at once), :mod:`.geometry` (gaze-locked poses around the goal), :mod:`.ik`,
+:mod:`.bullet` (PyBullet, imported quietly), :mod:`.collide`, :mod:`.derive` (forward
+axis, shiver joint, default reach), :mod:`.model` (a loaded robot), :mod:`.assemble`,
+:mod:`.load` (a robot name or path -> a loaded robot, cached per process and per set of
+package folders), :mod:`.scene` (a PyBullet world holding the robot), :mod:`.summary`
+(what ``aouc robot`` prints). Other layers use :func:`load_robot`, :func:`load_arm`,
+:func:`robot_diagnostics` and :func:`describe_robot`. Importing this package imports none
+of them.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["describe_robot", "load_robot", "robot_diagnostics", "set_package_dirs"]
+__all__ = ["describe_robot", "load_robot", "robot_diagnostics"]
 
 
 def __getattr__(name: str) -> Any:
-    if name in ("load_robot", "robot_diagnostics", "set_package_dirs"):
-        from . import load
+    if name in ("load_robot", "robot_diagnostics"):
+        from . import load as loader
 
-        return getattr(load, name)
+        return getattr(loader, name)
     if name == "describe_robot":
         from .summary import describe_robot
 

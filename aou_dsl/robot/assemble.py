@@ -133,7 +133,7 @@ def assemble(name: str, urdf: Urdf, desc: Description | None, dirs: tuple[str, .
              base: RobotSpec | None = None) -> Robot:
     """The robot ``name`` from ``urdf``, pinned by ``desc`` (and the built-in ``base``
     it extends), the rest derived. See the module's docstring."""
-    from . import derive
+    from .derive import forward_axis, shiver_joint
     from .kinematics import frame_id
     from .model import Robot, reduced_model
 
@@ -150,14 +150,14 @@ def assemble(name: str, urdf: Urdf, desc: Description | None, dirs: tuple[str, .
     if pins.get("forward"):
         forward = pins["forward"]
     else:
-        forward, src["forward"] = derive.forward_axis(model, q_mid, frame_id(model, link))
+        forward, src["forward"] = forward_axis(model, q_mid, frame_id(model, link))
     offset = float(pins.get("ee_offset", 0.0))
     roll = float(pins.get("ee_roll", 0.0))
     model = _gazing(urdf, joints, velocity, (link, forward, offset, roll)) or model
     frame = GAZE_FRAME if model.existFrame(GAZE_FRAME) else link
     shiver = pins.get("shiver_joint")
     if not shiver:
-        shiver, src["shiver_joint"] = derive.shiver_joint(model, q_mid,
+        shiver, src["shiver_joint"] = shiver_joint(model, q_mid,
                                                           frame_id(model, frame), "+z")
     n = len(joints)
     src.setdefault("joint_accel", NO_SOURCE)

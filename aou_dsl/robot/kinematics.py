@@ -9,15 +9,14 @@ commands that need kinematics pay for it.
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from ..core.diagnostics import AouError, Span, diag
 from ..core.robot_specs import DEFAULT_JOINT_JERK, RobotSpec
 
-__all__ = ["ArmModel", "arm_model", "frame_id", "load_arm"]
+__all__ = ["ArmModel", "arm_model", "frame_id"]
 
 
 @dataclass(frozen=True)
@@ -247,27 +246,3 @@ def arm_model(spec: RobotSpec, model: Any, *, no_effort: tuple[str, ...] = ()) -
         effort=effort,
         jmax=np.array(spec.joint_jerk or (DEFAULT_JOINT_JERK,) * n, dtype=float),
     )
-
-
-@functools.cache
-def load_arm(robot: str, ee_frame: str | None = None) -> ArmModel:
-    """The arm of ``robot`` (a built-in name or a robot file's path), its kinematics built
-    from the URDF's joints alone (no mesh is read), once per process.
-
-    Raises:
-        AouError: V109 for an unknown robot or a robot file aou cannot use (I501 when it
-            cannot be read), R402 for a frame the model lacks (listing the valid ones).
-    """
-    from .load import load_robot
-
-    r = load_robot(robot)
-    arm = arm_model(r.spec, r.model, no_effort=r.no_effort)
-    if ee_frame is None or ee_frame == r.spec.ee_frame:
-        return arm
-    fid = frame_id(r.model, ee_frame)
-    if fid < 0:
-        valid = sorted({f.name for f in r.model.frames})
-        raise AouError(diag("R402", f"robot `{robot}` has no frame `{ee_frame}`",
-                            Span.whole_file(f"<robot {robot}>"),
-                            hint=f"frames: {', '.join(valid)}", valid=valid))
-    return replace(arm, frame_id=fid)

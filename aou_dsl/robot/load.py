@@ -17,75 +17,18 @@ import os
 import shutil
 import tempfile
 from collections.abc import Sequence
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import replace
 
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
+from ..core.options import package_dirs as package_dirs_of
 from ..core.robot_specs import ROBOT_FILE_TYPES, ROBOTS, UNSOURCED, RobotSpec, is_robot_file
 from .assemble import assemble, filled_velocities
-from .urdf import GAZE_FRAME, Gaze, Urdf, gaze_offset, gaze_rpy, kinematic_xml, read_urdf, scene_xml
+from .kinematics import ArmModel, arm_model, frame_id
+from .model import Robot, gaze_of, reduced_model
+from .urdf import read_urdf, scene_xml
 
-__all__ = ["Robot", "load_robot", "reduced_model", "robot_diagnostics", "scene_urdf",
-           "set_package_dirs", "unknown_robot"]
-
-_PACKAGE_DIRS: tuple[str, ...] = ()
-
-
-def set_package_dirs(dirs: Sequence[str]) -> None:
-    """Folders searched first for ``package://`` meshes, for every robot loaded after
-    (the command line's ``--package-dir``)."""
-    global _PACKAGE_DIRS
-    _PACKAGE_DIRS = tuple(os.path.abspath(d) for d in dirs)
-
-
-@dataclass(frozen=True)
-class Robot:
-    """A loaded robot.
-
-    Attributes:
-        spec: everything aou knows of it, pinned or derived.
-        urdf: its URDF, parsed.
-        model: the Pinocchio model of its arm joints (the rest locked at zero), with
-            ``spec.ee_frame``.
-        package_dirs: folders given for its ``package://`` meshes.
-        description: the robot description file it was read from ("" for none).
-        no_effort: arm joints whose URDF gives no effort limit.
-        filled_velocity: velocity limits [rad/s] given to joints whose URDF has none.
-        warnings: C313 diagnostics (limits from no source).
-        reach_ok: whether the derived default reach passed every probe (None: pinned).
-    """
-
-    spec: RobotSpec
-    urdf: Urdf
-    model: Any
-    package_dirs: tuple[str, ...] = ()
-    description: str = ""
-    no_effort: tuple[str, ...] = ()
-    filled_velocity: dict[str, float] = field(default_factory=dict)
-    warnings: tuple[Diagnostic, ...] = ()
-    reach_ok: bool | None = None
-
-    @property
-    def collision(self) -> bool:
-        """Whether any link the arm moves has collision geometry."""
-        moved: set[str] = set()
-        frontier = [self.urdf.joint(self.spec.arm_joints[0]).child]
-        while frontier:
-            link = frontier.pop()
-            moved.add(link)
-            frontier += [j.child for j in self.urdf.children(link)]
-        return bool(moved & self.urdf.collision_links)
-
-    @property
-    def gaze(self) -> Gaze | None:
-        """``(ee_link, forward, ee_offset, ee_roll)`` when aou adds the end-effector frame."""
-        return gaze_of(self.spec)
-
-
-def gaze_of(spec: RobotSpec) -> Gaze | None:
-    """``(ee_link, forward, ee_offset, ee_roll)`` when aou adds the end-effector frame."""
-    return (spec.ee_link, spec.forward, spec.ee_offset, spec.ee_roll) if spec.ee_link else None
-
+__all__ = ["Robot", "load_arm", "load_robot", "robot_diagnostics", "scene_urdf",
+           "unknown_robot"]
 
 def unknown_robot(robot: str, span: Span) -> Diagnostic:
     """V109 for a name that is neither a built-in arm nor a robot file."""
@@ -96,21 +39,19 @@ def unknown_robot(robot: str, span: Span) -> Diagnostic:
                 hint=did_you_mean(robot, ROBOTS), found=robot, valid=list(ROBOTS))
 
 
-def load_robot(robot: str, package_dirs: Sequence[str] | None = None) -> Robot:
+def load_robot(robot: str, package_dirs: Sequence[str] = ()) -> Robot:
     """The robot named ``robot`` (a built-in name or a file path), loaded once.
 
     Args:
         robot: a name of :data:`aou_dsl.core.robot_specs.ROBOTS`, or a ``.urdf``/``.toml`` path.
-        package_dirs: folders searched first for ``package://`` meshes; None for those
-            of :func:`set_package_dirs`.
+        package_dirs: folders searched first for ``package://`` meshes (the command
+            line's ``--package-dir``, :attr:`BuildOptions.package_dirs`).
 
     Raises:
         AouError: V109 for an unknown robot or a robot file aou cannot use, I501 for a
             file that cannot be read.
     """
-    dirs = _PACKAGE_DIRS if package_dirs is None else tuple(
-        os.path.abspath(d) for d in package_dirs)
-    return _load(robot, dirs)
+    return _load(robot, package_dirs_of(package_dirs))
 
 
 @functools.cache
@@ -160,43 +101,8 @@ def _builtin(name: str, dirs: tuple[str, ...]) -> Robot:
     return Robot(spec, urdf, model, dirs, "", no_effort, filled, tuple(warnings))
 
 
-def reduced_model(urdf: Urdf, joints: Sequence[str], velocity: dict[str, float],
-                  gaze: Gaze | None) -> Any:
-    """The Pinocchio model of ``joints`` (every other joint welded at zero), built from
-    the URDF's kinematics only; with :data:`GAZE_FRAME` when ``gaze`` is given.
-
-    Raises:
-        AouError: V109 when Pinocchio cannot build it, or its joints are not ``joints``.
-    """
-    import numpy as np
-    import pinocchio as pin
-
-    try:
-        model = pin.buildModelFromXML(kinematic_xml(urdf, joints, velocity))
-    except (RuntimeError, ValueError) as exc:
-        raise AouError(diag("V109", f"`{os.path.basename(urdf.path)}`: Pinocchio cannot "
-                            f"build its kinematics: {exc}", Span.whole_file(urdf.path))
-                       ) from None
-    names = tuple(model.names[1:])
-    if names != tuple(joints):
-        raise AouError(diag(
-            "V109", f"`{os.path.basename(urdf.path)}`: the arm's joints from the base "
-            f"outward are {', '.join(names)}; expected {', '.join(joints)}",
-            Span.whole_file(urdf.path), hint="list `arm_joints` from the base outward"))
-    if gaze is not None:  # added here, not in the XML: link and joint names may clash
-        from .kinematics import frame_id
-
-        parent = frame_id(model, gaze[0])
-        f = model.frames[parent]
-        turn = pin.SE3(pin.rpy.rpyToMatrix(*gaze_rpy(gaze[1], gaze[3])),
-                       np.array(gaze_offset(gaze[1], gaze[2])))
-        model.addFrame(pin.Frame(GAZE_FRAME, f.parentJoint, parent, f.placement * turn,
-                                 pin.FrameType.OP_FRAME))
-    return model
-
-
-def robot_diagnostics(robot: str, *, collision_check: bool = True,
-                      span: Span | None = None) -> list[Diagnostic]:
+def robot_diagnostics(robot: str, *, collision_check: bool = True, span: Span | None = None,
+                      package_dirs: Sequence[str] = ()) -> list[Diagnostic]:
     """What a build says about its robot: C313 warnings (limits from no source) and,
     unless ``collision_check`` is False, C312 when the arm has no collision geometry.
     They point at ``span`` (where the robot was named: the ``robot`` line, the command
@@ -206,7 +112,7 @@ def robot_diagnostics(robot: str, *, collision_check: bool = True,
     Raises:
         AouError: as :func:`load_robot`.
     """
-    r = load_robot(robot)
+    r = load_robot(robot, package_dirs)
     out = list(r.warnings)
     if collision_check and not r.collision:
         out.append(diag(
@@ -223,14 +129,11 @@ def robot_diagnostics(robot: str, *, collision_check: bool = True,
     return out
 
 
-_TMP: list[str] = []
-
-
+@functools.cache
 def _tmp_dir() -> str:
-    if not _TMP:
-        _TMP.append(tempfile.mkdtemp(prefix="aou-robots-"))
-        atexit.register(shutil.rmtree, _TMP[0], True)
-    return _TMP[0]
+    path = tempfile.mkdtemp(prefix="aou-robots-")
+    atexit.register(shutil.rmtree, path, True)
+    return path
 
 
 @functools.cache
@@ -251,11 +154,34 @@ def _scene_file(robot: str, dirs: tuple[str, ...], visuals: bool) -> str:
     return path
 
 
-def scene_urdf(robot: str, *, visuals: bool = False) -> str:
+def scene_urdf(robot: str, *, visuals: bool = False, package_dirs: Sequence[str] = ()) -> str:
     """The path of the URDF PyBullet loads for ``robot``: mesh paths absolute, the
     end-effector frame added when aou adds one, visual shapes only if ``visuals``.
 
     Raises:
         AouError: V109 when a mesh the copy needs cannot be found.
     """
-    return _scene_file(robot, _PACKAGE_DIRS, visuals)
+    return _scene_file(robot, package_dirs_of(package_dirs), visuals)
+
+
+@functools.cache
+def load_arm(robot: str, ee_frame: str | None = None,
+             package_dirs: tuple[str, ...] = ()) -> ArmModel:
+    """The arm of ``robot`` (a built-in name or a robot file's path), its kinematics built
+    from the URDF's joints alone (no mesh is read), once per process.
+
+    Raises:
+        AouError: V109 for an unknown robot or a robot file aou cannot use (I501 when it
+            cannot be read), R402 for a frame the model lacks (listing the valid ones).
+    """
+    r = load_robot(robot, package_dirs)
+    arm = arm_model(r.spec, r.model, no_effort=r.no_effort)
+    if ee_frame is None or ee_frame == r.spec.ee_frame:
+        return arm
+    fid = frame_id(r.model, ee_frame)
+    if fid < 0:
+        valid = sorted({f.name for f in r.model.frames})
+        raise AouError(diag("R402", f"robot `{robot}` has no frame `{ee_frame}`",
+                            Span.whole_file(f"<robot {robot}>"),
+                            hint=f"frames: {', '.join(valid)}", valid=valid))
+    return replace(arm, frame_id=fid)

@@ -9,69 +9,27 @@ none leaks into another.
 
 from __future__ import annotations
 
-import contextlib
 import os
-import sys
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..core.diagnostics import AouError, Span, diag
+from ..core.options import SceneOptions
+from .bullet import import_pybullet, quiet
 
-__all__ = ["Scene", "SceneOptions", "import_pybullet", "quiet", "urdf_path"]
-
-
-@contextlib.contextmanager
-def quiet():
-    """Keep PyBullet's C library from printing its banner ("pybullet build time: ...")
-    on standard output or error: it would corrupt ``--format json`` output."""
-    sys.stdout.flush()
-    sys.stderr.flush()
-    saved = [os.dup(1), os.dup(2)]
-    try:
-        with open(os.devnull, "w") as null:
-            os.dup2(null.fileno(), 1)
-            os.dup2(null.fileno(), 2)
-            yield
-    finally:
-        os.dup2(saved[0], 1)
-        os.dup2(saved[1], 2)
-        for fd in saved:
-            os.close(fd)
+__all__ = ["Scene", "SceneOptions", "urdf_path"]
 
 
-_quiet = quiet
-
-
-def import_pybullet():
-    """Import PyBullet quietly (see :func:`quiet`)."""
-    if "pybullet" not in sys.modules:
-        with _quiet():
-            import pybullet  # noqa: F401
-    return sys.modules["pybullet"]
-
-
-def urdf_path(robot: str, *, visuals: bool = False) -> tuple[str, str]:
+def urdf_path(robot: str, *, visuals: bool = False,
+              package_dirs: tuple[str, ...] = ()) -> tuple[str, str]:
     """The URDF PyBullet loads for ``robot`` (a name or a robot file's path; every mesh
     path in it absolute, the end-effector frame aou adds included; visual shapes only if
     ``visuals``) and its folder."""
     from .load import scene_urdf
 
-    urdf = scene_urdf(robot, visuals=visuals)
+    urdf = scene_urdf(robot, visuals=visuals, package_dirs=package_dirs)
     return urdf, os.path.dirname(urdf)
-
-
-@dataclass(frozen=True)
-class SceneOptions:
-    """The scene around the robot.
-
-    Attributes:
-        target_size: edge of the cube at the goal, which nothing may touch [m].
-        table_height: height of the table plane in the base frame [m]; None for no table.
-    """
-
-    target_size: float = 0.05
-    table_height: float | None = 0.0
 
 
 @dataclass
@@ -90,15 +48,16 @@ class Scene:
     def __post_init__(self):
         from .load import load_robot
 
-        spec = load_robot(self.robot).spec
-        urdf, _ = urdf_path(self.robot, visuals=self.visuals)
+        dirs = self.options.package_dirs
+        spec = load_robot(self.robot, dirs).spec
+        urdf, _ = urdf_path(self.robot, visuals=self.visuals, package_dirs=dirs)
         pb = import_pybullet()
         self.pb = pb
-        with _quiet():
+        with quiet():
             self.client = pb.connect(pb.DIRECT)
         flags = pb.URDF_USE_SELF_COLLISION | pb.URDF_USE_SELF_COLLISION_EXCLUDE_PARENT
         try:
-            with _quiet():  # PyBullet prints warnings about the URDF (inertia, materials)
+            with quiet():  # PyBullet prints warnings about the URDF (inertia, materials)
                 self.body = pb.loadURDF(urdf, useFixedBase=True, flags=flags,
                                         physicsClientId=self.client)
         except pb.error as exc:
@@ -150,6 +109,13 @@ class Scene:
         if self.client is not None:
             self.pb.disconnect(physicsClientId=self.client)
             self.client = None
+
+    def __del__(self) -> None:
+        """A scene dropped from a cache disconnects its physics client."""
+        try:
+            self.close()
+        except Exception:  # noqa: BLE001 - the interpreter may be shutting down
+            pass
 
     def __enter__(self) -> Scene:
         return self

@@ -54,7 +54,8 @@ def _joints(r: Robot) -> list[dict[str, Any]]:
     return out
 
 
-def describe_robot(robot: str) -> tuple[dict[str, Any], str]:
+def describe_robot(robot: str, package_dirs: tuple[str, ...] = ()
+                   ) -> tuple[dict[str, Any], str]:
     """A robot (a built-in name, or a URDF or robot description path) as aou loads it.
 
     Returns:
@@ -64,7 +65,7 @@ def describe_robot(robot: str) -> tuple[dict[str, Any], str]:
     Raises:
         AouError: as :func:`aou_dsl.robot.load.load_robot`.
     """
-    r = load_robot(robot)
+    r = load_robot(robot, package_dirs)
     spec = r.spec
     kind = ("built-in" if robot in ROBOTS else
             "robot description" if r.description else "URDF")

@@ -1,1 +1,3 @@
-"""Checks that a trajectory is safe to send to an arm (limits now; PyBullet replay next)."""
+"""Safety: every sample of a trajectory replayed and checked before it reaches an arm: joint
+limits (:mod:`.limits`), the PyBullet replay (:mod:`.replay`, :mod:`.sweep`), the replay's own
+forward kinematics (:mod:`.urdf_fk`) and the motion generators' limits (:mod:`.controllers`)."""

@@ -23,14 +23,16 @@ error and the joint torques against the URDF effort limits (a check).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.options import SceneOptions
 from ..core.trajectory import Trajectory
 from ..robot.load import load_arm
-from ..robot.scene import Scene, SceneOptions, urdf_path
+from ..robot.scene import Scene, urdf_path
 from .limits import Check, check_limits
 from .sweep import CONTACT_MARGIN, QUERY_RANGE, Geometry, Sweep, geometry
 from .urdf_fk import chain_fk, urdf_chain
@@ -96,7 +98,7 @@ def replay(tr: Trajectory, *, options: SceneOptions | None = None,
     Raises:
         AouError: R402 when the trajectory lacks a joint of the robot.
     """
-    arm = load_arm(tr.robot, tr.ee_frame)
+    arm = load_arm(tr.robot, tr.ee_frame, tr.package_dirs)
     cols = tr.columns(arm.joint_names)
     t, q = tr.t, np.ascontiguousarray(tr.q[:, cols], dtype=float)
     if tr.qd is not None and tr.qdd is not None:
@@ -106,7 +108,8 @@ def replay(tr: Trajectory, *, options: SceneOptions | None = None,
         qdd = np.gradient(qd, t, axis=0)
     checks = check_limits(arm, t, q, qd, qdd)
     goal = tuple(float(x) for x in tr.goal) if tr.goal is not None else None
-    scene, geo = _scene(tr.robot, options or SceneOptions())
+    options = options or SceneOptions(package_dirs=tr.package_dirs)
+    scene, geo = _scene(tr.robot, options)
     if scene.target is not None:  # the scene's cube stands at the goal (or far away)
         scene.pb.resetBasePositionAndOrientation(scene.target, goal or _AWAY, (0, 0, 0, 1),
                                                  physicsClientId=scene.client)
@@ -122,24 +125,17 @@ def replay(tr: Trajectory, *, options: SceneOptions | None = None,
     return report
 
 
-_SCENES: dict = {}
 #: Where the target cube waits when a trajectory has no goal [m].
 _AWAY = (0.0, 0.0, -100.0)
 
 
+@functools.lru_cache(maxsize=8)
 def _scene(robot: str, options: SceneOptions) -> tuple[Scene, Geometry]:
     """A scene per robot and options, kept with its geometry: loading the URDF is the
     slow part. Each replay sets the joint states, the cube's place and the physics
     settings it relies on."""
-    key = (robot, options)
-    if key not in _SCENES:
-        if len(_SCENES) >= 8:
-            for old, _ in _SCENES.values():
-                old.close()
-            _SCENES.clear()
-        scene = Scene(robot, _AWAY, options, visuals=False)
-        _SCENES[key] = (scene, geometry(scene, load_arm(robot).spec.allowed_contacts))
-    return _SCENES[key]
+    scene = Scene(robot, _AWAY, options, visuals=False)
+    return scene, geometry(scene, load_arm(robot, None, options.package_dirs).spec.allowed_contacts)
 
 
 def _contacts(sweep: Sweep, t: np.ndarray) -> tuple[list[Check], dict]:
@@ -195,7 +191,8 @@ def _agreement(sweep: Sweep, arm, frame: str, t: np.ndarray, q: np.ndarray
     spots = np.unique(np.linspace(0, len(t) - 1, AGREE_SPOTS).astype(int))
     for j in spots:
         sweep.visit(int(j))
-    chain = urdf_chain(urdf_path(sweep.scene.robot, visuals=False)[0], frame,
+    chain = urdf_chain(urdf_path(sweep.scene.robot, visuals=False,
+                                 package_dirs=sweep.scene.options.package_dirs)[0], frame,
                        arm.joint_names)
     pos, rot = chain_fk(chain, q)
     pin_pos, pin_rot = batch_fk(arm, q)

@@ -33,6 +33,7 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
+from ..core.memo import Keyed
 from ..lang.cv import CANONICAL, classify
 from ..lang.descriptors import REGISTRY, Descriptor
 from ..lang.ir import State
@@ -283,9 +284,9 @@ _LIMIT_CODES = frozenset({"C304", "C308", "C309", "C311"})
 def compiled(text: str) -> BuildResult:
     """The build of a synthesized text (robot and goal are in it), the checks included, as
     ``aouc compile`` makes it; kept for the texts made last."""
-    from ..api import compile as compile_source
+    from ..build.builder import build_source
 
-    return compile_source(source=text)
+    return build_source(text)
 
 
 def _failure(text: str) -> Diagnostic | None:
@@ -300,7 +301,11 @@ def _failure(text: str) -> Diagnostic | None:
     return None
 
 
-_CEILINGS: dict[tuple[State, Limits], float | None] = {}
+@functools.lru_cache(maxsize=64)
+def _ceiling(probe: Keyed) -> float | None:
+    """:func:`_highest` kept per state, arm and lowest intensity (``probe.key``)."""
+    make, lo = probe.value
+    return _highest(make, lo)
 
 
 def _highest(make, lo: float) -> float | None:
@@ -324,12 +329,7 @@ def _lowered(make, intensity: float, lo: float, why: Diagnostic,
     Raises:
         AouError: the failure, when even ``lo`` fails.
     """
-    if key is not None and key in _CEILINGS:
-        best = _CEILINGS[key]
-    else:
-        best = _highest(make, lo)
-        if key is not None:
-            _CEILINGS[key] = best
+    best = _highest(make, lo) if key is None else _ceiling(Keyed((*key, lo), (make, lo)))
     if best is None:
         raise AouError(diag(why.code, f"no intensity of this behaviour compiles on the arm: "
                             f"{why.message}", _WHERE))

@@ -1,0 +1,143 @@
+"""A warm session: the pipeline kept in one process between runs, for tools that run it
+again and again on small changes (an editor linting on every keystroke, a studio
+recompiling on every slider move, a worker building file after file).
+
+A :class:`Session` keeps what is slow to make and does not change between runs: the
+parser (built once per process), every arm it has loaded (the robot loader caches by
+name and package folders; :meth:`Session.warm` loads one ahead), and the last results of
+each stage, keyed by that stage's inputs:
+
+- ``lint``: by the text and its path;
+- ``build`` (compile, check, measure): by the linted behaviour and timeline (their values
+  and source positions, which the build's diagnostics point at), the file's path and the
+  :class:`~aou_dsl.core.options.BuildOptions`. A change that leaves them as they were (a
+  comment at the end of a line, trailing spaces) lints again but builds nothing; a changed
+  descriptor builds again.
+
+A session is not shared between threads without a lock of the caller's; each worker
+process of a pool holds its own.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+from collections.abc import Hashable
+from typing import TYPE_CHECKING, Any
+
+from ..core.options import BuildOptions
+
+if TYPE_CHECKING:
+    from ..core.trajectory import Trajectory
+    from ..lang.linter import FileResult
+    from ..measuring.measured import Measured
+    from .builder import BuildResult
+
+__all__ = ["Session"]
+
+
+class _Kept(OrderedDict):
+    """The last ``size`` results of one stage, most recent last."""
+
+    def __init__(self, size: int):
+        super().__init__()
+        self.size = size
+
+    def get_or(self, key: Hashable, make: Any) -> Any:
+        if key in self:
+            self.move_to_end(key)
+            return self[key]
+        value = self[key] = make()
+        while len(self) > self.size:
+            self.popitem(last=False)
+        return value
+
+
+class Session:
+    """The pipeline kept warm: ``text -> lint -> layout -> compile -> check -> measure``,
+    re-running only the stages whose inputs changed.
+
+    Args:
+        options: how builds are made unless a call says otherwise.
+        keep: how many results of each stage are kept.
+
+    Example::
+
+        session = Session(BuildOptions(robot="panda"))
+        session.warm()
+        res = session.build(text, "hesitant.aou")   # compiled, checked, measured
+        res = session.build(text + "# note\\n", "hesitant.aou")  # linted again only
+    """
+
+    def __init__(self, options: BuildOptions | None = None, *, keep: int = 16):
+        self.options = options or BuildOptions()
+        self._lints = _Kept(keep)
+        self._builds = _Kept(keep)
+        self.runs = {"lint": 0, "build": 0}
+
+    def warm(self, robot: str | None = None) -> None:
+        """Load ``robot`` (the options' robot, else the Panda) and run every stage once
+        on a small behaviour, so that the first real build pays no start-up."""
+        from .parallel import warm
+
+        warm((robot or self.options.robot or "panda",), self.options)
+
+    def lint(self, text: str, path: str = "<string>") -> FileResult:
+        """The lint of ``text`` (named ``path`` in diagnostics), kept for the same text."""
+        from ..lang.linter import lint_source
+
+        def run() -> FileResult:
+            self.runs["lint"] += 1
+            return lint_source(text, path)
+
+        return self._lints.get_or((path, text), run)
+
+    def build(self, text: str, path: str = "<string>", options: BuildOptions | None = None,
+              **changes: Any) -> BuildResult:
+        """Lint, compile, check and measure ``text`` with the session's options (or
+        ``options``, with ``changes``), re-using the last build of the same behaviour."""
+        from .builder import build_lint
+
+        opts = options or self.options
+        if changes:
+            opts = opts.replace(**changes)
+        linted = self.lint(text, path)
+        if linted.behaviour is None or linted.timeline is None:
+            return build_lint(linted, opts)  # refused: nothing to compile, nothing kept
+
+        def run() -> BuildResult:
+            self.runs["build"] += 1
+            return build_lint(_fresh(linted), opts)
+
+        key = (_behaviour_key(linted), path, opts)
+        return self._builds.get_or(key, run)
+
+    def build_file(self, path: str, options: BuildOptions | None = None,
+                   **changes: Any) -> BuildResult:
+        """:meth:`build` of a file's text.
+
+        Raises:
+            AouError: I501 when the file cannot be read.
+        """
+        from ..lang.linter import read_source
+
+        return self.build(read_source(path), path, options, **changes)
+
+    def measure(self, trajectory: Trajectory) -> Measured:
+        """The eleven descriptors of a trajectory (measuring keeps no state to reuse)."""
+        from ..measuring.measured import measure
+
+        return measure(trajectory)
+
+
+def _behaviour_key(linted: FileResult) -> Hashable:
+    """What a build of a linted file depends on: its behaviour and timeline as values
+    (their reprs: frozen records of the file's numbers and spans, without identities)."""
+    return repr(linted.behaviour), repr(linted.timeline), repr(linted.cv)
+
+
+def _fresh(linted: FileResult) -> FileResult:
+    """A copy a build may change (``--robot`` re-points its behaviour) without touching
+    the lint the session keeps."""
+    import copy
+
+    return copy.copy(linted)
