@@ -37,13 +37,13 @@ from typing import TYPE_CHECKING, Any
 
 from ..core.diagnostics import AouError
 from ..core.options import BuildOptions
+from .session import Session, warm
 
 if TYPE_CHECKING:
     from ..lang.linter import FileResult
     from .builder import BuildResult
 
-__all__ = ["BuildPool", "build_many", "build_text", "default_jobs", "encoded", "warm",
-           "write_result"]
+__all__ = ["BuildPool", "build_many", "build_text", "default_jobs", "encoded", "write_result"]
 
 #: Files linted and handed out at once, per worker, the longest motions first: a
 #: short file last keeps no core idle at the end while another builds a long one.
@@ -86,8 +86,6 @@ def build_many(paths: Iterable[str], options: BuildOptions | None = None, jobs: 
     elif pool is not None:
         yield from pool.map(paths, opts, encode=encode)
     elif jobs <= 1 or len(paths) <= 1:
-        from .session import Session
-
         session = Session(opts)
         for p in paths:
             yield session.build_file(p)
@@ -167,22 +165,6 @@ def write_result(path: str, res: BuildResult, fmt: str, *, inputs: list[str] | t
 
 
 # --- the pool -----------------------------------------------------------------------------
-
-#: A small behaviour built once by each worker before its first file: the parser, the
-#: robot, the compiler's caches, the checks' scene and the measurement all warm.
-_WARM = "approach\npause 1.25s x2\nretreat 0.06m a=0.12\n"
-
-
-def warm(robots: tuple[str, ...] = ("panda",), options: BuildOptions | None = None) -> None:
-    """A worker's start: one thread for numerical libraries (the pool already uses every
-    core), then a small behaviour built for each of ``robots`` with ``options``."""
-    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
-        os.environ.setdefault(var, "1")
-    from .builder import build_source
-
-    for r in robots:  # a robot this behaviour does not suit is simply less warm
-        build_source(_WARM, "<warm-up>", options, robot=r)
-
 
 def _start(robots: tuple[str, ...], options: BuildOptions | None, ready) -> None:
     """A worker's initializer: SIGINT ignored (the parent stops its workers itself; a
