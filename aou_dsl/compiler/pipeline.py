@@ -20,7 +20,7 @@ from ..core.memo import Keyed
 from ..core.trajectory import Trajectory
 from ..lang.ir import Behaviour
 from ..lang.layout import layout
-from ..lang.primitives import KINDS, MIN_SHIVER_F
+from ..lang.primitives import KINDS, MIN_SHIVER_F, Timing
 from ..lang.timeline import Episode, Pose, Timeline
 from ..robot.geometry import ReachFrame, reach_frame
 from ..robot.ik import IKStatus, solve_path
@@ -136,7 +136,7 @@ def _follows(arm: ArmModel, frame: ReachFrame, options: CompileOptions, tl: Time
         return False
     q = ik.q[0]
     for ep in tl.episodes:
-        if KINDS[ep.kind].timing not in ("hold", "oscillation"):
+        if KINDS[ep.kind].timing not in (Timing.HOLD, Timing.OSCILLATION):
             ik = solve_path(arm, _waypoints(ep, frame, options)[1], q)
             if ik.failure is not None:
                 return False
@@ -154,7 +154,7 @@ def _siblings(arm: ArmModel, frame: ReachFrame, episodes: tuple[Episode, ...],
         return []
     out = []
     for e in later:
-        if KINDS[e.kind].timing in ("hold", "oscillation"):
+        if KINDS[e.kind].timing in (Timing.HOLD, Timing.OSCILLATION):
             continue
         s, targets = _waypoints(e, frame, options)
         ik = solve_path(arm, targets, q)
@@ -213,9 +213,9 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
     for i, ep in enumerate(tl.episodes):
         seg: PathSegment | JointSegment | None
         timing = KINDS[ep.kind].timing
-        if timing == "hold":
+        if timing is Timing.HOLD:
             segments.append(JointSegment(q, ep.duration))
-        elif timing == "oscillation":
+        elif timing is Timing.OSCILLATION:
             seg, shiver_fail = shiver_segment(arm, q, ep.amplitude, ep.f, ep.duration)
             if shiver_fail is not None:
                 f_ok = shiver_fail.wanted
@@ -237,7 +237,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
                 return res
             worst_p = max(worst_p, ik.worst_position_error)
             worst_r = max(worst_r, ik.worst_rotation_error)
-            if timing == "fixed":
+            if timing is Timing.FIXED:
                 seg, tilt_fail = tilt_segment(arm, s, ik.q, ep.duration, functools.partial(
                     _siblings, arm, frame, tl.episodes[i:], ik.q[-1], options))
                 if tilt_fail is not None:

@@ -82,7 +82,7 @@ def _lean_toppra():
     same solver calls with the same arguments in the same order (the seidel solver
     warm-starts from its previous call), so the same law to the last bit, about a sixth
     faster on aou's paths. ``tests/test_speed_props.py`` compares the two."""
-    stock: Any = _import_toppra().algorithm.TOPPRA
+    stock: Any = _import_toppra().algorithm.TOPPRA  # an untyped library's class
     nan = float("nan")
 
     class LeanTOPPRA(stock):

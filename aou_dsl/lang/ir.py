@@ -19,6 +19,7 @@ import functools
 import math
 import types
 import typing
+from collections.abc import Hashable
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -81,7 +82,8 @@ def _check(obj: Any, name: str, value: Any, hint: Any) -> Any:
 
 
 @functools.cache
-def _hints(cls: type) -> dict[str, Any]:
+def _hints(cls: Any) -> dict[str, Any]:
+    """The type hints of an IR class, resolved once per class."""
     return typing.get_type_hints(cls)
 
 
@@ -91,7 +93,7 @@ class Model:
 
     def __post_init__(self) -> None:
         cls = type(self)
-        hints = _hints(cls)
+        hints = _hints(typing.cast(Hashable, cls))  # a class is hashable
         for f in dataclasses.fields(self):
             value = getattr(self, f.name)
             checked = _check(self, f.name, value, hints[f.name])

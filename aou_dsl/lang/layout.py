@@ -22,13 +22,11 @@ A sequence is laid out as written. The descriptor form is laid out in three step
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
 
 from .cv import composition, infer
 from .descriptors import EpisodeValues
-from .ir import Behaviour, State
-from .primitives import KINDS, Approach
-from .primitives.approach import translation
+from .ir import Behaviour, Node, State
+from .primitives import KINDS, Approach, Gaze, Tilt
 from .timeline import Episode, Pose, Timeline
 
 __all__ = ["STOP_ORDER", "episode_values", "layout", "nominal_values"]
@@ -61,14 +59,13 @@ def _sequence(b: Behaviour) -> list[Episode]:
     return out
 
 
-def _sequence_episode(p: Any, pose: Pose, standoff: float) -> Episode:
+def _sequence_episode(p: Node, pose: Pose, standoff: float) -> Episode:
+    arg: float | None = None
     if isinstance(p, Approach):
-        d = standoff if p.length is None else pose.d - p.length
-        return translation(p, p.span, pose, d)
-    kind: Any = KINDS[p.kind]
-    if p.kind in ("gaze", "tilt"):  # to a plane angle, by a roll: as written
-        return kind.episode(p, pose, p.angle)
-    return kind.episode(p, pose)
+        arg = standoff if p.length is None else pose.d - p.length
+    elif isinstance(p, (Gaze, Tilt)):  # to a plane angle, by a roll: as written
+        arg = p.angle
+    return KINDS[p.kind].episode(p, pose, arg)
 
 
 # --- the descriptor form --------------------------------------------------------------------
@@ -83,7 +80,7 @@ class _Stop:
     """
 
     kind: str
-    items: list[tuple[Any, float | None]] = field(default_factory=list)
+    items: list[tuple[Node, float | None]] = field(default_factory=list)
 
 
 def _split(n: int, k: int) -> list[int]:
@@ -91,11 +88,11 @@ def _split(n: int, k: int) -> list[int]:
     return [n // k + (1 if i < n % k else 0) for i in range(k)]
 
 
-def _count(node: Any) -> int:
+def _count(node: Node | None) -> int:
     return node.count if node is not None else 0
 
 
-def _gazes(b: Behaviour) -> list[tuple[Any, float]]:
+def _gazes(b: Behaviour) -> list[tuple[Node, float]]:
     out = []
     for plane in ("horizontal", "vertical"):
         g = b.first("gaze", plane)
@@ -147,7 +144,7 @@ def _share_pauses(stops: list[_Stop], gaze_stops: list[_Stop], retreat_stops: li
     joins a retreat stop, just before the retreats: the pause that starts them ends it."""
     firsts: dict[str, _Stop] = {}
     for st in gaze_stops:
-        plane = next(n.plane for n, _ in st.items if n.kind == "gaze")
+        plane = next(n.plane for n, _ in st.items if isinstance(n, Gaze))
         firsts.setdefault(plane, st)
     short = max(0, len(firsts) - max(0, free))
     for st, host in zip(list(firsts.values())[len(firsts) - short:], retreat_stops,
@@ -167,7 +164,7 @@ def _alternate_tilts(stops: list[_Stop]) -> None:
                 n += 1
 
 
-def _motion(b: Behaviour, approach: Any, stops: list[_Stop]
+def _motion(b: Behaviour, approach: Approach | None, stops: list[_Stop]
             ) -> tuple[list[Episode], set[int], list[int]]:
     """The motion episodes in order; the gaps that need a pause (gap ``i`` is before
     episode ``i``); then the gaps that want one, best first (after the other gazes, then
@@ -181,13 +178,12 @@ def _motion(b: Behaviour, approach: Any, stops: list[_Stop]
     for j, stop in enumerate(stops):
         target = s.standoff + net * (k - j) / (k + 1)
         if approach is not None and pose.d > target + 1e-12:
-            out.append(translation(approach, approach.span, pose, target))
+            out.append(KINDS["approach"].episode(approach, pose, target))
             pose = out[-1].end
         if stop.kind == "pause":
             stop_gaps.append(len(out))
         for node, arg in stop.items:
-            kind: Any = KINDS[node.kind]
-            ep = kind.episode(node, pose) if arg is None else kind.episode(node, pose, arg)
+            ep = KINDS[node.kind].episode(node, pose, arg)
             if ep.kind == "retreat":
                 required.add(len(out))
             out.append(ep)
@@ -197,7 +193,7 @@ def _motion(b: Behaviour, approach: Any, stops: list[_Stop]
             elif ep.kind == "gaze":
                 gaze_gaps.setdefault(ep.plane, []).append(len(out))
     if approach is not None and pose.d > s.standoff + 1e-12:
-        out.append(translation(approach, approach.span, pose, s.standoff))
+        out.append(KINDS["approach"].episode(approach, pose, s.standoff))
     # A plane's gaze angle is read at a pause that ends one of its gazes: one per plane is
     # needed (shared with a retreat's pause where one follows a gaze); the rest are wanted.
     wanted: list[int] = []
@@ -231,7 +227,7 @@ def _descriptor(b: Behaviour, state: State) -> list[Episode]:
         if i in gaps and pause is not None:
             at = motion[i].start if i < n else (motion[-1].end if motion else
                                                 Pose(b.settings.start))
-            out.append(KINDS["pause"].episode(pause, at))  # type: ignore[attr-defined]
+            out.append(KINDS["pause"].episode(pause, at))
         if i < n:
             out.append(motion[i])
     return out

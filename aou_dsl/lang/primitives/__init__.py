@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from .approach import Approach, ApproachKind
 from .gaze import GAZE_ANGULAR_ACCEL, Gaze, GazeKind
-from .kind import MIN_ANGLE, MIN_PAUSE, MIN_RETREAT, Kind
+from .kind import MIN_ANGLE, MIN_PAUSE, MIN_RETREAT, Kind, Timing
 from .pause import Pause, PauseKind
 from .retreat import Retreat, RetreatKind
 from .shiver import MIN_SHIVER_F, Shiver, ShiverKind, shiver_duration
@@ -24,6 +24,7 @@ __all__ = [
     "Approach",
     "Gaze",
     "Kind",
+    "Timing",
     "Pause",
     "Retreat",
     "Shiver",

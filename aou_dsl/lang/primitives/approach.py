@@ -10,7 +10,7 @@ from ...core.units import Dim
 from ..ir import DEFAULTS, Node
 from ..parse import Word
 from ..timeline import Episode, Pose
-from .kind import MIN_RETREAT, Key, Kind, fmt, move
+from .kind import MIN_RETREAT, Key, Kind, fmt, given, move
 
 __all__ = ["Approach", "ApproachKind", "translation"]
 
@@ -89,6 +89,10 @@ class ApproachKind(Kind):
             return Approach(span=r.st.span, length=length, a=a or DEFAULTS["approach_a"],
                             v=v or DEFAULTS["speed_cap"], count=r.count)
         return None
+
+    def episode(self, node, pose: Pose, arg: float | None = None) -> Episode:
+        """A move along the line of sight to ``arg`` [m] from the goal."""
+        return translation(node, node.span, pose, given(arg, "an approach's end"))
 
     def values(self, node):
         return {"peak_acceleration": node.a}

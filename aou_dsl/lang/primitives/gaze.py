@@ -8,8 +8,8 @@ from typing import Literal
 
 from ...core.units import Dim
 from ..ir import DEFAULTS, Node
-from ..timeline import Pose
-from .kind import MIN_ANGLE, Key, Kind, fmt, move, repeat
+from ..timeline import Episode, Pose
+from .kind import MIN_ANGLE, Key, Kind, fmt, given, move, repeat
 
 __all__ = ["GAZE_ANGULAR_ACCEL", "Gaze", "GazeKind"]
 
@@ -57,8 +57,9 @@ class GazeKind(Kind):
                         count=r.count)
         return None
 
-    def episode(self, node, pose: Pose, angle: float):
-        """An arc from ``pose`` to the plane angle ``angle`` [rad] in the node's plane."""
+    def episode(self, node, pose: Pose, arg: float | None = None) -> Episode:
+        """An arc from ``pose`` to the plane angle ``arg`` [rad] in the node's plane."""
+        angle = given(arg, "a gaze's plane angle")
         if node.plane == "horizontal":
             end = Pose(pose.d, angle, pose.v, pose.roll)
         else:

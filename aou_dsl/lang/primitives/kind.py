@@ -8,10 +8,12 @@ the C-V inference, and how to print it back as source. Pure Python.
 
 from __future__ import annotations
 
+import abc
+import enum
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from ...core.units import Dim
 from ..ir import Node
@@ -21,7 +23,8 @@ from ..timeline import Episode, Pose
 if TYPE_CHECKING:
     from ..values import Reader
 
-__all__ = ["MIN_ANGLE", "MIN_PAUSE", "MIN_RETREAT", "Key", "Kind", "fmt", "move"]
+__all__ = ["MIN_ANGLE", "MIN_PAUSE", "MIN_RETREAT", "Key", "Kind", "Timing", "fmt", "given",
+           "move"]
 
 #: Shortest pause [s] that can be told apart from the stop between two episodes.
 MIN_PAUSE = 0.2
@@ -40,8 +43,26 @@ class Key:
     what: str
 
 
-class Kind:
-    """One primitive kind. Subclasses set the class attributes and the methods."""
+class Timing(enum.Enum):
+    """How the compiler times a kind's episodes."""
+
+    #: Held still for the episode's duration (a pause).
+    HOLD = "hold"
+    #: A periodic swing of one joint, its frequency and cycles given (a shiver).
+    OSCILLATION = "oscillation"
+    #: A path run in the duration the layout set (a tilt at its declared speed).
+    FIXED = "fixed"
+    #: The fastest run of the path under the arm's limits and the declared peak
+    #: acceleration (approach, retreat, gaze).
+    OPTIMAL = "optimal"
+
+
+class Kind(abc.ABC):
+    """One primitive kind: the contract a new kind implements. Subclasses set the class
+    attributes ``name``, ``node``, ``usage`` and ``evidence`` (checked when the subclass is
+    made) and implement the abstract methods (checked when it is instantiated)."""
+
+    _REQUIRED: ClassVar[tuple[str, ...]] = ("name", "node", "usage", "evidence")
 
     #: The statement keyword (``approach``) and the IR node class it reads into.
     name: ClassVar[str]
@@ -50,30 +71,48 @@ class Kind:
     usage: ClassVar[str]
     #: The ``key=`` arguments it takes.
     keys: ClassVar[Mapping[str, Key]] = {}
-    #: How the compiler times its episodes: ``hold`` (a pause), ``oscillation`` (a
-    #: shiver), ``fixed`` (a set duration), ``optimal`` (fastest under the limits).
-    timing: ClassVar[str] = "optimal"
+    #: How the compiler times its episodes.
+    timing: ClassVar[Timing] = Timing.OPTIMAL
     #: Its path coordinate is a distance along the line of sight [m] (else an angle).
     translation: ClassVar[bool] = False
     #: C-V evidence: channel -> (episode value key, "sum" or "max").
-    evidence: ClassVar[Mapping[str, tuple[str, str]]] = {}
+    evidence: ClassVar[Mapping[str, tuple[str, str]]]
 
+    def __init_subclass__(cls, **kw) -> None:
+        super().__init_subclass__(**kw)
+        missing = [a for a in Kind._REQUIRED if not hasattr(cls, a)]
+        if missing:
+            raise TypeError(f"primitive kind {cls.__name__} does not set {', '.join(missing)}")
+
+    @abc.abstractmethod
     def read(self, r: Reader) -> Node | None:
         """The statement's node, or None after reporting what does not fit."""
-        raise NotImplementedError
 
-    def values(self, node: Node) -> dict[str, float]:
+    @abc.abstractmethod
+    def episode(self, node: Any, pose: Pose, arg: float | None = None) -> Episode:
+        """One episode of ``node`` from ``pose``. ``arg`` is where it goes when the
+        layout decides it: the distance to the goal an approach ends at [m], the plane
+        angle a gaze turns to or the roll a tilt turns by [rad]; other kinds take none."""
+
+    @abc.abstractmethod
+    def values(self, node: Any) -> dict[str, float]:
         """The values one episode of ``node`` shows, as the descriptor form declares
         them (before any layout)."""
-        raise NotImplementedError
 
+    @abc.abstractmethod
     def episode_values(self, ep: Episode) -> dict[str, float]:
         """The values a laid-out episode shows."""
-        raise NotImplementedError
 
-    def format(self, node: Node) -> str:
+    @abc.abstractmethod
+    def format(self, node: Any) -> str:
         """A descriptor-form statement that validates back to ``node``."""
-        raise NotImplementedError
+
+
+def given(arg: float | None, what: str) -> float:
+    """The layout's argument of an episode that needs one."""
+    if arg is None:
+        raise ValueError(f"{what} is the layout's to give")
+    return arg
 
 
 def fmt(x: float) -> str:

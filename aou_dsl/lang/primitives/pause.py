@@ -8,7 +8,7 @@ from typing import Literal
 from ...core.units import Dim
 from ..ir import Node
 from ..timeline import Episode, Pose
-from .kind import MIN_PAUSE, Kind, fmt, repeat
+from .kind import MIN_PAUSE, Kind, Timing, fmt, repeat
 
 __all__ = ["Pause", "PauseKind"]
 
@@ -26,7 +26,7 @@ class PauseKind(Kind):
     name = "pause"
     node = Pause
     usage = "pause DURATION [xN]"
-    timing = "hold"
+    timing = Timing.HOLD
     evidence = {"stillness": ("duration", "sum")}
 
     def read(self, r):
@@ -39,7 +39,7 @@ class PauseKind(Kind):
             return Pause(span=r.st.span, duration=d, count=r.count)
         return None
 
-    def episode(self, node, pose: Pose) -> Episode:
+    def episode(self, node, pose: Pose, arg: float | None = None) -> Episode:
         return Episode("pause", node.span, pose, pose, node.duration)
 
     def values(self, node):

@@ -7,7 +7,7 @@ from typing import Literal
 
 from ...core.units import Dim
 from ..ir import DEFAULTS, Node
-from ..timeline import Pose
+from ..timeline import Episode, Pose
 from .approach import translation
 from .kind import MIN_RETREAT, Key, Kind, fmt, repeat
 
@@ -49,7 +49,7 @@ class RetreatKind(Kind):
                            v=v or DEFAULTS["speed_cap"], count=r.count)
         return None
 
-    def episode(self, node, pose: Pose):
+    def episode(self, node, pose: Pose, arg: float | None = None) -> Episode:
         """Away from the goal by ``length`` (toward it when negative: an approach)."""
         return translation(node, node.span, pose, pose.d + node.length)
 

@@ -10,7 +10,7 @@ from ...core.units import Dim
 from ..ir import DEFAULTS, Node
 from ..parse import Word
 from ..timeline import Episode, Pose
-from .kind import MIN_ANGLE, Key, Kind, fmt, repeat
+from .kind import MIN_ANGLE, Key, Kind, Timing, fmt, repeat
 
 __all__ = ["MIN_CYCLES", "MIN_SHIVER_F", "Shiver", "ShiverKind", "shiver_cycles",
            "shiver_duration"]
@@ -68,7 +68,7 @@ class ShiverKind(Kind):
     node = Shiver
     usage = "shiver ANGLE [f=FREQ] [for DURATION] [xN]"
     keys = {"f": Key(Dim.FREQUENCY, "Hz", "shiver frequency")}
-    timing = "oscillation"
+    timing = Timing.OSCILLATION
     evidence = {"tremor": ("amplitude", "sum")}
 
     def read(self, r):
@@ -94,7 +94,7 @@ class ShiverKind(Kind):
             return node
         return None
 
-    def episode(self, node, pose: Pose) -> Episode:
+    def episode(self, node, pose: Pose, arg: float | None = None) -> Episode:
         return Episode("shiver", node.span, pose, pose, shiver_duration(node.duration, node.f),
                        amplitude=node.amplitude, f=node.f)
 

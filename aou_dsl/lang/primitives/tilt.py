@@ -9,7 +9,7 @@ from typing import Literal
 from ...core.units import Dim
 from ..ir import DEFAULTS, Node
 from ..timeline import Episode, Pose
-from .kind import MIN_ANGLE, Key, Kind, fmt, repeat
+from .kind import MIN_ANGLE, Key, Kind, Timing, fmt, given, repeat
 
 __all__ = ["Tilt", "TiltKind"]
 
@@ -30,7 +30,7 @@ class TiltKind(Kind):
     node = Tilt
     usage = "tilt ANGLE [v=ANGSPEED] [xN]"
     keys = {"v": Key(Dim.ANGULAR_SPEED, "deg/s", "angular speed")}
-    timing = "fixed"
+    timing = Timing.FIXED
     evidence = {"exploration": ("angle", "sum")}
 
     def read(self, r):
@@ -44,7 +44,8 @@ class TiltKind(Kind):
             return Tilt(span=r.st.span, angle=angle, v=v or DEFAULTS["tilt_v"], count=r.count)
         return None
 
-    def episode(self, node, pose: Pose, delta: float) -> Episode:
+    def episode(self, node, pose: Pose, arg: float | None = None) -> Episode:
+        delta = given(arg, "a tilt's roll")
         end = Pose(pose.d, pose.h, pose.v, pose.roll + delta)
         duration = abs(delta) / node.v
         return Episode("tilt", node.span, pose, end, duration,
