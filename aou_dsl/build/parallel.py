@@ -6,15 +6,14 @@ order of the inputs, whatever order they finish in; each result is the one
 :func:`aou_dsl.build.builder.build_file` gives for that path (the documents are the same bytes).
 
 - ``jobs=1``: one file after another, in this process.
-- ``jobs=N``: a pool of N worker processes (:class:`BuildPool`), started once and kept
-  warm (the compiler, the checks and the measurement imported, the default robot
-  loaded, before the first file). This process lints the files (a millisecond each)
-  and hands them out a window at a time, the longest motions first, so that no worker
-  idles at the end while another builds a long one. Interrupting is this process's
-  alone: the workers ignore SIGINT (Ctrl-C); a ``KeyboardInterrupt`` or any exception
-  that leaves a pool's ``with`` block, or closing a ``build_many`` that started its own
-  pool, cancels the builds not started and stops the workers at once
-  (:meth:`BuildPool.terminate`).
+- ``jobs=N``: this process and ``N - 1`` worker processes (:mod:`.batch`): this process
+  builds from the shortest file while the workers start, and each worker that has warmed
+  up takes the longest file left, so a batch is never slower than ``jobs=1`` for the
+  workers' start. A :class:`~.pool.BuildPool` given as ``pool=`` is used instead: workers
+  started once and kept warm between maps, handed files a window at a time, the longest
+  motions first. Interrupting is this process's alone: the workers ignore SIGINT (Ctrl-C);
+  a ``KeyboardInterrupt`` or any exception, or closing ``build_many``'s iterator, cancels
+  the builds not started and stops the workers at once (:meth:`BuildPool.terminate`).
 
 The parent's own share is what caps the speed-up, so it is kept small: a document's
 samples come back as the trajectory's arrays (one buffer each, not a float at a time),
@@ -30,37 +29,18 @@ Dask is imported only when a cluster is given (the optional extra ``cluster``).
 
 from __future__ import annotations
 
-import contextlib
-import os
 from collections.abc import Iterable, Iterator
 from typing import TYPE_CHECKING, Any
 
 from ..core.diagnostics import AouError
 from ..core.options import BuildOptions
-from .session import Session, warm
+from .pool import BuildPool, _pack, default_jobs, encoded
+from .session import Session
 
 if TYPE_CHECKING:
-    from ..lang.linter import FileResult
     from .builder import BuildResult
 
 __all__ = ["BuildPool", "build_many", "build_text", "default_jobs", "encoded", "write_result"]
-
-#: Files linted and handed out at once, per worker, the longest motions first: a
-#: short file last keeps no core idle at the end while another builds a long one.
-_WINDOW = 8
-#: How long a pool waits for its workers to warm up before it hands out files [s].
-_START_TIMEOUT = 120.0
-#: How long stopping a pool waits for a worker to end after it was told to [s].
-_STOP_TIMEOUT = 2.0
-
-
-def default_jobs() -> int:
-    """The cores this process may use."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # not on Linux
-        return max(1, os.cpu_count() or 1)
-
 
 def build_many(paths: Iterable[str], options: BuildOptions | None = None, jobs: int = 1,
                *, cluster: Any = None, pool: BuildPool | None = None,
@@ -89,10 +69,10 @@ def build_many(paths: Iterable[str], options: BuildOptions | None = None, jobs: 
         session = Session(opts)
         for p in paths:
             yield session.build_file(p)
-    else:
-        with BuildPool(min(jobs, len(paths)), robots=(opts.robot or "panda",),
-                       options=opts) as own:
-            yield from own.map(paths, opts, encode=encode)
+    else:  # this process builds too; workers join as they warm up
+        from .batch import shared_map
+
+        yield from shared_map(paths, opts, min(jobs, len(paths)), encode)
 
 
 def build_text(text: str, path: str, options: BuildOptions, encode: str | None = None
@@ -102,47 +82,6 @@ def build_text(text: str, path: str, options: BuildOptions, encode: str | None =
     from .builder import build_source
 
     return _pack(build_source(text, path, options), encode)
-
-
-def _build_linted(lint: FileResult, options: BuildOptions, encode: str | None
-                  ) -> BuildResult:
-    """One build of a file the parent has linted (``build_lint`` of it)."""
-    from .builder import build_lint
-
-    return _pack(build_lint(lint, options), encode)
-
-
-# --- what goes back to the parent --------------------------------------------------------
-
-#: The attribute a worker puts the encoded document in: ``(format, bytes)``.
-_ENCODED = "_encoded"
-def _pack(res: BuildResult, encode: str | None) -> BuildResult:
-    """In the worker: the result ready to go back; its document also encoded in
-    ``encode`` when asked (a byte format), so that the parent only writes bytes. The
-    document's lists of samples stay behind: the parent makes them again from the
-    trajectory's arrays when it needs them, which travel as raw bytes (lists pickle
-    float by float, which made reading the results back most of the parent's work)."""
-    if encode is not None and res.document is not None:
-        from ..compiler.output import FOLDER_FORMATS
-        from ..compiler.output import encode as encode_doc
-
-        if encode not in FOLDER_FORMATS:
-            setattr(res, _ENCODED, (encode, encode_doc(res.document, encode)))
-    res.drop_samples()
-    return res
-
-
-def encoded(res: BuildResult, fmt: str) -> bytes:
-    """The bytes of ``res.document`` in ``fmt`` (a byte format): those a worker encoded
-    (``build_many(..., encode=fmt)``), else encoded here."""
-    from ..compiler.output import encode
-
-    done = getattr(res, _ENCODED, None)
-    if done is not None and done[0] == fmt:
-        return done[1]
-    if res.document is None:
-        raise ValueError(f"{res.path}: the build failed, there is no document")
-    return encode(res.document, fmt)
 
 
 def write_result(path: str, res: BuildResult, fmt: str, *, inputs: list[str] | tuple = ()
@@ -162,176 +101,6 @@ def write_result(path: str, res: BuildResult, fmt: str, *, inputs: list[str] | t
         raise ValueError(f"{res.path}: the build failed, there is no document")
     else:
         write_output(path, res.document, fmt, inputs=inputs)
-
-
-# --- the pool -----------------------------------------------------------------------------
-
-def _start(robots: tuple[str, ...], options: BuildOptions | None, ready) -> None:
-    """A worker's initializer: SIGINT ignored (the parent stops its workers itself; a
-    terminal's Ctrl-C reaches every process of the group), warm, then wait for the
-    others, though not for ever: the parent may have gone on or stopped the pool."""
-    import signal
-    import threading
-
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
-        warm(robots, options)
-    finally:
-        with contextlib.suppress(threading.BrokenBarrierError):
-            ready.wait(timeout=_START_TIMEOUT)
-
-
-@contextlib.contextmanager
-def _sigint_held() -> Iterator[None]:
-    """SIGINT held back in this thread, so also in the processes it starts meanwhile
-    (they inherit the mask: a worker cannot be interrupted before its initializer
-    ignores SIGINT); one that arrives meanwhile is delivered here at the end."""
-    import signal
-
-    if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - not POSIX
-        yield
-        return
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
-
-
-def _cost(lint: FileResult) -> float:
-    """How long a linted file's build will take, roughly: its planned motion [s]."""
-    return lint.timeline.planned_duration if lint.timeline is not None else 0.0
-
-
-class BuildPool:
-    """Worker processes kept warm between maps (``with BuildPool(4) as pool: ...``).
-
-    The workers start at once and each imports the build's stages and loads the default
-    robot before it takes a file; :meth:`map` can be called again and again (a sweep
-    that compiles in rounds pays the start once). Scripts that make a pool need the
-    ``if __name__ == "__main__":`` guard: each worker is a fresh interpreter.
-
-    The workers ignore SIGINT: a ``KeyboardInterrupt`` is this process's, and leaving
-    the ``with`` block by one (or by any exception) stops the workers at once
-    (:meth:`terminate`); leaving it normally waits for the builds handed out.
-    """
-
-    def __init__(self, jobs: int | None = None, *, robots: tuple[str, ...] = ("panda",),
-                 options: BuildOptions | None = None):
-        import multiprocessing
-        import threading
-        from concurrent.futures import ProcessPoolExecutor
-
-        self.jobs = jobs or default_jobs()
-        # "spawn": a fresh interpreter per worker (no copy of this process's threads or
-        # physics clients).
-        ctx = multiprocessing.get_context("spawn")
-        ready = ctx.Barrier(self.jobs + 1)
-        self._pool = ProcessPoolExecutor(max_workers=self.jobs, mp_context=ctx,
-                                         initializer=_start, initargs=(robots, options, ready))
-        # Once the workers are stopped, the pool's thread may still put an end-of-work
-        # sentinel into the queue that hands out the builds, which nobody reads any more:
-        # a pipe that cannot be written then is nothing to report (by default its feeder
-        # thread prints a traceback; it takes this setting when it starts, at a submit).
-        calls = getattr(self._pool, "_call_queue", None)
-        if calls is not None and hasattr(calls, "_ignore_epipe"):
-            calls._ignore_epipe = True
-        try:
-            with _sigint_held():  # one task each makes the pool start every worker
-                for _ in range(self.jobs):
-                    self._pool.submit(os.getpid)
-            # until every worker has built its warm-up behaviour; a slow or failed start
-            # goes on regardless
-            with contextlib.suppress(threading.BrokenBarrierError):
-                ready.wait(timeout=_START_TIMEOUT)
-        except BaseException:  # interrupted while the workers warm up
-            self.terminate()
-            raise
-
-    def map(self, paths: Iterable[str], options: BuildOptions | None = None, *,
-            encode: str | None = None) -> Iterator[BuildResult]:
-        """``build_file(path, options)`` of every path, in input order.
-
-        The files are linted here (a millisecond each), a window at a time; a file lint
-        refuses is finished here, the others are handed out longest motion first, the
-        next window while this one is built, so no worker waits between windows.
-        """
-        from concurrent.futures import Future
-
-        opts = options or BuildOptions()
-        todo = iter(paths)
-        size = _WINDOW * self.jobs
-        current = self._window(todo, size, opts, encode)
-        while current:
-            upcoming = self._window(todo, size, opts, encode)
-            for got in current:
-                yield got.result() if isinstance(got, Future) else got
-            current = upcoming
-
-    def _window(self, todo: Iterator[str], size: int, options: BuildOptions,
-                encode: str | None) -> list:
-        """The next ``size`` paths, each a finished result or a submitted build."""
-        from ..lang.linter import lint_file
-        from .builder import build_lint
-
-        lints = [lint_file(p) for _, p in zip(range(size), todo, strict=False)]
-        out: list = [None] * len(lints)
-        for k in sorted(range(len(lints)), key=lambda k: -_cost(lints[k])):
-            lint = lints[k]
-            if lint.behaviour is None or lint.timeline is None or lint.cv is None:
-                out[k] = build_lint(lint, options)  # refused: nothing to compile
-            else:
-                out[k] = self._pool.submit(_build_linted, lint, options, encode)
-        return out
-
-    @property
-    def pids(self) -> list[int]:
-        """The workers' process ids (to measure the CPU time they use)."""
-        return sorted(self._pool._processes or {})  # type: ignore[attr-defined]
-
-    def close(self) -> None:
-        """Wait for the builds handed out, then end the workers."""
-        try:
-            self._pool.shutdown(wait=True, cancel_futures=True)
-        except BaseException:  # interrupted while waiting
-            self.terminate()
-            raise
-
-    def terminate(self) -> None:
-        """Stop now: the builds not started are cancelled, the workers are ended even
-        in the middle of a build (whose result is lost), and this returns once they
-        have (within a few seconds)."""
-        pool = self._pool
-        procs = list((getattr(pool, "_processes", None) or {}).values())
-        manager = getattr(pool, "_executor_manager_thread", None)
-        results = getattr(pool, "_result_queue", None)
-        pool.shutdown(wait=False, cancel_futures=True)
-        for p in procs:
-            with contextlib.suppress(OSError, ValueError):  # already ended
-                p.terminate()
-        for p in procs:
-            with contextlib.suppress(ValueError):
-                p.join(_STOP_TIMEOUT)
-                if p.is_alive():
-                    p.kill()
-                    p.join(_STOP_TIMEOUT)
-        # The pool's thread may be reading a result a worker was writing when it ended:
-        # with this process's copy of the pipe's writing end closed, it reads the end of
-        # the pipe instead of waiting for ever (and so does not hold up this process's exit).
-        writer = getattr(results, "_writer", None)
-        if writer is not None:
-            writer.close()
-        if manager is not None:
-            manager.join(_STOP_TIMEOUT)
-
-    def __enter__(self) -> BuildPool:
-        return self
-
-    def __exit__(self, kind: type[BaseException] | None, *exc: object) -> None:
-        if kind is None:
-            self.close()
-        else:  # an interruption or an error: the builds still running are not wanted
-            self.terminate()
 
 
 def _on_cluster(paths: list[str], options: BuildOptions, cluster: Any,

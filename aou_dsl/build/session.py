@@ -128,14 +128,16 @@ class Session:
 
     def build_file(self, path: str, options: BuildOptions | None = None,
                    **changes: Any) -> BuildResult:
-        """:meth:`build` of a file's text.
+        """:meth:`build` of a file's text; a file that cannot be read is a result with
+        its I501 diagnostic, as :func:`~aou_dsl.build.builder.build_file` gives."""
+        from ..lang.linter import lint_file
+        from .builder import build_lint
 
-        Raises:
-            AouError: I501 when the file cannot be read.
-        """
-        from ..lang.linter import read_source
-
-        return self.build(read_source(path), path, options, **changes)
+        linted = lint_file(path)
+        if linted.source is None or linted.behaviour is None:
+            opts = options or self.options
+            return build_lint(linted, opts.replace(**changes) if changes else opts)
+        return self.build(linted.source, path, options, **changes)
 
     def measure(self, trajectory: Trajectory) -> Measured:
         """The eleven descriptors of a trajectory (measuring keeps no state to reuse)."""
