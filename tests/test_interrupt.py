@@ -89,12 +89,13 @@ def test_one_ctrl_c_ends_a_parallel_compile(tmp_path, to, phase):
             cwd=ROOT, env=env, start_new_session=True, stdout=subprocess.DEVNULL,
             stderr=stderr)
     try:
-        _wait_for(lambda: len(_workers(proc.pid)) == 2, proc)  # both workers started
+        # --jobs 2: aouc builds too, beside one worker
+        _wait_for(lambda: len(_workers(proc.pid)) == 1, proc)
         if phase == "warming up":  # importing the compiler, loading the robot (seconds)
             time.sleep(0.5)
         else:
             _wait_for(lambda: (out / f"{inputs[0].stem}.json").exists(), proc)
-        assert len(_workers(proc.pid)) == 2 and proc.poll() is None, "ended before Ctrl-C"
+        assert len(_workers(proc.pid)) == 1 and proc.poll() is None, "ended before Ctrl-C"
         if to == "the group":
             os.killpg(proc.pid, signal.SIGINT)
         else:
