@@ -12,7 +12,7 @@ import os
 import sys
 from collections.abc import Callable, Sequence
 
-from .cli_args import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, build_parser
+from .cli_args import EXIT_ERRORS, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, build_parser
 from .cli_tools import cmd_robot, cmd_synth
 from .diagnostics import RULES, AouError, Diagnostic, Severity, Span
 from .report import format_github, format_json, format_suppressed, format_text
@@ -47,6 +47,13 @@ def _scene_kw(args: argparse.Namespace) -> dict:
 def _read_kw(args: argparse.Namespace) -> dict:
     return {"robot": args.robot, "goal": args.goal, "ee_frame": args.ee_frame,
             "angle_unit": args.angle_unit, "time_unit": args.time_unit}
+
+
+def _reads(args: argparse.Namespace, paths: Sequence[str]) -> list[str]:
+    """Every file the command reads (the output rule keeps its outputs off them)."""
+    from .reads import files_read
+
+    return files_read(paths, getattr(args, "robot", None))
 
 
 def _count(n: int, noun: str) -> str:
@@ -125,9 +132,9 @@ def _cmd_explain(args: argparse.Namespace) -> int:
 
 
 def _cmd_compile(args: argparse.Namespace) -> int:
-    from .compiler.output import FORMATS, output_paths
+    from .compiler.output import FOLDER_FORMATS, FORMATS, output_paths
     from .diagnostics import has_errors
-    from .files import check_format
+    from .files import check_format, guard_output
     from .linter import collect_inputs
     from .parallel import build_many, default_jobs, write_result
     from .safety.scene import SceneOptions
@@ -136,12 +143,15 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     if problems:
         _print_diags(problems)
         return EXIT_USAGE
+    sources = [src for src, _ in inputs]
+    reads = _reads(args, sources)
     try:
         dests, fmt = output_paths(inputs, args.output, args.format)
         check_format(args.output, args.format, FORMATS)  # --format csv -o x.json
+        for dest in dests:  # before any work: the output rule
+            guard_output(dest, reads, bag=fmt in FOLDER_FORMATS)
     except AouError as err:
         return _fail(err)
-    sources = [src for src, _ in inputs]
     options = {"robot": args.robot, "rate": args.rate, "check": not args.no_check,
                "scene": SceneOptions(**_scene_kw(args)),
                "collision_check": not args.no_collision_check, "controller": args.controller}
@@ -155,7 +165,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
             print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)
             continue
         try:
-            write_result(dest, res, fmt, inputs=sources)
+            write_result(dest, res, fmt, inputs=reads)
         except AouError as err:
             worst = max(worst, _fail(err))
             continue
@@ -217,8 +227,11 @@ def _cmd_measure(args: argparse.Namespace) -> int:
 def _cmd_plot(args: argparse.Namespace) -> int:
     from .api import read_trajectory
     from .linter import lint_paths
-    from .media.plot import cv_figure, profile_data, profile_figure, save
+    from .files import check_output
+    from .media.plot import FORMATS, cv_figure, profile_data, profile_figure, save
 
+    reads = _reads(args, args.paths)
+    check_output(args.output, FORMATS, reads=reads)
     if args.cv:
         results, problems = lint_paths(args.paths)
         bad = problems + [d for r in results if not r.ok for d in r.diagnostics]
@@ -234,19 +247,20 @@ def _cmd_plot(args: argparse.Namespace) -> int:
         data = profile_data(tr)
         _print_diags(list(data.diagnostics))  # R405: no goal, no goal-distance panel
         fig = profile_figure(data)
-    save(fig, args.output)
+    save(fig, args.output, reads)
     print(f"wrote {args.output}", file=sys.stderr)
     return EXIT_OK
 
 
-def _render(paths: list[str], output: str, args: argparse.Namespace, read_kw: dict) -> int:
+def _render(paths: list[str], output: str, args: argparse.Namespace, read_kw: dict,
+            reads: Sequence[str]) -> int:
     import time
 
     from .api import read_trajectory
     from .media.render import Camera, check_output, render_video, start_workers
     from .safety.scene import SceneOptions
 
-    check_output(output)
+    check_output(output, reads)
     w, h = args.size
     camera = Camera(distance=args.camera_distance, yaw=args.camera_yaw,
                     pitch=args.camera_pitch, target=args.camera_target, width=w, height=h)
@@ -259,7 +273,8 @@ def _render(paths: list[str], output: str, args: argparse.Namespace, read_kw: di
         raise
     start = time.perf_counter()
     info = render_video(motions, output, fps=args.fps, camera=camera,
-                        scene_options=SceneOptions(**_scene_kw(args)), workers=workers)
+                        scene_options=SceneOptions(**_scene_kw(args)), workers=workers,
+                        inputs=reads)
     print(f"wrote {output}: {info['frames']} frames at {info['fps']:g} fps "
           f"({info['duration']:.2f} s), {info['size'][0]}x{info['size'][1]}, "
           f"{_count(info['drawn'], 'image')} drawn (a frame where the arm holds still "
@@ -272,28 +287,35 @@ def _cmd_render(args: argparse.Namespace) -> int:
     if not paths:
         print("aouc: render takes FILE, or --side-by-side A B", file=sys.stderr)
         return EXIT_USAGE
-    return _render(paths, args.output, args, _read_kw(args))
+    return _render(paths, args.output, args, _read_kw(args), _reads(args, paths))
 
 
 def _cmd_variants(args: argparse.Namespace) -> int:
-    from .compiler.output import write_atomic
+    from .files import guard_output, write_atomic
     from .linter import lint_file
-    from .media.variants import make_variants, parse_vary
+    from .media.variants import base_stem, make_variants, parse_vary
 
     name, low, high = parse_vary(args.vary)
+    reads = _reads(args, [args.path])
     base = lint_file(args.path)
     if not base.ok or base.behaviour is None or base.source is None:
         _print_diags(base.diagnostics, sources={args.path: base.source or ""})
         return _exit_for(base.diagnostics)
-    stem = os.path.splitext(os.path.basename(args.path))[0]
     folder = args.output or "."
     variants = make_variants(base.behaviour, base.source, name, low, high,
-                             os.path.join(folder, f"{stem}-{name}"))
+                             os.path.join(folder, f"{base_stem(args.path)}-{name}"))
+    for v in variants:  # both checked before either is written
+        guard_output(v.path, reads, force=args.force)
+    if args.render:
+        from .media.render import check_output
+
+        check_output(args.render, [*reads, *(v.path for v in variants)])
     for v in variants:
-        write_atomic(v.path, v.text.encode(), inputs=[args.path])
+        write_atomic(v.path, v.text.encode(), inputs=reads)
         print(f"wrote {v.path} ({name}={v.value:g})", file=sys.stderr)
     if args.render:
-        return _render([v.path for v in variants], args.render, args, {})
+        return _render([v.path for v in variants], args.render, args, {},
+                       [*reads, *(v.path for v in variants)])
     return EXIT_OK
 
 
@@ -331,7 +353,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _internal(exc, args.debug)
     except KeyboardInterrupt:
         print("aouc: interrupted", file=sys.stderr)
-        return EXIT_USAGE
+        return EXIT_INTERRUPTED
     except BrokenPipeError:
         return EXIT_OK
     except Exception as exc:  # noqa: BLE001 - the last line of defence

@@ -15,7 +15,7 @@ from ..cv import CANONICAL, CVPoint
 from ..diagnostics import Diagnostic, Span, diag
 from ..trajectory import Trajectory
 
-__all__ = ["ProfileData", "cv_figure", "profile_data", "profile_figure", "save"]
+__all__ = ["FORMATS", "ProfileData", "cv_figure", "profile_data", "profile_figure", "save"]
 
 _COLOURS = {"approach": "#4c9a2a", "retreat": "#c0392b", "pause": "#95a5a6",
             "gaze": "#2e86c1", "tilt": "#8e44ad", "shiver": "#e67e22"}
@@ -194,16 +194,35 @@ def cv_figure(points: list[tuple[str, CVPoint]]):
     return fig
 
 
-def save(fig, path: str) -> None:
-    """Save atomically (a temporary file beside ``path``, then renamed), making the
-    folders missing on the way.
+#: The figure formats ``aouc plot`` writes.
+FORMATS = ("png", "svg", "pdf")
+
+#: What would differ between two saves of one figure, left out: the date, the
+#: software's version, and SVG's random ids (drawn from a fixed salt).
+_METADATA = {"png": {"Software": None}, "svg": {"Date": None, "Creator": None},
+             "pdf": {"CreationDate": None, "ModDate": None, "Creator": None,
+                     "Producer": None}}
+
+
+def save(fig, path: str, inputs=()) -> None:
+    """Save atomically and deterministically (the same figure gives the same bytes),
+    making the folders missing on the way; never over one of ``inputs``. The figure is
+    drawn in memory and the file written whole (:func:`aou_dsl.files.write_atomic`), so
+    no temporary file is ever left.
 
     Raises:
-        AouError: I502 when the extension is unknown or the folder cannot be written.
+        AouError: I502 when the extension is unknown or the folder cannot be written,
+            or a code of the output rule (:func:`aou_dsl.files.guard_output`).
     """
-    from ..files import atomic, check_output
+    import io
 
-    fmt = check_output(path, ("png", "svg", "pdf"))
-    with atomic(path) as tmp:
-        fig.savefig(tmp, format=fmt, dpi=120, metadata={"Software": None}
-                    if fmt == "png" else None)
+    import matplotlib
+
+    from ..files import check_output, write_atomic
+
+    fmt = check_output(path, FORMATS, reads=inputs)
+    buf = io.BytesIO()
+    with matplotlib.rc_context({"svg.hashsalt": "aou", "svg.id": "aou-figure",
+                                "pdf.compression": 6}):
+        fig.savefig(buf, format=fmt, dpi=120, metadata=_METADATA[fmt])
+    write_atomic(path, buf.getvalue(), inputs=inputs)

@@ -355,7 +355,7 @@ def _progress_bar(label: str):
 
 def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = Camera(),
                  scene_options=None, quiet: bool = False, jobs: int | None = None,
-                 workers=None) -> dict:
+                 workers=None, inputs=()) -> dict:
     """Render one trajectory, or several side by side, into ``path`` (.mp4 or .gif).
 
     Trajectories of different lengths are padded with their last frame. Written to a
@@ -369,7 +369,7 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
     from ..safety.scene import SceneOptions
 
     try:
-        fmt = check_output(path)
+        fmt = check_output(path, inputs)
         # Import the encoder first: a missing one should fail before minutes of drawing.
         if fmt == "mp4":
             import imageio.v2 as imageio
@@ -388,7 +388,7 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
                      workers.pool if workers else None)
     n = max(len(c.owner) for c in clips)
     try:
-        with atomic(path) as tmp:  # frames go to the encoder as they are drawn
+        with atomic(path, inputs=inputs) as tmp:  # frames go to the encoder as they are drawn
             if fmt == "mp4":
                 with imageio.get_writer(tmp, format="FFMPEG", fps=fps, codec="libx264",
                                         quality=8, macro_block_size=8,
@@ -415,6 +415,7 @@ def _cores() -> int:
     return default_jobs()
 
 
-def check_output(path: str) -> str:
-    """Check a video path before rendering: .mp4 or .gif, its folder writable or makeable."""
-    return _check_output(path, ("mp4", "gif"))
+def check_output(path: str, reads=()) -> str:
+    """Check a video path before rendering: .mp4 or .gif, its folder writable or makeable,
+    and not one of the files the command ``reads`` (the output rule)."""
+    return _check_output(path, ("mp4", "gif"), reads=reads)
