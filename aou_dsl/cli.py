@@ -196,11 +196,28 @@ def _cmd_check(args: argparse.Namespace) -> int:
         return EXIT_ERRORS
     report = check(tr, dynamic=not args.no_dynamic, controller=args.controller,
                    **_scene_kw(args))
+    failed = _check_diagnostics(args.path, report)
     if args.format == "json":
-        print(format_json({"path": args.path, **report.to_json()}))
+        print(format_json({"path": args.path, **report.to_json(),
+                           "diagnostics": [d.to_json() for d in failed]}))
     else:
         print(format_check(args.path, tr.robot, tr.t, report))
-    return EXIT_OK if report.ok else EXIT_ERRORS
+    _print_diags(failed)
+    return EXIT_ERRORS if failed else EXIT_OK
+
+
+def _check_diagnostics(path: str, report) -> list[Diagnostic]:
+    """A failed check as the code compile gives it (C311 the controller's jerk, C306 the
+    rest): ``check`` never fails without a code."""
+    from .diagnostics import diag
+
+    out = [diag("C311" if c.name == "joint-jerk" else "C306",
+                f"{c.name} check failed" + ("" if c.time is None else f" at t={c.time:.3f}s")
+                + f": {c.detail}", Span.whole_file(path), check=c.name, time=c.time,
+                joint=c.joint, value=c.value, limit=c.limit) for c in report.failed()]
+    if not report.ok and not out:
+        out.append(diag("C306", "the checks failed", Span.whole_file(path)))
+    return out
 
 
 def _cmd_measure(args: argparse.Namespace) -> int:
@@ -213,7 +230,10 @@ def _cmd_measure(args: argparse.Namespace) -> int:
     missing = missing_descriptors(tr.goal)  # what the C-V point could not use
     if args.format == "json":
         doc = m.to_json()
-        doc["cv"] = {**doc["cv"], "missing_descriptors": list(missing)}
+        doc["cv"] = {**doc["cv"], "missing_descriptors": list(missing),
+                     "placed": not missing}  # no goal: C and V without the gazes, no state
+        if missing:
+            doc["cv"]["state"] = None
         print(format_json({"path": args.path, "robot": tr.robot, **doc}))
     else:
         print(format_measured(args.path, tr.robot, m, missing))
@@ -226,8 +246,8 @@ def _cmd_measure(args: argparse.Namespace) -> int:
 
 def _cmd_plot(args: argparse.Namespace) -> int:
     from .api import read_trajectory
-    from .linter import lint_paths
     from .files import check_output
+    from .linter import lint_paths
     from .media.plot import FORMATS, cv_figure, profile_data, profile_figure, save
 
     reads = _reads(args, args.paths)

@@ -13,7 +13,8 @@ from collections.abc import Callable
 
 from . import __version__
 
-__all__ = ["EXIT_ERRORS", "EXIT_INTERRUPTED", "EXIT_OK", "EXIT_USAGE", "build_parser", "number", "usage_error"]
+__all__ = ["EXIT_ERRORS", "EXIT_INTERRUPTED", "EXIT_OK", "EXIT_USAGE", "build_parser", "number",
+           "usage_error"]
 
 EXIT_OK = 0
 EXIT_ERRORS = 1

@@ -227,8 +227,13 @@ _TMP: list[str] = []
 
 
 def _tmp_dir() -> str:
+    """This process's folder for the copies PyBullet loads (``aou-robots-PID-...``),
+    removed at exit; those of processes that were killed are removed here first."""
     if not _TMP:
-        _TMP.append(tempfile.mkdtemp(prefix="aou-robots-"))
+        from ..files import sweep_stale
+
+        sweep_stale(tempfile.gettempdir(), "aou-robots-")
+        _TMP.append(tempfile.mkdtemp(prefix=f"aou-robots-{os.getpid()}-"))
         atexit.register(shutil.rmtree, _TMP[0], True)
     return _TMP[0]
 

@@ -15,7 +15,7 @@ from ..cv import CANONICAL, CVPoint
 from ..diagnostics import Diagnostic, Span, diag
 from ..trajectory import Trajectory
 
-__all__ = ["FORMATS", "ProfileData", "cv_figure", "profile_data", "profile_figure", "save"]
+__all__ = ["FORMATS", "ProfileData", "cv_figure", "point_labels", "profile_data", "profile_figure", "save"]
 
 _COLOURS = {"approach": "#4c9a2a", "retreat": "#c0392b", "pause": "#95a5a6",
             "gaze": "#2e86c1", "tilt": "#8e44ad", "shiver": "#e67e22"}
@@ -161,6 +161,23 @@ def profile_figure(d: ProfileData):
     return fig
 
 
+def point_labels(points: list[tuple[str, CVPoint]], most: int = 3
+                 ) -> list[tuple[str, CVPoint]]:
+    """One label per place on the map: behaviours at one point (to the hundredth, as the
+    map can tell them apart) share it, ``a, b, c +2 more (state)``, instead of being
+    printed over each other."""
+    places: dict[tuple[float, float], list[tuple[str, CVPoint]]] = {}
+    for label, p in points:
+        places.setdefault((round(p.C, 2), round(p.V, 2)), []).append((label, p))
+    out = []
+    for group in places.values():
+        names = [label for label, _ in group]
+        more = f" +{len(names) - most} more" if len(names) > most else ""
+        out.append((f"{', '.join(names[:most])}{more} ({group[0][1].state.value})",
+                    group[0][1]))
+    return out
+
+
 def cv_figure(points: list[tuple[str, CVPoint]]):
     """The C-V plane: the five canonical states, the borders of their regions (nearest
     state), and each behaviour's inferred point, labelled."""
@@ -178,10 +195,9 @@ def cv_figure(points: list[tuple[str, CVPoint]]):
     xs = [p.C for _, p in points]
     ys = [p.V for _, p in points]
     ax.scatter(xs, ys, s=40, color="#c0392b", zorder=3)
-    for (label, p) in points:  # labelled on the side toward the centre, clear of the
-        right = p.C > 0.3  # canonical squares' labels and of the plot's edges
-        ax.annotate(f"{label} ({p.state.value})", (p.C, p.V),
-                    xytext=(-6 if right else 6, -12 if p.V > 0.3 else 5),
+    for text, p in point_labels(points):  # labelled on the side toward the centre,
+        right = p.C > 0.3  # clear of the canonical squares' labels and the plot's edges
+        ax.annotate(text, (p.C, p.V), xytext=(-6 if right else 6, -12 if p.V > 0.3 else 5),
                     textcoords="offset points", fontsize=8, ha="right" if right else "left")
     ax.set_xlim(-1.25, 1.25)
     ax.set_ylim(-1.25, 1.25)

@@ -16,7 +16,7 @@ display.
 from __future__ import annotations
 
 import math
-import sys
+import os
 from dataclasses import dataclass
 from typing import Any
 
@@ -24,6 +24,7 @@ import numpy as np
 
 from ..files import atomic
 from ..files import check_output as _check_output
+from .annotate import progress_bar
 
 __all__ = ["Camera", "frame_configurations", "frame_times", "render_configurations",
            "render_video", "start_workers", "Workers"]
@@ -195,6 +196,7 @@ class _Clip:
     goal: tuple
     qs: np.ndarray  # (D, n) configurations drawn
     owner: np.ndarray  # (F,) frame -> index into qs
+    title: str = ""  # its caption, side by side
 
     @classmethod
     def of(cls, traj, fps: float) -> _Clip:
@@ -207,7 +209,8 @@ class _Clip:
             goal = final_goal(traj)
         else:
             goal = traj.goal
-        return cls(traj.robot, tuple(float(x) for x in goal), qk[new], np.cumsum(new) - 1)
+        return cls(traj.robot, tuple(float(x) for x in goal), qk[new], np.cumsum(new) - 1,
+                   traj.title or os.path.basename(traj.path))
 
 
 @dataclass
@@ -307,13 +310,15 @@ class _Drawer:
 
 
 def _video_frames(clips: list[_Clip], drawer: _Drawer):
-    """The video's frames in order, the clips side by side (a shorter clip holds its
-    last frame)."""
+    """The video's frames in order, the clips side by side, each captioned with its
+    behaviour's name (a shorter clip holds its last frame)."""
+    from .annotate import side_by_side
+
     n = max(len(c.owner) for c in clips)
     for k in range(n):
         parts = [drawer.image(i, int(c.owner[min(k, len(c.owner) - 1)]))
                  for i, c in enumerate(clips)]
-        yield parts[0] if len(parts) == 1 else np.concatenate(parts, axis=1)
+        yield parts[0] if len(parts) == 1 else side_by_side(parts, [c.title for c in clips])
 
 
 def _pedestal(scene, goal, options) -> None:
@@ -332,25 +337,6 @@ def _pedestal(scene, goal, options) -> None:
     pb.createMultiBody(0, -1, visual, basePosition=[goal[0], goal[1],
                                                     options.table_height + height / 2],
                        physicsClientId=c)
-
-
-def _progress_bar(label: str):
-    """A progress bar of the images drawn on stderr: in place on a terminal, else by 10 %."""
-    tty = sys.stderr.isatty()
-    state = {"shown": -1}
-
-    def show(done: int, total: int) -> None:
-        pct = int(100 * done / total)
-        if tty:
-            bar = "#" * (pct // 5) + "-" * (20 - pct // 5)
-            end = "\n" if done == total else ""
-            print(f"\r{label} [{bar}] {pct:3d}% image {done}/{total}", end=end,
-                  file=sys.stderr, flush=True)
-        elif pct // 10 != state["shown"] // 10 or done == total:
-            state["shown"] = pct
-            print(f"{label}: {pct}% ({done}/{total} images)", file=sys.stderr, flush=True)
-
-    return show
 
 
 def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = Camera(),
@@ -384,7 +370,7 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
         raise
     label = "rendering" if len(trajs) == 1 else f"rendering {len(trajs)} side by side"
     drawer = _Drawer(clips, camera, opts, workers.jobs if workers else jobs or _cores(),
-                     (lambda d, t: None) if quiet else _progress_bar(label),
+                     (lambda d, t: None) if quiet else progress_bar(label),
                      workers.pool if workers else None)
     n = max(len(c.owner) for c in clips)
     try:
@@ -417,5 +403,5 @@ def _cores() -> int:
 
 def check_output(path: str, reads=()) -> str:
     """Check a video path before rendering: .mp4 or .gif, its folder writable or makeable,
-    and not one of the files the command ``reads`` (the output rule)."""
+    not one of the files the command ``reads``."""
     return _check_output(path, ("mp4", "gif"), reads=reads)
