@@ -15,7 +15,8 @@ from ..cv import CANONICAL, CVPoint
 from ..diagnostics import Diagnostic, Span, diag
 from ..trajectory import Trajectory
 
-__all__ = ["FORMATS", "ProfileData", "cv_figure", "point_labels", "profile_data", "profile_figure", "save"]
+__all__ = ["FORMATS", "ProfileData", "cv_figure", "point_labels", "profile_data", "profile_figure",
+           "save"]
 
 _COLOURS = {"approach": "#4c9a2a", "retreat": "#c0392b", "pause": "#95a5a6",
             "gaze": "#2e86c1", "tilt": "#8e44ad", "shiver": "#e67e22"}
