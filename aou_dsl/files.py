@@ -160,14 +160,15 @@ def _guard_bag(path: str, reads: Sequence[str], where: Span, folder: bool) -> No
 
 #: The first line of a text file aou wrote carries this; a JSON document has this
 #: ``generator``. aou's own outputs may be replaced without ``--force``.
-OWN_MARK = re.compile(rb'\A(#[^\n]*written by `?aouc |\{[^\n]{0,200}"generator": ?"aouc )')
+OWN_MARK = re.compile(rb'\A(#[^\n]*written by `?aouc |\{\s*[^\n]{0,200}?"generator": ?"aouc )')
 
 
 def is_own_output(path: str) -> bool:
     """Whether the existing regular file ``path`` is one aou wrote: its first line is a
     comment saying ``written by `aouc ...``` (behaviour files from ``synth`` and
     ``variants``, robot descriptions from ``robot -o``), or it is a JSON document whose
-    ``generator`` is ``aouc ...`` (within its first 200 characters)."""
+    ``generator`` is ``aouc ...`` (on its first line with content, within 200
+    characters: trajectories from ``compile``, ``robot -o`` in JSON)."""
     try:
         with open(path, "rb") as fh:
             head = fh.read(512)
