@@ -214,6 +214,7 @@ def test_a_temporary_file_a_killed_write_left_is_removed_by_the_next(tmp_path):
     assert os.listdir(out) == ["inactive.json"]
 
 
+@pytest.mark.slow
 def test_the_checks_temporary_folder_of_a_killed_process_is_removed(tmp_path):
     """The copy of the robot PyBullet loads lives in ``aou-robots-PID-*`` in $TMPDIR,
     removed at exit; a killed process cannot, so the next one that needs one does."""

@@ -247,7 +247,9 @@ def _scene_file(robot: str, dirs: tuple[str, ...], visuals: bool) -> str:
             "V109", f"robot `{robot}`: {len(missing)} mesh file(s) not found, first "
             f"`{missing[0]}`", Span.whole_file(r.urdf.path),
             hint="give the folder of the package (or one holding it) with --package-dir, "
-                 "or in ROS_PACKAGE_PATH, or `package_dirs` in a robot description"))
+                 "or in ROS_PACKAGE_PATH, or `package_dirs` in a robot description; or "
+                 "compile with --no-check (the checks are then skipped, and the output "
+                 "says so)"))
     digest = hashlib.sha256(text.encode()).hexdigest()[:12]
     stem = os.path.splitext(os.path.basename(r.urdf.path))[0]
     path = os.path.join(_tmp_dir(), f"{stem}-{digest}.urdf")
