@@ -306,6 +306,7 @@ def write_atomic(path: str, data: bytes, *, inputs: Sequence[str] = ()) -> None:
     target = os.path.realpath(path)
     folder = os.path.dirname(target) or "."
     made = make_folders(folder, where)
+    sweep_stale(folder)
     try:
         if _write_unnamed(folder, target, data):
             made = []
@@ -316,6 +317,19 @@ def write_atomic(path: str, data: bytes, *, inputs: Sequence[str] = ()) -> None:
         _remove_folders(made)
     with atomic(path, inputs=inputs) as tmp, open(tmp, "wb") as fh:
         fh.write(data)
+
+
+def _link(fd: int, path: str) -> bool:
+    """Give the unnamed file ``fd`` the name ``path``: ``linkat`` of ``/proc/self/fd/FD``
+    following the link (Python's ``os.link`` does not follow it on Linux)."""
+    import ctypes
+
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        return libc.linkat(-100, f"/proc/self/fd/{fd}".encode(), -100,  # AT_FDCWD
+                           os.fsencode(path), 0x400) == 0  # AT_SYMLINK_FOLLOW
+    except (OSError, AttributeError):
+        return False
 
 
 def _write_unnamed(folder: str, target: str, data: bytes) -> bool:
@@ -329,9 +343,7 @@ def _write_unnamed(folder: str, target: str, data: bytes) -> bool:
         with os.fdopen(fd, "wb", closefd=False) as fh:
             fh.write(data)
         tmp = os.path.join(folder, f"{temp_prefix()}{os.urandom(6).hex()}.link")
-        try:
-            os.link(f"/proc/self/fd/{fd}", tmp)
-        except OSError:
+        if not _link(fd, tmp):
             return False
         try:
             os.replace(tmp, target)

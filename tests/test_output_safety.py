@@ -137,8 +137,8 @@ def test_a_bag_beside_other_files_and_into_a_missing_folder(ws, capsys):
 
 # --- killed and interrupted ---------------------------------------------------------------
 
-#: Runs ``aouc ARGV`` with one step of the write (``os.link``: naming the written file;
-#: ``os.replace``: renaming it over the output) held, told by a marker file, so that the
+#: Runs ``aouc ARGV`` with one step of the write held (``link``: naming the written
+#: file; ``replace``: renaming it over the output), told by a marker file, so that the
 #: test kills it there, mid-write, every time. ``named`` makes it write as on a file
 #: system without unnamed files (a named temporary file).
 HOLD = textwrap.dedent("""
@@ -146,17 +146,20 @@ HOLD = textwrap.dedent("""
     from pathlib import Path
     import aou_dsl.files as files
     marker, where, named, argv = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:]
-    real = getattr(os, where)
-    class Held:
-        def __getattr__(self, name):
-            return getattr(os, name)
-        def __hold(self, *a, **k):
+    def hold(real):
+        def held(*a, **k):
             Path(marker).write_text(str(os.getpid()))
             time.sleep(600)
             return real(*a, **k)
-    held = Held()
-    setattr(held, where, held._Held__hold)
-    files.os = held
+        return held
+    if where == "link":
+        files._link = hold(files._link)
+    else:
+        class Os:
+            def __getattr__(self, name):
+                return getattr(os, name)
+        files.os = Os()
+        files.os.replace = hold(os.replace)
     if named == "named":
         files._write_unnamed = lambda *a: False
     from aou_dsl.cli import main
