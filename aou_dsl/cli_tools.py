@@ -73,6 +73,9 @@ def cmd_robot(args: argparse.Namespace) -> int:
     except AouError as err:
         raise _with_alias(err, args.robot) from None
     missing = _missing_meshes(args.robot)
+    if missing:  # shapes named, but not there to load: not "yes"
+        text = text.replace("  collision geometry: yes\n", "  collision geometry: named, "
+                            "but its mesh files are missing (V109 below)\n")
     if args.format == "json":
         out = format_json({"generator": f"aouc {__version__}", **doc} if args.output
                           else doc)

@@ -46,8 +46,9 @@ def test_robot_says_at_once_that_meshes_are_missing_and_how_to_compile_anyway(he
                                                                              capsys):
     urdf = _panda_without_meshes(here)
     assert main(["robot", str(urdf)]) == EXIT_ERRORS
-    err = capsys.readouterr().err
+    out, err = capsys.readouterr()
     assert " V109 [error]" in err and "gone/" in err and "--no-check" in err
+    assert "collision geometry: yes" not in out and "missing" in out
     # ... and compile, which needs the meshes for its checks, says the same
     (here / "m.aou").write_text('behaviour m : confident\nrobot "arm.urdf"\napproach\n')
     assert main(["compile", "m.aou", "-o", "m.json"]) == EXIT_ERRORS
@@ -201,3 +202,19 @@ def test_check_never_fails_without_a_code(here, capsys):
     assert main(["check", "far.json", "--no-dynamic", "--format", "json"]) == EXIT_ERRORS
     diags = json.loads(capsys.readouterr().out)["diagnostics"]
     assert diags and all(d["code"] in ("C306", "C311") for d in diags)
+
+
+def test_a_profile_of_a_very_long_episode_list_is_drawn_with_what_a_figure_can_show():
+    """A trajectory may list any number of episodes; the figure shades the first
+    MAX_SHADED and says so, instead of drawing for minutes."""
+    from aou_dsl.media.plot import MAX_SHADED, ProfileData, profile_figure
+
+    n, joints = 200, 2
+    t = np.linspace(0, 10, n)
+    eps = tuple(("pause", k * 1e-4, k * 1e-4 + 5e-5) for k in range(50_000))
+    d = ProfileData("many", ("a", "b"), t, np.ones(n), np.ones(n), np.zeros((n, joints)),
+                    np.zeros((n, joints)), -np.ones(joints), np.ones(joints),
+                    np.ones(joints), eps)
+    fig = profile_figure(d)
+    assert f"the first {MAX_SHADED} of 50000 episodes" in fig.axes[0].get_title()
+    assert len(fig.axes[0].patches) == MAX_SHADED

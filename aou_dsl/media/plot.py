@@ -61,6 +61,11 @@ class ProfileData:
         return bool(np.isfinite(self.distance).any())
 
 
+#: The most episodes shaded in a profile (a file can list any number; more than a
+#: figure can show would take minutes to draw and show nothing).
+MAX_SHADED = 400
+
+
 def profile_data(rec: Trajectory) -> ProfileData:
     """From a trajectory: its compiler episodes are shaded, or, for a recording, the
     episodes ``aouc measure`` finds (with the line of sight). Without a goal there is no
@@ -130,7 +135,7 @@ def profile_figure(d: ProfileData):
     ax_v, ax_q, ax_qd = panel["v"], panel["q"], panel["qd"]
     ax_v.plot(d.t, d.speed, color="black", lw=1.2, label="end-effector speed")
     top = max(float(d.speed.max()), 1e-3) * 1.25
-    for kind, a, b in d.episodes:
+    for kind, a, b in d.episodes[:MAX_SHADED]:
         for ax in axes:
             ax.axvspan(a, b, color=_COLOURS.get(kind, "#dddddd"), alpha=0.15, lw=0)
         ax_v.text((a + b) / 2, top * 0.93, kind, ha="center", va="top", fontsize=7,
@@ -139,7 +144,9 @@ def profile_figure(d: ProfileData):
     ax_v.set_ylabel("speed [m/s]")
     title = d.title or "velocity profile"
     ax_v.set_title((f"{title} (episodes as measured)" if d.measured else title)
-                   + ("" if d.has_goal else "; no goal: no goal distance"))
+                   + ("" if d.has_goal else "; no goal: no goal distance")
+                   + (f"; the first {MAX_SHADED} of {len(d.episodes)} episodes shaded"
+                      if len(d.episodes) > MAX_SHADED else ""))
     if "d" in panel:
         panel["d"].plot(d.t, d.distance, color="#34495e", lw=1.2)
         panel["d"].set_ylabel("goal distance [m]")
