@@ -117,10 +117,11 @@ def main(argv: list[str]) -> int:
             a.axvline(r[0], color="k", lw=0.4, ls=":")
     handles = [plt.Rectangle((0, 0), 1, 1, color=COLOURS[s], alpha=0.4) for s in State]
     handles.append(plt.Line2D([0], [0], color="k", lw=0.6, ls=":"))
+    fig.suptitle("live regulation: an uncertainty estimate becomes checked motion",
+                 y=0.995, fontsize=12)
     fig.legend(handles, [*(s.value for s in State), "re-plan"], loc="upper center",
-               ncol=6, title="state planned (shading)")
-    fig.suptitle("live regulation: an uncertainty estimate becomes checked motion", y=0.995,
-                 fontsize=11, x=0.02, ha="left")
+               bbox_to_anchor=(0.5, 0.965), ncol=6, title="state planned (shading)")
+    fig.subplots_adjust(top=0.84)
     fig.savefig(png, dpi=90)
     plt.close(fig)
 
