@@ -325,8 +325,8 @@ _RULE_LIST = [
          "aouc compile a.aou --cluster tcp://127.0.0.1:9"),
     Rule("I506", "not-aou-output", _E,
          "`synth`, `variants` or `robot -o` would replace an existing file that aou did not "
-         "write (aou's files start with a `# written by `aouc ...`` line, or are JSON with "
-         "an `aouc` generator).",
+         "write (aou's own files start with a comment line saying they were written by "
+         "aouc, or are JSON with an `aouc` generator).",
          "A hand-written behaviour or robot file is not lost to a command that makes "
          "one; `--force` replaces it.",
          "aouc synth --state confident --no-verify -o a.aou"),
