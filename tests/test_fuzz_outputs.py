@@ -371,3 +371,43 @@ def test_random_chains_of_links_never_reach_an_input(tmp_path, capsys, fresh_tmp
         if not (root / out).exists():  # a chain the generator broke: not a scenario
             continue
         refused(root, [out if a == "OUT" else a for a in argv], capsys, fresh_tmp)
+
+
+def _limited() -> None:
+    """In the child: at most 2 GB of memory (the promise: no process over 2 GB)."""
+    import resource
+
+    resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("command,argv,roles,ext", COMMANDS, ids=[c for c, *_ in COMMANDS])
+def test_as_a_process_a_refusal_ends_at_once_small_and_clean(command, argv, roles, ext,
+                                                            tmp_path):
+    """The same refusals by ``aouc`` as its own process: within :data:`HANG` seconds,
+    under 2 GB, exit 2 with an I code, and $TMPDIR (fresh) left empty; a FIFO output
+    and a link to each input."""
+    import subprocess
+    import sys
+
+    from .conftest import ROOT
+
+    for k, make in enumerate(["fifo", *roles]):
+        root = tmp_path / f"ws{k}"
+        root.mkdir()
+        found = _workspace(root)
+        tmp = tmp_path / f"tmp{k}"
+        tmp.mkdir()
+        out = f"o.{ext}" if ext else "o"
+        if make == "fifo":
+            os.mkfifo(root / out)
+        else:
+            (root / out).symlink_to(found[make])
+        before = _snapshot(root)
+        done = subprocess.run(
+            [sys.executable, "-m", "aou_dsl", *[out if a == "OUT" else a for a in argv]],
+            cwd=root, env={**os.environ, "TMPDIR": str(tmp), "PYTHONPATH": str(ROOT)},
+            capture_output=True, text=True, timeout=HANG, preexec_fn=_limited)
+        assert done.returncode == 2, (argv, make, done.stderr)
+        assert "Traceback" not in done.stderr and " I50" in done.stderr, done.stderr
+        assert _snapshot(root) == before and os.listdir(tmp) == []
