@@ -118,12 +118,12 @@ def robot_files(robot: str, package_dirs: Iterable[str] = ()) -> list[str]:
 def files_read(paths: Iterable[str] = (), robot: str | None = None,
                package_dirs: Iterable[str] = ()) -> list[str]:
     """Every file a command reads: ``paths`` (``.aou`` files, trajectories, recordings),
-    the robot files the ``.aou`` files name (or ``robot``, the command line's
-    ``--robot``, which overrides them), the URDFs those load and the URDFs' meshes; each
-    once, in that order."""
+    ``robot`` (the command line's ``--robot``) and the robot files the ``.aou`` files
+    name (looked at even when ``--robot`` overrides them), the URDFs those load and the
+    URDFs' meshes; each once, in that order."""
     paths = list(paths)
-    robots = [robot] if robot else [r for p in paths if p.lower().endswith(".aou")
-                                    for r in _aou_robots(p)]
+    robots = ([robot] if robot else []) + [r for p in paths if p.lower().endswith(".aou")
+                                           for r in _aou_robots(p)]
     out: list[str] = []
     for f in [*paths, *(f for r in dict.fromkeys(robots) for f in robot_files(
             r, package_dirs))]:

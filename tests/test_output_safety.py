@@ -269,3 +269,26 @@ def test_plot_leaves_no_temporary_file_and_repeats_its_bytes(tmp_path, monkeypat
         assert Path(f"one.{ext}").read_bytes() == Path(f"two.{ext}").read_bytes(), ext
     assert set(os.listdir(tmp_path)) - before == {f"{n}.{e}" for n in ("one", "two")
                                                   for e in ("png", "svg", "pdf")}
+
+
+# --- what a command reads ------------------------------------------------------------------
+
+
+def test_the_files_a_command_reads_follow_the_chain_and_never_block(ws):
+    """aou file -> its robot file (and --robot's) -> the URDF it names -> every mesh,
+    package:// ones too; a FIFO or a missing file on the way is listed, not opened."""
+    from aou_dsl.reads import files_read
+
+    from .test_fuzz_outputs import _deadline
+
+    got = [os.path.relpath(p) for p in files_read(["y.aou"])]
+    assert got[:3] == ["y.aou", "arm/arm.toml", "arm/arm.urdf"]
+    assert sorted(got[3:]) == ["arm/armpkg/meshes/l2.stl", "arm/meshes/base.stl",
+                               "arm/meshes/l1.stl"]
+    os.mkfifo("arm/fifo.toml")
+    Path("f.aou").write_text('robot "arm/fifo.toml"\napproach\n')
+    with _deadline(20):
+        got = [os.path.relpath(p) for p in files_read(["f.aou", "gone.aou"],
+                                                      robot="arm/arm.urdf")]
+    assert got[:3] == ["f.aou", "gone.aou", "arm/arm.urdf"]
+    assert "arm/fifo.toml" in got and "arm/meshes/l1.stl" in got
