@@ -2,7 +2,9 @@
 
 Exit codes: 0 no error, 1 the input has errors (or warnings under ``--strict``), 2 usage
 or I/O problems, and internal errors (a one-line message; ``--debug`` shows the
-traceback). A 2 is never hidden by a flag.
+traceback), 130 interrupted (Ctrl-C). A 2 is never hidden by a flag. Every command that
+writes obeys one output rule (:func:`aou_dsl.files.guard_output`), given the files it
+reads (:func:`aou_dsl.reads.files_read`).
 """
 
 from __future__ import annotations
