@@ -31,7 +31,7 @@ from pathlib import Path
 
 import pytest
 
-from aou_dsl.cli import main
+from aou_dsl.cli.commands import main
 
 #: Seconds one refused command may take before it counts as a hang.
 HANG = 60

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pytest
 
-from aou_dsl.cli_args import EXIT_INTERRUPTED
+from aou_dsl.cli.args import EXIT_INTERRUPTED
 
 from .conftest import BEHAVIOURS, ROOT
 

@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from aou_dsl.cli import main
-from aou_dsl.cli_args import EXIT_ERRORS, EXIT_OK
+from aou_dsl.cli.args import EXIT_ERRORS, EXIT_OK
+from aou_dsl.cli.commands import main
 
 from .conftest import BEHAVIOURS
 
@@ -33,7 +33,7 @@ def here(tmp_path, monkeypatch):
 
 def _panda_without_meshes(folder: Path) -> Path:
     """The Panda's URDF with its meshes named where there are none."""
-    from aou_dsl.arms.load import scene_urdf
+    from aou_dsl.robot.load import scene_urdf
 
     text = open(scene_urdf("panda")).read()
     text = re.sub(r'filename="[^"]*/([^/"]+)"', r'filename="gone/\1"', text)
@@ -141,7 +141,7 @@ def test_varying_a_variant_keeps_the_base_name_and_one_mark(here, capsys):
 
 
 def test_behaviours_at_one_point_share_one_label_on_the_cv_map():
-    from aou_dsl.linter import lint_file
+    from aou_dsl.lang.linter import lint_file
     from aou_dsl.media.plot import cv_figure, point_labels
 
     cv = lint_file(str(BEHAVIOURS / "hesitant.aou")).cv

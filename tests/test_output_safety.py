@@ -20,8 +20,8 @@ from pathlib import Path
 
 import pytest
 
-from aou_dsl.cli import main
-from aou_dsl.cli_args import EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE
+from aou_dsl.cli.args import EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE
+from aou_dsl.cli.commands import main
 
 from .conftest import BEHAVIOURS, ROOT
 from .test_fuzz_outputs import _workspace
@@ -144,7 +144,7 @@ def test_a_bag_beside_other_files_and_into_a_missing_folder(ws, capsys):
 HOLD = textwrap.dedent("""
     import os, sys, time
     from pathlib import Path
-    import aou_dsl.files as files
+    import aou_dsl.core.files as files
     marker, where, named, argv = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:]
     def hold(real):
         def held(*a, **k):
@@ -162,7 +162,7 @@ HOLD = textwrap.dedent("""
         files.os.replace = hold(os.replace)
     if named == "named":
         files._write_unnamed = lambda *a: False
-    from aou_dsl.cli import main
+    from aou_dsl.cli.commands import main
     raise SystemExit(main(argv))
 """)
 
@@ -277,7 +277,7 @@ def test_plot_leaves_no_temporary_file_and_repeats_its_bytes(tmp_path, monkeypat
 def test_the_files_a_command_reads_follow_the_chain_and_never_block(ws):
     """aou file -> its robot file (and --robot's) -> the URDF it names -> every mesh,
     package:// ones too; a FIFO or a missing file on the way is listed, not opened."""
-    from aou_dsl.reads import files_read
+    from aou_dsl.robot.files_read import files_read
 
     from .test_fuzz_outputs import _deadline
 

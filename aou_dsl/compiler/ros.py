@@ -26,8 +26,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .. import __version__
-from ..diagnostics import AouError, Span, diag
+from ..core.diagnostics import AouError, Span, diag
+from ..version import __version__
 
 __all__ = ["MSGTYPE", "TOPIC", "encode_yaml", "is_bag", "message", "read_bag", "write_bag"]
 
@@ -123,7 +123,7 @@ def write_bag(doc: dict, path: str, *, topic: str = TOPIC, inputs: Sequence[str]
 
     The bag is made in a temporary folder beside ``path`` and renamed onto it when
     complete; the folders missing on the way are made. ``path`` must be new, an empty
-    folder or a bag aou wrote (:func:`aou_dsl.files.guard_output`), which is replaced.
+    folder or a bag aou wrote (:func:`aou_dsl.core.files.guard_output`), which is replaced.
 
     Raises:
         AouError: I502 when it cannot be written, or ``path`` is, holds or links to an
@@ -131,7 +131,7 @@ def write_bag(doc: dict, path: str, *, topic: str = TOPIC, inputs: Sequence[str]
     """
     from rosbags.rosbag2 import StoragePlugin, Writer
 
-    from ..files import guard_output, make_folders, sweep_stale, temp_prefix
+    from ..core.files import guard_output, make_folders, sweep_stale, temp_prefix
 
     where = Span.whole_file(path)
     final = os.path.abspath(path.rstrip(os.sep) or path)

@@ -11,9 +11,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..cv import CANONICAL, CVPoint
-from ..diagnostics import Diagnostic, Span, diag
-from ..trajectory import Trajectory
+from ..core.diagnostics import Diagnostic, Span, diag
+from ..core.trajectory import Trajectory
+from ..lang.cv import CANONICAL, CVPoint
 
 __all__ = ["FORMATS", "ProfileData", "cv_figure", "point_labels", "profile_data", "profile_figure",
            "save"]
@@ -72,11 +72,11 @@ def profile_data(rec: Trajectory) -> ProfileData:
     goal distance, and R405 (a warning) says so.
 
     Raises:
-        AouError: as :func:`aou_dsl.measuring.descriptors.measure` for a recording that
+        AouError: as :func:`aou_dsl.measuring.measured.measure` for a recording that
             cannot be measured.
     """
-    from ..kinematics import load_arm
-    from ..measuring.fk import batch_fk
+    from ..robot.batch_fk import batch_fk
+    from ..robot.load import load_arm
 
     arm = load_arm(rec.robot, rec.ee_frame)
     cols = rec.columns(arm.joint_names)
@@ -88,7 +88,7 @@ def profile_data(rec: Trajectory) -> ProfileData:
     episodes = rec.episodes
     extra: dict = {}
     if not episodes:
-        from ..measuring.descriptors import measure
+        from ..measuring.measured import measure
 
         m = measure(rec)
         episodes = tuple((e.kind, e.t_start + t[0], e.t_end + t[0]) for e in m.episodes)
@@ -231,18 +231,18 @@ _METADATA = {"png": {"Software": None}, "svg": {"Date": None, "Creator": None},
 def save(fig, path: str, inputs=()) -> None:
     """Save atomically and deterministically (the same figure gives the same bytes),
     making the folders missing on the way; never over one of ``inputs``. The figure is
-    drawn in memory and the file written whole (:func:`aou_dsl.files.write_atomic`), so
+    drawn in memory and the file written whole (:func:`aou_dsl.core.files.write_atomic`), so
     no temporary file is ever left.
 
     Raises:
         AouError: I502 when the extension is unknown or the folder cannot be written,
-            or a code of the output rule (:func:`aou_dsl.files.guard_output`).
+            or a code of the output rule (:func:`aou_dsl.core.files.guard_output`).
     """
     import io
 
     import matplotlib
 
-    from ..files import check_output, write_atomic
+    from ..core.files import check_output, write_atomic
 
     fmt = check_output(path, FORMATS, reads=inputs)
     buf = io.BytesIO()

@@ -18,17 +18,17 @@ import os
 import re
 from dataclasses import dataclass, replace
 
-from ..declared import source_of
-from ..descriptors import REGISTRY
-from ..diagnostics import AouError, Span, diag
-from ..ir import Behaviour
-from ..linter import lint_source
-from ..parse import KeyVal, Statement, parse
-from ..primitives import KINDS
+from ..core.diagnostics import AouError, Span, diag
+from ..lang.declared import source_of
+from ..lang.descriptors import REGISTRY
+from ..lang.ir import Behaviour
+from ..lang.linter import lint_source
+from ..lang.parse import KeyVal, Statement, parse
+from ..lang.primitives import KINDS
 
 __all__ = ["MARK", "Variant", "base_stem", "make_variants", "parse_vary"]
 
-#: The first line of a variant: aou's mark (:func:`aou_dsl.files.is_own_output`).
+#: The first line of a variant: aou's mark (:func:`aou_dsl.core.files.is_own_output`).
 MARK = "# written by `aouc variants`"
 
 
