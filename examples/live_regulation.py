@@ -105,14 +105,23 @@ def main(argv: list[str]) -> int:
     ax[1].set_ylim(-0.05, 1.05)
     ax[2].plot(t[::5], dist, color="k")
     ax[2].set_ylabel("hand to goal [m]")
-    ax[3].plot(t, qd, lw=0.7)
+    ax[3].plot(t, qd, lw=0.7, label=list(reg.arm.joint_names))
     ax[3].set_ylabel("joint velocity [rad/s]")
     ax[3].set_xlabel("time [s]")
+    ax[3].legend(fontsize=7, ncol=7, loc="lower left")
+    ax[0].legend(fontsize=8, loc="upper right")
+    ax[1].plot([], [], color="grey", lw=3, label="intensity of the state planned")
+    ax[1].legend(fontsize=8, loc="upper right")
     for r in out["replans"]:
         for a in ax:
             a.axvline(r[0], color="k", lw=0.4, ls=":")
     handles = [plt.Rectangle((0, 0), 1, 1, color=COLOURS[s], alpha=0.4) for s in State]
-    fig.legend(handles, [s.value for s in State], loc="upper center", ncol=5)
+    handles.append(plt.Line2D([0], [0], color="k", lw=0.6, ls=":"))
+    fig.suptitle("live regulation: an uncertainty estimate becomes checked motion",
+                 y=0.995, fontsize=12)
+    fig.legend(handles, [*(s.value for s in State), "re-plan"], loc="upper center",
+               bbox_to_anchor=(0.5, 0.965), ncol=6, title="state planned (shading)")
+    fig.subplots_adjust(top=0.84)
     fig.savefig(png, dpi=90)
     plt.close(fig)
 

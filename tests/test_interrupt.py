@@ -1,8 +1,9 @@
 """Ctrl-C during `aouc compile --jobs 2`: one interrupt ends the run at once, with
-`aouc: interrupted` and exit status 2, whether it reaches the whole process group (as a
-terminal's Ctrl-C does) or only `aouc` itself, while the workers warm up or while they
-build; no worker is left running, no worker prints a traceback, and the files written
-are complete ones, the first of the inputs in order.
+`aouc: interrupted` and exit status 130 (128 + SIGINT, as shells report it), whether it
+reaches the whole process group (as a terminal's Ctrl-C does) or only `aouc` itself,
+while the workers warm up or while they build; no worker is left running, no worker
+prints a traceback, and the files written are complete ones, the first of the inputs in
+order.
 
 Each case runs `python -m aou_dsl` of this checkout in a session of its own, so the
 interrupt reaches only its processes."""
@@ -18,7 +19,7 @@ from pathlib import Path
 
 import pytest
 
-from aou_dsl.cli.commands import EXIT_USAGE
+from aou_dsl.cli.args import EXIT_INTERRUPTED
 
 from .conftest import BEHAVIOURS, ROOT
 
@@ -110,7 +111,7 @@ def test_one_ctrl_c_ends_a_parallel_compile(tmp_path, to, phase):
             proc.wait()
 
     err = log.read_text()
-    assert proc.returncode == EXIT_USAGE, err
+    assert proc.returncode == EXIT_INTERRUPTED, err
     assert "aouc: interrupted" in err
     for word in ("Traceback", "KeyboardInterrupt", "Exception"):  # from no process
         assert word not in err, err

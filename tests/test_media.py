@@ -164,7 +164,8 @@ def test_variants_differ_in_one_statement_and_lint_clean(tmp_path):
     base = src.read_text().splitlines()
     for label, value in (("low", 1.0), ("high", 2.5)):
         path = tmp_path / f"hesitant-pause_duration-{label}.aou"
-        lines = path.read_text().splitlines()
+        mark, *lines = path.read_text().splitlines()  # aou's mark, then the file
+        assert mark.startswith("# written by `aouc variants` from hesitant.aou")
         changed = [i for i, (a, b) in enumerate(zip(base, lines, strict=True)) if a != b]
         assert len(changed) == 1 and lines[changed[0]].startswith("pause ")
         r = lint_file(str(path))

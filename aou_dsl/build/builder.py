@@ -19,6 +19,7 @@ from ..lang.linter import FileResult, lint_file, lint_source
 
 if TYPE_CHECKING:  # the numerical stages load only when a build runs
     from ..compiler.pipeline import CompileResult
+    from ..core.options import SceneOptions
     from ..core.trajectory import Trajectory
     from ..lang.descriptors import Descriptors
     from ..measuring.measured import Measured

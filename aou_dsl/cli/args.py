@@ -13,11 +13,14 @@ from collections.abc import Callable
 
 from ..version import __version__
 
-__all__ = ["EXIT_ERRORS", "EXIT_OK", "EXIT_USAGE", "build_parser", "number", "usage_error"]
+__all__ = ["EXIT_ERRORS", "EXIT_INTERRUPTED", "EXIT_OK", "EXIT_USAGE", "build_parser", "number",
+           "usage_error"]
 
 EXIT_OK = 0
 EXIT_ERRORS = 1
 EXIT_USAGE = 2
+#: Interrupted (Ctrl-C): 128 + SIGINT, as shells report it.
+EXIT_INTERRUPTED = 130
 
 
 class Parser(argparse.ArgumentParser):
@@ -110,6 +113,12 @@ def _package_dir(p: argparse.ArgumentParser) -> None:
     p.add_argument("--package-dir", action="append", default=[], metavar="DIR",
                    help="a folder holding ROS packages, searched first for the URDF's "
                    "package:// meshes (repeatable)")
+
+
+def _force(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--force", action="store_true",
+                   help="replace an existing output file aou did not write (without it, "
+                   "only aou's own outputs are replaced)")
 
 
 def _controller(p: argparse.ArgumentParser) -> None:
@@ -230,6 +239,7 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
                      help="descriptor and its two values, in the descriptor's unit")
     var.add_argument("-o", "--output", metavar="DIR", help="folder (default: here)")
     var.add_argument("--render", metavar="X.mp4|X.gif", help="also render the pair")
+    _force(var)
     _render(var)
     _scene(var)
     c["measure"] = meas = sub.add_parser(
@@ -246,6 +256,7 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
                      help="toml: a robot description pinning every value")
     rob.add_argument("-o", "--output", metavar="FILE",
                      help="write to FILE instead of standard output (e.g. -o arm.toml)")
+    _force(rob)
     _package_dir(rob)
     c["synth"] = syn = sub.add_parser(
         "synth", help="write a .aou file for a state, or a point of the C-V plane, at an "
@@ -264,6 +275,7 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
                      help="skip the compile that fits the values to the arm")
     syn.add_argument("-o", "--output", metavar="FILE.aou",
                      help="output file (default: standard output)")
+    _force(syn)
     c["rules"] = rules = sub.add_parser("rules", help="list the diagnostic codes, or explain some")
     rules.add_argument("codes", nargs="*", metavar="CODE")
     rules.add_argument("--format", choices=("text", "json"), default="text")

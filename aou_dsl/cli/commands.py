@@ -2,7 +2,9 @@
 
 Exit codes: 0 no error, 1 the input has errors (or warnings under ``--strict``), 2 usage
 or I/O problems, and internal errors (a one-line message; ``--debug`` shows the
-traceback). A 2 is never hidden by a flag.
+traceback), 130 interrupted (Ctrl-C). A 2 is never hidden by a flag. Every command that
+writes obeys one output rule (:func:`aou_dsl.core.files.guard_output`), given the files it
+reads (:func:`aou_dsl.robot.files_read.files_read`).
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ import sys
 from collections.abc import Callable, Sequence
 
 from ..core.diagnostics import RULES, AouError, Diagnostic, Severity, Span
-from .args import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, build_parser
+from .args import EXIT_ERRORS, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, build_parser
 from .report import format_github, format_json, format_suppressed, format_text
 from .tools import cmd_robot, cmd_synth
 
@@ -54,6 +56,13 @@ def _read_kw(args: argparse.Namespace) -> dict:
     return {"robot": args.robot, "goal": args.goal, "ee_frame": args.ee_frame,
             "angle_unit": args.angle_unit, "time_unit": args.time_unit,
             "package_dirs": _package_dirs(args)}
+
+
+def _reads(args: argparse.Namespace, paths: Sequence[str]) -> list[str]:
+    """Every file the command reads (the output rule keeps its outputs off them)."""
+    from ..robot.files_read import files_read
+
+    return files_read(paths, getattr(args, "robot", None))
 
 
 def _count(n: int, noun: str) -> str:
@@ -133,9 +142,9 @@ def _cmd_explain(args: argparse.Namespace) -> int:
 
 def _cmd_compile(args: argparse.Namespace) -> int:
     from ..build.parallel import build_many, default_jobs, write_result
-    from ..compiler.output import FORMATS, output_paths
+    from ..compiler.output import FOLDER_FORMATS, FORMATS, output_paths
     from ..core.diagnostics import has_errors
-    from ..core.files import check_format
+    from ..core.files import check_format, guard_output
     from ..core.options import BuildOptions, SceneOptions
     from ..lang.linter import collect_inputs
 
@@ -143,12 +152,15 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     if problems:
         _print_diags(problems)
         return EXIT_USAGE
+    sources = [src for src, _ in inputs]
+    reads = _reads(args, sources)
     try:
         dests, fmt = output_paths(inputs, args.output, args.format)
         check_format(args.output, args.format, FORMATS)  # --format csv -o x.json
+        for dest in dests:  # before any work: the output rule
+            guard_output(dest, reads, bag=fmt in FOLDER_FORMATS)
     except AouError as err:
         return _fail(err)
-    sources = [src for src, _ in inputs]
     options = BuildOptions(robot=args.robot, rate=args.rate, check=not args.no_check,
                            scene=SceneOptions(**_scene_kw(args)),
                            collision_check=not args.no_collision_check,
@@ -163,7 +175,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
             print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)
             continue
         try:
-            write_result(dest, res, fmt, inputs=sources)
+            write_result(dest, res, fmt, inputs=reads)
         except AouError as err:
             worst = max(worst, _fail(err))
             continue
@@ -194,11 +206,28 @@ def _cmd_check(args: argparse.Namespace) -> int:
         return EXIT_ERRORS
     report = check(tr, dynamic=not args.no_dynamic, controller=args.controller,
                    **_scene_kw(args))
+    failed = _check_diagnostics(args.path, report)
     if args.format == "json":
-        print(format_json({"path": args.path, **report.to_json()}))
+        print(format_json({"path": args.path, **report.to_json(),
+                           "diagnostics": [d.to_json() for d in failed]}))
     else:
         print(format_check(args.path, tr.robot, tr.t, report))
-    return EXIT_OK if report.ok else EXIT_ERRORS
+    _print_diags(failed)
+    return EXIT_ERRORS if failed else EXIT_OK
+
+
+def _check_diagnostics(path: str, report) -> list[Diagnostic]:
+    """A failed check as the code compile gives it (C311 the controller's jerk, C306 the
+    rest): ``check`` never fails without a code."""
+    from ..core.diagnostics import diag
+
+    out = [diag("C311" if c.name == "joint-jerk" else "C306",
+                f"{c.name} check failed" + ("" if c.time is None else f" at t={c.time:.3f}s")
+                + f": {c.detail}", Span.whole_file(path), check=c.name, time=c.time,
+                joint=c.joint, value=c.value, limit=c.limit) for c in report.failed()]
+    if not report.ok and not out:
+        out.append(diag("C306", "the checks failed", Span.whole_file(path)))
+    return out
 
 
 def _cmd_measure(args: argparse.Namespace) -> int:
@@ -211,7 +240,10 @@ def _cmd_measure(args: argparse.Namespace) -> int:
     missing = missing_descriptors(tr.goal)  # what the C-V point could not use
     if args.format == "json":
         doc = m.to_json()
-        doc["cv"] = {**doc["cv"], "missing_descriptors": list(missing)}
+        doc["cv"] = {**doc["cv"], "missing_descriptors": list(missing),
+                     "placed": not missing}  # no goal: C and V without the gazes, no state
+        if missing:
+            doc["cv"]["state"] = None
         print(format_json({"path": args.path, "robot": tr.robot, **doc}))
     else:
         print(format_measured(args.path, tr.robot, m, missing))
@@ -224,9 +256,12 @@ def _cmd_measure(args: argparse.Namespace) -> int:
 
 def _cmd_plot(args: argparse.Namespace) -> int:
     from ..api import read_trajectory
+    from ..core.files import check_output
     from ..lang.linter import lint_paths
-    from ..media.plot import cv_figure, profile_data, profile_figure, save
+    from ..media.plot import FORMATS, cv_figure, profile_data, profile_figure, save
 
+    reads = _reads(args, args.paths)
+    check_output(args.output, FORMATS, reads=reads)
     if args.cv:
         results, problems = lint_paths(args.paths)
         bad = problems + [d for r in results if not r.ok for d in r.diagnostics]
@@ -242,19 +277,20 @@ def _cmd_plot(args: argparse.Namespace) -> int:
         data = profile_data(tr)
         _print_diags(list(data.diagnostics))  # R405: no goal, no goal-distance panel
         fig = profile_figure(data)
-    save(fig, args.output)
+    save(fig, args.output, reads)
     print(f"wrote {args.output}", file=sys.stderr)
     return EXIT_OK
 
 
-def _render(paths: list[str], output: str, args: argparse.Namespace, read_kw: dict) -> int:
+def _render(paths: list[str], output: str, args: argparse.Namespace, read_kw: dict,
+            reads: Sequence[str]) -> int:
     import time
 
     from ..api import read_trajectory
     from ..core.options import SceneOptions
     from ..media.render import Camera, check_output, render_video, start_workers
 
-    check_output(output)
+    check_output(output, reads)
     w, h = args.size
     camera = Camera(distance=args.camera_distance, yaw=args.camera_yaw,
                     pitch=args.camera_pitch, target=args.camera_target, width=w, height=h)
@@ -269,7 +305,7 @@ def _render(paths: list[str], output: str, args: argparse.Namespace, read_kw: di
     info = render_video(motions, output, fps=args.fps, camera=camera,
                         scene_options=SceneOptions(**_scene_kw(args),
                                                    package_dirs=_package_dirs(args)),
-                        workers=workers)
+                        workers=workers, inputs=reads)
     print(f"wrote {output}: {info['frames']} frames at {info['fps']:g} fps "
           f"({info['duration']:.2f} s), {info['size'][0]}x{info['size'][1]}, "
           f"{_count(info['drawn'], 'image')} drawn (a frame where the arm holds still "
@@ -282,28 +318,35 @@ def _cmd_render(args: argparse.Namespace) -> int:
     if not paths:
         print("aouc: render takes FILE, or --side-by-side A B", file=sys.stderr)
         return EXIT_USAGE
-    return _render(paths, args.output, args, _read_kw(args))
+    return _render(paths, args.output, args, _read_kw(args), _reads(args, paths))
 
 
 def _cmd_variants(args: argparse.Namespace) -> int:
-    from ..compiler.output import write_atomic
+    from ..core.files import guard_output, write_atomic
     from ..lang.linter import lint_file
-    from ..media.variants import make_variants, parse_vary
+    from ..media.variants import base_stem, make_variants, parse_vary
 
     name, low, high = parse_vary(args.vary)
+    reads = _reads(args, [args.path])
     base = lint_file(args.path)
     if not base.ok or base.behaviour is None or base.source is None:
         _print_diags(base.diagnostics, sources={args.path: base.source or ""})
         return _exit_for(base.diagnostics)
-    stem = os.path.splitext(os.path.basename(args.path))[0]
     folder = args.output or "."
     variants = make_variants(base.behaviour, base.source, name, low, high,
-                             os.path.join(folder, f"{stem}-{name}"))
+                             os.path.join(folder, f"{base_stem(args.path)}-{name}"))
+    for v in variants:  # both checked before either is written
+        guard_output(v.path, reads, force=args.force)
+    if args.render:
+        from ..media.render import check_output
+
+        check_output(args.render, [*reads, *(v.path for v in variants)])
     for v in variants:
-        write_atomic(v.path, v.text.encode(), inputs=[args.path])
+        write_atomic(v.path, v.text.encode(), inputs=reads)
         print(f"wrote {v.path} ({name}={v.value:g})", file=sys.stderr)
     if args.render:
-        return _render([v.path for v in variants], args.render, args, {})
+        return _render([v.path for v in variants], args.render, args, {},
+                       [*reads, *(v.path for v in variants)])
     return EXIT_OK
 
 
@@ -337,7 +380,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _internal(exc, args.debug)
     except KeyboardInterrupt:
         print("aouc: interrupted", file=sys.stderr)
-        return EXIT_USAGE
+        return EXIT_INTERRUPTED
     except BrokenPipeError:
         return EXIT_OK
     except Exception as exc:  # noqa: BLE001 - the last line of defence

@@ -153,8 +153,10 @@ def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = 
         lines.append(f"  line of sight off the goal: median {los.median:.3g} deg, "
                      f"max {los.max:.3g} deg")
     point = f"  C-V: C={m.cv.C:+.2f} V={m.cv.V:+.2f} -> {m.cv.state}"
-    if missing:
-        point += (f" (incomplete: read without the gaze descriptors {', '.join(missing)}, "
-                  "unknown without a goal)")
+    if missing:  # no state named: a point without the gazes would mislead
+        point = (f"  C-V: not placed: without a goal the gaze descriptors "
+                 f"{', '.join(missing)} are unknown, and the point needs them (give "
+                 f"--goal X,Y,Z, or --goal final); read without them, C={m.cv.C:+.2f} "
+                 f"V={m.cv.V:+.2f}")
     lines.append(point)
     return "\n".join(lines)

@@ -6,10 +6,50 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .args import EXIT_OK, usage_error
-from .report import format_json
+from ..core.diagnostics import AouError, Diagnostic, Span, diag
+from ..version import __version__
+from .args import EXIT_ERRORS, EXIT_OK, usage_error
+from .report import format_json, format_text
 
 __all__ = ["cmd_robot", "cmd_synth"]
+
+
+#: Names people call the built-in arms by: ``aouc robot franka`` suggests ``panda``.
+ALIASES = {"franka": "panda", "franka_panda": "panda", "fr3": "panda", "emika": "panda",
+           "panda_arm": "panda", "xarm": "xarm7", "ufactory": "xarm7", "gen3": "kinova",
+           "kinova_gen3": "kinova", "unitree": "z1", "ur": "ur5", "ur5e": "ur5",
+           "ur3e": "ur3", "ur10e": "ur10"}
+
+
+def _with_alias(err: AouError, robot: str) -> AouError:
+    """V109 for an unknown robot, with a did-you-mean from :data:`ALIASES` when the
+    spelling gave none."""
+    from dataclasses import replace
+
+    alias = ALIASES.get(robot.lower().replace("-", "_").replace(" ", "_"))
+    if alias is None:
+        return err
+    return AouError([replace(d, hint=f"did you mean `{alias}`?") if d.code == "V109"
+                     and not d.hint else d for d in err.diagnostics])
+
+
+def _missing_meshes(robot: str) -> list[Diagnostic]:
+    """V109 when meshes the checks load cannot be found: said here, not first at the
+    compile (and how to compile without them)."""
+    from ..robot.load import load_robot
+    from ..robot.urdf import scene_xml
+
+    r = load_robot(robot)
+    _, missing = scene_xml(r.urdf, r.package_dirs, r.gaze, visuals=False)
+    if not missing:
+        return []
+    return [diag("V109", f"robot `{robot}`: {len(missing)} mesh file(s) of its collision "
+                 f"shapes not found, first `{missing[0]}`: the safety checks cannot load it",
+                 Span.whole_file(r.urdf.path),
+                 hint="give the folder of the package (or one holding it) with "
+                 "--package-dir, or in ROS_PACKAGE_PATH, or `package_dirs` in a robot "
+                 "description; or compile with --no-check (the checks are then skipped, "
+                 "and the output says so)")]
 
 
 def cmd_robot(args: argparse.Namespace) -> int:
@@ -24,29 +64,42 @@ def cmd_robot(args: argparse.Namespace) -> int:
     from ..core.files import check_output, write_atomic
     from ..core.options import package_dirs
     from ..robot import describe_robot
+    from ..robot.files_read import robot_files
 
+    reads = robot_files(args.robot, args.package_dir)
     if args.output:
-        check_output(args.output)
-    doc, text = describe_robot(args.robot, package_dirs(args.package_dir))
+        check_output(args.output, reads=reads, force=args.force)
+    try:
+        doc, text = describe_robot(args.robot, package_dirs(args.package_dir))
+    except AouError as err:
+        raise _with_alias(err, args.robot) from None
+    missing = _missing_meshes(args.robot)
+    if missing:  # shapes named, but not there to load: not "yes"
+        text = text.replace("  collision geometry: yes\n", "  collision geometry: named, "
+                            "but its mesh files are missing (V109 below)\n")
     if args.format == "json":
-        out = format_json(doc)
-    elif args.format == "toml":
-        out = doc["toml"]
+        out = format_json({"generator": f"aouc {__version__}", **doc} if args.output
+                          else doc)
     else:
-        out = text
+        out = doc["toml"] if args.format == "toml" else text
+        if args.output:  # aou's mark: `robot -o` may replace this file again
+            out = f"# written by `aouc robot {args.robot}`\n{out}"
     out = out if out.endswith("\n") else out + "\n"
     if args.output:
-        write_atomic(args.output, out.encode(), inputs=[args.robot])
+        write_atomic(args.output, out.encode(), inputs=reads)
         print(f"{args.robot} -> {args.output}", file=sys.stderr)
     else:
         sys.stdout.write(out)
-    return EXIT_OK
+    for d in missing:
+        print(format_text(d), file=sys.stderr)
+    return EXIT_ERRORS if missing else EXIT_OK
 
 
 def cmd_synth(args: argparse.Namespace) -> int:
     """``aouc synth``: a behaviour file for a state or a C-V point, fitted to the arm."""
 
     from ..core.files import check_output, write_atomic
+    from ..robot.files_read import robot_files
     from ..synth.synthesis import synthesize
 
     if args.V is not None and args.C is None:  # argparse requires --state or --C
@@ -54,13 +107,14 @@ def cmd_synth(args: argparse.Namespace) -> int:
                            "with --state")
     if args.C is not None and args.V is None:
         return usage_error("synth", "a point of the C-V plane needs --V too")
+    reads = robot_files(args.robot, args.package_dir) if args.robot else []
     if args.output is not None:
-        check_output(args.output, ("aou",))
+        check_output(args.output, ("aou",), reads=reads, force=args.force)
     text = synthesize(args.state, C=args.C, V=args.V, intensity=args.intensity,
                       robot=args.robot, verify=not args.no_verify)
     if args.output is None:
         sys.stdout.write(text)
         return EXIT_OK
-    write_atomic(args.output, text.encode())
+    write_atomic(args.output, text.encode(), inputs=reads)
     print(f"wrote {args.output}", file=sys.stderr)
     return EXIT_OK

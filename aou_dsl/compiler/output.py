@@ -78,11 +78,18 @@ def document_header(result, *, measured: dict, declared: dict, cv: dict,
         "goal": {"position": list(tr.goal)},
         "rate": rate,
         "duration": tr.duration,
-        "descriptors": {"declared": declared, "measured": measured},
+        "descriptors": {"declared": _clean(declared), "measured": measured},
         "cv": cv,
         "episodes": [{"kind": k, "t_start": a, "t_end": e} for k, a, e in tr.episodes],
         "checks": checks or {},
     }
+
+
+def _clean(declared: dict) -> dict:
+    """Declared values as written: a unit's round trip (6 deg to radians and back gives
+    6.000000000000001) rounded off at 12 significant digits; counts stay whole."""
+    return {k: float(f"{v:.12g}") if isinstance(v, float) else v
+            for k, v in declared.items()}
 
 
 def encode(doc: dict, fmt: str) -> bytes:

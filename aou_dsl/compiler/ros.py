@@ -18,6 +18,7 @@ are deterministic: the same document gives the same bytes.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import tempfile
@@ -26,13 +27,14 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..core.diagnostics import AouError, Span, diag
+from ..core.files import BAG_TOPIC
 from ..version import __version__
 
 __all__ = ["MSGTYPE", "TOPIC", "encode_yaml", "is_bag", "message", "read_bag", "write_bag"]
 
 #: The topic of a ros2_control ``joint_trajectory_controller`` named
 #: ``joint_trajectory_controller`` (``<controller>/joint_trajectory``).
-TOPIC = "/joint_trajectory_controller/joint_trajectory"
+TOPIC = BAG_TOPIC
 MSGTYPE = "trajectory_msgs/msg/JointTrajectory"
 
 
@@ -121,30 +123,30 @@ def write_bag(doc: dict, path: str, *, topic: str = TOPIC, inputs: Sequence[str]
     """Write the message as a ROS 2 bag (MCAP storage) in the folder ``path``.
 
     The bag is made in a temporary folder beside ``path`` and renamed onto it when
-    complete; an existing bag there is replaced, anything else is left alone.
+    complete; the folders missing on the way are made. ``path`` must be new, an empty
+    folder or a bag aou wrote (:func:`aou_dsl.core.files.guard_output`), which is replaced.
 
     Raises:
-        AouError: I502 when ``path`` exists and is not a bag, would hold or replace an
-            input, or cannot be written.
+        AouError: I502 when it cannot be written, or ``path`` is, holds or links to an
+            input, is a special file, or holds files other than a bag aou wrote.
     """
     from rosbags.rosbag2 import StoragePlugin, Writer
 
+    from ..core.files import guard_output, make_folders, sweep_stale, temp_prefix
+
     where = Span.whole_file(path)
     final = os.path.abspath(path.rstrip(os.sep) or path)
-    for src in inputs:
-        real = os.path.realpath(src)
-        if real == os.path.realpath(final) or real.startswith(os.path.realpath(final) + os.sep):
-            raise AouError(diag("I502", f"refusing to write the bag `{path}` over the input "
-                                f"`{src}`", where, hint="choose another output with -o"))
-    if os.path.lexists(final) and not is_bag(final):
-        raise AouError(diag("I502", f"cannot write the bag `{path}`: it exists and is not "
-                            "a ROS 2 bag", where, hint="remove it or choose another -o"))
+    guard_output(final, inputs, bag=True)
+    final = os.path.realpath(final)
     data = _serialized(doc)
     parent = os.path.dirname(final)
+    made = make_folders(parent, where)
+    sweep_stale(parent)
     try:
-        tmp = tempfile.mkdtemp(prefix=".aouc-", dir=parent)
+        tmp = tempfile.mkdtemp(prefix=temp_prefix(), dir=parent)
     except OSError as exc:
         raise AouError(diag("I502", f"cannot write `{path}`: {exc.strerror}", where)) from None
+    done = False
     try:
         bag = os.path.join(tmp, os.path.basename(final))
         ts = _typestore()
@@ -160,10 +162,14 @@ def write_bag(doc: dict, path: str, *, topic: str = TOPIC, inputs: Sequence[str]
             if os.path.lexists(old):
                 os.rename(old, final)
             raise
+        done = True
     except OSError as exc:
         raise AouError(diag("I502", f"cannot write `{path}`: {exc.strerror}", where)) from None
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+        for f in () if done else made:
+            with contextlib.suppress(OSError):
+                os.rmdir(f)
 
 
 def read_bag(path: str) -> tuple[str, str, dict]:

@@ -4,31 +4,49 @@ Every file aou writes (trajectories, figures, videos, behaviour files) appears w
 not at all: it is written to a temporary name beside the target and renamed over it
 when complete, and an input is never overwritten. The folders missing on the way to it
 are made first (and removed again if the write fails).
+
+The output rule, one for every command that writes (:func:`guard_output`): an output
+may not be, or link to, any file the command reads (:mod:`aou_dsl.robot.files_read` lists them:
+the ``.aou`` file, its robot file, the URDF, every mesh, the trajectory); it may not be
+a device, a FIFO or a socket; a bag is written only into a new or empty folder or over
+a bag aou wrote; and where a command is asked to (``synth``, ``variants``, ``robot
+-o``), an existing file is replaced only when aou wrote it (:func:`is_own_output`) or
+with ``--force``.
+
+A temporary file carries the writer's process id (``.aouc-PID-...``); one left by a
+process that was killed is removed by the next write into that folder. A file written
+from bytes has no name at all until it is complete (Linux's ``O_TMPFILE``).
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
+import re
+import stat
 import tempfile
 from collections.abc import Iterator, Sequence
 from typing import Any
 
 from .diagnostics import AouError, Span, diag
 
-__all__ = ["atomic", "check_format", "check_output", "decode", "read_bytes", "read_text",
+__all__ = ["atomic", "check_format", "check_output", "decode", "guard_output", "is_own_output",
+           "make_folders", "read_bytes", "read_text", "sweep_stale", "temp_prefix",
            "write_atomic"]
 
 
-def check_output(path: str, formats: Sequence[str] = ()) -> str:
+def check_output(path: str, formats: Sequence[str] = (), *, reads: Sequence[str] = (),
+                 force: bool = True) -> str:
     """Check, before any long work, that ``path`` can be written: its extension is one of
     ``formats`` (when given), and its folder exists and is writable or can be made (the
-    folders missing on the way are made when the file is written, by :func:`atomic`).
-    Returns the extension.
+    folders missing on the way are made when the file is written, by :func:`atomic`),
+    and it obeys the output rule against ``reads`` (:func:`guard_output`). Returns the
+    extension.
 
     Raises:
-        AouError: I502 naming what is wrong.
+        AouError: I502 naming what is wrong, or the codes of :func:`guard_output`.
     """
+    guard_output(path, reads, force=force)
     where = Span.whole_file(path)
     ext = os.path.splitext(path)[1].lower().lstrip(".")
     if formats and ext not in formats:
@@ -65,6 +83,155 @@ def check_format(path: str | None, fmt: str | None, known: Sequence[str]) -> Non
             f"to write {ext}"))
 
 
+def _clash(path: str, read: str) -> str | None:
+    """How ``path`` would write over the input ``read`` (None: it would not)."""
+    try:
+        if os.path.realpath(path) == os.path.realpath(read):
+            return "is" if os.path.abspath(path) == os.path.abspath(read) else "links to"
+        if os.path.exists(path) and os.path.exists(read) and os.path.samefile(path, read):
+            return "is a hard link of"
+    except (OSError, ValueError):
+        return None
+    return None
+
+
+def _special(mode: int) -> str | None:
+    """What a file that is neither a regular file nor a folder is, in words."""
+    for test, name in ((stat.S_ISCHR, "character device"), (stat.S_ISBLK, "block device"),
+                       (stat.S_ISFIFO, "FIFO (named pipe)"), (stat.S_ISSOCK, "socket")):
+        if test(mode):
+            return name
+    return None
+
+
+def guard_output(path: str, reads: Sequence[str] = (), *, force: bool = True,
+                 bag: bool = False) -> None:
+    """The output rule: refuse ``path`` when it is, or links to, one of the files the
+    command ``reads``; when it is a device, a FIFO or a socket; for a ``bag`` (a folder),
+    when it holds one of ``reads`` or anything but a bag aou wrote; and unless ``force``,
+    when it is an existing file aou did not write (:func:`is_own_output`).
+
+    Raises:
+        AouError: I502 naming the clash (an input, a special file, a folder holding
+            other files, a folder where a file goes or the reverse), I506 for an existing
+            file aou did not write (without ``force``).
+    """
+    where = Span.whole_file(path)
+    for read in reads:
+        how = _clash(path, read)
+        if how is not None:
+            raise AouError(diag("I502", f"refusing to write `{path}`: it {how} `{read}`, "
+                                "which this command reads", where,
+                                hint="choose another output with -o", input=read))
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):
+        return  # a new file (or a dangling link, replaced by the file)
+    kind = _special(mode)
+    if kind is not None:
+        raise AouError(diag("I502", f"refusing to write `{path}`: it is a {kind}, not a "
+                            "regular file", where, hint="choose a file name with -o"))
+    if bag:
+        _guard_bag(path, reads, where, stat.S_ISDIR(mode))
+    elif stat.S_ISDIR(mode):
+        raise AouError(diag("I502", f"cannot write `{path}`: it is a folder", where))
+    elif not force and not is_own_output(path):
+        raise AouError(diag("I506", f"refusing to replace `{path}`: aou did not write it",
+                            where, hint="choose another output with -o, or give --force "
+                            "to replace it"))
+
+
+def _guard_bag(path: str, reads: Sequence[str], where: Span, folder: bool) -> None:
+    if not folder:
+        raise AouError(diag("I502", f"cannot write the bag `{path}`: it is a file, and a "
+                            "bag is a folder", where, hint="choose another output with -o"))
+    real = os.path.realpath(path)
+    for read in reads:
+        if os.path.realpath(read).startswith(real + os.sep):
+            raise AouError(diag("I502", f"refusing to write the bag `{path}`: it holds "
+                                f"`{read}`, which this command reads", where,
+                                hint="choose another output with -o", input=read))
+    if os.listdir(real) and not _is_aou_bag(real):
+        raise AouError(diag("I502", f"refusing to write the bag `{path}`: the folder holds "
+                            "files other than a bag aou wrote", where,
+                            hint="a bag goes into a new or empty folder, or over a bag aou "
+                            "wrote: choose another output with -o"))
+
+
+#: The first line of a text file aou wrote carries this; a JSON document has this
+#: ``generator``. aou's own outputs may be replaced without ``--force``.
+OWN_MARK = re.compile(rb'\A(#[^\n]*written by `?aouc |\{\s*[^\n]{0,200}?"generator": ?"aouc )')
+
+
+def is_own_output(path: str) -> bool:
+    """Whether the existing regular file ``path`` is one aou wrote: its first line is a
+    comment saying ``written by `aouc ...``` (behaviour files from ``synth`` and
+    ``variants``, robot descriptions from ``robot -o``), or it is a JSON document whose
+    ``generator`` is ``aouc ...`` (on its first line with content, within 200
+    characters: trajectories from ``compile``, ``robot -o`` in JSON)."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(512)
+    except OSError:
+        return False
+    return OWN_MARK.match(head) is not None
+
+
+#: The topic of the bags aou writes (a ROS 2 ``joint_trajectory_controller``'s).
+BAG_TOPIC = "/joint_trajectory_controller/joint_trajectory"
+
+
+def _is_aou_bag(folder: str) -> bool:
+    """Whether ``folder`` holds a bag aou wrote and nothing else: ``metadata.yaml`` and
+    ``NAME.mcap`` (NAME: the folder's name) on aou's topic."""
+    name = os.path.basename(folder)
+    if sorted(os.listdir(folder)) != sorted(["metadata.yaml", f"{name}.mcap"]):
+        return False
+    try:
+        with open(os.path.join(folder, "metadata.yaml"), "rb") as fh:
+            return BAG_TOPIC.encode() in fh.read(1 << 16)
+    except OSError:
+        return False
+
+
+def temp_prefix() -> str:
+    """The name a temporary file or folder of this process starts with."""
+    return f".aouc-{os.getpid()}-"
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True
+    return True
+
+
+def sweep_stale(folder: str, prefix: str = ".aouc-") -> None:
+    """Remove the temporary files and folders (``PREFIX PID-...``) in ``folder`` left by
+    processes that no longer run (killed while writing), when this user owns them."""
+    import shutil
+
+    pat = re.compile(re.escape(prefix) + r"(\d+)-")
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return
+    for e in entries:
+        m = pat.match(e.name)
+        if m is None or int(m.group(1)) == os.getpid() or _alive(int(m.group(1))):
+            continue
+        with contextlib.suppress(OSError):
+            if e.stat(follow_symlinks=False).st_uid != os.getuid():
+                continue
+            if e.is_dir(follow_symlinks=False):
+                shutil.rmtree(e.path, ignore_errors=True)
+            else:
+                os.unlink(e.path)
+
+
 @contextlib.contextmanager
 def atomic(path: str, *, inputs: Sequence[str] = ()) -> Iterator[str]:
     """A temporary file name beside ``path`` to write to; renamed over ``path`` when the
@@ -72,17 +239,17 @@ def atomic(path: str, *, inputs: Sequence[str] = ()) -> Iterator[str]:
     to ``path`` are made first, and removed again when nothing was written.
 
     Raises:
-        AouError: I502 when the file cannot be written or would overwrite an input.
+        AouError: I502 when the file cannot be written; the codes of :func:`guard_output`
+            when it would write over one of ``inputs`` or a special file.
     """
     where = Span.whole_file(path)
+    guard_output(path, inputs)
     target = os.path.realpath(path)
-    if any(os.path.exists(i) and os.path.realpath(i) == target for i in inputs):
-        raise AouError(diag("I502", f"refusing to overwrite the input `{path}`", where,
-                            hint="choose another output with -o"))
     ext = os.path.splitext(path)[1]
-    made = _make_folders(os.path.dirname(target), where)
+    made = make_folders(os.path.dirname(target), where)
+    sweep_stale(os.path.dirname(target) or ".")
     try:
-        fd, tmp = tempfile.mkstemp(prefix=".aouc-", suffix=ext or ".tmp",
+        fd, tmp = tempfile.mkstemp(prefix=temp_prefix(), suffix=ext or ".tmp",
                                    dir=os.path.dirname(target) or ".")
         os.close(fd)
     except OSError as exc:
@@ -103,8 +270,12 @@ def atomic(path: str, *, inputs: Sequence[str] = ()) -> Iterator[str]:
             _remove_folders(made)
 
 
-def _make_folders(folder: str, where: Span) -> list[str]:
-    """Make ``folder`` and the folders missing above it; the ones made, deepest first."""
+def make_folders(folder: str, where: Span) -> list[str]:
+    """Make ``folder`` and the folders missing above it; the ones made, deepest first.
+
+    Raises:
+        AouError: I502 naming the folder that cannot be made.
+    """
     made = []
     while folder and not os.path.lexists(folder):
         made.append(folder)
@@ -120,7 +291,7 @@ def _make_folders(folder: str, where: Span) -> list[str]:
 
 
 def _remove_folders(made: list[str]) -> None:
-    """Remove the folders :func:`_make_folders` made (deepest first), if still empty:
+    """Remove the folders :func:`make_folders` made (deepest first), if still empty:
     a failed write leaves nothing behind."""
     for f in made:
         with contextlib.suppress(OSError):
@@ -128,9 +299,62 @@ def _remove_folders(made: list[str]) -> None:
 
 
 def write_atomic(path: str, data: bytes, *, inputs: Sequence[str] = ()) -> None:
-    """Write ``data`` to ``path`` atomically; never over one of ``inputs``."""
+    """Write ``data`` to ``path`` atomically; never over one of ``inputs`` (nor against
+    the rest of :func:`guard_output`). Where the file system allows, the data goes into
+    a file without a name, named only when complete: a process killed while writing
+    leaves nothing."""
+    where = Span.whole_file(path)
+    guard_output(path, inputs)
+    target = os.path.realpath(path)
+    folder = os.path.dirname(target) or "."
+    made = make_folders(folder, where)
+    sweep_stale(folder)
+    try:
+        if _write_unnamed(folder, target, data):
+            made = []
+            return
+    except OSError as exc:
+        raise AouError(diag("I502", f"cannot write `{path}`: {exc.strerror}", where)) from None
+    finally:
+        _remove_folders(made)
     with atomic(path, inputs=inputs) as tmp, open(tmp, "wb") as fh:
         fh.write(data)
+
+
+def _link(fd: int, path: str) -> bool:
+    """Give the unnamed file ``fd`` the name ``path``: ``linkat`` of ``/proc/self/fd/FD``
+    following the link (Python's ``os.link`` does not follow it on Linux)."""
+    import ctypes
+
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        return libc.linkat(-100, f"/proc/self/fd/{fd}".encode(), -100,  # AT_FDCWD
+                           os.fsencode(path), 0x400) == 0  # AT_SYMLINK_FOLLOW
+    except (OSError, AttributeError):
+        return False
+
+
+def _write_unnamed(folder: str, target: str, data: bytes) -> bool:
+    """Write ``data`` into a file without a name in ``folder``, then name it ``target``;
+    False (nothing done) where the file system cannot (no ``O_TMPFILE``, no ``/proc``)."""
+    try:
+        fd = os.open(folder, os.O_TMPFILE | os.O_WRONLY, 0o644)  # type: ignore[attr-defined]
+    except (AttributeError, OSError):
+        return False
+    try:
+        with os.fdopen(fd, "wb", closefd=False) as fh:
+            fh.write(data)
+        tmp = os.path.join(folder, f"{temp_prefix()}{os.urandom(6).hex()}.link")
+        if not _link(fd, tmp):
+            return False
+        try:
+            os.replace(tmp, target)
+        finally:
+            if os.path.lexists(tmp):
+                os.unlink(tmp)
+        return True
+    finally:
+        os.close(fd)
 
 
 def read_text(path: str, what: str = "") -> str:

@@ -302,7 +302,10 @@ _RULE_LIST = [
          "Nothing can be checked or compiled.",
          "aouc lint missing.aou"),
     Rule("I502", "cannot-write", _E,
-         "An output file cannot be written, or would overwrite an input.",
+         "An output file cannot be written, or would overwrite an input: it is, or links "
+         "to, a file the command reads (the `.aou` file, its robot file, the URDF, a mesh, "
+         "the trajectory); it is a device, a FIFO or a socket; or a bag's folder holds "
+         "other files than a bag aou wrote.",
          "aou writes atomically and never overwrites its inputs.",
          "aouc compile a.aou -o a.aou"),
     Rule("I503", "no-inputs", _E,
@@ -320,6 +323,13 @@ _RULE_LIST = [
          "one (`tcp://HOST:PORT`).",
          "Nothing is built: the files would have had no workers.",
          "aouc compile a.aou --cluster tcp://127.0.0.1:9"),
+    Rule("I506", "not-aou-output", _E,
+         "`synth`, `variants` or `robot -o` would replace an existing file that aou did not "
+         "write (aou's own files start with a comment line saying they were written by "
+         "aouc, or are JSON with an `aouc` generator).",
+         "A hand-written behaviour or robot file is not lost to a command that makes "
+         "one; `--force` replaces it.",
+         "aouc synth --state confident --no-verify -o a.aou"),
 ]
 
 RULES: dict[str, Rule] = {r.code: r for r in _RULE_LIST}

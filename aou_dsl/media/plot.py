@@ -15,7 +15,8 @@ from ..core.diagnostics import Diagnostic, Span, diag
 from ..core.trajectory import Trajectory
 from ..lang.cv import CANONICAL, CVPoint
 
-__all__ = ["ProfileData", "cv_figure", "profile_data", "profile_figure", "save"]
+__all__ = ["FORMATS", "ProfileData", "cv_figure", "point_labels", "profile_data", "profile_figure",
+           "save"]
 
 _COLOURS = {"approach": "#4c9a2a", "retreat": "#c0392b", "pause": "#95a5a6",
             "gaze": "#2e86c1", "tilt": "#8e44ad", "shiver": "#e67e22"}
@@ -58,6 +59,11 @@ class ProfileData:
     def has_goal(self) -> bool:
         """Whether the goal distance is known (else its panel is left out)."""
         return bool(np.isfinite(self.distance).any())
+
+
+#: The most episodes shaded in a profile (a file can list any number; more than a
+#: figure can show would take minutes to draw and show nothing).
+MAX_SHADED = 400
 
 
 def profile_data(rec: Trajectory) -> ProfileData:
@@ -129,7 +135,7 @@ def profile_figure(d: ProfileData):
     ax_v, ax_q, ax_qd = panel["v"], panel["q"], panel["qd"]
     ax_v.plot(d.t, d.speed, color="black", lw=1.2, label="end-effector speed")
     top = max(float(d.speed.max()), 1e-3) * 1.25
-    for kind, a, b in d.episodes:
+    for kind, a, b in d.episodes[:MAX_SHADED]:
         for ax in axes:
             ax.axvspan(a, b, color=_COLOURS.get(kind, "#dddddd"), alpha=0.15, lw=0)
         ax_v.text((a + b) / 2, top * 0.93, kind, ha="center", va="top", fontsize=7,
@@ -138,7 +144,9 @@ def profile_figure(d: ProfileData):
     ax_v.set_ylabel("speed [m/s]")
     title = d.title or "velocity profile"
     ax_v.set_title((f"{title} (episodes as measured)" if d.measured else title)
-                   + ("" if d.has_goal else "; no goal: no goal distance"))
+                   + ("" if d.has_goal else "; no goal: no goal distance")
+                   + (f"; the first {MAX_SHADED} of {len(d.episodes)} episodes shaded"
+                      if len(d.episodes) > MAX_SHADED else ""))
     if "d" in panel:
         panel["d"].plot(d.t, d.distance, color="#34495e", lw=1.2)
         panel["d"].set_ylabel("goal distance [m]")
@@ -161,6 +169,23 @@ def profile_figure(d: ProfileData):
     return fig
 
 
+def point_labels(points: list[tuple[str, CVPoint]], most: int = 3
+                 ) -> list[tuple[str, CVPoint]]:
+    """One label per place on the map: behaviours at one point (to the hundredth, as the
+    map can tell them apart) share it, ``a, b, c +2 more (state)``, instead of being
+    printed over each other."""
+    places: dict[tuple[float, float], list[tuple[str, CVPoint]]] = {}
+    for label, p in points:
+        places.setdefault((round(p.C, 2), round(p.V, 2)), []).append((label, p))
+    out = []
+    for group in places.values():
+        names = [label for label, _ in group]
+        more = f" +{len(names) - most} more" if len(names) > most else ""
+        out.append((f"{', '.join(names[:most])}{more} ({group[0][1].state.value})",
+                    group[0][1]))
+    return out
+
+
 def cv_figure(points: list[tuple[str, CVPoint]]):
     """The C-V plane: the five canonical states, the borders of their regions (nearest
     state), and each behaviour's inferred point, labelled."""
@@ -178,10 +203,9 @@ def cv_figure(points: list[tuple[str, CVPoint]]):
     xs = [p.C for _, p in points]
     ys = [p.V for _, p in points]
     ax.scatter(xs, ys, s=40, color="#c0392b", zorder=3)
-    for (label, p) in points:  # labelled on the side toward the centre, clear of the
-        right = p.C > 0.3  # canonical squares' labels and of the plot's edges
-        ax.annotate(f"{label} ({p.state.value})", (p.C, p.V),
-                    xytext=(-6 if right else 6, -12 if p.V > 0.3 else 5),
+    for text, p in point_labels(points):  # labelled on the side toward the centre,
+        right = p.C > 0.3  # clear of the canonical squares' labels and the plot's edges
+        ax.annotate(text, (p.C, p.V), xytext=(-6 if right else 6, -12 if p.V > 0.3 else 5),
                     textcoords="offset points", fontsize=8, ha="right" if right else "left")
     ax.set_xlim(-1.25, 1.25)
     ax.set_ylim(-1.25, 1.25)
@@ -194,16 +218,35 @@ def cv_figure(points: list[tuple[str, CVPoint]]):
     return fig
 
 
-def save(fig, path: str) -> None:
-    """Save atomically (a temporary file beside ``path``, then renamed), making the
-    folders missing on the way.
+#: The figure formats ``aouc plot`` writes.
+FORMATS = ("png", "svg", "pdf")
+
+#: What would differ between two saves of one figure, left out: the date, the
+#: software's version, and SVG's random ids (drawn from a fixed salt).
+_METADATA = {"png": {"Software": None}, "svg": {"Date": None, "Creator": None},
+             "pdf": {"CreationDate": None, "ModDate": None, "Creator": None,
+                     "Producer": None}}
+
+
+def save(fig, path: str, inputs=()) -> None:
+    """Save atomically and deterministically (the same figure gives the same bytes),
+    making the folders missing on the way; never over one of ``inputs``. The figure is
+    drawn in memory and the file written whole (:func:`aou_dsl.core.files.write_atomic`), so
+    no temporary file is ever left.
 
     Raises:
-        AouError: I502 when the extension is unknown or the folder cannot be written.
+        AouError: I502 when the extension is unknown or the folder cannot be written,
+            or a code of the output rule (:func:`aou_dsl.core.files.guard_output`).
     """
-    from ..core.files import atomic, check_output
+    import io
 
-    fmt = check_output(path, ("png", "svg", "pdf"))
-    with atomic(path) as tmp:
-        fig.savefig(tmp, format=fmt, dpi=120, metadata={"Software": None}
-                    if fmt == "png" else None)
+    import matplotlib
+
+    from ..core.files import check_output, write_atomic
+
+    fmt = check_output(path, FORMATS, reads=inputs)
+    buf = io.BytesIO()
+    with matplotlib.rc_context({"svg.hashsalt": "aou", "svg.id": "aou-figure",
+                                "pdf.compression": 6}):
+        fig.savefig(buf, format=fmt, dpi=120, metadata=_METADATA[fmt])
+    write_atomic(path, buf.getvalue(), inputs=inputs)

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import functools
 import math
-import sys
+import os
 from dataclasses import dataclass
 from typing import Any
 
@@ -25,6 +25,7 @@ import numpy as np
 
 from ..core.files import atomic
 from ..core.files import check_output as _check_output
+from .annotate import progress_bar
 
 __all__ = ["Camera", "frame_configurations", "frame_times", "render_configurations",
            "render_video", "start_workers", "Workers"]
@@ -192,6 +193,7 @@ class _Clip:
     goal: tuple
     qs: np.ndarray  # (D, n) configurations drawn
     owner: np.ndarray  # (F,) frame -> index into qs
+    title: str = ""  # its caption, side by side
 
     @classmethod
     def of(cls, traj, fps: float) -> _Clip:
@@ -204,7 +206,8 @@ class _Clip:
             goal = final_goal(traj)
         else:
             goal = traj.goal
-        return cls(traj.robot, tuple(float(x) for x in goal), qk[new], np.cumsum(new) - 1)
+        return cls(traj.robot, tuple(float(x) for x in goal), qk[new], np.cumsum(new) - 1,
+                   traj.title or os.path.basename(traj.path))
 
 
 @dataclass
@@ -303,13 +306,15 @@ class _Drawer:
 
 
 def _video_frames(clips: list[_Clip], drawer: _Drawer):
-    """The video's frames in order, the clips side by side (a shorter clip holds its
-    last frame)."""
+    """The video's frames in order, the clips side by side, each captioned with its
+    behaviour's name (a shorter clip holds its last frame)."""
+    from .annotate import side_by_side
+
     n = max(len(c.owner) for c in clips)
     for k in range(n):
         parts = [drawer.image(i, int(c.owner[min(k, len(c.owner) - 1)]))
                  for i, c in enumerate(clips)]
-        yield parts[0] if len(parts) == 1 else np.concatenate(parts, axis=1)
+        yield parts[0] if len(parts) == 1 else side_by_side(parts, [c.title for c in clips])
 
 
 def _pedestal(scene, goal, options) -> None:
@@ -330,28 +335,9 @@ def _pedestal(scene, goal, options) -> None:
                        physicsClientId=c)
 
 
-def _progress_bar(label: str):
-    """A progress bar of the images drawn on stderr: in place on a terminal, else by 10 %."""
-    tty = sys.stderr.isatty()
-    state = {"shown": -1}
-
-    def show(done: int, total: int) -> None:
-        pct = int(100 * done / total)
-        if tty:
-            bar = "#" * (pct // 5) + "-" * (20 - pct // 5)
-            end = "\n" if done == total else ""
-            print(f"\r{label} [{bar}] {pct:3d}% image {done}/{total}", end=end,
-                  file=sys.stderr, flush=True)
-        elif pct // 10 != state["shown"] // 10 or done == total:
-            state["shown"] = pct
-            print(f"{label}: {pct}% ({done}/{total} images)", file=sys.stderr, flush=True)
-
-    return show
-
-
 def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = Camera(),
                  scene_options=None, quiet: bool = False, jobs: int | None = None,
-                 workers=None) -> dict:
+                 workers=None, inputs=()) -> dict:
     """Render one trajectory, or several side by side, into ``path`` (.mp4 or .gif).
 
     Trajectories of different lengths are padded with their last frame. Written to a
@@ -365,7 +351,7 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
     from ..core.options import SceneOptions
 
     try:
-        fmt = check_output(path)
+        fmt = check_output(path, inputs)
         # Import the encoder first: a missing one should fail before minutes of drawing.
         if fmt == "mp4":
             import imageio.v2 as imageio
@@ -380,11 +366,11 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
         raise
     label = "rendering" if len(trajs) == 1 else f"rendering {len(trajs)} side by side"
     drawer = _Drawer(clips, camera, opts, workers.jobs if workers else jobs or _cores(),
-                     (lambda d, t: None) if quiet else _progress_bar(label),
+                     (lambda d, t: None) if quiet else progress_bar(label),
                      workers.pool if workers else None)
     n = max(len(c.owner) for c in clips)
     try:
-        with atomic(path) as tmp:  # frames go to the encoder as they are drawn
+        with atomic(path, inputs=inputs) as tmp:  # frames go to the encoder as they are drawn
             if fmt == "mp4":
                 with imageio.get_writer(tmp, format="FFMPEG", fps=fps, codec="libx264",
                                         quality=8, macro_block_size=8,
@@ -411,6 +397,7 @@ def _cores() -> int:
     return default_jobs()
 
 
-def check_output(path: str) -> str:
-    """Check a video path before rendering: .mp4 or .gif, its folder writable or makeable."""
-    return _check_output(path, ("mp4", "gif"))
+def check_output(path: str, reads=()) -> str:
+    """Check a video path before rendering: .mp4 or .gif, its folder writable or makeable,
+    not one of the files the command ``reads``."""
+    return _check_output(path, ("mp4", "gif"), reads=reads)

@@ -131,7 +131,12 @@ def robot_diagnostics(robot: str, *, collision_check: bool = True, span: Span | 
 
 @functools.cache
 def _tmp_dir() -> str:
-    path = tempfile.mkdtemp(prefix="aou-robots-")
+    """This process's folder for the copies PyBullet loads (``aou-robots-PID-...``),
+    removed at exit; those of processes that were killed are removed here first."""
+    from ..core.files import sweep_stale
+
+    sweep_stale(tempfile.gettempdir(), "aou-robots-")
+    path = tempfile.mkdtemp(prefix=f"aou-robots-{os.getpid()}-")
     atexit.register(shutil.rmtree, path, True)
     return path
 
@@ -145,7 +150,9 @@ def _scene_file(robot: str, dirs: tuple[str, ...], visuals: bool) -> str:
             "V109", f"robot `{robot}`: {len(missing)} mesh file(s) not found, first "
             f"`{missing[0]}`", Span.whole_file(r.urdf.path),
             hint="give the folder of the package (or one holding it) with --package-dir, "
-                 "or in ROS_PACKAGE_PATH, or `package_dirs` in a robot description"))
+                 "or in ROS_PACKAGE_PATH, or `package_dirs` in a robot description; or "
+                 "compile with --no-check (the checks are then skipped, and the output "
+                 "says so)"))
     digest = hashlib.sha256(text.encode()).hexdigest()[:12]
     stem = os.path.splitext(os.path.basename(r.urdf.path))[0]
     path = os.path.join(_tmp_dir(), f"{stem}-{digest}.urdf")
