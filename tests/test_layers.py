@@ -215,3 +215,36 @@ def test_every_public_name_of_the_package_resolves():
 
     for name in aou_dsl.__all__:
         assert getattr(aou_dsl, name) is not None, name
+
+
+def test_every_code_is_a_constant_and_no_code_is_spelt_out():
+    """aou_dsl.core.codes holds one constant per registered code (a misspelt one fails at
+    import), and no module writes a code as a string literal."""
+    from aou_dsl.core import codes
+    from aou_dsl.core.rules import RULES
+
+    assert set(codes.__all__) == set(RULES)
+    assert all(getattr(codes, c) == c for c in RULES)
+    literal = re.compile(r'''(?<![\w'"])"[SVMCRI]\d{3}"(?![\w"])''')
+    spelt = []
+    for p in PACKAGE.rglob("*.py"):
+        if p.name in ("rules.py", "codes.py"):
+            continue
+        tree = ast.parse(p.read_text())
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Constant) and isinstance(node.value, str) and \
+                    literal.fullmatch(f'"{node.value}"'):
+                spelt.append(f"{p.relative_to(ROOT)}:{node.lineno}: {node.value}")
+    assert not spelt, spelt
+
+
+def test_the_exit_status_comes_from_the_rule_category():
+    """Usage codes (I) exit 2, every other category 1, by the registry's category."""
+    from aou_dsl.cli.commands import _exit_for
+    from aou_dsl.core.diagnostics import Span, diag
+    from aou_dsl.core.rules import RULES, Category
+
+    where = Span.whole_file("x.aou")
+    for code, rule in RULES.items():
+        want = 2 if rule.category is Category.USAGE else 1
+        assert _exit_for([diag(code, "m", where)]) == want, code

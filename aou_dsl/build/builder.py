@@ -13,6 +13,7 @@ import time
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from ..core.codes import C305, C306, C310, C311
 from ..core.diagnostics import AouError, Diagnostic, Span, diag, has_errors
 from ..core.options import BuildOptions, SceneOptions
 from ..lang.linter import FileResult, lint_file, lint_source
@@ -77,7 +78,7 @@ class BuildResult:
         """
         if self.compiled is None or self.compiled.trajectory is None:
             raise AouError(self.diagnostics or diag(
-                "C305", "the build failed: there is no trajectory", Span.whole_file(self.path)))
+                C305, "the build failed: there is no trajectory", Span.whole_file(self.path)))
         return self.compiled.trajectory
 
 
@@ -118,12 +119,12 @@ def _check(res: BuildResult, rate: float, scene: SceneOptions,
     for c in report.failed():
         if any(c is m for m in motion):
             res.diagnostics.append(diag(
-                "C311" if c.name == "joint-jerk" else "C306",
+                C311 if c.name == "joint-jerk" else C306,
                 f"{c.name} check failed: {describe(c)}", _span_at(res.compiled, c.time),
                 check=c.name, time=c.time, joint=c.joint, value=c.value, limit=c.limit))
             continue
         res.diagnostics.append(diag(
-            "C306", f"{c.name} check failed at t={c.time:.3f}s: {_what(c)}",
+            C306, f"{c.name} check failed at t={c.time:.3f}s: {_what(c)}",
             _span_at(res.compiled, c.time), check=c.name, time=c.time, joint=c.joint,
             value=c.value, limit=c.limit))
     return {"kinematic": report.to_json()}
@@ -196,7 +197,7 @@ def build_lint(lint: FileResult, options: BuildOptions | None = None,
     res.declared = want = declared(b, tl)
     for mm in compare(want, m.descriptors):
         res.diagnostics.append(diag(
-            "C310", f"{mm.name}: declared {_fmt(mm.declared)}, measured {_fmt(mm.measured)} "
+            C310, f"{mm.name}: declared {_fmt(mm.declared)}, measured {_fmt(mm.measured)} "
             "on the compiled trajectory", _span_of(b, mm.name), descriptor=mm.name,
             declared=mm.declared, measured=mm.measured))
     res.header = document_header(

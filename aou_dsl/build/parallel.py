@@ -32,6 +32,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Iterator
 from typing import TYPE_CHECKING, Any
 
+from ..core.codes import I505
 from ..core.diagnostics import AouError
 from ..core.options import BuildOptions
 from .pool import BuildPool, _pack, default_jobs, encoded
@@ -141,7 +142,7 @@ def _connect(client: Any, address: str) -> Any:
     from ..core.diagnostics import Span, diag
 
     def fail(why: str) -> AouError:
-        return AouError(diag("I505", f"cannot connect to the cluster `{address}`: {why}",
+        return AouError(diag(I505, f"cannot connect to the cluster `{address}`: {why}",
                              Span.whole_file("<command line>"),
                              hint="give the scheduler's address, e.g. --cluster "
                                   "tcp://scheduler-host:8786 (`dask scheduler` prints it)"))

@@ -14,7 +14,9 @@ import os
 import sys
 from collections.abc import Callable, Sequence
 
+from ..core.codes import C306, C311
 from ..core.diagnostics import RULES, AouError, Diagnostic, Severity, Span
+from ..core.rules import category
 from .args import EXIT_ERRORS, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, build_parser
 from .report import format_github, format_json, format_suppressed, format_text
 from .tools import cmd_robot, cmd_synth
@@ -33,7 +35,8 @@ def _print_diags(diags: list[Diagnostic], fmt: str = "text",
 
 def _exit_for(diags: list[Diagnostic]) -> int:
     """2 when the input could not be read or written (I codes), else 1."""
-    return EXIT_USAGE if any(d.code.startswith("I") for d in diags) else EXIT_ERRORS
+    usage = any(category(d.code).is_usage for d in diags)
+    return EXIT_USAGE if usage else EXIT_ERRORS
 
 
 def _fail(err: AouError) -> int:
@@ -78,7 +81,7 @@ def _cmd_lint(args: argparse.Namespace) -> int:
 
     results, problems = lint_paths(args.paths)
     counts = severity_counts(results)
-    io_errors = bool(problems) or any(d.code.startswith("I")
+    io_errors = bool(problems) or any(category(d.code).is_usage
                                       for r in results for d in r.diagnostics)
     if args.format == "json":
         print(format_json({"files": [r.to_json() for r in results],
@@ -221,12 +224,12 @@ def _check_diagnostics(path: str, report) -> list[Diagnostic]:
     rest): ``check`` never fails without a code."""
     from ..core.diagnostics import diag
 
-    out = [diag("C311" if c.name == "joint-jerk" else "C306",
+    out = [diag(C311 if c.name == "joint-jerk" else C306,
                 f"{c.name} check failed" + ("" if c.time is None else f" at t={c.time:.3f}s")
                 + f": {c.detail}", Span.whole_file(path), check=c.name, time=c.time,
                 joint=c.joint, value=c.value, limit=c.limit) for c in report.failed()]
     if not report.ok and not out:
-        out.append(diag("C306", "the checks failed", Span.whole_file(path)))
+        out.append(diag(C306, "the checks failed", Span.whole_file(path)))
     return out
 
 

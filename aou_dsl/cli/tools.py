@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from ..core.codes import V109
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..version import __version__
 from .args import EXIT_ERRORS, EXIT_OK, usage_error
@@ -29,7 +30,7 @@ def _with_alias(err: AouError, robot: str) -> AouError:
     alias = ALIASES.get(robot.lower().replace("-", "_").replace(" ", "_"))
     if alias is None:
         return err
-    return AouError([replace(d, hint=f"did you mean `{alias}`?") if d.code == "V109"
+    return AouError([replace(d, hint=f"did you mean `{alias}`?") if d.code == V109
                      and not d.hint else d for d in err.diagnostics])
 
 
@@ -43,7 +44,7 @@ def _missing_meshes(robot: str) -> list[Diagnostic]:
     _, missing = scene_xml(r.urdf, r.package_dirs, r.gaze, visuals=False)
     if not missing:
         return []
-    return [diag("V109", f"robot `{robot}`: {len(missing)} mesh file(s) of its collision "
+    return [diag(V109, f"robot `{robot}`: {len(missing)} mesh file(s) of its collision "
                  f"shapes not found, first `{missing[0]}`: the safety checks cannot load it",
                  Span.whole_file(r.urdf.path),
                  hint="give the folder of the package (or one holding it) with "

@@ -20,6 +20,7 @@ import zipfile
 
 import numpy as np
 
+from ..core.codes import I502
 from ..core.diagnostics import AouError, Span, diag
 from ..core.files import write_atomic
 from ..version import __version__
@@ -124,9 +125,9 @@ def encode(doc: dict, fmt: str) -> bytes:
 
         return encode_yaml(doc)
     if fmt in FOLDER_FORMATS:
-        raise AouError(diag("I502", f"`{fmt}` output is a folder (a ROS 2 bag), not bytes: "
+        raise AouError(diag(I502, f"`{fmt}` output is a folder (a ROS 2 bag), not bytes: "
                             "write it with write_output", Span.whole_file("<output>")))
-    raise AouError(diag("I502", f"unknown output format `{fmt}`: expected one of "
+    raise AouError(diag(I502, f"unknown output format `{fmt}`: expected one of "
                         f"{', '.join(FORMATS)}", Span.whole_file("<output>")))
 
 
@@ -169,10 +170,10 @@ def output_paths(inputs: list[tuple[str, str | None]], output: str | None, fmt: 
         ext = os.path.splitext(output or "")[1].lstrip(".")
         fmt = ext if output and not many and not is_dir and ext else "json"
     if fmt not in FORMATS:
-        raise AouError(diag("I502", f"unknown output format `{fmt}`: expected one of "
+        raise AouError(diag(I502, f"unknown output format `{fmt}`: expected one of "
                             f"{', '.join(FORMATS)}", Span.whole_file(output or fmt)))
     if many and output and not is_dir and os.path.splitext(output)[1]:
-        raise AouError(diag("I502", f"several inputs need -o to be a folder, found "
+        raise AouError(diag(I502, f"several inputs need -o to be a folder, found "
                             f"`{output}`", Span.whole_file(output)))
     folder = output if (many or is_dir) else None
     suffix = "" if fmt in FOLDER_FORMATS else f".{fmt}"
@@ -190,7 +191,7 @@ def output_paths(inputs: list[tuple[str, str | None]], output: str | None, fmt: 
     for (src, _), dest in zip(inputs, dests, strict=True):
         key = os.path.realpath(dest)
         if key in seen:
-            raise AouError(diag("I502", f"`{seen[key]}` and `{src}` would both be written to "
+            raise AouError(diag(I502, f"`{seen[key]}` and `{src}` would both be written to "
                                 f"`{dest}`", Span.whole_file(src),
                                 hint="compile them into different folders with -o"))
         seen[key] = src

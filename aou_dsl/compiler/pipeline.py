@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.codes import C303, C304, C305, C308, C309, V124
 from ..core.diagnostics import AouError, Diagnostic, diag, has_errors
 from ..core.memo import Keyed
 from ..core.trajectory import Trajectory
@@ -123,7 +124,7 @@ def _ik_diag(ep: Episode, status: IKStatus, t: float, joint: str | None, b: Beha
             f"the default {s.start:g} m"
         hint = (f"this pose is {d:.3g} m from the goal, no closer than the start ({line}): "
                 f"a smaller `start`, or {hint[0].lower()}{hint[1:]}")
-    return diag(CODES.get(status, "C303"),
+    return diag(CODES.get(status, C303),
                 f"{ep.kind} at t={t:.2f}s: {status.value}{where} on {s.robot}", ep.span,
                 hint=hint, reason=status.name.lower(), time=t, joint=joint)
 
@@ -220,7 +221,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
             if shiver_fail is not None:
                 f_ok = shiver_fail.wanted
                 edit = f"f={f_ok:g}Hz" if f_ok and f_ok >= MIN_SHIVER_F else None
-                res.diagnostics.append(_too_fast("C308", shiver_fail, ep, edit,
+                res.diagnostics.append(_too_fast(C308, shiver_fail, ep, edit,
                                                  max_frequency=f_ok))
                 return res
             segments.append(seg)
@@ -243,7 +244,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
                 if tilt_fail is not None:
                     v_ok = tilt_fail.wanted
                     edit = f"v={v_ok:g}deg/s" if v_ok else None
-                    res.diagnostics.append(_too_fast("C309", tilt_fail, ep, edit,
+                    res.diagnostics.append(_too_fast(C309, tilt_fail, ep, edit,
                                                      max_velocity=v_ok))
                     return res
             else:
@@ -251,12 +252,12 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
                                       cartesian=KINDS[ep.kind].translation)
                 if seg is None:
                     reason = fail.reason if fail is not None else "no time law"
-                    res.diagnostics.append(diag("C305", f"{ep.kind}: {reason}", ep.span))
+                    res.diagnostics.append(diag(C305, f"{ep.kind}: {reason}", ep.span))
                     return res
                 if fail is not None:
                     unit = "m/s^2" if KINDS[ep.kind].translation else "rad/s^2"
                     res.diagnostics.append(diag(
-                        "C304", f"{ep.kind} reaches {fail.achieved:.3g} {unit}, not the "
+                        C304, f"{ep.kind} reaches {fail.achieved:.3g} {unit}, not the "
                         f"declared {fail.wanted:.3g} {unit}: {fail.reason}",
                         ep.span, joint=fail.joint, achieved=fail.achieved,
                         declared=fail.wanted))
@@ -276,7 +277,7 @@ def target_path(res: CompileResult) -> tuple[np.ndarray, np.ndarray]:
     positions (N, 3) and rotations (N, 3, 3). For accuracy studies and benchmarks."""
     tr, tl, frame = res.trajectory, res.timeline, res.frame
     if tr is None or tl is None or frame is None:
-        raise AouError(diag("C305", "the compilation failed: there is no path to follow",
+        raise AouError(diag(C305, "the compilation failed: there is no path to follow",
                             res.behaviour.span))
     pos = np.empty((len(tr.t), 3))
     rot = np.empty((len(tr.t), 3, 3))
@@ -299,7 +300,7 @@ def sample(res: CompileResult, rate: float) -> Trajectory:
     """The compiled motion sampled at ``rate`` [Hz] (the checks use a dense clock
     whatever the output rate)."""
     if res.trajectory is None or res.timeline is None:
-        raise AouError(diag("C305", "the compilation failed: there is nothing to sample",
+        raise AouError(diag(C305, "the compilation failed: there is nothing to sample",
                             res.behaviour.span))
     dirs = res.trajectory.package_dirs
     arm = load_arm(res.behaviour.settings.robot, None, dirs)
@@ -324,7 +325,7 @@ def evaluate(res: CompileResult, t: np.ndarray
     ``t`` [s], shape (N,): each (N, n). Before the start and after the end the arm rests
     in its first and last configuration (as a controller holds it)."""
     if res.trajectory is None or not res.segments:
-        raise AouError(diag("C305", "the compilation failed: there is nothing to sample",
+        raise AouError(diag(C305, "the compilation failed: there is nothing to sample",
                             res.behaviour.span))
     q, qd, qdd = _evaluate(res.segments, np.asarray(t, dtype=float))
     return q, qd, qdd
@@ -335,7 +336,7 @@ def positions(res: CompileResult, t: np.ndarray) -> np.ndarray:
     the same as ``evaluate(res, t)[0]``, without the velocities and accelerations (a
     controller's view of the motion reads positions only)."""
     if res.trajectory is None or not res.segments:
-        raise AouError(diag("C305", "the compilation failed: there is nothing to sample",
+        raise AouError(diag(C305, "the compilation failed: there is nothing to sample",
                             res.behaviour.span))
     return _evaluate(res.segments, np.asarray(t, dtype=float), positions=True)[0]
 
@@ -368,7 +369,7 @@ def _sample(arm: ArmModel, b: Behaviour, tl: Timeline,
             package_dirs: tuple[str, ...] = ()) -> Trajectory:
     """Sample the segments on one clock at ``rate``; the last sample is the end."""
     if not segments:
-        raise AouError(diag("V124", "the behaviour has nothing to move or hold", b.span))
+        raise AouError(diag(V124, "the behaviour has nothing to move or hold", b.span))
     bounds = np.concatenate([[0.0], np.cumsum([s.duration for s in segments])])
     t = _clock(float(bounds[-1]), rate)
     q, qd, qdd = _evaluate(segments, t)

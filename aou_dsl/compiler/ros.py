@@ -26,6 +26,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..core.codes import I502, R401
 from ..core.diagnostics import AouError, Span, diag
 from ..core.files import BAG_TOPIC
 from ..version import __version__
@@ -145,7 +146,7 @@ def write_bag(doc: dict, path: str, *, topic: str = TOPIC, inputs: Sequence[str]
     try:
         tmp = tempfile.mkdtemp(prefix=temp_prefix(), dir=parent)
     except OSError as exc:
-        raise AouError(diag("I502", f"cannot write `{path}`: {exc.strerror}", where)) from None
+        raise AouError(diag(I502, f"cannot write `{path}`: {exc.strerror}", where)) from None
     done = False
     try:
         bag = os.path.join(tmp, os.path.basename(final))
@@ -164,7 +165,7 @@ def write_bag(doc: dict, path: str, *, topic: str = TOPIC, inputs: Sequence[str]
             raise
         done = True
     except OSError as exc:
-        raise AouError(diag("I502", f"cannot write `{path}`: {exc.strerror}", where)) from None
+        raise AouError(diag(I502, f"cannot write `{path}`: {exc.strerror}", where)) from None
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
         for f in () if done else made:
@@ -189,9 +190,9 @@ def read_bag(path: str) -> tuple[str, str, dict]:
     except AouError:
         raise
     except Exception as exc:  # rosbags raises its own errors for any unreadable bag
-        raise AouError(diag("R401", f"cannot read the bag `{path}`: {exc}",
+        raise AouError(diag(R401, f"cannot read the bag `{path}`: {exc}",
                             Span.whole_file(path))) from None
-    raise AouError(diag("R401", f"the bag `{path}` holds no message", Span.whole_file(path)))
+    raise AouError(diag(R401, f"the bag `{path}` holds no message", Span.whole_file(path)))
 
 
 def _plain(msg) -> dict:

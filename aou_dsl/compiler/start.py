@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
+from ..core.codes import C301, C302, C303
 from ..core.diagnostics import Diagnostic, diag
 from ..lang.ir import Behaviour
 from ..lang.timeline import Pose, Timeline
@@ -22,7 +23,7 @@ from ..robot.kinematics import ArmModel
 
 __all__ = ["CODES", "start_diagnostic"]
 
-CODES = {IKStatus.UNREACHABLE: "C301", IKStatus.JOINT_LIMIT: "C302"}
+CODES = {IKStatus.UNREACHABLE: C301, IKStatus.JOINT_LIMIT: C302}
 
 
 def start_diagnostic(arm: ArmModel, frame: ReachFrame, b: Behaviour, failure: IKFailure,
@@ -43,7 +44,7 @@ def start_diagnostic(arm: ArmModel, frame: ReachFrame, b: Behaviour, failure: IK
         hint = f"at `start {fits}cm` every pose of the motion is within reach; or {other}" \
             if fits is not None else f"a smaller `start`, or {other}"
     where = next((s.spans[k] for k in blame if k in s.spans), b.span)
-    return diag(CODES.get(failure.status, "C303"), f"the start pose, {s.start:g} m from "
+    return diag(CODES.get(failure.status, C303), f"the start pose, {s.start:g} m from "
                 f"the goal ({said}): {failure.status.value}{joint} on {s.robot}", where,
                 hint=hint, reason=failure.status.name.lower(), time=0.0,
                 joint=failure.joint, start=s.start)

@@ -28,6 +28,7 @@ import tempfile
 from collections.abc import Iterator, Sequence
 from typing import Any
 
+from .codes import I501, I502, I506
 from .diagnostics import AouError, Span, diag
 
 __all__ = ["atomic", "check_format", "check_output", "decode", "guard_output", "is_own_output",
@@ -50,16 +51,16 @@ def check_output(path: str, formats: Sequence[str] = (), *, reads: Sequence[str]
     where = Span.whole_file(path)
     ext = os.path.splitext(path)[1].lower().lstrip(".")
     if formats and ext not in formats:
-        raise AouError(diag("I502", f"cannot write `{path}`: expected a file ending in "
+        raise AouError(diag(I502, f"cannot write `{path}`: expected a file ending in "
                             f"{', '.join('.' + f for f in formats)}", where))
     folder = os.path.dirname(os.path.abspath(path))
     while not os.path.lexists(folder):  # the nearest folder that exists must take a new one
         folder = os.path.dirname(folder)
     if not os.path.isdir(folder):
-        raise AouError(diag("I502", f"cannot write `{path}`: `{folder}` is a file, not a "
+        raise AouError(diag(I502, f"cannot write `{path}`: `{folder}` is a file, not a "
                             "folder", where))
     if not os.access(folder, os.W_OK):
-        raise AouError(diag("I502", f"cannot write `{path}`: the folder `{folder}` is not "
+        raise AouError(diag(I502, f"cannot write `{path}`: the folder `{folder}` is not "
                             "writable", where))
     return ext
 
@@ -78,7 +79,7 @@ def check_format(path: str | None, fmt: str | None, known: Sequence[str]) -> Non
     ext = ext.lower().lstrip(".")
     if ext in known and ext != fmt:
         raise AouError(diag(
-            "I502", f"refusing to write {fmt} into `{path}`, whose extension names {ext}",
+            I502, f"refusing to write {fmt} into `{path}`, whose extension names {ext}",
             Span.whole_file(path), hint=f"name it `{stem}.{fmt}`, or leave out --format "
             f"to write {ext}"))
 
@@ -120,7 +121,7 @@ def guard_output(path: str, reads: Sequence[str] = (), *, force: bool = True,
     for read in reads:
         how = _clash(path, read)
         if how is not None:
-            raise AouError(diag("I502", f"refusing to write `{path}`: it {how} `{read}`, "
+            raise AouError(diag(I502, f"refusing to write `{path}`: it {how} `{read}`, "
                                 "which this command reads", where,
                                 hint="choose another output with -o", input=read))
     try:
@@ -129,30 +130,30 @@ def guard_output(path: str, reads: Sequence[str] = (), *, force: bool = True,
         return  # a new file (or a dangling link, replaced by the file)
     kind = _special(mode)
     if kind is not None:
-        raise AouError(diag("I502", f"refusing to write `{path}`: it is a {kind}, not a "
+        raise AouError(diag(I502, f"refusing to write `{path}`: it is a {kind}, not a "
                             "regular file", where, hint="choose a file name with -o"))
     if bag:
         _guard_bag(path, reads, where, stat.S_ISDIR(mode))
     elif stat.S_ISDIR(mode):
-        raise AouError(diag("I502", f"cannot write `{path}`: it is a folder", where))
+        raise AouError(diag(I502, f"cannot write `{path}`: it is a folder", where))
     elif not force and not is_own_output(path):
-        raise AouError(diag("I506", f"refusing to replace `{path}`: aou did not write it",
+        raise AouError(diag(I506, f"refusing to replace `{path}`: aou did not write it",
                             where, hint="choose another output with -o, or give --force "
                             "to replace it"))
 
 
 def _guard_bag(path: str, reads: Sequence[str], where: Span, folder: bool) -> None:
     if not folder:
-        raise AouError(diag("I502", f"cannot write the bag `{path}`: it is a file, and a "
+        raise AouError(diag(I502, f"cannot write the bag `{path}`: it is a file, and a "
                             "bag is a folder", where, hint="choose another output with -o"))
     real = os.path.realpath(path)
     for read in reads:
         if os.path.realpath(read).startswith(real + os.sep):
-            raise AouError(diag("I502", f"refusing to write the bag `{path}`: it holds "
+            raise AouError(diag(I502, f"refusing to write the bag `{path}`: it holds "
                                 f"`{read}`, which this command reads", where,
                                 hint="choose another output with -o", input=read))
     if os.listdir(real) and not _is_aou_bag(real):
-        raise AouError(diag("I502", f"refusing to write the bag `{path}`: the folder holds "
+        raise AouError(diag(I502, f"refusing to write the bag `{path}`: the folder holds "
                             "files other than a bag aou wrote", where,
                             hint="a bag goes into a new or empty folder, or over a bag aou "
                             "wrote: choose another output with -o"))
@@ -254,7 +255,7 @@ def atomic(path: str, *, inputs: Sequence[str] = ()) -> Iterator[str]:
         os.close(fd)
     except OSError as exc:
         _remove_folders(made)
-        raise AouError(diag("I502", f"cannot write `{path}`: {exc.strerror}", where)) from None
+        raise AouError(diag(I502, f"cannot write `{path}`: {exc.strerror}", where)) from None
     done = False
     try:
         yield tmp
@@ -262,7 +263,7 @@ def atomic(path: str, *, inputs: Sequence[str] = ()) -> Iterator[str]:
         os.replace(tmp, target)
         done = True
     except OSError as exc:
-        raise AouError(diag("I502", f"cannot write `{path}`: {exc.strerror}", where)) from None
+        raise AouError(diag(I502, f"cannot write `{path}`: {exc.strerror}", where)) from None
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
@@ -285,7 +286,7 @@ def make_folders(folder: str, where: Span) -> list[str]:
             os.mkdir(f)
     except OSError as exc:
         _remove_folders(made)
-        raise AouError(diag("I502", f"cannot write `{where.path}`: cannot make the folder "
+        raise AouError(diag(I502, f"cannot write `{where.path}`: cannot make the folder "
                             f"`{exc.filename}`: {exc.strerror}", where)) from None
     return made
 
@@ -314,7 +315,7 @@ def write_atomic(path: str, data: bytes, *, inputs: Sequence[str] = ()) -> None:
             made = []
             return
     except OSError as exc:
-        raise AouError(diag("I502", f"cannot write `{path}`: {exc.strerror}", where)) from None
+        raise AouError(diag(I502, f"cannot write `{path}`: {exc.strerror}", where)) from None
     finally:
         _remove_folders(made)
     with atomic(path, inputs=inputs) as tmp, open(tmp, "wb") as fh:
@@ -390,7 +391,7 @@ def decode(data: bytes, path: str, what: str = "") -> str:
     name = f"{what + ' ' if what else ''}`{path}`"
     for bom, encoding in _OTHER_BOMS.items():
         if data.startswith(bom):
-            raise AouError(diag("I501", f"cannot read {name}: it is saved as {encoding}, "
+            raise AouError(diag(I501, f"cannot read {name}: it is saved as {encoding}, "
                                 "not UTF-8", Span.whole_file(path),
                                 hint="save it as UTF-8 (in Notepad: Save as, Encoding UTF-8)"))
     try:
@@ -399,7 +400,7 @@ def decode(data: bytes, path: str, what: str = "") -> str:
         line = data.count(b"\n", 0, exc.start) + 1
         start = data.rfind(b"\n", 0, exc.start) + 1
         col = len(data[start:exc.start].decode("utf-8", "replace").removeprefix("\ufeff")) + 1
-        raise AouError(diag("I501", f"cannot read {name}: not UTF-8 text (byte "
+        raise AouError(diag(I501, f"cannot read {name}: not UTF-8 text (byte "
                             f"0x{data[exc.start]:02x} at line {line})",
                             Span.point(path, line, col),
                             hint="save it as UTF-8, or check that it is a text file"),
@@ -412,6 +413,6 @@ def _read(path: str, what: str, text: bool) -> Any:
             data = fh.read()
     except OSError as exc:
         reason = exc.strerror or str(exc)
-        raise AouError(diag("I501", f"cannot read {what + ' ' if what else ''}`{path}`: "
+        raise AouError(diag(I501, f"cannot read {what + ' ' if what else ''}`{path}`: "
                             f"{reason}", Span.whole_file(path))) from None
     return decode(data, path, what) if text else data

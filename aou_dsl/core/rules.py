@@ -18,7 +18,7 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 
-__all__ = ["RULES", "Rule", "Severity"]
+__all__ = ["RULES", "Category", "Rule", "Severity", "category"]
 
 
 class Severity(enum.StrEnum):
@@ -27,6 +27,22 @@ class Severity(enum.StrEnum):
     ERROR = "error"
     WARNING = "warning"
     NOTE = "note"
+
+
+class Category(enum.Enum):
+    """Where a problem comes from; it decides the exit status: a usage or input/output
+    problem exits 2, a problem of the input's content exits 1."""
+
+    SYNTAX = "S"
+    VALIDATION = "V"
+    MODEL = "M"
+    COMPILE = "C"
+    READING = "R"
+    USAGE = "I"
+
+    @property
+    def is_usage(self) -> bool:
+        return self is Category.USAGE
 
 
 @dataclass(frozen=True, slots=True)
@@ -39,6 +55,10 @@ class Rule:
     what: str
     why: str
     example: str
+
+    @property
+    def category(self) -> Category:
+        return Category(self.code[0])
 
 
 _E, _W, _N = Severity.ERROR, Severity.WARNING, Severity.NOTE
@@ -333,3 +353,8 @@ _RULE_LIST = [
 ]
 
 RULES: dict[str, Rule] = {r.code: r for r in _RULE_LIST}
+
+
+def category(code: str) -> Category:
+    """The category of a registered code (KeyError for one the registry lacks)."""
+    return RULES[code].category

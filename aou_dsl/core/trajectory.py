@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from .codes import R402
 from .diagnostics import AouError, Span, diag
 
 __all__ = ["Trajectory"]
@@ -67,7 +68,7 @@ class Trajectory:
         missing = [n for n in names if n not in self.joint_names]
         if missing:
             raise AouError(diag(
-                "R402", f"the trajectory lacks joint(s) {', '.join(missing)} of robot "
+                R402, f"the trajectory lacks joint(s) {', '.join(missing)} of robot "
                 f"`{self.robot}`; its columns are {', '.join(self.joint_names)}",
                 Span.whole_file(self.path), missing=missing))
         return np.array([self.joint_names.index(n) for n in names], dtype=int)

@@ -9,8 +9,10 @@ import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from ..core.codes import I501, I503, M201, M202, M203, M204
 from ..core.diagnostics import AouError, Diagnostic, Severity, Span, diag, has_errors
 from ..core.files import read_text
+from ..core.rules import Category, category
 from .cv import CANONICAL, DEFAULT_WEIGHTS, CVPoint, CVWeights, composition, effort_to_cv, infer
 from .descriptors import REGISTRY
 from .ir import Behaviour
@@ -91,7 +93,7 @@ def _model_checks(b: Behaviour, timeline: Timeline | None, weights: CVWeights
     inferred = point.state
     where = b.header_span or (b.primitives[0].span if b.primitives else b.span)
     if b.state is None:
-        out.append(diag("M204", f"no state declared; the primitives express `{inferred}` "
+        out.append(diag(M204, f"no state declared; the primitives express `{inferred}` "
                         f"(C={point.C:+.2f}, V={point.V:+.2f})", where,
                         inferred=inferred.value, C=point.C, V=point.V))
     elif inferred is not b.state:
@@ -101,7 +103,7 @@ def _model_checks(b: Behaviour, timeline: Timeline | None, weights: CVWeights
         ) or "no primitives (C and V at their floor)"
         c0, v0 = CANONICAL[b.state]
         out.append(diag(
-            "M201",
+            M201,
             f"declared `{b.state}` but the primitives express `{inferred}`: inferred "
             f"C={point.C:+.2f}, V={point.V:+.2f}; `{b.state}` sits at C={c0:+.0f}, V={v0:+.0f}",
             where,
@@ -113,7 +115,7 @@ def _model_checks(b: Behaviour, timeline: Timeline | None, weights: CVWeights
         ep = effort_to_cv(effort, weights)
         if b.state is not None and ep.state is not b.state:
             out.append(diag(
-                "M202",
+                M202,
                 f"the effort vector maps to C={ep.C:+.2f}, V={ep.V:+.2f}, nearest to "
                 f"`{ep.state}`, not the declared `{b.state}`",
                 effort.span, declared=b.state.value, effort_state=ep.state.value,
@@ -124,7 +126,7 @@ def _model_checks(b: Behaviour, timeline: Timeline | None, weights: CVWeights
     for name, d in REGISTRY.items():
         if state in d.no_effect and d.kind in kinds:
             p = next(p for p in b.primitives if p.kind == d.kind)
-            out.append(diag("M203", f"the study found no clear perceived effect of {name} on "
+            out.append(diag(M203, f"the study found no clear perceived effect of {name} on "
                             f"how {state} a motion looks", p.span, descriptor=name,
                             state=state.value))
     return point, out
@@ -179,7 +181,8 @@ def lint_file(path: str, *, weights: CVWeights = DEFAULT_WEIGHTS) -> FileResult:
     else:
         result = lint_source(text, path, weights=weights)
     first = result.diagnostics[0] if result.diagnostics else None
-    if first and first.code[0] in "SI" and path.lower().endswith(TRAJECTORY_EXTENSIONS):
+    unread = first is not None and category(first.code) in (Category.SYNTAX, Category.USAGE)
+    if first and unread and path.lower().endswith(TRAJECTORY_EXTENSIONS):
         result.diagnostics[0] = replace(first, hint=(
             "this looks like a trajectory, not a behaviour: `aouc measure`, `check` and "
             "`plot` read trajectories; `lint` and `compile` read `.aou` files"))
@@ -195,13 +198,13 @@ def collect_inputs(paths: list[str]) -> tuple[list[tuple[str, str | None]], list
         if os.path.isdir(p):
             found = sorted(str(f) for f in Path(p).rglob("*.aou") if f.is_file())
             if not found:
-                problems.append(diag("I503", f"no `.aou` files in folder `{p}`",
+                problems.append(diag(I503, f"no `.aou` files in folder `{p}`",
                                      Span.whole_file(p)))
             files.extend((f, p) for f in found)
         elif os.path.exists(p):
             files.append((p, None))
         else:
-            problems.append(diag("I501", f"cannot read `{p}`: no such file or folder",
+            problems.append(diag(I501, f"cannot read `{p}`: no such file or folder",
                                  Span.whole_file(p)))
     return files, problems
 

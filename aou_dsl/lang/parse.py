@@ -20,6 +20,7 @@ from pathlib import Path
 import lark
 from lark import Lark, Token, Transformer
 
+from ..core.codes import S001, S002, S003
 from ..core.diagnostics import AouError, Span, diag
 from ..core.units import parse_quantity
 
@@ -331,7 +332,7 @@ def _unexpected_character(path: str, text: str, err: lark.exceptions.UnexpectedC
     elif not ch.isprintable() or ch.isspace():
         shown = f"U+{ord(ch):04X} (an invisible character)"
         hint = "delete it, or replace it with an ordinary space"
-    return AouError(diag("S003", f"unexpected character {shown}", span, hint=hint, found=ch))
+    return AouError(diag(S003, f"unexpected character {shown}", span, hint=hint, found=ch))
 
 
 #: `1,5s`: a comma between the digits of a number, with what follows it up to its unit.
@@ -346,7 +347,7 @@ def _comma(path: str, text: str, tok: Token) -> AouError | None:
     line_start = text.rfind("\n", 0, at) + 1
     if text.rfind("(", line_start, at) > text.rfind(")", line_start, at):  # in a vector
         return AouError(diag(
-            "S001", "a vector has three numbers, `(X, Y, Z)`; this one has more",
+            S001, "a vector has three numbers, `(X, Y, Z)`; this one has more",
             _tok_span(path, tok), found=",",
             hint="the decimal mark is a point: `0.5`, not `0,5`"
             if re.search(r"\d,\d", text[line_start:at + 2]) else None))
@@ -357,12 +358,12 @@ def _comma(path: str, text: str, tok: Token) -> AouError | None:
     if m and m.start(0) == start and text[at - 1:at].isdigit():
         written, meant = m.group(0), f"{m.group(1)}.{m.group(2)}"
         return AouError(diag(
-            "S001", f"unexpected `,` in `{written}`: the decimal mark is a point",
+            S001, f"unexpected `,` in `{written}`: the decimal mark is a point",
             Span(path, tok.line or 1, (tok.column or 1) - (at - start), tok.line or 1,
                  (tok.column or 1) + len(written) - (at - start)),
             hint=f"write `{meant}`", found=","))
     if _number_before(text, at):
-        return AouError(diag("S001", "unexpected `,` after a number", _tok_span(path, tok),
+        return AouError(diag(S001, "unexpected `,` after a number", _tok_span(path, tok),
                              hint="commas separate the numbers of a vector, written in "
                              "parentheses: `goal (0.5, 0, 0.3)`", found=","))
     return None
@@ -384,12 +385,12 @@ def _syntax_error(path: str, text: str, err: lark.exceptions.UnexpectedInput) ->
             hint = "a `}` closes a `sequence {` block; is the `{` missing?"
         elif tok.type == "LBRACE":
             hint = "`{` only follows `sequence`"
-        return AouError(diag("S001", f"expected {expected}, found {_found_text(tok)}", span,
+        return AouError(diag(S001, f"expected {expected}, found {_found_text(tok)}", span,
                              hint=hint, found=str(tok), expected=sorted(err.expected)))
     expected = _expected_text(set(getattr(err, "expected", set()) or set()))
     hint = "is a `sequence {` block missing its closing `}`?" if "RBRACE" in (
         getattr(err, "expected", None) or ()) else None
-    return AouError(diag("S002", f"unexpected end of file; expected {expected}",
+    return AouError(diag(S002, f"unexpected end of file; expected {expected}",
                          _end_span(path, text), hint=hint))
 
 

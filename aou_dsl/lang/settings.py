@@ -8,6 +8,7 @@ import os
 from collections.abc import Callable
 from typing import Any
 
+from ..core.codes import V102, V105, V106, V109, V111, V113, V117, V122
 from ..core.diagnostics import Span
 from ..core.robot_specs import ROBOT_FILE_TYPES, ROBOTS
 from ..core.units import Dim
@@ -28,14 +29,14 @@ def _robot(ctx: Ctx, st: Statement, args: Args) -> Any:
     read when the behaviour compiles."""
     pos = args.positional
     if len(pos) != 1 or not isinstance(pos[0], Word):
-        ctx.error("V113", '`robot` takes one name, e.g. `robot panda`, or a quoted path, '
+        ctx.error(V113, '`robot` takes one name, e.g. `robot panda`, or a quoted path, '
                   'e.g. `robot "my_arm.urdf"`', st.keyword_span)
         return None
     word = pos[0]
     if word.quoted:
         return _robot_file(ctx, word)
     if word.text not in ROBOTS:
-        ctx.error("V109", f"unknown robot `{word.text}`: expected one of "
+        ctx.error(V109, f"unknown robot `{word.text}`: expected one of "
                   f"{', '.join(ROBOTS)}, or a quoted path to a robot file",
                   word.span, hint=did_you_mean(word.text, ROBOTS), found=word.text,
                   valid=list(ROBOTS))
@@ -47,14 +48,14 @@ def _robot_file(ctx: Ctx, word: Word) -> str | None:
     """The quoted path joined to the file's folder (as given when absolute)."""
     text = word.text
     if not text.lower().endswith(ROBOT_FILE_TYPES):
-        ctx.error("V109", f"robot file `{text}` is neither a URDF nor a robot description",
+        ctx.error(V109, f"robot file `{text}` is neither a URDF nor a robot description",
                   word.span, hint=f"a robot file ends in {' or '.join(ROBOT_FILE_TYPES)}",
                   found=text)
         return None
     folder = os.path.dirname(ctx.path) if not ctx.path.startswith("<") else ""
     path = text if os.path.isabs(text) else os.path.normpath(os.path.join(folder, text))
     if not os.path.isfile(path):
-        ctx.error("V109", f"robot file `{text}` not found (looked for `{path}`)", word.span,
+        ctx.error(V109, f"robot file `{text}` not found (looked for `{path}`)", word.span,
                   hint="a relative path starts from the folder of the .aou file",
                   found=text)
         return None
@@ -64,7 +65,7 @@ def _robot_file(ctx: Ctx, word: Word) -> str | None:
 def _vector(ctx: Ctx, st: Statement, args: Args) -> tuple[Vector, list[float]] | None:
     pos = args.positional
     if len(pos) != 1 or not isinstance(pos[0], Vector):
-        ctx.error("V113", f"`{st.keyword}` takes a vector, e.g. `{st.keyword} (0.5, 0, 0.3)`",
+        ctx.error(V113, f"`{st.keyword}` takes a vector, e.g. `{st.keyword} (0.5, 0, 0.3)`",
                   st.keyword_span)
         return None
     return pos[0], []
@@ -82,7 +83,7 @@ def _goal(ctx: Ctx, st: Statement, args: Args) -> Any:
         comps.append(value)
     norm = math.sqrt(sum(c * c for c in comps))
     if norm > MAX_GOAL_DISTANCE:
-        ctx.error("V122", f"the goal is {norm:.3g} m from the robot's base; at most "
+        ctx.error(V122, f"the goal is {norm:.3g} m from the robot's base; at most "
                   f"{MAX_GOAL_DISTANCE:g} m", vec.span)
         return None
     return tuple(comps)
@@ -95,13 +96,13 @@ def _direction(ctx: Ctx, st: Statement, args: Args) -> Any:
     vec, comps = got
     for q in vec.items:
         if q.unit:
-            ctx.error("V102", f"`from` is a direction and takes plain numbers, found "
+            ctx.error(V102, f"`from` is a direction and takes plain numbers, found "
                       f"`{q.text}`", q.span)
             return None
         comps.append(q.value)
     norm = math.sqrt(sum(c * c for c in comps))
     if not math.isfinite(norm) or norm == 0:
-        ctx.error("V105", "`from` must be a finite, non-zero vector", vec.span)
+        ctx.error(V105, "`from` must be a finite, non-zero vector", vec.span)
         return None
     return tuple(c / norm for c in comps)
 
@@ -109,7 +110,7 @@ def _direction(ctx: Ctx, st: Statement, args: Args) -> Any:
 def _distance(ctx: Ctx, st: Statement, args: Args) -> Any:
     pos = args.positional
     if len(pos) != 1 or not isinstance(pos[0], Quantity):
-        ctx.error("V113", f"`{st.keyword}` takes a distance, e.g. `{st.keyword} 0.30m`",
+        ctx.error(V113, f"`{st.keyword}` takes a distance, e.g. `{st.keyword} 0.30m`",
                   st.keyword_span)
         return None
     what = f"the {st.keyword} distance"
@@ -121,17 +122,17 @@ def _effort(ctx: Ctx, st: Statement, args: Args) -> Any:
     for k in "WTSF":
         kv = args.keys.get(k)
         if kv is None:
-            ctx.error("V113", f"`effort` needs all of W= T= S= F=; `{k}=` is missing",
+            ctx.error(V113, f"`effort` needs all of W= T= S= F=; `{k}=` is missing",
                       st.keyword_span)
         elif not isinstance(kv.value, Quantity) or kv.value.unit:
-            ctx.error("V113", f"`{k}=` takes a plain number in [-1, 1]", kv.value.span)
+            ctx.error(V113, f"`{k}=` takes a plain number in [-1, 1]", kv.value.span)
         elif not -1.0 <= kv.value.value <= 1.0:
-            ctx.error("V106", f"effort {k} must lie in [-1, 1], found {kv.value.text}",
+            ctx.error(V106, f"effort {k} must lie in [-1, 1], found {kv.value.text}",
                       kv.value.span, factor=k, found=kv.value.value)
         else:
             factors[k] = kv.value.value
     for a in args.positional:
-        ctx.error("V113", "`effort` takes only W= T= S= F=", a.span)
+        ctx.error(V113, "`effort` takes only W= T= S= F=", a.span)
     if len(factors) != 4:
         return None
     return Effort(span=st.span, W=factors["W"], T=factors["T"], S=factors["S"], F=factors["F"])
@@ -155,7 +156,7 @@ def read_settings(ctx: Ctx, stmts: list[Statement]) -> Settings:
     for st in stmts:
         key, reader, keys = _READERS[st.keyword]
         if key in spans:
-            ctx.error("V111", f"`{st.keyword}` is set twice (first at {spans[key]})",
+            ctx.error(V111, f"`{st.keyword}` is set twice (first at {spans[key]})",
                       st.keyword_span)
             continue
         spans[key] = st.span
@@ -167,6 +168,6 @@ def read_settings(ctx: Ctx, stmts: list[Statement]) -> Settings:
     standoff = values.get("standoff", DEFAULTS["standoff"])
     if ("start" in values or "standoff" in values) and start <= standoff:
         where = spans.get("start") or spans["standoff"]
-        ctx.error("V117", f"the start distance ({start:g} m) must be larger than the "
+        ctx.error(V117, f"the start distance ({start:g} m) must be larger than the "
                   f"standoff ({standoff:g} m)", where, start=start, standoff=standoff)
     return Settings(**values, spans=spans)

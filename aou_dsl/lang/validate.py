@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from ..core.codes import V101, V107, V108, V111, V113, V114, V115
 from ..core.diagnostics import Diagnostic, Span
 from .ir import Behaviour, Node, State
 from .parse import Colon, SequenceBlock, Statement, SyntaxTree, Word
@@ -44,18 +45,18 @@ def _primitive(ctx: Ctx, st: Statement, in_sequence: bool) -> Node | None:
 def _header(ctx: Ctx, st: Statement) -> tuple[str | None, State | None]:
     pos = list(st.args)
     if not pos or not isinstance(pos[0], Word):
-        ctx.error("V113", "`behaviour` takes a name, e.g. `behaviour peek : curious`",
+        ctx.error(V113, "`behaviour` takes a name, e.g. `behaviour peek : curious`",
                   st.keyword_span)
         return None, None
     name, rest = pos[0].text, pos[1:]
     if not rest:
         return name, None
     if not isinstance(rest[0], Colon) or len(rest) != 2 or not isinstance(rest[1], Word):
-        ctx.error("V113", "the header is `behaviour NAME : STATE`", rest[0].span)
+        ctx.error(V113, "the header is `behaviour NAME : STATE`", rest[0].span)
         return name, None
     sw = rest[1]
     if sw.text not in State.__members__.values():
-        ctx.error("V114", f"unknown state `{sw.text}`: expected one of "
+        ctx.error(V114, f"unknown state `{sw.text}`: expected one of "
                   f"{', '.join(s.value for s in State)}", sw.span,
                   hint=did_you_mean(sw.text, [s.value for s in State]), found=sw.text)
         return name, None
@@ -79,13 +80,13 @@ class _File:
 
 def _block(ctx: Ctx, f: _File, item: SequenceBlock) -> None:
     if f.block is not None:
-        ctx.error("V111", f"a file has one `sequence` block; the first is at {f.block.span}",
+        ctx.error(V111, f"a file has one `sequence` block; the first is at {f.block.span}",
                   item.span)
         return
     f.block = item
     for st in item.statements:
         if st.keyword not in KINDS:
-            ctx.error("V101" if st.keyword not in KEYWORDS else "V113",
+            ctx.error(V101 if st.keyword not in KEYWORDS else V113,
                       f"`{st.keyword}` is not a primitive; a sequence holds only "
                       f"{', '.join(KINDS)}", st.keyword_span,
                       hint=did_you_mean(st.keyword, KINDS))
@@ -101,7 +102,7 @@ def _descriptor_statement(ctx: Ctx, f: _File, st: Statement) -> None:
     key = f"gaze {getattr(p, 'plane', '')}" if p is not None and p.kind == "gaze" \
         else st.keyword
     if key in f.seen:
-        ctx.error("V107", f"`{key}` appears twice in the descriptor form (first at "
+        ctx.error(V107, f"`{key}` appears twice in the descriptor form (first at "
                   f"{f.seen[key]})", st.keyword_span,
                   hint="use `xN` for more episodes, or a `sequence { }` block for episodes "
                   "that differ")
@@ -114,10 +115,10 @@ def _descriptor_statement(ctx: Ctx, f: _File, st: Statement) -> None:
 def _statement(ctx: Ctx, f: _File, st: Statement, first: bool) -> None:
     if st.keyword == "behaviour":
         if f.header is not None:
-            ctx.error("V111", f"the header is given twice (first at {f.header})",
+            ctx.error(V111, f"the header is given twice (first at {f.header})",
                       st.keyword_span)
         elif not first:
-            ctx.error("V115", "the `behaviour` header must be the first statement",
+            ctx.error(V115, "the `behaviour` header must be the first statement",
                       st.keyword_span)
         else:
             f.header = st.span
@@ -127,7 +128,7 @@ def _statement(ctx: Ctx, f: _File, st: Statement, first: bool) -> None:
     elif st.keyword in KINDS:
         _descriptor_statement(ctx, f, st)
     else:
-        ctx.error("V101", f"unknown statement `{st.keyword}`", st.keyword_span,
+        ctx.error(V101, f"unknown statement `{st.keyword}`", st.keyword_span,
                   hint=did_you_mean(st.keyword, KEYWORDS) or
                   f"statements are {', '.join(KEYWORDS)}", found=st.keyword)
 
@@ -142,7 +143,7 @@ def validate_tree(tree: SyntaxTree) -> Validated:
         else:
             _statement(ctx, f, item, first=i == 0)
     if f.block is not None and f.first_primitive is not None:
-        ctx.error("V108", "a file has either a `sequence { }` block or descriptor-form "
+        ctx.error(V108, "a file has either a `sequence { }` block or descriptor-form "
                   "primitives, not both", f.first_primitive,
                   hint=f"the sequence block is at {f.block.span}")
     settings = read_settings(ctx, f.settings)

@@ -13,6 +13,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from ..core.codes import V102, V103, V104, V105, V111, V112, V113, V116, V118, V123
 from ..core.diagnostics import Diagnostic, Span, diag
 from ..core.units import UNITS, Dim, as_unit, suggest_unit, units_for
 from .parse import Colon, KeyVal, Quantity, Statement, Vector, Word
@@ -61,33 +62,33 @@ def si(ctx: Ctx, q: Quantity, dim: Dim, *, what: str, bare_unit: str | None) -> 
     fits = ", ".join(units_for(dim))
     if q.unit == "":
         if bare_unit is None:
-            ctx.error("V103", f"{what} `{q.text}` needs a unit: expected {_a(dim)} ({fits})",
+            ctx.error(V103, f"{what} `{q.text}` needs a unit: expected {_a(dim)} ({fits})",
                       q.span, hint=f"write e.g. `{q.text}{units_for(dim)[0]}`",
                       expected=str(dim), found=q.text)
             return None
         return q.value * UNITS[bare_unit][1]
     if q.unit not in UNITS:
         meant = suggest_unit(q.unit, dim)
-        ctx.error("V104", f"unknown unit `{q.unit}` in `{q.text}`: expected {_a(dim)} ({fits})",
+        ctx.error(V104, f"unknown unit `{q.unit}` in `{q.text}`: expected {_a(dim)} ({fits})",
                   q.span, hint=f"did you mean `{q.text[:-len(q.unit)]}{meant}`?" if meant
                   else None, found=q.unit)
         return None
     found_dim, factor = UNITS[q.unit]
     if found_dim is not dim:
-        ctx.error("V102", f"{what}: expected {_a(dim)} ({fits}), found {_a(found_dim)} "
+        ctx.error(V102, f"{what}: expected {_a(dim)} ({fits}), found {_a(found_dim)} "
                   f"`{q.text}`",
                   q.span, expected=str(dim), found=str(found_dim))
         return None
     value = q.value * factor
     if not math.isfinite(value):
-        ctx.error("V105", f"{what} must be a finite number, found `{q.text}`", q.span)
+        ctx.error(V105, f"{what} must be a finite number, found `{q.text}`", q.span)
         return None
     return value
 
 
 def positive(ctx: Ctx, value: float | None, q: Quantity, what: str) -> float | None:
     if value is not None and not value > 0:
-        ctx.error("V105", f"{what} must be positive, found `{q.text}`", q.span, found=q.text)
+        ctx.error(V105, f"{what} must be positive, found `{q.text}`", q.span, found=q.text)
         return None
     return value
 
@@ -116,12 +117,12 @@ def split_args(ctx: Ctx, st: Statement, allowed: Iterable[str], repeat: bool) ->
             i += bad[2]
         elif isinstance(a, Word) and repeat and _REPEAT.match(a.text):
             if out.count is not None:
-                ctx.error("V116", f"`{st.keyword}` has two repeat counts", a.span)
+                ctx.error(V116, f"`{st.keyword}` has two repeat counts", a.span)
             out.count = int(a.text[1:])
         elif isinstance(a, Word) and a.text == "for" and st.keyword == "shiver":
             nxt = args[i + 1] if i + 1 < len(args) else None
             if not isinstance(nxt, Quantity):
-                ctx.error("V113", "`for` must be followed by a duration, e.g. `for 1s`",
+                ctx.error(V113, "`for` must be followed by a duration, e.g. `for 1s`",
                           a.span)
             else:
                 out.for_ = nxt
@@ -173,7 +174,7 @@ def _bad_count(ctx: Ctx, text: str, span: Span, _: int) -> None:
         hint = f"write `x{int(n)}`"
     else:
         hint = "write e.g. `x2`"
-    ctx.error("V116", f"a repeat count is a whole number of episodes, 0 or more: found "
+    ctx.error(V116, f"a repeat count is a whole number of episodes, 0 or more: found "
               f"`{text}`", span, hint=hint, found=text)
 
 
@@ -184,10 +185,10 @@ def _key(ctx: Ctx, st: Statement, a: KeyVal, allowed: list[str], out: Args) -> N
         if a.key == "for" and st.keyword == "shiver":  # `for` is a word, not a key
             keys += " and `for DURATION`"
             hint = f"write `for {a.value.text}`, with a space, not `=`"
-        ctx.error("V112", f"`{st.keyword}` takes {keys}; found `{a.key}=`", a.span,
+        ctx.error(V112, f"`{st.keyword}` takes {keys}; found `{a.key}=`", a.span,
                   hint=hint, found=a.key)
     elif a.key in out.keys:
-        ctx.error("V111", f"`{a.key}=` is given twice", a.span)
+        ctx.error(V111, f"`{a.key}=` is given twice", a.span)
     else:
         out.keys[a.key] = a
 
@@ -215,7 +216,7 @@ class Reader:
         found = f", found `{first.text}`" if isinstance(first, Quantity | Word) else ""
         span = first.span if isinstance(first, Quantity | Word | Vector | Colon) \
             else self.st.keyword_span
-        self.error("V113", f"`{self.st.keyword}` needs {what}{found}; usage: "
+        self.error(V113, f"`{self.st.keyword}` needs {what}{found}; usage: "
                    f"{self.kind.usage}", span)
 
     def quantity(self, what: str) -> Quantity | None:
@@ -241,7 +242,7 @@ class Reader:
             self.pos.pop(0)
             return first.text
         found = f", found `{first.text}`" if isinstance(first, Word | Quantity) else ""
-        self.error("V113", f"{message}{found}",
+        self.error(V113, f"{message}{found}",
                    first.span if isinstance(first, Word | Quantity) else self.st.keyword_span,
                    hint=did_you_mean(first.text, choices) if isinstance(first, Word) else None)
         if isinstance(first, Word):
@@ -260,7 +261,7 @@ class Reader:
         unit = self._after(q) if q.unit == "" else None
         if isinstance(unit, Word) and as_unit(unit.text) and unit in self.pos:
             self.pos.remove(unit)  # `1.25 s`: one slip, one diagnostic
-            self.error("V103", f"{what} `{q.text}` needs a unit glued to it: found "
+            self.error(V103, f"{what} `{q.text}` needs a unit glued to it: found "
                        f"`{q.text} {unit.text}`", q.span.to(unit.span),
                        hint=f"write `{q.text}{as_unit(unit.text)}`, without a space")
             return None
@@ -277,7 +278,7 @@ class Reader:
         if kv is None:
             return None
         if not isinstance(kv.value, Quantity):
-            self.error("V113", f"`{kv.key}=` takes a {spec.dim}, found `{kv.value.text}`",
+            self.error(V113, f"`{kv.key}=` takes a {spec.dim}, found `{kv.value.text}`",
                        kv.value.span)
             return None
         value = si(self.ctx, kv.value, spec.dim, what=f"`{kv.key}=` ({spec.what})",
@@ -287,7 +288,7 @@ class Reader:
     def amplitude(self, q: Quantity | None, value: float | None, what: str) -> float | None:
         """In the descriptor form, angles are amplitudes: positive."""
         if q is not None and value is not None and not self.in_sequence and value <= 0:
-            self.error("V118", f"{what} in the descriptor form is an amplitude and must "
+            self.error(V118, f"{what} in the descriptor form is an amplitude and must "
                        f"be positive, found `{q.text}`", q.span,
                        hint="signed angles (directions) belong in a `sequence { }` block")
             return None
@@ -298,7 +299,7 @@ class Reader:
         """Values under ``least`` (SI) cannot be seen or measured (V123)."""
         if q is not None and value is not None and 0 < abs(value) < least:
             shown = f"{math.degrees(least):g} deg" if unit == "deg" else f"{least * 1e3:g} mm"
-            self.error("V123", f"{what} `{q.text}` is too small to be seen or measured; "
+            self.error(V123, f"{what} `{q.text}` is too small to be seen or measured; "
                        f"at least {shown}", q.span)
 
     def done(self) -> bool:
@@ -311,7 +312,7 @@ class Reader:
             hint = self._slip(a)
             if hint and "repeat count" in hint:  # `x 3`: one slip, one diagnostic
                 skip.append(self._after(a))
-            self.error("V113", f"unexpected argument `{text}` to `{self.st.keyword}`; "
+            self.error(V113, f"unexpected argument `{text}` to `{self.st.keyword}`; "
                        f"usage: {self.kind.usage}", a.span, hint=hint)
         return len(self.ctx.diags) == self.n_before
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from ..core.codes import V110, V119, V120, V121, V123, V124, V125
 from .declared import source_of, written
 from .descriptors import REGISTRY, compare, derive
 from .ir import Behaviour
@@ -27,7 +28,7 @@ def _episodes(ctx: Ctx, b: Behaviour) -> bool:
     n = sum(p.count for p in b.primitives)
     if n > MAX_EPISODES:
         big = max(b.primitives, key=lambda p: p.count)
-        ctx.error("V110", f"the behaviour has {n} episodes; at most {MAX_EPISODES} are allowed",
+        ctx.error(V110, f"the behaviour has {n} episodes; at most {MAX_EPISODES} are allowed",
                   big.span, found=n, limit=MAX_EPISODES)
         return False
     return True
@@ -37,7 +38,7 @@ def _time(ctx: Ctx, b: Behaviour, tl: Timeline) -> bool:
     t = tl.planned_duration
     if t > MAX_MOTION_TIME:
         big = max(tl.episodes, key=lambda e: e.duration)
-        ctx.error("V110", f"the behaviour asks for about {t:.0f} s of motion; at most "
+        ctx.error(V110, f"the behaviour asks for about {t:.0f} s of motion; at most "
                   f"{MAX_MOTION_TIME:.0f} s are allowed", big.span, found=t,
                   limit=MAX_MOTION_TIME)
         return False
@@ -59,7 +60,7 @@ def _standoff(ctx: Ctx, b: Behaviour) -> bool:
             new = dist - p.length if p.kind == "approach" else dist + p.length
             if new < s.standoff - 1e-9:
                 left = max(dist - s.standoff, 0.0)
-                ctx.error("V120", f"this {p.kind} would end {s.standoff - new:.3g} m inside "
+                ctx.error(V120, f"this {p.kind} would end {s.standoff - new:.3g} m inside "
                           f"the standoff ({s.standoff:g} m from the goal); {left:.3g} m are "
                           "left", p.span, left=left)
                 return False
@@ -75,7 +76,7 @@ def _reach(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
     if far is not None and far[0] > MAX_REACH_DISTANCE + 1e-9:
         where = b.settings.spans.get("start") if far[1] is tl.episodes[0] and \
             far[1].start.d >= far[1].end.d else None
-        ctx.error("V119", f"the end-effector would be {far[0]:.3g} m from the goal; at most "
+        ctx.error(V119, f"the end-effector would be {far[0]:.3g} m from the goal; at most "
                   f"{MAX_REACH_DISTANCE:g} m", where or far[1].span, distance=far[0])
 
 
@@ -88,7 +89,7 @@ def _swept(ctx: Ctx, tl: Timeline) -> None:
         turn = math.hypot(e.end.h - e.start.h, e.end.v - e.start.v)
         arc = 2.0 * e.start.d * math.sin(turn / 2.0)
         if 0.0 < arc < MIN_RETREAT:
-            ctx.error("V123", f"this gaze of {math.degrees(turn):.3g} deg at "
+            ctx.error(V123, f"this gaze of {math.degrees(turn):.3g} deg at "
                       f"{e.start.d:.3g} m from the goal moves the end-effector "
                       f"{arc * 1e3:.2g} mm; at least {MIN_RETREAT * 1e3:g} mm can be seen",
                       e.span, hint="a larger angle, or gaze from further away",
@@ -110,14 +111,14 @@ def _short_moves(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
     least_mm = f"{MIN_RETREAT * 1e3:g} mm"
     least = f"at least {least_mm}"
     if b.form == "sequence":
-        ctx.error("V123", f"this approach runs the rest of the way to the standoff: "
+        ctx.error(V123, f"this approach runs the rest of the way to the standoff: "
                   f"{mm}, too little to be seen or measured; {least}", e.span,
                   hint=f"the moves before it end {mm} from the standoff: end them at "
                   f"least {least_mm} from it, or leave this approach out",
                   moved=e.path_length, least=MIN_RETREAT)
         return
     pieces = sum(1 for x in tl.episodes if x.kind == "approach")
-    ctx.error("V123", f"the layout splits the approach into {pieces} pieces (one to each "
+    ctx.error(V123, f"the layout splits the approach into {pieces} pieces (one to each "
               f"stop, the last to the standoff) and the shortest moves {mm}, too little to "
               f"be seen or measured; {least}", e.span,
               hint=_further_start(b, pieces), moved=e.path_length, least=MIN_RETREAT)
@@ -141,7 +142,7 @@ def _touching(ctx: Ctx, tl: Timeline) -> None:
     """V125: two pauses in a row are one hold."""
     for a, b in zip(tl.episodes, tl.episodes[1:], strict=False):
         if a.kind == b.kind == "pause":
-            ctx.report("V125", f"this pause follows another with no motion between them: "
+            ctx.report(V125, f"this pause follows another with no motion between them: "
                        f"they are seen and measured as one hold of "
                        f"{a.duration + b.duration:.3g} s", b.span,
                        hint="put a motion between them, or write one longer pause")
@@ -184,7 +185,7 @@ def _realisable(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
             f"no layout of this file can show more than {_shown(m.name, m.measured)}" \
             if REGISTRY[m.name].is_count else \
             f"its layout shows {_shown(m.name, m.measured)}"
-        ctx.error("V121", f"{m.name} is declared {_shown(m.name, m.declared)} but {shows}",
+        ctx.error(V121, f"{m.name} is declared {_shown(m.name, m.declared)} but {shows}",
                   node.span if node else b.span,
                   hint="pauses need motion between them (an approach, a retreat, a gaze...); "
                   "a retreat needs a pause before and after it, a gaze one after it",
@@ -201,7 +202,7 @@ def check_whole(ctx: Ctx, b: Behaviour) -> Timeline | None:
     if not _time(ctx, b, tl):
         return None
     if not tl.episodes:
-        ctx.error("V124", "the behaviour has nothing to move or hold: no primitive makes an "
+        ctx.error(V124, "the behaviour has nothing to move or hold: no primitive makes an "
                   "episode", b.span, hint="add a primitive, e.g. `approach` or `pause 1s`")
         return tl
     _reach(ctx, b, tl)

@@ -28,6 +28,7 @@ import time
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+from ..core.codes import I504
 from ..core.diagnostics import AouError, Span, diag
 from ..lang.cv import CANONICAL, classify
 from ..lang.ir import State
@@ -59,7 +60,7 @@ def from_uncertainty(u: float) -> tuple[float, float, float]:
         AouError: I501 when ``u`` is not a number in [0, 1].
     """
     if not (isinstance(u, int | float) and 0.0 <= u <= 1.0):
-        raise AouError(diag("I504", f"the uncertainty must be a number in [0, 1], found "
+        raise AouError(diag(I504, f"the uncertainty must be a number in [0, 1], found "
                             f"{u!r}", _WHERE))
     s = 4.0 * float(u)
     k = min(int(s), 3)
@@ -130,7 +131,7 @@ class Regulator:
         from ..robot.load import load_arm
 
         if not 0.0 < intensity_step <= 1.0 or not 0.0 < transition_scale <= 1.0:
-            raise AouError(diag("I504", "intensity_step and transition_scale must lie in "
+            raise AouError(diag(I504, "intensity_step and transition_scale must lie in "
                                 "(0, 1]", _WHERE))
         self.robot, self.goal = robot, goal
         self.arm = load_arm(robot)
@@ -178,7 +179,7 @@ class Regulator:
         """
         if uncertainty is not None:
             if C is not None or V is not None or intensity is not None:
-                raise AouError(diag("I504", "give an uncertainty, or C, V and intensity; "
+                raise AouError(diag(I504, "give an uncertainty, or C, V and intensity; "
                                     "not both", _WHERE))
             c, v, i = from_uncertainty(uncertainty)
             if self._u is not None and abs(uncertainty - self._u) <= self.hysteresis.uncertainty:
@@ -187,12 +188,12 @@ class Regulator:
                 self._u = float(uncertainty)
             return c, v, i
         if C is None or V is None:
-            raise AouError(diag("I504", "give C and V (and an intensity), or an "
+            raise AouError(diag(I504, "give C and V (and an intensity), or an "
                                 "uncertainty", _WHERE))
         i = 0.5 if intensity is None else intensity
         for name, x, lo in (("C", C, -1.0), ("V", V, -1.0), ("intensity", i, 0.0)):
             if not (isinstance(x, int | float) and lo <= x <= 1.0):
-                raise AouError(diag("I504", f"{name} must be a number in [{lo:g}, 1], found "
+                raise AouError(diag(I504, f"{name} must be a number in [{lo:g}, 1], found "
                                     f"{x!r}", _WHERE))
         return float(C), float(V), float(i)
 
@@ -302,7 +303,7 @@ class Regulator:
             except (TypeError, ValueError):
                 a = np.full(1, np.nan)
             if a.shape != (n,) or not np.all(np.isfinite(a)):
-                raise AouError(diag("I504", f"{name} must be {n} finite numbers (the joints "
+                raise AouError(diag(I504, f"{name} must be {n} finite numbers (the joints "
                                     f"of {self.robot}), found {x!r:.60}", _WHERE))
             out.append(a)
         return out[0], out[1], out[2]

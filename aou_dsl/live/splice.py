@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
+from ..core.codes import C306
 from ..core.diagnostics import AouError, Span, diag
 
 if TYPE_CHECKING:
@@ -210,7 +211,7 @@ def join_plan(reg: Regulator, plan: Trajectory, x: State3, phase: float | None,
                          qdd=np.vstack([qdd[:-1], plan.qdd[k:]]), episodes=episodes)
         timings["splice"] = time.perf_counter() - clock
         return out, t_k, T
-    raise AouError(diag("C306", f"no jerk-limited transition from the arm's state into the "
+    raise AouError(diag(C306, f"no jerk-limited transition from the arm's state into the "
                         f"plan passes the checks on {reg.robot}", _WHERE,
                         hint="the arm may be too close to a joint limit or an obstacle; "
                         "try restart=True"))
@@ -230,13 +231,13 @@ def brake_and_hold(reg: Regulator, x: State3, timings: dict[str, float]
     got = transition(reg, x, None, rate)
     timings["transition"] = time.perf_counter() - clock
     if got is None:
-        raise AouError(diag("C306", f"the arm cannot brake within its joint ranges on "
+        raise AouError(diag(C306, f"the arm cannot brake within its joint ranges on "
                             f"{reg.robot}", _WHERE))
     t, q, qd, qdd = got
     goal = reg.goal or reg.arm.spec.goal
     clock = time.perf_counter()
     if not _checked(reg, t, q, qd, qdd, goal):
-        raise AouError(diag("C306", "braking to rest fails the checks", _WHERE))
+        raise AouError(diag(C306, "braking to rest fails the checks", _WHERE))
     timings["check"] = time.perf_counter() - clock
     T = float(t[-1])
     hold = T + np.arange(1, int(round(hold_for * rate)) + 1) / rate

@@ -14,6 +14,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
+from ..core.codes import R401
 from ..core.diagnostics import AouError, Span, diag
 
 __all__ = ["FORMAT", "Goal", "Header", "read_header"]
@@ -106,7 +107,7 @@ def read_header(path: str, doc: Any, *, own_goal: bool = True, text: str | None 
     points at the first in ``text``, the document's JSON, when given). ``own_goal``
     False: the file's goal is not read (one given on the command line replaces it)."""
     if not isinstance(doc, dict):
-        raise AouError(diag("R401", "a trajectory document is a JSON object",
+        raise AouError(diag(R401, "a trajectory document is a JSON object",
                             Span.whole_file(path)))
     skip = ("t", "q", "qd", "qdd") if own_goal else ("t", "q", "qd", "qdd", "goal")
     fields = {k: v for k, v in doc.items() if k not in skip}
@@ -114,7 +115,7 @@ def read_header(path: str, doc: Any, *, own_goal: bool = True, text: str | None 
         header = Header.model_validate(fields)
     except ValidationError as exc:
         errors = exc.errors(include_url=False)
-        raise AouError(diag("R401", _message(errors, doc), _span(path, text, _first(errors)),
+        raise AouError(diag(R401, _message(errors, doc), _span(path, text, _first(errors)),
                             fields=[".".join(str(x) for x in e["loc"]) for e in errors])
                        ) from None
     return header

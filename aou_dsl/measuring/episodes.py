@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.codes import R406
 from ..core.diagnostics import AouError, Span, diag
 from ..lang.descriptors import EpisodeValues
 from ..robot.batch_fk import classical_acceleration, linear_jacobian
@@ -283,7 +284,7 @@ def _self_check(c: Context, peak: float, at: int, window: int, u: np.ndarray,
     bound = 1.25 * float(np.abs(joint_side).max()) + 4.0 * noise
     if peak > bound + 1e-6:
         raise AouError(diag(
-            "R406", f"the hand's peak acceleration {peak:.4g} m/s^2 at t={c.rest.t[at]:.3f}s "
+            R406, f"the hand's peak acceleration {peak:.4g} m/s^2 at t={c.rest.t[at]:.3f}s "
             f"is more than the joints' motion there produces ({bound:.4g} m/s^2); this is "
             "an error of the measurement, not a value", Span.whole_file(c.path),
             measured=peak, bound=bound))

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.codes import R401, R403, R405, R407
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..core.trajectory import Trajectory
 from ..lang.cv import CVPoint, composition, infer
@@ -116,7 +117,7 @@ class Measured:
 
 
 def _bad(path: str, message: str, **fields) -> AouError:
-    return AouError(diag("R401", message, Span.whole_file(path), **fields))
+    return AouError(diag(R401, message, Span.whole_file(path), **fields))
 
 
 def _checked(rec: Trajectory, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -259,7 +260,7 @@ def _undersampled(where: Span, t0: float, t1: float, per_cycle: float, h: float
                   ) -> Diagnostic:
     """R407: an oscillation sampled too coarsely to tell a shiver from tilts."""
     f = 1.0 / (per_cycle * h)
-    return diag("R407", f"the hand rolls back and forth at about {f:.2g} Hz from t={t0:.3f}s to "
+    return diag(R407, f"the hand rolls back and forth at about {f:.2g} Hz from t={t0:.3f}s to "
                 f"t={t1:.3f}s, sampled {per_cycle:.2g} times per cycle: too few to tell a "
                 "shiver from tilts by its speed profile, so it is reported as neither",
                 where, hint=f"sample it at {math.ceil(SHAPED_CYCLE * f)} Hz or more "
@@ -290,11 +291,11 @@ def measure(rec: Trajectory) -> Measured:
     diags = [_undersampled(where, t0 + float(rec.t[0]), t1 + float(rec.t[0]), per_cycle,
                            ctx.rest.h) for t0, t1, per_cycle in coarse]
     if ctx.goal is None:
-        diags.append(diag("R405", "the trajectory has no goal: gaze descriptors and the line "
+        diags.append(diag(R405, "the trajectory has no goal: gaze descriptors and the line "
                           "of sight are not measured; approach and retreat are read along "
                           "the hand's forward axis", where,
                           hint="give it with --goal X,Y,Z, or --goal final"))
-    diags += [diag("R403", f"{name} differs between episodes: "
+    diags += [diag(R403, f"{name} differs between episodes: "
                    f"{', '.join(f'{v:.4g}' for v in vals)}; reporting the "
                    f"{REGISTRY[name].aggregate} {descriptors[name]:.4g}", where,
                    descriptor=name, values=vals)

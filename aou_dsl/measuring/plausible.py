@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from ..core.codes import R404
 from ..core.diagnostics import AouError, Span, diag
 from ..core.trajectory import Trajectory
 from .locate import Where
@@ -58,14 +59,14 @@ def check_units(rec: Trajectory, angle_unit: str | None, time_unit: str | None,
     for unit, table, what in ((angle_unit, ANGLE_UNITS, "angle"),
                               (time_unit, TIME_UNITS, "time")):
         if unit is not None and unit not in table:
-            raise AouError(diag("R404", f"unknown {what} unit `{unit}`: expected one of "
+            raise AouError(diag(R404, f"unknown {what} unit `{unit}`: expected one of "
                                 f"{', '.join(table)}", Span.whole_file(where.path)))
     wrong = [f"--{flag} {unit}" for flag, unit, right in
              (("angle-unit", angle_unit, "rad"), ("time-unit", time_unit, "s"))
              if unit not in (None, right)]
     arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs)
     if trusted and wrong and _as_written(rec, arm, where):
-        raise AouError(diag("R404", f"aou wrote this file, in radians and seconds: "
+        raise AouError(diag(R404, f"aou wrote this file, in radians and seconds: "
                             f"{' and '.join(wrong)} would misread it", Span.whole_file(
                                 where.path), hint="leave the units out for files aou wrote"))
     t = np.asarray(rec.t, float) * TIME_UNITS[time_unit or "s"]
@@ -110,7 +111,7 @@ def _plausible_clock(t: np.ndarray, where: Where) -> None:
     step = np.diff(t)
     if len(step) and float(np.median(step)) >= SLOWEST_STEP:
         i = int(np.argmax(step >= SLOWEST_STEP)) + 1
-        raise AouError(diag("R404", f"the times look like milliseconds: one sample every "
+        raise AouError(diag(R404, f"the times look like milliseconds: one sample every "
                             f"{float(np.median(step)):g} s ({where.label(i)} has t={t[i]:g} "
                             f"after t={t[i - 1]:g})", where.span(i, "t"),
                             hint="give --time-unit ms, or --time-unit s if the clock really "
@@ -134,7 +135,7 @@ def _plausible_angles(col: np.ndarray, name: str, limits: tuple[float, float],
         return
     i = int(np.argmin(inside))
     raise AouError(diag(
-        "R404", f"joint `{name}` reads {col[i]:g} at {where.label(i)}, outside its limits "
+        R404, f"joint `{name}` reads {col[i]:g} at {where.label(i)}, outside its limits "
         f"[{limits[0]:.3g}, {limits[1]:.3g}] rad: the angles look like degrees",
         where.span(i), hint="give --angle-unit deg, or --angle-unit rad if they really are "
         "radians", joint=name, **where.fields(i)))
@@ -150,7 +151,7 @@ def _obeyed_limits(col: np.ndarray, name: str, limits: tuple[float, float], unit
     other = "rad" if unit == "deg" else "deg"
     fits = _within(col / ANGLE_UNITS[unit] * ANGLE_UNITS[other], lo, hi).all()
     raise AouError(diag(
-        "R404", f"with --angle-unit {unit}, joint `{name}` reads {col[0]:.4g} rad at "
+        R404, f"with --angle-unit {unit}, joint `{name}` reads {col[0]:.4g} rad at "
         f"{where.label(0)} and every one of its {len(col)} samples lies outside its limits "
         f"[{lo:.3g}, {hi:.3g}] rad: the unit given contradicts the robot's limits",
         where.span(0), hint=f"the values fit the limits in {other}: give --angle-unit "
@@ -204,7 +205,7 @@ def _plausible_speeds(rec: Trajectory, arm: Any, t: np.ndarray, q: np.ndarray,
         hint = ("check the units: times in seconds (--time-unit ms for milliseconds), "
                 "angles in radians (--angle-unit deg for degrees), and the robot (--robot)")
     raise AouError(diag(
-        "R404", f"{given}joint `{name}` moves at {speed:.3g} {per} around {where.label(i)}, "
+        R404, f"{given}joint `{name}` moves at {speed:.3g} {per} around {where.label(i)}, "
         f"{ratio:.0f} times its velocity limit of {limit:.3g} {per}: {why}",
         where.span(i, "t"), hint=hint, joint=name, unit=time_unit or "s",
         **where.fields(i)))

@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from ..core.codes import I501, R401, R405
 from ..core.diagnostics import AouError, Severity, Span, diag
 from ..core.files import decode, read_bytes
 from ..core.trajectory import Trajectory
@@ -43,7 +44,7 @@ FORMATS = ("json", "csv", "npz")
 
 def _bad(path: str, message: str, hint: str | None = None, span: Span | None = None,
          **fields) -> AouError:
-    return AouError(diag("R401", message, span or Span.whole_file(path), hint=hint, **fields))
+    return AouError(diag(R401, message, span or Span.whole_file(path), hint=hint, **fields))
 
 
 def _check_arrays(t: np.ndarray, q: np.ndarray, names: tuple[str, ...], where: Where
@@ -153,7 +154,7 @@ def _json(path: str, text: str, own_goal: bool) -> tuple[Trajectory, Header]:
     try:
         doc = json.loads(text)
     except json.JSONDecodeError as exc:
-        raise AouError(diag("R401", f"not valid JSON: {exc.msg}",
+        raise AouError(diag(R401, f"not valid JSON: {exc.msg}",
                             Span.point(path, exc.lineno, exc.colno))) from None
     header = read_header(path, doc, own_goal=own_goal, text=text)
     missing = [k for k in ("t", "q") if k not in doc]
@@ -240,7 +241,7 @@ def _read_csv(path: str, text: str, robot: str | None,
     values = _csv_values(path, rows[1:], header, lines)
     robot = robot or notes.get("robot")
     if not robot:
-        raise AouError(diag("I501", f"cannot read `{path}` as a recording without its robot: "
+        raise AouError(diag(I501, f"cannot read `{path}` as a recording without its robot: "
                             "the CSV does not say which robot made it (no `# robot:` line)",
                             Span.whole_file(path), hint="give --robot NAME|PATH"))
     if goal is None and notes.get("goal"):
@@ -280,7 +281,7 @@ def _unread(path: str, what: str) -> AouError:
     """I501: ``path`` (``what`` it is) is in none of :data:`FORMATS`."""
     bag = "bag" in what or what == "YAML"
     return AouError(diag(
-        "I501", f"cannot read `{path}`: it is {what}, not a trajectory aou reads; aou "
+        I501, f"cannot read `{path}`: it is {what}, not a trajectory aou reads; aou "
         "reads trajectories from JSON, CSV and NPZ files (and compiles `.aou` files)",
         Span.whole_file(path), hint=(
             "aou writes ROS 2 bags and YAML for ROS (--format mcap|yaml) but does not read "
@@ -385,7 +386,7 @@ def read_recording(path: str, *, robot: str | None = None,
     _check_clock(rec.t, where)
     if isinstance(goal, str):
         if goal != "final":
-            raise AouError(diag("R405", f"unknown goal `{goal}`: give X,Y,Z or `final`",
+            raise AouError(diag(R405, f"unknown goal `{goal}`: give X,Y,Z or `final`",
                                 Span.whole_file(path), severity=Severity.ERROR))
         rec = rec.with_(goal=final_goal(rec))
     return rec

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.codes import R405
 from ..core.diagnostics import Diagnostic, Span, diag
 from ..core.trajectory import Trajectory
 from ..lang.cv import CANONICAL, CVPoint
@@ -100,7 +101,7 @@ def profile_data(rec: Trajectory) -> ProfileData:
                 else np.full(len(t), np.nan))
     if rec.goal is None:
         extra["diagnostics"] = (diag(
-            "R405", "the trajectory has no goal: the plot leaves out the goal-distance "
+            R405, "the trajectory has no goal: the plot leaves out the goal-distance "
             "panel and the line of sight",
             Span.whole_file(rec.path), hint="give it with --goal X,Y,Z, or --goal final"),)
     return ProfileData(rec.title, arm.joint_names, t, speed, distance, q, qd,

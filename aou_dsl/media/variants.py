@@ -18,6 +18,7 @@ import os
 import re
 from dataclasses import dataclass, replace
 
+from ..core.codes import I504
 from ..core.diagnostics import AouError, Span, diag
 from ..lang.declared import source_of
 from ..lang.descriptors import REGISTRY
@@ -53,13 +54,13 @@ def parse_vary(text: str) -> tuple[str, float, float]:
         name, values = text.split("=", 1)
         low, high = (float(v) for v in values.split(","))
     except ValueError:
-        raise AouError(diag("I504", f"--vary takes NAME=LOW,HIGH, e.g. "
+        raise AouError(diag(I504, f"--vary takes NAME=LOW,HIGH, e.g. "
                             f"pause_duration=1.0,2.5; found `{text}`", where)) from None
     if name not in REGISTRY:
-        raise AouError(diag("I504", f"unknown descriptor `{name}`: expected one of "
+        raise AouError(diag(I504, f"unknown descriptor `{name}`: expected one of "
                             f"{', '.join(REGISTRY)}", where))
     if not (math.isfinite(low) and math.isfinite(high)):
-        raise AouError(diag("I504", f"--vary values must be finite numbers, found `{text}`",
+        raise AouError(diag(I504, f"--vary values must be finite numbers, found `{text}`",
                             where))
     return name, low, high
 
@@ -142,16 +143,16 @@ def make_variants(b: Behaviour, text: str, descriptor: str, low: float, high: fl
     where = b.span
     d = REGISTRY[descriptor]
     if b.form != "descriptor":
-        raise AouError(diag("I504", "variants are made from descriptor-form files, where "
+        raise AouError(diag(I504, "variants are made from descriptor-form files, where "
                             "each descriptor is set by one statement", where))
     prim = source_of(b, descriptor)
     if prim is None:
-        raise AouError(diag("I504", f"`{b.name}` has no `{d.kind}` statement to vary; "
+        raise AouError(diag(I504, f"`{b.name}` has no `{d.kind}` statement to vary; "
                             f"add one to the base first", where))
     out = []
     for label, value in (("low", low), ("high", high)):
         if d.is_count and (value != int(value) or value < 0):
-            raise AouError(diag("I504", f"{descriptor} is a count: expected a whole number, "
+            raise AouError(diag(I504, f"{descriptor} is a count: expected a whole number, "
                                 f"found {value:g}", where))
         new = prim.replace(**{d.ir_field: int(value) if d.is_count else value * d.scale})
         body = _rewrite(text, prim.span, KINDS[d.kind].format(prim), KINDS[d.kind].format(new))

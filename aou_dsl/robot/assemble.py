@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..core.codes import C313, V109
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..core.robot_specs import (
     DEFAULT_JOINT_ACCEL,
@@ -69,13 +70,13 @@ def default_limits_warning(spec: RobotSpec, urdf: Urdf, description: str, *, acc
         toml = os.path.splitext(spec.name)[0] + ".toml"
         hint = (f"write `{toml}` with `urdf = \"{os.path.basename(urdf.path)}\"` and "
                 f"{keys}, then use it: `robot \"{toml}\"` in the file or `--robot {toml}`")
-    return diag("C313", f"robot `{spec.name}`: no sourced {' or '.join(what)} limit; aou "
+    return diag(C313, f"robot `{spec.name}`: no sourced {' or '.join(what)} limit; aou "
                 "plans with its conservative default", Span.whole_file(urdf.path),
                 hint=hint, defaults=[k for k in keys.split(" and ")])
 
 
 def _bad(urdf: Urdf, where: str, message: str) -> AouError:
-    return AouError(diag("V109", message, Span.whole_file(where or urdf.path)))
+    return AouError(diag(V109, message, Span.whole_file(where or urdf.path)))
 
 
 def _check_names(urdf: Urdf, pins: dict[str, Any], joints: tuple[str, ...], where: str

@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 import os
 
+from ..core.codes import V109
 from ..core.diagnostics import AouError, Span, diag
 from .urdf import Joint, Urdf
 
@@ -55,7 +56,7 @@ def arm_joints(urdf: Urdf) -> tuple[str, ...]:
         if len(branches) > 1:
             names = ", ".join(f"`{j.child}`" for j in branches)
             raise AouError(diag(
-                "V109", f"`{_base(urdf)}` branches at link `{link}` into several arms "
+                V109, f"`{_base(urdf)}` branches at link `{link}` into several arms "
                 f"({names}); aou moves one", Span.whole_file(urdf.path),
                 hint="name the arm's joints with `arm_joints = [...]` in a robot "
                      "description file (.toml) beside the URDF"))
@@ -64,7 +65,7 @@ def arm_joints(urdf: Urdf) -> tuple[str, ...]:
             out.append(j.name)
         link = j.child
     if not out:
-        raise AouError(diag("V109", f"`{_base(urdf)}` has no joint that moves an arm",
+        raise AouError(diag(V109, f"`{_base(urdf)}` has no joint that moves an arm",
                             Span.whole_file(urdf.path)))
     return tuple(out)
 

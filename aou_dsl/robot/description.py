@@ -35,6 +35,7 @@ import tomllib
 from dataclasses import dataclass, field
 from typing import Any
 
+from ..core.codes import V109
 from ..core.diagnostics import AouError, Span, diag
 from ..core.files import read_text
 
@@ -81,7 +82,7 @@ def _line(text: str, key: str) -> int:
 def _error(path: str, text: str, key: str | None, message: str, hint: str | None = None
            ) -> AouError:
     line = _line(text, key) if key else 1
-    return AouError(diag("V109", f"robot description `{os.path.basename(path)}`: {message}",
+    return AouError(diag(V109, f"robot description `{os.path.basename(path)}`: {message}",
                          Span(path, line, 1, line, 2), hint=hint))
 
 
@@ -170,7 +171,7 @@ def read_description(path: str) -> Description:
     except tomllib.TOMLDecodeError as exc:
         m = re.search(r"line (\d+)", str(exc))
         line = int(m.group(1)) if m else 1
-        raise AouError(diag("V109", f"robot description `{os.path.basename(path)}` is not "
+        raise AouError(diag(V109, f"robot description `{os.path.basename(path)}` is not "
                             f"valid TOML: {exc}", Span(path, line, 1, line, 2))) from None
     return _checked(path, text, doc)
 

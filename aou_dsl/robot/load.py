@@ -19,6 +19,7 @@ import tempfile
 from collections.abc import Sequence
 from dataclasses import replace
 
+from ..core.codes import C312, R402, V109
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..core.options import package_dirs as package_dirs_of
 from ..core.robot_specs import ROBOT_FILE_TYPES, ROBOTS, UNSOURCED, RobotSpec, is_robot_file
@@ -34,7 +35,7 @@ def unknown_robot(robot: str, span: Span) -> Diagnostic:
     """V109 for a name that is neither a built-in arm nor a robot file."""
     from ..lang.values import did_you_mean
 
-    return diag("V109", f"unknown robot `{robot}`: expected one of {', '.join(ROBOTS)}, "
+    return diag(V109, f"unknown robot `{robot}`: expected one of {', '.join(ROBOTS)}, "
                 f"or a quoted path to a robot file ({' or '.join(ROBOT_FILE_TYPES)})", span,
                 hint=did_you_mean(robot, ROBOTS), found=robot, valid=list(ROBOTS))
 
@@ -116,7 +117,7 @@ def robot_diagnostics(robot: str, *, collision_check: bool = True, span: Span | 
     out = list(r.warnings)
     if collision_check and not r.collision:
         out.append(diag(
-            "C312", f"robot `{robot}` has no collision geometry on the links its arm moves: "
+            C312, f"robot `{robot}` has no collision geometry on the links its arm moves: "
             "self-collision and contact with the target and the table cannot be checked",
             Span.whole_file(r.urdf.path),
             hint="add <collision> shapes to the URDF, or compile with --no-collision-check "
@@ -147,7 +148,7 @@ def _scene_file(robot: str, dirs: tuple[str, ...], visuals: bool) -> str:
     text, missing = scene_xml(r.urdf, r.package_dirs, r.gaze, visuals=visuals)
     if missing:
         raise AouError(diag(
-            "V109", f"robot `{robot}`: {len(missing)} mesh file(s) not found, first "
+            V109, f"robot `{robot}`: {len(missing)} mesh file(s) not found, first "
             f"`{missing[0]}`", Span.whole_file(r.urdf.path),
             hint="give the folder of the package (or one holding it) with --package-dir, "
                  "or in ROS_PACKAGE_PATH, or `package_dirs` in a robot description; or "
@@ -188,7 +189,7 @@ def load_arm(robot: str, ee_frame: str | None = None,
     fid = frame_id(r.model, ee_frame)
     if fid < 0:
         valid = sorted({f.name for f in r.model.frames})
-        raise AouError(diag("R402", f"robot `{robot}` has no frame `{ee_frame}`",
+        raise AouError(diag(R402, f"robot `{robot}` has no frame `{ee_frame}`",
                             Span.whole_file(f"<robot {robot}>"),
                             hint=f"frames: {', '.join(valid)}", valid=valid))
     return replace(arm, frame_id=fid)

@@ -11,6 +11,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from ..core.codes import V109
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..core.robot_specs import RobotSpec
 from .kinematics import frame_id
@@ -82,13 +83,13 @@ def reduced_model(urdf: Urdf, joints: Sequence[str], velocity: dict[str, float],
     try:
         model = pin.buildModelFromXML(kinematic_xml(urdf, joints, velocity))
     except (RuntimeError, ValueError) as exc:
-        raise AouError(diag("V109", f"`{os.path.basename(urdf.path)}`: Pinocchio cannot "
+        raise AouError(diag(V109, f"`{os.path.basename(urdf.path)}`: Pinocchio cannot "
                             f"build its kinematics: {exc}", Span.whole_file(urdf.path))
                        ) from None
     names = tuple(model.names[1:])
     if names != tuple(joints):
         raise AouError(diag(
-            "V109", f"`{os.path.basename(urdf.path)}`: the arm's joints from the base "
+            V109, f"`{os.path.basename(urdf.path)}`: the arm's joints from the base "
             f"outward are {', '.join(names)}; expected {', '.join(joints)}",
             Span.whole_file(urdf.path), hint="list `arm_joints` from the base outward"))
     if gaze is not None:  # added here, not in the XML: link and joint names may clash

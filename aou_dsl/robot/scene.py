@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.codes import V109
 from ..core.diagnostics import AouError, Span, diag
 from ..core.options import SceneOptions
 from .bullet import import_pybullet, quiet
@@ -62,7 +63,7 @@ class Scene:
                                         physicsClientId=self.client)
         except pb.error as exc:
             self.close()
-            raise AouError(diag("V109", f"PyBullet cannot load robot `{self.robot}`: {exc}",
+            raise AouError(diag(V109, f"PyBullet cannot load robot `{self.robot}`: {exc}",
                                 Span.whole_file(urdf))) from None
         #: The arm's joint names, in the order of :meth:`set_arm`'s ``q``.
         self.arm_joints: tuple[str, ...] = spec.arm_joints

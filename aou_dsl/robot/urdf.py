@@ -24,6 +24,7 @@ import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from ..core.codes import V109
 from ..core.diagnostics import AouError, Span, diag
 from ..core.files import read_text
 
@@ -96,7 +97,7 @@ class Urdf:
 
 
 def _bad(path: str, message: str, hint: str | None = None) -> AouError:
-    return AouError(diag("V109", message, Span.whole_file(path), hint=hint))
+    return AouError(diag(V109, message, Span.whole_file(path), hint=hint))
 
 
 def _vec3(text: str | None, default: tuple[float, float, float]

@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..core.codes import C305, V109
 from ..core.diagnostics import AouError, Span, diag
 
 if TYPE_CHECKING:
@@ -112,7 +113,7 @@ def get(name: str | None) -> Controller:
     key = name or "default"
     if key not in CONTROLLERS:
         known = [c for c in CONTROLLERS if c != "default"]
-        raise AouError(diag("V109", f"unknown controller `{name}`: expected one of "
+        raise AouError(diag(V109, f"unknown controller `{name}`: expected one of "
                             f"{', '.join(known)}", Span.whole_file("<controller>"),
                             found=name, valid=known))
     return CONTROLLERS[key]
@@ -163,7 +164,7 @@ def _trajectory(motion) -> Trajectory:
     """The trajectory of a compilation (or the trajectory itself)."""
     tr = motion.trajectory if hasattr(motion, "segments") else motion
     if tr is None:
-        raise AouError(diag("C305", "the compilation failed: there is nothing to check",
+        raise AouError(diag(C305, "the compilation failed: there is nothing to check",
                             motion.behaviour.span))
     return tr
 

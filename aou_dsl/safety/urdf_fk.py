@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.codes import R402
 from ..core.diagnostics import AouError, Span, diag
 
 __all__ = ["Chain", "chain_fk", "urdf_chain"]
@@ -81,7 +82,7 @@ def urdf_chain(urdf: str, frame: str, columns: tuple[str, ...]) -> Chain:
     if frame not in links and "joint:" + frame in joints:  # a link's name wins, as in Pinocchio
         link = joints["joint:" + frame][1].find("child").get("link", "")  # type: ignore[union-attr]
     if link not in links:
-        raise AouError(diag("R402", f"the robot file has no link or joint `{frame}`",
+        raise AouError(diag(R402, f"the robot file has no link or joint `{frame}`",
                             Span.whole_file(urdf)))
     steps = []
     current = link

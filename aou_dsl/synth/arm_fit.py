@@ -16,6 +16,7 @@ import math
 from dataclasses import dataclass
 
 from ..compiler.fits import floor_sig
+from ..core.codes import C304
 from ..core.diagnostics import AouError, has_errors
 from ..lang.ir import DEFAULTS
 from ..lang.primitives import MIN_SHIVER_F, shiver_duration
@@ -92,11 +93,11 @@ def fit_limits(robot: str, goal: tuple[float, float, float] | None = None) -> Li
 
     arm = load_arm(robot)
     res = build_source(_probe(robot, goal), f"<synth probe {robot}>", check=False)
-    errors = [d for d in res.diagnostics if d.code != "C304"]
+    errors = [d for d in res.diagnostics if d.code != C304]
     if has_errors(errors):
         raise AouError([d for d in errors if d.severity.value == "error"])
     reached = min((float(d.fields["achieved"]) for d in res.diagnostics
-                   if d.code == "C304"), default=PROBE_ACCEL)
+                   if d.code == C304), default=PROBE_ACCEL)
     j = arm.joint_names.index(arm.spec.shiver_joint)
     return Limits(robot, goal, reached, floor_sig(MARGIN * reached), arm.spec.shiver_joint,
                   MARGIN * float(arm.plan_vmax[j]), MARGIN * float(arm.plan_amax[j]))

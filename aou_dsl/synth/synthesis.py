@@ -32,6 +32,7 @@ import math
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
+from ..core.codes import C304, C305, C308, C309, C311, I504
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..core.memo import Keyed
 from ..lang.cv import CANONICAL, classify
@@ -90,7 +91,7 @@ _MIN_COUNT = {"retreat": 1, "pause": 1}
 
 def _check_intensity(intensity: float) -> float:
     if not (isinstance(intensity, int | float) and 0.0 <= intensity <= 1.0):
-        raise AouError(diag("I504", f"the intensity must be a number in [0, 1], found "
+        raise AouError(diag(I504, f"the intensity must be a number in [0, 1], found "
                             f"{intensity!r}", _WHERE))
     return float(intensity)
 
@@ -205,7 +206,7 @@ def _floor(state: State, limits: Limits) -> float:
         return 0.0
     lo, hi = 0.0, 1.0
     if not ok(hi):
-        raise AouError(diag("I504", f"no intensity of `{state}` reads as {state} on "
+        raise AouError(diag(I504, f"no intensity of `{state}` reads as {state} on "
                             f"{limits.robot}", _WHERE))
     while hi - lo > 0.01:
         mid = (lo + hi) / 2
@@ -234,12 +235,12 @@ def synthesize(state: State | str | None = None, C: float | None = None,
     """
     intensity = _check_intensity(intensity)
     if state is not None and (C is not None or V is not None):
-        raise AouError(diag("I504", "give a state or a C-V point, not both", _WHERE))
+        raise AouError(diag(I504, "give a state or a C-V point, not both", _WHERE))
     if state is None and (C is None or V is None):
-        raise AouError(diag("I504", "give a state, or both C and V", _WHERE))
+        raise AouError(diag(I504, "give a state, or both C and V", _WHERE))
     for name, x in (("C", C), ("V", V)):
         if x is not None and not (isinstance(x, int | float) and -1.0 <= x <= 1.0):
-            raise AouError(diag("I504", f"{name} must be a number in [-1, 1], found {x!r}",
+            raise AouError(diag(I504, f"{name} must be a number in [-1, 1], found {x!r}",
                                 _WHERE))
     limits = fit_limits(robot or "panda", _goal(goal))
     st = _state(state) if state is not None else None
@@ -251,7 +252,7 @@ def synthesize(state: State | str | None = None, C: float | None = None,
         i_eff = max(intensity, lo)
         text = make(i_eff)
         why = _failure(text) if verify else None
-        reached = why.fields.get("achieved") if why is not None and why.code == "C304" else None
+        reached = why.fields.get("achieved") if why is not None and why.code == C304 else None
         if not reached:
             break
         # somewhere on this reach the joints reach less than on the probe's line
@@ -277,7 +278,7 @@ def _maker(st: State | None, point: tuple[float, float] | None, intensity: float
 
 
 #: Compile warnings that mean the arm cannot perform a declared value.
-_LIMIT_CODES = frozenset({"C304", "C308", "C309", "C311"})
+_LIMIT_CODES = frozenset({C304, C308, C309, C311})
 
 
 @functools.lru_cache(maxsize=32)
@@ -297,7 +298,7 @@ def _failure(text: str) -> Diagnostic | None:
     if bad:
         return bad[0]
     if res.document is None:
-        return diag("C305", "the build made no trajectory", _WHERE)
+        return diag(C305, "the build made no trajectory", _WHERE)
     return None
 
 
@@ -342,10 +343,10 @@ def _goal(goal) -> tuple[float, float, float] | None:
     try:
         x, y, z = (float(v) for v in goal)
     except (TypeError, ValueError):
-        raise AouError(diag("I504", f"the goal must be three numbers (x, y, z) [m], found "
+        raise AouError(diag(I504, f"the goal must be three numbers (x, y, z) [m], found "
                             f"{goal!r}", _WHERE)) from None
     if not all(math.isfinite(v) for v in (x, y, z)):
-        raise AouError(diag("I504", f"the goal must be finite, found {goal!r}", _WHERE))
+        raise AouError(diag(I504, f"the goal must be finite, found {goal!r}", _WHERE))
     return x, y, z
 
 
@@ -353,7 +354,7 @@ def _state(state: State | str) -> State:
     try:
         return State(state)
     except ValueError:
-        raise AouError(diag("I504", f"unknown state `{state}`: expected one of "
+        raise AouError(diag(I504, f"unknown state `{state}`: expected one of "
                             f"{', '.join(s.value for s in State)}", _WHERE)) from None
 
 

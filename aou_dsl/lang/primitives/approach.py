@@ -6,6 +6,7 @@ import re
 from dataclasses import dataclass
 from typing import Literal
 
+from ...core.codes import V105, V113
 from ...core.units import Dim
 from ..ir import DEFAULTS, Node
 from ..parse import Word
@@ -51,12 +52,12 @@ def _check_repeat(r, length: float | None) -> None:
     span = word.span if word is not None else r.st.keyword_span
     text = word.text if word is not None else f"x{r.count}"
     if not r.in_sequence:
-        r.error("V113", f"an approach takes no `{text}` in the descriptor form: it runs "
+        r.error(V113, f"an approach takes no `{text}` in the descriptor form: it runs "
                 "once, from start to standoff", span,
                 hint="for an approach in steps, write them in a `sequence { }` block, "
                 "e.g. `approach 0.05m x3`")
     else:
-        r.error("V113", f"an approach without a length runs the rest of the way to the "
+        r.error(V113, f"an approach without a length runs the rest of the way to the "
                 f"standoff: `{text}` would repeat it with nothing left to approach", span,
                 hint="give it a length to approach in steps, e.g. `approach 0.05m x3`")
 
@@ -76,11 +77,11 @@ class ApproachKind(Kind):
         if q is not None:
             length = r.si(q, Dim.LENGTH, "approach length")
             if length is not None and not r.in_sequence:
-                r.error("V113", "an approach length is only allowed in a `sequence { }`; "
+                r.error(V113, "an approach length is only allowed in a `sequence { }`; "
                         "in the descriptor form the approach runs from start to standoff",
                         q.span)
             elif length == 0:
-                r.error("V105", "an approach length must not be zero", q.span)
+                r.error(V105, "an approach length must not be zero", q.span)
             else:  # a move along the line of sight, either way: by its magnitude
                 r.visible(q, length, MIN_RETREAT, "an approach of", "m")
         _check_repeat(r, length)

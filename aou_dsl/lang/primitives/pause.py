@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
+from ...core.codes import V105
 from ...core.units import Dim
 from ..ir import Node
 from ..timeline import Episode, Pose
@@ -33,7 +34,7 @@ class PauseKind(Kind):
         q = r.quantity("a duration")
         d = r.positive(q, r.si(q, Dim.TIME, "pause duration"), "pause duration")
         if q is not None and d is not None and d < MIN_PAUSE:
-            r.error("V105", f"a pause must last at least {MIN_PAUSE}s to be told apart from "
+            r.error(V105, f"a pause must last at least {MIN_PAUSE}s to be told apart from "
                     f"the stop between two episodes, found `{q.text}`", q.span)
         if r.done() and d is not None:
             return Pause(span=r.st.span, duration=d, count=r.count)

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
+from ...core.codes import V105
 from ...core.units import Dim
 from ..ir import DEFAULTS, Node
 from ..timeline import Episode, Pose
@@ -41,7 +42,7 @@ class RetreatKind(Kind):
         if q is not None and not r.in_sequence:
             d = r.positive(q, d, "retreat distance")
         elif q is not None and d == 0:
-            r.error("V105", "a retreat distance must not be zero", q.span)
+            r.error(V105, "a retreat distance must not be zero", q.span)
         r.visible(q, d, MIN_RETREAT, "a retreat of", "m")
         a, v = r.key("a"), r.key("v")
         if r.done() and d is not None:

@@ -6,6 +6,7 @@ import math
 from dataclasses import dataclass
 from typing import Literal
 
+from ...core.codes import V105, V126
 from ...core.units import Dim
 from ..ir import DEFAULTS, Node
 from ..parse import Word
@@ -35,7 +36,7 @@ MIN_SHIVER_F = 1.0
 #: Fewest cycles of a shiver: it fades in over the first and out over the last.
 MIN_CYCLES = 3
 #: The rule of a shiver that lasts longer than its `for` says.
-LENGTHENED = "V126"
+LENGTHENED = V126
 
 
 def shiver_cycles(requested: float, f: float) -> int:
@@ -77,7 +78,7 @@ class ShiverKind(Kind):
         r.visible(q, amp, MIN_ANGLE, "a shiver of", "deg")
         f = r.key("f")
         if f is not None and f < MIN_SHIVER_F:
-            r.error("V105", f"a shiver is a fast tremor of at least {MIN_SHIVER_F:g} Hz, "
+            r.error(V105, f"a shiver is a fast tremor of at least {MIN_SHIVER_F:g} Hz, "
                     f"found `{r.args.keys['f'].value.text}`", r.args.keys["f"].value.span,
                     hint="a slower roll back and forth is a tilt: `tilt 5deg x4` rolls "
                     "5 deg one way, back, and again")

@@ -6,6 +6,7 @@ import math
 from dataclasses import dataclass
 from typing import Literal
 
+from ...core.codes import V105
 from ...core.units import Dim
 from ..ir import DEFAULTS, Node
 from ..timeline import Episode, Pose
@@ -37,7 +38,7 @@ class TiltKind(Kind):
         q = r.quantity("an angle")
         angle = r.amplitude(q, r.si(q, Dim.ANGLE, "tilt angle"), "a tilt angle")
         if q is not None and angle == 0:
-            r.error("V105", "a tilt angle must not be zero", q.span)
+            r.error(V105, "a tilt angle must not be zero", q.span)
         r.visible(q, angle, MIN_ANGLE, "a tilt of", "deg")
         v = r.key("v")
         if r.done() and angle is not None:
