@@ -99,6 +99,39 @@ def _waypoints(ep: Episode, frame: ReachFrame, opts: CompileOptions
     return s, targets
 
 
+def _motion_key(arm: ArmModel, frame: ReachFrame, ep: Episode, q: np.ndarray,
+                options: CompileOptions) -> tuple:
+    """What one motion episode's IK and timing depend on: the arm, the reach, the
+    episode's path and bounds (not its place in the file), where it starts."""
+    return (arm.spec.name, arm.frame_id, frame.goal.tobytes(), frame.R0.tobytes(), ep.kind,
+            ep.start, ep.end, ep.a, ep.vmax, ep.plane, q.tobytes(), options.step_length,
+            options.step_angle, options.package_dirs)
+
+
+def _solved_path(arm, frame, ep, q, options, targets):
+    """IK of an episode's waypoints from ``q``; kept for recompilations (a changed pause
+    or another statement leaves the other episodes' paths as they were)."""
+    return _solved(Keyed(_motion_key(arm, frame, ep, q, options), (arm, targets, q)))
+
+
+@functools.lru_cache(maxsize=256)
+def _solved(probe: Keyed):
+    arm, targets, q = probe.value
+    return solve_path(arm, targets, q)
+
+
+def _timed_path(arm, frame, ep, q, options, s, q_path):
+    """:func:`time_path` of an episode's solved path; kept like :func:`_solved_path`."""
+    key = (*_motion_key(arm, frame, ep, q, options), "timed")
+    return _timed(Keyed(key, (arm, s, q_path, ep)))
+
+
+@functools.lru_cache(maxsize=256)
+def _timed(probe: Keyed):
+    arm, s, q_path, ep = probe.value
+    return time_path(arm, s, q_path, ep.a, ep.vmax, cartesian=KINDS[ep.kind].translation)
+
+
 def _start_configuration(arm: ArmModel, frame: ReachFrame, pose: Pose):
     """IK of the start pose, by continuation from the robot's posture. The same reach
     always starts the same way, so the result is kept for recompilations."""
@@ -227,7 +260,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
             segments.append(seg)
         else:
             s, targets = _waypoints(ep, frame, options)
-            ik = solve_path(arm, targets, q)
+            ik = _solved_path(arm, frame, ep, q, options, targets)
             lap("ik")
             if ik.failure is not None:
                 f = ik.failure
@@ -248,8 +281,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
                                                      max_velocity=v_ok))
                     return res
             else:
-                seg, fail = time_path(arm, s, ik.q, ep.a, ep.vmax,
-                                      cartesian=KINDS[ep.kind].translation)
+                seg, fail = _timed_path(arm, frame, ep, q, options, s, ik.q)
                 if seg is None:
                     reason = fail.reason if fail is not None else "no time law"
                     res.diagnostics.append(diag(C305, f"{ep.kind}: {reason}", ep.span))
