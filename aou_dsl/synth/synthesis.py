@@ -45,6 +45,7 @@ from .writer import render
 
 if TYPE_CHECKING:
     from ..build.builder import BuildResult
+    from ..build.session import Session
 
 __all__ = ["SPANS", "STUDY_INTENSITY", "STUDY_SOURCE", "blend_weights", "compiled", "recipe",
            "study", "synthesize"]
@@ -281,13 +282,19 @@ def _maker(st: State | None, point: tuple[float, float] | None, intensity: float
 _LIMIT_CODES = frozenset({C304, C308, C309, C311})
 
 
-@functools.lru_cache(maxsize=32)
+@functools.cache
+def _session() -> Session:
+    """The warm session synthesis and the live regulator build in: arms loaded once, the
+    last builds kept, a changed text re-solving only the episodes it changed."""
+    from ..build.session import Session
+
+    return Session(keep=32)
+
+
 def compiled(text: str) -> BuildResult:
     """The build of a synthesized text (robot and goal are in it), the checks included, as
     ``aouc compile`` makes it; kept for the texts made last."""
-    from ..build.builder import build_source
-
-    return build_source(text)
+    return _session().build(text)
 
 
 def _failure(text: str) -> Diagnostic | None:
