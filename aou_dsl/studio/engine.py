@@ -1,0 +1,128 @@
+"""The studio's one door to the pipeline: a text compiled for a robot, and measured.
+
+Everything the studio shows comes from an :class:`Engine`: it lints, compiles, checks
+and measures a ``.aou`` text exactly as ``aouc compile`` does (:func:`aou_dsl.build.
+build_source`), or reads and measures a recording, and keeps the last good result, so a
+text that fails leaves the motion before it on screen. It runs in the studio's process,
+so the arms it has loaded stay loaded (the robot models, the PyBullet scene of the
+checks): the first build pays for them, the builds after do not.
+
+The surface is small on purpose (:meth:`Engine.build`, :meth:`Engine.read`,
+:attr:`Engine.last_good`, :meth:`Engine.urdf_path`), so another warm session can stand in
+for it. Builds are serialised: the studio's callbacks run on several threads, the
+pipeline's native libraries want one at a time.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+from ..diagnostics import AouError, Diagnostic, has_errors
+
+if TYPE_CHECKING:
+    from ..cv import CVPoint
+    from ..descriptors import Descriptors
+    from ..ir import Behaviour
+    from ..measuring.descriptors import Measured
+    from ..trajectory import Trajectory
+
+__all__ = ["Engine", "Motion"]
+
+
+@dataclass(frozen=True)
+class Motion:
+    """One build or reading: what the studio shows.
+
+    Attributes:
+        path: the file it came from; text: the ``.aou`` text built ("" for a recording).
+        diagnostics: everything the pipeline said (errors, warnings, notes).
+        trajectory, measured: the motion and its eleven measured descriptors (None when
+            the build failed).
+        declared: the descriptors the file declares; behaviour: its IR (None for a
+            recording or a text that does not lint); cv: the file's C-V point.
+        seconds: how long the build took.
+    """
+
+    path: str
+    text: str
+    diagnostics: tuple[Diagnostic, ...]
+    trajectory: Trajectory | None = None
+    measured: Measured | None = None
+    declared: Descriptors | None = None
+    behaviour: Behaviour | None = None
+    cv: CVPoint | None = None
+    seconds: float = 0.0
+    recorded: bool = field(default=False)
+
+    @property
+    def ok(self) -> bool:
+        return self.trajectory is not None and not has_errors(list(self.diagnostics))
+
+
+class Engine:
+    """Builds for one robot (``robot`` overrides the files' ``robot`` line; None keeps
+    it), remembering the last good :class:`Motion`."""
+
+    def __init__(self, robot: str | None = None) -> None:
+        self.robot = robot
+        self.last_good: Motion | None = None
+        self.last: Motion | None = None
+        self._lock = threading.Lock()
+
+    def build(self, text: str, path: str) -> Motion:
+        """Lint, compile, check and measure ``text`` (named ``path`` in diagnostics).
+        Never raises for a problem of the text: it is in the diagnostics."""
+        from ..build import build_source
+
+        start = time.perf_counter()
+        with self._lock:
+            res = build_source(text, path, robot=self.robot)
+        lint = res.lint
+        motion = Motion(
+            path, text, tuple(res.diagnostics),
+            trajectory=res.compiled.trajectory if res.ok and res.compiled else None,
+            measured=res.measured if res.ok else None, declared=res.declared,
+            behaviour=lint.behaviour, cv=lint.cv, seconds=time.perf_counter() - start)
+        return self._keep(motion)
+
+    def read(self, path: str) -> Motion:
+        """A recording (CSV, JSON, NPZ) read for ``robot`` and measured: its episodes are
+        the measured ones."""
+        from ..api import measure, read_trajectory
+
+        start = time.perf_counter()
+        try:
+            with self._lock:
+                tr = read_trajectory(path, robot=self.robot, goal="final"
+                                     if path.lower().endswith(".csv") else None)
+                m = measure(tr)
+        except AouError as err:
+            return self._keep(Motion(path, "", tuple(err.diagnostics)))
+        episodes = tuple((e.kind, e.t_start + m.t_origin, e.t_end + m.t_origin)
+                         for e in m.episodes)
+        tr = tr.with_(episodes=tr.episodes or episodes)
+        motion = Motion(path, "", tuple(m.diagnostics), trajectory=tr, measured=m,
+                        cv=m.cv, seconds=time.perf_counter() - start, recorded=True)
+        return self._keep(motion)
+
+    def _keep(self, motion: Motion) -> Motion:
+        self.last = motion
+        if motion.ok:
+            self.last_good = motion
+        return motion
+
+    def urdf_path(self, robot: str) -> str:
+        """The URDF of ``robot`` with its visual meshes, its ``package://`` paths resolved
+        as the compiler resolves them (absolute) and the end-effector frame aou adds: the
+        file the checks and ``aouc render`` load.
+
+        Raises:
+            AouError: V109 when a mesh cannot be found.
+        """
+        from ..arms.load import scene_urdf
+
+        with self._lock:
+            return scene_urdf(robot, visuals=True)
