@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import os
 import threading
+import time
 from typing import Any
 
 from ..diagnostics import AouError, Severity
@@ -53,6 +54,7 @@ class Studio:
         self._wake = threading.Condition()
         self._closed = False
         self.server: Any = None
+        self._marked = 0.0  # when the timeline's marker last moved
 
     # --- start and stop -------------------------------------------------------------
 
@@ -71,7 +73,13 @@ class Studio:
                                         label=f"aou studio: {os.path.basename(self.path)}",
                                         verbose=False)
         self.server.scene.set_up_direction("+z")
+        # Plain lights, no shadows nor environment map: a laptop without a GPU (or a
+        # browser rendering WebGL in software) keeps a smooth frame rate.
+        self.server.scene.configure_environment_map(None)
+        self.server.scene.configure_default_lights(True, cast_shadow=False)
+        self.server.scene.add_light_ambient("/ambient", intensity=0.6)
         scene.add_table(self.server)
+        assert first.trajectory is not None
         self.arm = scene.Arm(self.server, self.engine.urdf_path(first.trajectory.robot),
                              "/arm")
         self.ghost: scene.Arm | None = None
@@ -158,7 +166,10 @@ class Studio:
         if self.ghost is not None:
             self.ghost.pose(t)
         m = self.shown
-        if m is not None and m.trajectory is not None:
+        now = time.monotonic()
+        if m is not None and m.trajectory is not None and (
+                now - self._marked > 0.2 or not self.player.playing):  # 5 Hz is enough
+            self._marked = now
             tr = m.trajectory
             self.timeline.content = timeline(tr.episodes, float(tr.t[0]), tr.duration, t)
 
@@ -215,9 +226,9 @@ class Studio:
             with self._wake:
                 while self._pending is None and not self._closed:
                     self._wake.wait()
-                if self._closed:
-                    return
                 values, self._pending = self._pending, None
+            if values is None:  # closed
+                return
             self.set_values(values)
 
     def set_values(self, values: dict[str, float]) -> Motion:

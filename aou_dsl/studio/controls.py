@@ -34,6 +34,8 @@ RANGES: dict[str, tuple[float, float, float]] = {
     "shiver_amplitude": (1.0, 20.0, 0.5),
 }
 _FPS = 30.0
+#: The time slider follows the clock every this many frames.
+_SLIDER_EVERY = 6
 
 
 def slider_range(name: str, value: float) -> tuple[float, float, float]:
@@ -89,7 +91,9 @@ class Player:
 
     def _run(self) -> None:
         last = time.perf_counter()
+        tick = 0
         while not self._stop.wait(1.0 / _FPS):
+            tick += 1
             now = time.perf_counter()
             dt, last = now - last, now
             if not self.playing or self.duration <= 0:
@@ -100,7 +104,8 @@ class Player:
                     self.t = self.t % self.duration if self.loop.value else self.duration
                 t = self.t
             self.on_frame(t)
-            self.time.value = round(t, 2)
+            if tick % _SLIDER_EVERY == 0:  # the page's widgets need not follow every frame
+                self.time.value = round(t, 2)
 
     def close(self) -> None:
         self._stop.set()

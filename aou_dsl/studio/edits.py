@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 from ..declared import source_of, written
 from ..descriptors import REGISTRY
@@ -121,7 +122,7 @@ def _is_count(a) -> bool:
     return isinstance(a, Word) and a.text[:1] == "x" and a.text[1:].isdigit()
 
 
-def _token(st: Statement, field: str) -> Quantity | Word | KeyVal | None:
+def _token(st: Statement, field: str) -> Any:
     """The argument of ``st`` that carries IR ``field``: ``xN`` for the count, ``key=``
     for a key the kind takes, else the first number."""
     kind = KINDS[st.keyword]

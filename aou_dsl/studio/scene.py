@@ -99,7 +99,7 @@ class Arm:
                             for m in mids[:-1]], dtype=np.uint8)
         self.server.scene.add_line_segments(
             f"{self.root}_path", seg, np.repeat(colours[:, None, :], 2, axis=1),
-            line_width=2.0 if self.ghost else 4.0)
+            thickness=2.0 if self.ghost else 4.0, thickness_units="screen")
         if tk.goal is not None and not self.ghost:
             self.server.scene.add_box("/goal", color=(230, 180, 40),
                                       dimensions=(0.05, 0.05, 0.05),
@@ -119,7 +119,7 @@ class Arm:
         seg = np.array([[tk.hand[k], tk.hand[k] + tk.forward[k] * reach]])
         if self._sight is None:
             self._sight = self.server.scene.add_line_segments(
-                f"{self.root}_sight", seg, (40, 40, 40), line_width=1.5)
+                f"{self.root}_sight", seg, (40, 40, 40), thickness=1.5, thickness_units="screen")
         else:
             self._sight.points = seg
 
