@@ -38,8 +38,8 @@ def serve(path: str, *, robot: str | None = None, host: str = "127.0.0.1", port:
     if studio.port != port:
         print(f"aouc: port {port} is taken: serving on {studio.port} (--port chooses)",
               file=sys.stderr)
-    print(f"aouc studio: {studio.url} (Ctrl-C stops)", file=sys.stderr, flush=True)
     try:
+        print(f"aouc studio: {studio.url} (Ctrl-C stops)", file=sys.stderr, flush=True)
         (stop or threading.Event()).wait()
     except KeyboardInterrupt:  # the way to stop it
         print("aouc studio: stopped", file=sys.stderr)

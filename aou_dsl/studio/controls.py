@@ -19,19 +19,14 @@ from ..descriptors import REGISTRY
 
 __all__ = ["RANGES", "Player", "Sliders", "slider_range"]
 
-#: Slider ranges per descriptor, in its unit: (low, high, step).
+#: Slider ranges by the descriptor's unit (counts: ""): (low, high, step).
 RANGES: dict[str, tuple[float, float, float]] = {
-    "approach_acceleration": (0.01, 1.5, 0.01),
-    "pause_count": (0, 10, 1),
-    "pause_duration": (0.2, 5.0, 0.01),
-    "retreat_count": (0, 8, 1),
-    "retreat_distance": (0.005, 0.2, 0.005),
-    "retreat_acceleration": (0.01, 3.0, 0.01),
-    "horizontal_gaze": (1.0, 60.0, 0.5),
-    "vertical_gaze": (1.0, 60.0, 0.5),
-    "tilt_angle": (1.0, 60.0, 0.5),
-    "tilt_velocity": (5.0, 180.0, 1.0),
-    "shiver_amplitude": (1.0, 20.0, 0.5),
+    "": (0, 10, 1),
+    "s": (0.2, 5.0, 0.01),
+    "m": (0.005, 0.2, 0.005),
+    "m/s^2": (0.01, 3.0, 0.01),
+    "deg": (1.0, 60.0, 0.5),
+    "deg/s": (5.0, 180.0, 1.0),
 }
 _FPS = 30.0
 #: The time slider follows the clock every this many frames.
@@ -40,7 +35,7 @@ _SLIDER_EVERY = 6
 
 def slider_range(name: str, value: float) -> tuple[float, float, float]:
     """The range of ``name``'s slider, widened to hold the file's ``value``."""
-    lo, hi, step = RANGES[name]
+    lo, hi, step = RANGES[REGISTRY[name].unit]
     return min(lo, value), max(hi, value), step
 
 
