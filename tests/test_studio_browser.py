@@ -151,7 +151,12 @@ def test_the_canvas_draws_the_arm_and_it_moves(studio_of):
     moved = np.abs(later - start).sum(axis=2) > 30
     assert moved.sum() > 200  # the arm drew somewhere else
     shot = os.environ.get("AOU_STUDIO_SCREENSHOT")
-    if shot:
+    if shot:  # the README's picture: playing, without the browser's own notices
+        for close in page.locator(".mantine-Notification-closeButton").all():
+            close.click()
+        page.get_by_role("button", name="Play").click()
+        wait_for(lambda: studio.player.playing)
+        time.sleep(3)
         page.screenshot(path=shot)
 
 

@@ -209,9 +209,8 @@ class Studio:
         self.diags.content = plots.diagnostics_html(shown, note)
         s = self.shown
         dur = f"{s.trajectory.duration:.2f} s" if s and s.trajectory is not None else "-"
-        state = "built" if m.ok else "**failed**"
-        self.status.content = (f"**{os.path.basename(self.path)}**: {dur} of motion; "
-                               f"last build {state} in {m.seconds:.2f} s")
+        last = f"built in {m.seconds:.2f} s" if m.ok else "**the last build failed**"
+        self.status.content = f"**{os.path.basename(self.path)}**: {dur} of motion; {last}"
 
     # --- shaping ------------------------------------------------------------------
 
