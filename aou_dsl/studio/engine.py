@@ -90,20 +90,22 @@ class Engine:
 
     def read(self, path: str) -> Motion:
         """A recording (CSV, JSON, NPZ) read for ``robot`` and measured: its episodes are
-        the measured ones."""
+        the ones measured (not any the file carries); without a goal, the goal is the
+        hand's last position."""
         from ..api import measure, read_trajectory
 
         start = time.perf_counter()
         try:
             with self._lock:
-                tr = read_trajectory(path, robot=self.robot, goal="final"
-                                     if path.lower().endswith(".csv") else None)
+                tr = read_trajectory(path, robot=self.robot)
+                if tr.goal is None:  # the hand's last position, as `--goal final`
+                    tr = read_trajectory(path, robot=self.robot, goal="final")
                 m = measure(tr)
         except AouError as err:
             return self._keep(Motion(path, "", tuple(err.diagnostics)))
         episodes = tuple((e.kind, e.t_start + m.t_origin, e.t_end + m.t_origin)
                          for e in m.episodes)
-        tr = tr.with_(episodes=tr.episodes or episodes)
+        tr = tr.with_(episodes=episodes)
         motion = Motion(path, "", tuple(m.diagnostics), trajectory=tr, measured=m,
                         cv=m.cv, seconds=time.perf_counter() - start, recorded=True)
         return self._keep(motion)
