@@ -15,10 +15,13 @@ from __future__ import annotations
 import os
 import threading
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..diagnostics import AouError, Severity
 from .engine import Engine, Motion
+
+if TYPE_CHECKING:
+    from ..trajectory import Trajectory
 
 __all__ = ["LOCAL", "Studio"]
 
@@ -55,6 +58,9 @@ class Studio:
         self._closed = False
         self.server: Any = None
         self._marked = 0.0  # when the timeline's marker last moved
+        self.drawn: Trajectory | None = None  # the motion playing
+        self.previewed = 0  # counts the motions played before their checks
+        self._busy = threading.Lock()
 
     # --- start and stop -------------------------------------------------------------
 
@@ -90,7 +96,7 @@ class Studio:
         self.server.initial_camera.position = (1.3, -1.1, 0.9)
         self.server.initial_camera.look_at = (0.3, 0.0, 0.25)
         self.status = self.server.gui.add_markdown("")
-        self.player = Player(self.server, self._frame)
+        self.player = Player(self.server, self._frame, hold=self._busy.locked)
         self.sliders = Sliders(self.server, self._slid)
         self._panels()
         self._show(first)
@@ -165,35 +171,39 @@ class Studio:
         self.arm.pose(t)
         if self.ghost is not None:
             self.ghost.pose(t)
-        m = self.shown
         now = time.monotonic()
-        if m is not None and m.trajectory is not None and (
-                now - self._marked > 0.2 or not self.player.playing):  # 5 Hz is enough
-            self._marked = now
-            tr = m.trajectory
+        tr = self.drawn
+        if tr is not None and (now - self._marked > 0.2 or not self.player.playing):
+            self._marked = now  # 5 Hz is enough for the marker
             self.timeline.content = timeline(tr.episodes, float(tr.t[0]), tr.duration, t)
 
-    def _show(self, m: Motion) -> None:
-        """Put a good motion on screen (and its numbers beside it)."""
+    def _draw(self, tr: Trajectory) -> None:
+        """Play ``tr``: the arm, its path, the timeline and the speed profile."""
         from ..media.plot import profile_data
+        from . import plots
+
+        self.drawn = tr
+        self.arm.show(tr)
+        data = profile_data(tr)
+        self.profile.content = plots.velocity_profile(data.t, data.speed, data.episodes)
+        other = self.other.trajectory if self.other is not None else None
+        self.player.set_duration(max(tr.duration, other.duration if other else 0.0))
+        self._frame(0.0)
+
+    def _show(self, m: Motion, drawn: bool = False) -> None:
+        """Put a good motion on screen (``drawn``: it already plays) with its numbers."""
         from . import plots
         from .edits import settable
 
         assert m.trajectory is not None
         self.shown = m
-        self.arm.show(m.trajectory)
-        data = profile_data(m.trajectory)
-        self.profile.content = plots.velocity_profile(data.t, data.speed, data.episodes)
+        if not drawn:
+            self._draw(m.trajectory)
         measured = m.measured.descriptors if m.measured is not None else None
         self.table.content = plots.descriptor_table(m.declared, measured)
         if m.cv is not None:
             name = m.behaviour.name if m.behaviour is not None else os.path.basename(m.path)
             self.cvmap.content = plots.cv_map(m.cv, name)
-        duration = max(m.trajectory.duration, self.other.trajectory.duration
-                       if self.other is not None and self.other.trajectory is not None
-                       else 0.0)
-        self.player.set_duration(duration)
-        self._frame(0.0)
         if m.behaviour is not None:
             self.sliders.show(settable(m.behaviour))
         self.generation += 1
@@ -242,18 +252,26 @@ class Studio:
             failed = Motion(self.path, "", tuple(err.diagnostics))
             self._say(failed)
             return failed
-        m = self.engine.build(text, self.path)
-        if m.ok:
-            self._show(m)
-        else:
-            self._say(m)
+        with self._busy:
+            tr = self.engine.preview(text, self.path)
+            if tr is not None:  # it plays while the same text is checked and measured
+                self._draw(tr)
+                self.previewed += 1
+            m = self.engine.build(text, self.path)
+            if m.ok and m.trajectory is not None:
+                self._show(m, drawn=tr is not None and _same(tr, m.trajectory))
+            else:
+                if tr is not None and self.shown.trajectory is not None:
+                    self._draw(self.shown.trajectory)  # back to the last good motion
+                self._say(m)
         return m
 
     def save(self) -> str:
         """Write the text of the motion shown into the file (atomic); the path."""
         from ..files import write_atomic
 
-        m = self.shown
+        with self._busy:  # a build under way finishes first: Save writes what it shows
+            m = self.shown
         if m is None or self.recording or m.text == self.file_text:
             return self.path
         write_atomic(self.path, m.text.encode())
@@ -273,9 +291,14 @@ class Studio:
         if text == self.file_text:
             return
         self.file_text = text
-        m = self.engine.build(text, self.path)
+        with self._busy:
+            m = self.engine.build(text, self.path)
         if m.ok:
             self._show(m)
         else:
             self._say(m, "The file on disk does not build; the motion shown is the last "
                       "good one.")
+
+
+def _same(a: Trajectory, b: Trajectory) -> bool:
+    return bool(a.t.shape == b.t.shape and (a.t == b.t).all() and (a.q == b.q).all())

@@ -40,10 +40,13 @@ def slider_range(name: str, value: float) -> tuple[float, float, float]:
 
 
 class Player:
-    """The clock of the motion shown, and its controls in the page."""
+    """The clock of the motion shown, and its controls in the page. While ``hold()`` is
+    true (a build under way) the clock runs but no frame is drawn: the build gets the
+    processor."""
 
-    def __init__(self, server: Any, on_frame: Callable[[float], None]) -> None:
-        self.server, self.on_frame = server, on_frame
+    def __init__(self, server: Any, on_frame: Callable[[float], None],
+                 hold: Callable[[], bool] = lambda: False) -> None:
+        self.server, self.on_frame, self.hold = server, on_frame, hold
         self.duration = 0.0
         self.t = 0.0
         self.playing = True
@@ -92,6 +95,8 @@ class Player:
             now = time.perf_counter()
             dt, last = now - last, now
             if not self.playing or self.duration <= 0:
+                continue
+            if self.hold():  # a new motion is being built: its frames come next
                 continue
             with self._lock:
                 self.t += dt * float(self.speed.value)

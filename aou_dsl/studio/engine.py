@@ -7,10 +7,10 @@ text that fails leaves the motion before it on screen. It runs in the studio's p
 so the arms it has loaded stay loaded (the robot models, the PyBullet scene of the
 checks): the first build pays for them, the builds after do not.
 
-The surface is small on purpose (:meth:`Engine.build`, :meth:`Engine.read`,
-:attr:`Engine.last_good`, :meth:`Engine.urdf_path`), so another warm session can stand in
-for it. Builds are serialised: the studio's callbacks run on several threads, the
-pipeline's native libraries want one at a time.
+The surface is small on purpose (:meth:`Engine.build`, :meth:`Engine.preview`,
+:meth:`Engine.read`, :attr:`Engine.last_good`, :meth:`Engine.urdf_path`), so another warm
+session can stand in for it. Builds are serialised: the studio's callbacks run on several
+threads, the pipeline's native libraries want one at a time.
 """
 
 from __future__ import annotations
@@ -87,6 +87,27 @@ class Engine:
             measured=res.measured if res.ok else None, declared=res.declared,
             behaviour=lint.behaviour, cv=lint.cv, seconds=time.perf_counter() - start)
         return self._keep(motion)
+
+    def preview(self, text: str, path: str) -> Trajectory | None:
+        """The motion ``text`` compiles to, before the safety checks and the measurement
+        (None when it does not compile): the studio plays it while :meth:`build` checks
+        and measures the same text. The compiler is deterministic, so :meth:`build`
+        makes this very motion; only a check it fails can take it off screen."""
+        from ..compiler.pipeline import compile_behaviour
+        from ..linter import lint_source
+
+        with self._lock:
+            lint = lint_source(text, path)
+            b = lint.behaviour
+            if not lint.ok or b is None or lint.timeline is None:
+                return None
+            if self.robot is not None:
+                b = b.replace(settings=b.settings.replace(robot=self.robot))
+            try:
+                res = compile_behaviour(b, timeline=lint.timeline)
+            except AouError:  # an arm that cannot be loaded: build() says why
+                return None
+        return res.trajectory if res.ok else None
 
     def read(self, path: str) -> Motion:
         """A recording (CSV, JSON, NPZ) read for ``robot`` and measured: its episodes are

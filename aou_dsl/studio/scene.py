@@ -89,7 +89,8 @@ class Arm:
         self._sight: Any = None
 
     def show(self, tr: Trajectory) -> None:
-        """Draw ``tr``: its path coloured by episode, the goal, and its first pose."""
+        """Draw ``tr``: its path coloured by episode and the goal (:meth:`pose` poses the
+        arm)."""
         self.track = tk = track(tr, self.actuated)
         step = max(1, len(tk.t) // 600)  # the path as at most 600 segments
         pts = tk.hand[::step]
@@ -104,7 +105,6 @@ class Arm:
             self.server.scene.add_box("/goal", color=(230, 180, 40),
                                       dimensions=(0.05, 0.05, 0.05),
                                       position=tuple(tk.goal))
-        self.pose(0.0)
 
     def pose(self, t: float) -> None:
         """The arm at time ``t`` from the start, with its line of sight."""
