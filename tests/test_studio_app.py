@@ -70,3 +70,22 @@ def test_the_profile_and_timeline_show_every_episode(tmp_path):
         assert f"<title>{kind} " in svg and f"<title>{kind} " in line
     assert svg.count("<rect") == line.count("<rect") == len(tr.episodes)
     assert 'data-now="1.500"' in line
+
+
+def test_a_synthesized_file_gets_an_intensity_slider_that_writes_it_again(tmp_path):
+    from aou_dsl.synth import synthesize
+
+    path = tmp_path / "h.aou"
+    path.write_text(synthesize("hesitant", intensity=0.5, verify=False))
+    studio = Studio(str(path), port=0, watch=False).start()
+    try:
+        values = studio.sliders.values()
+        assert values["intensity"] == 0.5 and "pause_duration" in values
+        m = studio.set_values({**values, "intensity": 0.8})
+        assert m.ok and studio.shown is m
+        assert m.text == synthesize("hesitant", intensity=0.8, robot="panda", verify=False)
+        assert studio.sliders.values()["intensity"] == 0.8
+        studio.save()
+        assert path.read_text() == m.text
+    finally:
+        studio.close()

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from aou_dsl.declared import written
 from aou_dsl.diagnostics import AouError
 from aou_dsl.linter import lint_source
-from aou_dsl.studio.edits import apply, settable
+from aou_dsl.studio.edits import apply, settable, synth_origin
 
 HESITANT = """\
 # a comment that stays
@@ -110,3 +110,13 @@ def test_the_new_text_declares_the_new_values_and_keeps_the_others(pd, pc, rd, r
             assert line_new == line_old  # settings, comments and blank lines stay
         elif "#" in line_old:
             assert line_new.endswith(line_old[line_old.index("#") - 4:])
+
+
+def test_a_file_synth_wrote_for_a_state_says_its_intensity():
+    from aou_dsl.synth import synthesize
+
+    text = synthesize("hesitant", intensity=0.7, verify=False)
+    assert synth_origin(text) == ("hesitant", 0.7)
+    assert synth_origin(HESITANT) is None
+    blend = synthesize(C=-0.5, V=0.2, verify=False)  # a C-V point: no state to redo
+    assert synth_origin(blend) is None

@@ -50,7 +50,8 @@ class Studio:
         self.compare_path = compare
         self.host, self.asked_port = host, port
         self._watch = watch
-        self.file_text = ""
+        self.file_text = ""  # the file's text as on disk
+        self.base_text = ""  # the text the sliders edit (the file's, or re-synthesized)
         self.shown: Motion | None = None
         self.generation = 0  # counts the motions put on screen
         self._pending: dict[str, float] | None = None
@@ -113,7 +114,7 @@ class Studio:
         if self.recording:
             first = self.engine.read(self.path)
         else:
-            self.file_text = read_text(self.path)
+            self.file_text = self.base_text = read_text(self.path)
             first = self.engine.build(self.file_text, self.path)
         if not first.ok or first.trajectory is None:
             raise AouError([d for d in first.diagnostics if d.severity == Severity.ERROR])
@@ -193,7 +194,7 @@ class Studio:
     def _show(self, m: Motion, drawn: bool = False) -> None:
         """Put a good motion on screen (``drawn``: it already plays) with its numbers."""
         from . import plots
-        from .edits import settable
+        from .edits import settable, synth_origin
 
         assert m.trajectory is not None
         self.shown = m
@@ -205,7 +206,8 @@ class Studio:
             name = m.behaviour.name if m.behaviour is not None else os.path.basename(m.path)
             self.cvmap.content = plots.cv_map(m.cv, name)
         if m.behaviour is not None:
-            self.sliders.show(settable(m.behaviour))
+            origin = synth_origin(m.text)
+            self.sliders.show(settable(m.behaviour), origin[1] if origin else None)
         self.generation += 1
         self._say(m)
 
@@ -243,11 +245,18 @@ class Studio:
     def set_values(self, values: dict[str, float]) -> Motion:
         """Build the file's text with ``values`` (descriptor -> value in its unit) and
         show it; a text that fails leaves the last good motion on screen."""
-        from .edits import apply
+        from .controls import INTENSITY
+        from .edits import apply, synth_origin
 
         assert self.shown is not None
+        values = dict(values)
+        intensity = values.pop(INTENSITY, None)
+        origin = synth_origin(self.base_text)
         try:
-            text = apply(self.file_text, values, self.path)
+            if origin is not None and intensity is not None and intensity != origin[1]:
+                text = self._synthesized(origin[0], intensity)
+            else:
+                text = apply(self.base_text, values, self.path)
         except AouError as err:
             failed = Motion(self.path, "", tuple(err.diagnostics))
             self._say(failed)
@@ -259,12 +268,24 @@ class Studio:
                 self.previewed += 1
             m = self.engine.build(text, self.path)
             if m.ok and m.trajectory is not None:
+                if intensity is not None and origin is not None and intensity != origin[1]:
+                    self.base_text = text  # the sliders now shape the new file
                 self._show(m, drawn=tr is not None and _same(tr, m.trajectory))
             else:
                 if tr is not None and self.shown.trajectory is not None:
                     self._draw(self.shown.trajectory)  # back to the last good motion
                 self._say(m)
         return m
+
+    def _synthesized(self, state: str, intensity: float) -> str:
+        """The file ``aouc synth`` writes for ``state`` at ``intensity``, for the same
+        robot and goal (its values fitted to the arm; the build checks them)."""
+        from ..synth import synthesize
+
+        b = self.shown.behaviour if self.shown is not None else None
+        robot = self.engine.robot or (b.settings.robot if b is not None else None)
+        goal = b.settings.goal if b is not None and "goal" in b.settings.spans else None
+        return synthesize(state, intensity=intensity, robot=robot, goal=goal, verify=False)
 
     def save(self) -> str:
         """Write the text of the motion shown into the file (atomic); the path."""
@@ -290,7 +311,7 @@ class Studio:
             return
         if text == self.file_text:
             return
-        self.file_text = text
+        self.file_text = self.base_text = text
         with self._busy:
             m = self.engine.build(text, self.path)
         if m.ok:

@@ -17,7 +17,7 @@ from typing import Any
 
 from ..descriptors import REGISTRY
 
-__all__ = ["RANGES", "Player", "Sliders", "slider_range"]
+__all__ = ["INTENSITY", "RANGES", "Player", "Sliders", "slider_range"]
 
 #: Slider ranges by the descriptor's unit (counts: ""): (low, high, step).
 RANGES: dict[str, tuple[float, float, float]] = {
@@ -33,9 +33,19 @@ _FPS = 30.0
 _SLIDER_EVERY = 6
 
 
+#: The slider of a synthesized file's intensity.
+INTENSITY = "intensity"
+
+
+def _hint(name: str) -> str:
+    if name == INTENSITY:
+        return "write the file again as `aouc synth` would at this intensity"
+    return f"{name} [{REGISTRY[name].unit or 'count'}]"
+
+
 def slider_range(name: str, value: float) -> tuple[float, float, float]:
     """The range of ``name``'s slider, widened to hold the file's ``value``."""
-    lo, hi, step = RANGES[REGISTRY[name].unit]
+    lo, hi, step = (0.0, 1.0, 0.05) if name == INTENSITY else RANGES[REGISTRY[name].unit]
     return min(lo, value), max(hi, value), step
 
 
@@ -121,8 +131,11 @@ class Sliders:
         self.folder = server.gui.add_folder("Shape it")
         self.handles: dict[str, Any] = {}
 
-    def show(self, values: dict[str, float | int]) -> None:
-        """Sliders for ``values`` (made again when the set of descriptors changes)."""
+    def show(self, values: dict[str, float | int], intensity: float | None = None) -> None:
+        """Sliders for ``values`` (made again when the set of descriptors changes), and
+        for the ``intensity`` of a file ``aouc synth`` wrote (None: none)."""
+        if intensity is not None:
+            values = {INTENSITY: intensity, **values}
         fits = all(self.handles[n].min <= v <= self.handles[n].max
                    for n, v in values.items() if n in self.handles)
         if set(values) != set(self.handles) or not fits:
@@ -132,16 +145,17 @@ class Sliders:
             with self.folder:
                 for name, v in values.items():
                     lo, hi, step = slider_range(name, v)
-                    count = REGISTRY[name].is_count
+                    count = name != INTENSITY and REGISTRY[name].is_count
                     h = self.server.gui.add_slider(
                         name, int(lo) if count else lo, int(hi) if count else hi,
                         int(step) if count else step, int(v) if count else float(v),
-                        hint=f"{name} [{REGISTRY[name].unit or 'count'}]")
+                        hint=_hint(name))
                     h.on_update(self._moved)
                     self.handles[name] = h
             return
         for name, v in values.items():
-            self.handles[name].value = int(v) if REGISTRY[name].is_count else float(v)
+            count = name != INTENSITY and REGISTRY[name].is_count
+            self.handles[name].value = int(v) if count else float(v)
 
     def values(self) -> dict[str, float]:
         return {name: h.value for name, h in self.handles.items()}

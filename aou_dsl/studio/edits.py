@@ -14,6 +14,7 @@ descriptors a text sets, :func:`apply` rewrites them.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -26,7 +27,10 @@ from ..linter import lint_source
 from ..parse import KeyVal, Quantity, Statement, Word, parse
 from ..primitives import KINDS
 
-__all__ = ["Edit", "apply", "settable"]
+__all__ = ["Edit", "apply", "settable", "synth_origin"]
+
+#: The first line ``aouc synth`` writes for a state: its state and intensity.
+_SYNTH = re.compile(r"# (\w+) at intensity ([0-9.]+), written by `aouc synth`")
 
 
 @dataclass(frozen=True)
@@ -50,6 +54,15 @@ def settable(b: Behaviour) -> dict[str, float | int]:
         if source_of(b, name) is not None and v is not None:
             out[name] = v
     return out
+
+
+def synth_origin(text: str) -> tuple[str, float] | None:
+    """``(state, intensity)`` of a file ``aouc synth`` wrote for a state (its first
+    line says so), else None: such a file can be written again at another intensity."""
+    found = _SYNTH.match(text)
+    if found is None or "\n# C-V point (" in text:  # a blend: its point is not kept
+        return None
+    return found.group(1), float(found.group(2))
 
 
 def apply(text: str, changes: Mapping[str, float], path: str = "<studio>") -> str:
