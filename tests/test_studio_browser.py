@@ -37,6 +37,8 @@ if CHROMIUM is None:
                 "(apt-get install -y chromium), or set AOU_CHROMIUM to a Chromium binary",
                 allow_module_level=True)
 
+pytestmark = pytest.mark.slow  # a browser rendering WebGL in software: about a minute each
+
 #: Headless, no network chatter, WebGL in software (SwiftShader).
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
         "--disable-background-networking", "--disable-component-update", "--disable-sync",
