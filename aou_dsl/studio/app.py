@@ -105,7 +105,8 @@ class Studio:
         if self._watch and not self.recording:
             from .watch import Watcher
 
-            self.watcher: Watcher | None = Watcher(self.path, self._changed)
+            self.watcher: Watcher | None = Watcher(
+                self.path, lambda: self._guarded(self._changed))
         else:
             self.watcher = None
         return self
@@ -240,7 +241,21 @@ class Studio:
                 values, self._pending = self._pending, None
             if values is None:  # closed
                 return
-            self.set_values(values)
+            self._guarded(self.set_values, values)
+
+    def _guarded(self, work, *args) -> None:
+        """``work(*args)`` on a studio thread: a failure of aou itself is said in the page
+        and on stderr, and the studio goes on with the last good motion."""
+        try:
+            work(*args)
+        except Exception as exc:  # noqa: BLE001 - the thread must live on
+            import sys
+
+            print(f"aouc studio: internal error: {type(exc).__name__}: {exc} (please "
+                  "report it)", file=sys.stderr)
+            self.diags.content = ('<div id="aou-diagnostics"><p>internal error: '
+                                  f"{type(exc).__name__}; the motion shown is the last good "
+                                  "one (see the terminal)</p></div>")
 
     def set_values(self, values: dict[str, float]) -> Motion:
         """Build the file's text with ``values`` (descriptor -> value in its unit) and
