@@ -180,20 +180,17 @@ class Studio:
             self.timeline.content = timeline(tr.episodes, float(tr.t[0]), tr.duration, t)
 
     def _draw(self, tr: Trajectory) -> None:
-        """Play ``tr``: the arm, its path, the timeline and the speed profile."""
-        from ..media.plot import profile_data
-        from . import plots
-
+        """Play ``tr``: the arm, its path and the timeline (the speed profile follows
+        with the numbers)."""
         self.drawn = tr
         self.arm.show(tr)
-        data = profile_data(tr)
-        self.profile.content = plots.velocity_profile(data.t, data.speed, data.episodes)
         other = self.other.trajectory if self.other is not None else None
         self.player.set_duration(max(tr.duration, other.duration if other else 0.0))
         self._frame(0.0)
 
     def _show(self, m: Motion, drawn: bool = False) -> None:
         """Put a good motion on screen (``drawn``: it already plays) with its numbers."""
+        from ..media.plot import profile_data
         from . import plots
         from .edits import settable, synth_origin
 
@@ -201,6 +198,8 @@ class Studio:
         self.shown = m
         if not drawn:
             self._draw(m.trajectory)
+        data = profile_data(m.trajectory)
+        self.profile.content = plots.velocity_profile(data.t, data.speed, data.episodes)
         measured = m.measured.descriptors if m.measured is not None else None
         self.table.content = plots.descriptor_table(m.declared, measured)
         if m.cv is not None:
