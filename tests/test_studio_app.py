@@ -11,10 +11,10 @@ import pytest
 
 pytest.importorskip("viser", reason="the studio extra is missing: pip install '.[studio]'")
 
-from aou_dsl.api import compile as aou_compile  # noqa: E402
-from aou_dsl.api import measure  # noqa: E402
-from aou_dsl.studio import plots  # noqa: E402
-from aou_dsl.studio.app import Studio  # noqa: E402
+from aou_dsl.api import compile as aou_compile
+from aou_dsl.api import measure
+from aou_dsl.studio import plots
+from aou_dsl.studio.app import Studio
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -73,7 +73,7 @@ def test_the_profile_and_timeline_show_every_episode(tmp_path):
 
 
 def test_a_synthesized_file_gets_an_intensity_slider_that_writes_it_again(tmp_path):
-    from aou_dsl.synth import synthesize
+    from aou_dsl.synth.synthesis import synthesize
 
     path = tmp_path / "h.aou"
     path.write_text(synthesize("hesitant", intensity=0.5, verify=False))

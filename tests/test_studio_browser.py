@@ -25,9 +25,9 @@ import pytest
 pytest.importorskip("viser", reason="the studio extra is missing: pip install '.[studio]'")
 pytest.importorskip("playwright", reason="playwright is missing: pip install '.[test]'")
 
-from aou_dsl.api import compile as aou_compile  # noqa: E402
-from aou_dsl.api import lint, measure  # noqa: E402
-from aou_dsl.descriptors import REGISTRY  # noqa: E402
+from aou_dsl.api import compile as aou_compile
+from aou_dsl.api import lint, measure
+from aou_dsl.lang.descriptors import REGISTRY
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CHROMIUM = next((p for p in (os.environ.get("AOU_CHROMIUM"), shutil.which("chromium"),

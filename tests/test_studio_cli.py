@@ -12,7 +12,7 @@ import time
 
 import pytest
 
-from aou_dsl.cli import main
+from aou_dsl.cli.commands import main
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 

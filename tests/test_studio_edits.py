@@ -6,9 +6,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from aou_dsl.declared import written
-from aou_dsl.diagnostics import AouError
-from aou_dsl.linter import lint_source
+from aou_dsl.core.diagnostics import AouError
+from aou_dsl.lang.declared import written
+from aou_dsl.lang.linter import lint_source
 from aou_dsl.studio.edits import apply, settable, synth_origin
 
 HESITANT = """\
@@ -113,7 +113,7 @@ def test_the_new_text_declares_the_new_values_and_keeps_the_others(pd, pc, rd, r
 
 
 def test_a_file_synth_wrote_for_a_state_says_its_intensity():
-    from aou_dsl.synth import synthesize
+    from aou_dsl.synth.synthesis import synthesize
 
     text = synthesize("hesitant", intensity=0.7, verify=False)
     assert synth_origin(text) == ("hesitant", 0.7)

@@ -17,11 +17,11 @@ import threading
 import time
 from typing import TYPE_CHECKING, Any
 
-from ..diagnostics import AouError, Severity
+from ..core.diagnostics import AouError, Severity
 from .engine import Engine, Motion
 
 if TYPE_CHECKING:
-    from ..trajectory import Trajectory
+    from ..core.trajectory import Trajectory
 
 __all__ = ["LOCAL", "Studio"]
 
@@ -68,7 +68,7 @@ class Studio:
     def start(self) -> Studio:
         """Build the file, start serving, draw. Raises AouError when the first build of
         the file fails (there is nothing to show) or a robot cannot be drawn."""
-        from ..files import read_text
+        from ..core.files import read_text
 
         first = self._first_motion(read_text)
         import viser
@@ -122,7 +122,7 @@ class Studio:
         return first
 
     def _compare(self, scene) -> None:
-        from ..files import read_text
+        from ..core.files import read_text
 
         assert self.compare_path is not None
         other = Engine(self.engine.robot).build(read_text(self.compare_path),
@@ -294,7 +294,7 @@ class Studio:
     def _synthesized(self, state: str, intensity: float) -> str:
         """The file ``aouc synth`` writes for ``state`` at ``intensity``, for the same
         robot and goal (its values fitted to the arm; the build checks them)."""
-        from ..synth import synthesize
+        from ..synth.synthesis import synthesize
 
         b = self.shown.behaviour if self.shown is not None else None
         robot = self.engine.robot or (b.settings.robot if b is not None else None)
@@ -303,7 +303,7 @@ class Studio:
 
     def save(self) -> str:
         """Write the text of the motion shown into the file (atomic); the path."""
-        from ..files import write_atomic
+        from ..core.files import write_atomic
 
         with self._busy:  # a build under way finishes first: Save writes what it shows
             m = self.shown
@@ -316,7 +316,7 @@ class Studio:
 
     def _changed(self) -> None:
         """The file changed on disk: it is the truth, build it (unsaved values go)."""
-        from ..files import read_text
+        from ..core.files import read_text
 
         try:
             text = read_text(self.path)

@@ -15,7 +15,7 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from ..descriptors import REGISTRY
+from ..lang.descriptors import REGISTRY
 
 __all__ = ["INTENSITY", "RANGES", "Player", "Sliders", "slider_range"]
 

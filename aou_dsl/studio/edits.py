@@ -19,13 +19,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from ..declared import source_of, written
-from ..descriptors import REGISTRY
-from ..diagnostics import AouError, Span, diag
-from ..ir import Behaviour
-from ..linter import lint_source
-from ..parse import KeyVal, Quantity, Statement, Word, parse
-from ..primitives import KINDS
+from ..core.diagnostics import AouError, Span, diag
+from ..lang.declared import source_of, written
+from ..lang.descriptors import REGISTRY
+from ..lang.ir import Behaviour
+from ..lang.linter import lint_source
+from ..lang.parse import KeyVal, Quantity, Statement, Word, parse
+from ..lang.primitives import KINDS
 
 __all__ = ["Edit", "apply", "settable", "synth_origin"]
 

@@ -1,7 +1,7 @@
 """The studio's one door to the pipeline: a text compiled for a robot, and measured.
 
 Everything the studio shows comes from an :class:`Engine`: it lints, compiles, checks
-and measures a ``.aou`` text exactly as ``aouc compile`` does (:func:`aou_dsl.build.
+and measures a ``.aou`` text exactly as ``aouc compile`` does (:func:`aou_dsl.build.builder.
 build_source`), or reads and measures a recording, and keeps the last good result, so a
 text that fails leaves the motion before it on screen. It runs in the studio's process,
 so the arms it has loaded stay loaded (the robot models, the PyBullet scene of the
@@ -20,14 +20,14 @@ import time
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from ..diagnostics import AouError, Diagnostic, has_errors
+from ..core.diagnostics import AouError, Diagnostic, has_errors
 
 if TYPE_CHECKING:
-    from ..cv import CVPoint
-    from ..descriptors import Descriptors
-    from ..ir import Behaviour
-    from ..measuring.descriptors import Measured
-    from ..trajectory import Trajectory
+    from ..core.trajectory import Trajectory
+    from ..lang.cv import CVPoint
+    from ..lang.descriptors import Descriptors
+    from ..lang.ir import Behaviour
+    from ..measuring.measured import Measured
 
 __all__ = ["Engine", "Motion"]
 
@@ -75,7 +75,7 @@ class Engine:
     def build(self, text: str, path: str) -> Motion:
         """Lint, compile, check and measure ``text`` (named ``path`` in diagnostics).
         Never raises for a problem of the text: it is in the diagnostics."""
-        from ..build import build_source
+        from ..build.builder import build_source
 
         start = time.perf_counter()
         with self._lock:
@@ -94,7 +94,7 @@ class Engine:
         and measures the same text. The compiler is deterministic, so :meth:`build`
         makes this very motion; only a check it fails can take it off screen."""
         from ..compiler.pipeline import compile_behaviour
-        from ..linter import lint_source
+        from ..lang.linter import lint_source
 
         with self._lock:
             lint = lint_source(text, path)
@@ -145,7 +145,7 @@ class Engine:
         Raises:
             AouError: V109 when a mesh cannot be found.
         """
-        from ..arms.load import scene_urdf
+        from ..robot.load import scene_urdf
 
         with self._lock:
             return scene_urdf(robot, visuals=True)

@@ -17,9 +17,9 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from ..cv import CANONICAL, CVPoint
-from ..descriptors import REGISTRY, Descriptors
-from ..diagnostics import Diagnostic
+from ..core.diagnostics import Diagnostic
+from ..lang.cv import CANONICAL, CVPoint
+from ..lang.descriptors import REGISTRY, Descriptors
 from .scene import EPISODE_COLOURS
 
 __all__ = ["cv_map", "descriptor_table", "diagnostics_html", "timeline", "velocity_profile"]

@@ -4,7 +4,7 @@ coloured by episode and its line of sight; a second arm, ghosted, to compare.
 The arm is drawn from the URDF the safety checks and ``aouc render`` load (meshes found
 as the compiler finds them, :meth:`.engine.Engine.urdf_path`), through yourdfpy and
 viser's URDF helper. The hand's pose comes from aou's own forward kinematics
-(:func:`aou_dsl.measuring.fk.batch_fk`), so the path drawn is the path measured.
+(:func:`aou_dsl.robot.batch_fk.batch_fk`), so the path drawn is the path measured.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from ..trajectory import Trajectory
+from ..core.trajectory import Trajectory
 
 __all__ = ["EPISODE_COLOURS", "Arm", "Track", "track"]
 
@@ -51,8 +51,8 @@ class Track:
 def track(tr: Trajectory, actuated: tuple[str, ...]) -> Track:
     """``tr`` for drawing; ``actuated`` are the URDF's joints (those ``tr`` lacks, like
     fingers, stay at zero)."""
-    from ..kinematics import load_arm
-    from ..measuring.fk import batch_fk
+    from ..robot.batch_fk import batch_fk
+    from ..robot.load import load_arm
 
     arm = load_arm(tr.robot, tr.ee_frame)
     q = np.asarray(tr.q, float)
