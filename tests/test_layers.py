@@ -67,7 +67,8 @@ def _targets(module: str, path: Path) -> set[str]:
                 continue
             names = [f"{target}.{a.name}".lstrip(".") for a in node.names]
             found.update(n for n in names if n in MODULES)
-            found.add(target)
+            if not all(n in MODULES for n in names):  # names of the module itself
+                found.add(target)
         elif isinstance(node, ast.Import):
             for a in node.names:
                 if (a.name + ".").startswith("aou_dsl."):

@@ -276,6 +276,16 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     syn.add_argument("-o", "--output", metavar="FILE.aou",
                      help="output file (default: standard output)")
     _force(syn)
+    c["studio"] = stu = sub.add_parser(
+        "studio", help="see a behaviour in 3D in the browser and shape it live (`studio` extra)")
+    stu.add_argument("path", metavar="FILE", help="a .aou file, or a recording with --robot")
+    stu.add_argument("--port", type=int_in(1, 65535), default=8080, metavar="P",
+                     help="port to serve on (default 8080; the next free one when taken)")
+    stu.add_argument("--host", default="127.0.0.1", metavar="H",
+                     help="address to bind (default 127.0.0.1: this machine only)")
+    stu.add_argument("--compare", metavar="OTHER.aou",
+                     help="show a second behaviour, ghosted, on the same clock")
+    _robot(stu)
     c["rules"] = rules = sub.add_parser("rules", help="list the diagnostic codes, or explain some")
     rules.add_argument("codes", nargs="*", metavar="CODE")
     rules.add_argument("--format", choices=("text", "json"), default="text")

@@ -353,11 +353,18 @@ def _cmd_variants(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _cmd_studio(args: argparse.Namespace) -> int:
+    from ..studio import serve
+
+    return serve(args.path, robot=args.robot, host=args.host, port=args.port,
+                 compare=args.compare, package_dirs=_package_dirs(args))
+
+
 _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "lint": _cmd_lint, "rules": _cmd_rules, "explain": _cmd_explain,
     "compile": _cmd_compile, "check": _cmd_check, "measure": _cmd_measure,
     "plot": _cmd_plot, "render": _cmd_render, "variants": _cmd_variants,
-    "robot": cmd_robot, "synth": cmd_synth,
+    "robot": cmd_robot, "synth": cmd_synth, "studio": _cmd_studio,
 }
 
 
@@ -378,6 +385,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.command in ("plot", "render", "variants") and exc.name:
             print(f"aouc: this command needs the media extra ({exc.name} is missing): "
                   "pip install '.[media]' in aou's folder (the one with pyproject.toml)",
+                  file=sys.stderr)
+            return EXIT_USAGE
+        if args.command == "studio" and exc.name:
+            print(f"aouc: this command needs the studio extra ({exc.name} is missing): "
+                  "pip install '.[studio]' in aou's folder (the one with pyproject.toml)",
                   file=sys.stderr)
             return EXIT_USAGE
         return _internal(exc, args.debug)

@@ -1,0 +1,50 @@
+"""``aouc studio``: see a behaviour in 3D in the browser, its numbers beside it, and
+shape it live (the ``studio`` extra: viser, yourdfpy, watchfiles).
+
+- :mod:`.engine`: the one door to the pipeline (build, measure, keep the last good);
+- :mod:`.app`: the wiring; :mod:`.scene`: the 3D scene; :mod:`.controls`: the player
+  and the sliders; :mod:`.plots`: the numbers; :mod:`.edits`: Save's rewrite of the
+  text; :mod:`.watch`: reloading when the file changes on disk.
+
+docs/studio.md says how to use it.
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+
+__all__ = ["serve"]
+
+
+def serve(path: str, *, robot: str | None = None, host: str = "127.0.0.1", port: int = 8080,
+          compare: str | None = None, stop: threading.Event | None = None,
+          package_dirs: tuple[str, ...] = ()) -> int:
+    """Run the studio of ``path`` until interrupted (or ``stop`` is set); the exit status.
+
+    Raises:
+        AouError: the file (or ``compare``) does not build, or the robot cannot be drawn.
+        ImportError: the ``studio`` extra is not installed.
+    """
+    import viser  # noqa: F401 - the extra, before any work
+    import watchfiles  # noqa: F401
+    import yourdfpy  # noqa: F401
+
+    from .app import LOCAL, Studio
+
+    if host not in (LOCAL, "localhost"):
+        print(f"aouc: warning: the studio binds {host}: anyone who can reach this machine "
+              "can see the page and save into the file", file=sys.stderr)
+    studio = Studio(path, robot=robot, host=host, port=port, compare=compare,
+                    package_dirs=package_dirs).start()
+    if studio.port != port:
+        print(f"aouc: port {port} is taken: serving on {studio.port} (--port chooses)",
+              file=sys.stderr)
+    try:
+        print(f"aouc studio: {studio.url} (Ctrl-C stops)", file=sys.stderr, flush=True)
+        (stop or threading.Event()).wait()
+    except KeyboardInterrupt:  # the way to stop it
+        print("aouc studio: stopped", file=sys.stderr)
+    finally:
+        studio.close()
+    return 0

@@ -1,0 +1,232 @@
+"""The studio in a real browser: headless Chromium driven by Playwright.
+
+Each test starts a studio in this process on a copy of a behaviour, opens its page and
+works it as a user would (the sliders' number boxes, the Save button, an edit of the file
+on disk); what the page shows is then checked against aou's own measurement of the
+motion the studio holds.
+
+The system's Chromium is used (Debian's ``chromium`` package: Playwright's own browser
+download is not needed). Where none is found the tests are skipped, saying how to
+install it. ``AOU_STUDIO_SCREENSHOT=docs/img/studio.png`` also saves the page as the
+README shows it.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import shutil
+import tempfile
+import time
+
+import numpy as np
+import pytest
+
+pytest.importorskip("viser", reason="the studio extra is missing: pip install '.[studio]'")
+pytest.importorskip("playwright", reason="playwright is missing: pip install '.[test]'")
+
+from aou_dsl.api import compile as aou_compile
+from aou_dsl.api import lint, measure
+from aou_dsl.lang.descriptors import REGISTRY
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+CHROMIUM = next((p for p in (os.environ.get("AOU_CHROMIUM"), shutil.which("chromium"),
+                             "/usr/bin/chromium") if p and os.path.exists(p)), None)
+if CHROMIUM is None:
+    pytest.skip("no Chromium found for the studio's browser tests: install Debian's "
+                "(apt-get install -y chromium), or set AOU_CHROMIUM to a Chromium binary",
+                allow_module_level=True)
+
+pytestmark = pytest.mark.slow  # a browser rendering WebGL in software: about a minute each
+
+#: Headless, no network chatter, WebGL in software (SwiftShader).
+ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+        "--disable-background-networking", "--disable-component-update", "--disable-sync",
+        "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+
+
+@pytest.fixture(scope="module")
+def browser():
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as pw, tempfile.TemporaryDirectory() as profile:
+        ctx = pw.chromium.launch_persistent_context(
+            profile, executable_path=CHROMIUM, args=ARGS, headless=True,
+            viewport={"width": 1280, "height": 800})
+        yield ctx
+        ctx.close()
+
+
+@pytest.fixture
+def studio_of(tmp_path, browser):
+    """``studio_of(name)``: a studio of a copy of ``behaviours/name.aou`` and its page."""
+    from aou_dsl.studio.app import Studio
+
+    made = []
+
+    def start(name: str):
+        path = tmp_path / f"{name}.aou"
+        shutil.copy(os.path.join(ROOT, "behaviours", f"{name}.aou"), path)
+        studio = Studio(str(path), port=0).start()
+        made.append(studio)
+        page = browser.new_page()
+        page.goto(studio.url)
+        page.locator("canvas").first.wait_for(timeout=60_000)
+        page.locator("#aou-descriptors").wait_for(timeout=60_000)
+        return studio, page, path
+
+    yield start
+    for s in made:
+        s.close()
+
+
+def wait_for(what, timeout: float = 60.0, every: float = 0.1):
+    """Poll ``what()`` until it is truthy; its value (the test fails on timeout)."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        got = what()
+        if got:
+            return got
+        time.sleep(every)
+    raise AssertionError("timed out waiting for the page")
+
+
+def scene_canvas(page):
+    """The 3D view's canvas: the largest on the page (some are off-screen helpers)."""
+    sizes = page.locator("canvas").evaluate_all("cs => cs.map(c => c.width * c.height)")
+    return page.locator("canvas").nth(int(np.argmax(sizes)))
+
+
+def canvas(page) -> np.ndarray:
+    from PIL import Image
+
+    box = scene_canvas(page).bounding_box()
+    png = page.screenshot(clip=box, animations="disabled")
+    return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), dtype=float)
+
+
+def settled(page) -> np.ndarray:
+    """The canvas once two screenshots in a row agree (WebGL in software is slow)."""
+    last = canvas(page)
+    for _ in range(20):
+        time.sleep(0.3)
+        now = canvas(page)
+        if np.abs(now - last).max() == 0:
+            return now
+        last = now
+    return last
+
+
+def number_box(page, label: str):
+    """The number box beside the slider labelled ``label``."""
+    slider = page.locator("label", has_text=label).first.get_attribute("for")
+    return page.locator(f'div:has(> [id="{slider}"]) input:not([type=hidden])').first
+
+
+def type_value(page, label: str, value: str) -> None:
+    box = number_box(page, label)
+    box.click()
+    box.fill(value)
+    box.press("Enter")
+
+
+def measured_in_page(page, name: str) -> float | None:
+    cell = page.locator(f'#aou-descriptors tr[data-descriptor="{name}"] td[data-measured]')
+    if cell.count() == 0:
+        return None
+    return float(cell.first.get_attribute("data-measured"))
+
+
+def test_the_canvas_draws_the_arm_and_it_moves(studio_of):
+    studio, page, _ = studio_of("hesitant")
+    page.get_by_role("button", name="Pause").click()
+    wait_for(lambda: not studio.player.playing)
+    studio.player.seek(0.0)
+    start = settled(page)
+    kind, a, b = studio.shown.trajectory.episodes[0]
+    assert kind == "approach"
+    studio.player.seek(b - studio.shown.trajectory.t[0])  # the end of the first approach
+    later = settled(page)
+    background = start[0, 0]
+    drawn = np.abs(start - background).sum(axis=2) > 30
+    assert drawn.mean() > 0.01  # the arm, the table and the path: not a blank canvas
+    moved = np.abs(later - start).sum(axis=2) > 30
+    assert moved.sum() > 200  # the arm drew somewhere else
+    shot = os.environ.get("AOU_STUDIO_SCREENSHOT")
+    if shot:  # the README's picture: playing, without the browser's own notices
+        for close in page.locator(".mantine-Notification-closeButton").all():
+            close.click()
+        page.get_by_role("button", name="Play").click()
+        wait_for(lambda: studio.player.playing)
+        time.sleep(3)
+        page.screenshot(path=shot)
+
+
+def test_a_slider_rebuilds_and_the_motion_measures_the_new_value(studio_of):
+    studio, page, path = studio_of("hesitant")
+    before = path.read_text()
+    first = studio.generation
+    type_value(page, "pause_duration", "2.2")
+    wait_for(lambda: studio.generation > first and "2.2s" in studio.shown.text)
+    m = measure(studio.shown.trajectory)
+    assert REGISTRY["pause_duration"].matches(2.2, m.descriptors["pause_duration"])
+    assert m.descriptors["pause_count"] == 5  # the others as the file has them
+    shown = wait_for(lambda: (v := measured_in_page(page, "pause_duration")) and
+                     abs(v - 2.2) < 0.05 and v)
+    assert shown == pytest.approx(m.descriptors["pause_duration"], abs=1e-6)
+    assert path.read_text() == before  # nothing written before Save
+
+
+def test_a_value_the_arm_cannot_give_shows_its_diagnostic(studio_of):
+    studio, page, path = studio_of("fearful")
+    good = studio.shown
+    type_value(page, "shiver_amplitude", "20")
+    item = page.locator('#aou-diagnostics li[data-code="C308"]')
+    item.wait_for(timeout=60_000)
+    assert "shiver" in item.inner_text() and "hint:" in item.inner_text()
+    assert studio.shown is good  # the last good motion stays on screen
+    assert measured_in_page(page, "shiver_amplitude") == pytest.approx(
+        good.measured.descriptors["shiver_amplitude"])
+
+
+def test_save_writes_a_file_that_lints_clean_and_compiles_to_the_motion_shown(studio_of):
+    studio, page, path = studio_of("hesitant")
+    before = path.read_text()
+    first = studio.generation
+    type_value(page, "retreat_distance", "0.08")
+    wait_for(lambda: studio.generation > first and "0.08m" in studio.shown.text)
+    page.get_by_role("button", name="Save").click()
+    wait_for(lambda: path.read_text() != before)
+    saved = path.read_text()
+    assert saved == studio.shown.text
+    assert saved.splitlines()[:2] == before.splitlines()[:2]  # the comments stay
+    assert [ln for ln in saved.splitlines() if not ln.startswith("retreat")] == \
+        [ln for ln in before.splitlines() if not ln.startswith("retreat")]
+    result = lint(str(path))
+    assert result.ok and not [d for d in result.diagnostics if d.severity != "note"]
+    build = aou_compile(str(path))
+    assert build.ok
+    shown = studio.shown.trajectory
+    assert np.array_equal(build.trajectory.t, shown.t)
+    assert np.array_equal(build.trajectory.q, shown.q)
+    assert REGISTRY["retreat_distance"].matches(
+        0.08, build.measured.descriptors["retreat_distance"])
+    assert not [p for p in os.listdir(path.parent) if p != path.name]  # nothing else
+
+
+def test_editing_the_file_on_disk_reloads_the_motion(studio_of):
+    studio, page, path = studio_of("hesitant")
+    first = studio.generation
+    text = path.read_text().replace("pause 1.67s x5", "pause 1.2s x5")
+    path.write_text(text)  # as an editor saves it
+    wait_for(lambda: studio.generation > first and studio.shown.text == text)
+    m = measure(studio.shown.trajectory)
+    assert REGISTRY["pause_duration"].matches(1.2, m.descriptors["pause_duration"])
+    wait_for(lambda: (v := measured_in_page(page, "pause_duration")) is not None
+             and abs(v - m.descriptors["pause_duration"]) < 1e-6)
+    thumb = page.locator(f'[id="{page.locator("label", has_text="pause_duration").first.get_attribute("for")}"] [role="slider"]')  # noqa: E501
+    wait_for(lambda: thumb.get_attribute("aria-valuenow") == "1.2")
+    bad = text.replace("pause 1.2s x5", "pause 1.2s x3")  # too few pauses for 3 retreats
+    path.write_text(bad)
+    page.locator('#aou-diagnostics li[data-code="V121"]').wait_for(timeout=60_000)
+    assert studio.shown.text == text  # the last good motion stays on screen
