@@ -15,6 +15,8 @@ from collections.abc import Callable, Sequence
 from .cli_args import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, build_parser
 from .cli_tools import cmd_robot, cmd_synth
 from .diagnostics import RULES, AouError, Diagnostic, Severity, Span
+from .editor import cmd_server
+from .fmt import cmd_fmt
 from .report import format_github, format_json, format_suppressed, format_text
 
 __all__ = ["EXIT_ERRORS", "EXIT_OK", "EXIT_USAGE", "main"]
@@ -302,6 +304,7 @@ _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "compile": _cmd_compile, "check": _cmd_check, "measure": _cmd_measure,
     "plot": _cmd_plot, "render": _cmd_render, "variants": _cmd_variants,
     "robot": cmd_robot, "synth": cmd_synth,
+    "fmt": cmd_fmt, "server": cmd_server,
 }
 
 

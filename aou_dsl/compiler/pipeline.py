@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..diagnostics import AouError, Diagnostic, diag, has_errors
+from ..diagnostics import AouError, Diagnostic, Fix, diag, has_errors
 from ..ir import Behaviour
 from ..kinematics import ArmModel, load_arm
 from ..layout import layout
@@ -168,7 +168,8 @@ def _too_fast(code: str, fail: TimingFailure, ep: Episode, edit: str | None,
     """C308 or C309: the limit a shiver or a tilt exceeds; the hint is the edit that
     fits (the value the message gives), when there is one."""
     return diag(code, fail.reason, ep.span, hint=f"write `{edit}`" if edit else None,
-                joint=fail.joint, limit=fail.limit, **fields)
+                joint=fail.joint, limit=fail.limit, **fields,
+                fix=Fix(ep.span, edit, edit.split("=")[0]) if edit else None)
 
 
 def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),

@@ -1,0 +1,83 @@
+"""Compile diagnostics off the typing path.
+
+A compile takes a tenth of a second to a few seconds, so it runs in one worker thread
+(the robot models stay loaded there, in this process). Each document has a generation
+that every edit raises: a compile asked for an older generation is skipped if it has
+not started, and its result dropped if it has; only the newest text's diagnostics are
+ever published.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import traceback
+from collections.abc import Callable
+from concurrent.futures import Future, ThreadPoolExecutor
+
+from . import engine
+from .state import Document
+
+__all__ = ["Compiles"]
+
+
+class Compiles:
+    """Schedules :func:`engine.build` for documents; ``done`` is called on the event
+    loop with each fresh result."""
+
+    def __init__(self, done: Callable[[Document], None], log: Callable[[str], None]):
+        self._done = done
+        self._log = log
+        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="aou-compile")
+        self._timers: dict[str, asyncio.TimerHandle] = {}
+
+    def request(self, doc: Document, delay: float, robot: str | None) -> None:
+        """Compile ``doc`` as it is now, after ``delay`` seconds without a newer edit."""
+        loop = asyncio.get_running_loop()
+        timer = self._timers.pop(doc.uri, None)
+        if timer is not None:
+            timer.cancel()
+        gen = doc.generation
+        if delay <= 0:
+            self._start(loop, doc, gen, robot)
+        else:
+            self._timers[doc.uri] = loop.call_later(delay, self._start, loop, doc, gen, robot)
+
+    def _start(self, loop: asyncio.AbstractEventLoop, doc: Document, gen: int,
+               robot: str | None) -> None:
+        self._timers.pop(doc.uri, None)
+        if doc.generation != gen or doc.closed:
+            return
+        text, path = doc.text, doc.path
+
+        def job() -> engine.Built | None:
+            if doc.generation != gen or doc.closed:  # superseded while queued
+                return None
+            return engine.build(text, path, robot)
+
+        fut = self._pool.submit(job)
+        fut.add_done_callback(lambda f: self._back(loop, doc, gen, f))
+
+    def _back(self, loop: asyncio.AbstractEventLoop, doc: Document, gen: int,
+              fut: Future) -> None:
+        """From the worker thread: hand the result to the event loop (gone at exit)."""
+        if fut.cancelled() or loop.is_closed():
+            return
+        try:
+            loop.call_soon_threadsafe(self._finish, doc, gen, fut)
+        except RuntimeError:  # the loop closed in between: the server is exiting
+            pass
+
+    def _finish(self, doc: Document, gen: int, fut: Future) -> None:
+        try:
+            built = fut.result()
+        except Exception:  # noqa: BLE001 - a failed compile must not stop the server
+            self._log("aouc server: the compile failed: " + traceback.format_exc())
+            return
+        if built is None or doc.generation != gen or doc.closed:
+            return
+        doc.built = built
+        doc.built_generation = gen
+        self._done(doc)
+
+    def shutdown(self) -> None:
+        self._pool.shutdown(wait=False, cancel_futures=True)

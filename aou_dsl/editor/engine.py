@@ -1,0 +1,118 @@
+"""The language server's one door into the pipeline.
+
+Everything the editor knows of a file comes through these functions; nothing else in
+:mod:`aou_dsl.editor` imports the pipeline's stages. Each takes the document's text and
+its path (for relative robot files and the diagnostics' spans):
+
+- :func:`lint`: parse, validate, lay out and judge on the C-V model, as ``aouc lint``;
+  pure Python, fast enough to run on every keystroke;
+- :func:`build`: compile, check and measure, as ``aouc compile``, for the compile
+  diagnostics (C-codes) and the compiled episodes; the robot models stay loaded in the
+  process between calls (:func:`aou_dsl.kinematics.load_arm` is cached per process);
+- :func:`syntax`: the syntax tree, or None while the file does not parse;
+- :func:`format_text`: ``aouc fmt``'s output, or None on a syntax error;
+- :func:`rule`: a diagnostic code's registry entry.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+from ..diagnostics import RULES, AouError, Diagnostic, Rule
+
+if TYPE_CHECKING:
+    from ..linter import FileResult
+    from ..parse import SyntaxTree
+    from ..timeline import Episode
+
+__all__ = ["Built", "Shown", "build", "format_text", "lint", "rule", "syntax"]
+
+
+@dataclass(frozen=True)
+class Shown:
+    """One compiled episode as the arm moves it: times [s] and peaks of the
+    end-effector's translational speed [m/s] and acceleration [m/s^2]."""
+
+    episode: Episode
+    t_start: float
+    duration: float
+    peak_speed: float
+    peak_acceleration: float
+
+
+@dataclass
+class Built:
+    """What :func:`build` found: the build's diagnostics and, when it compiled, each
+    episode as compiled (in timeline order)."""
+
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+    episodes: list[Shown] = field(default_factory=list)
+
+
+def lint(text: str, path: str) -> FileResult:
+    """``aouc lint`` of the text: diagnostics, behaviour, timeline and C-V point."""
+    from ..linter import lint_source
+
+    return lint_source(text, path)
+
+
+def syntax(text: str, path: str) -> SyntaxTree | None:
+    from ..parse import parse
+
+    try:
+        return parse(text.removeprefix("\ufeff"), path)
+    except AouError:
+        return None
+
+
+def format_text(text: str, path: str) -> str | None:
+    from ..fmt import format_source
+
+    try:
+        return format_source(text, path)
+    except AouError:
+        return None
+
+
+def rule(code: str) -> Rule | None:
+    return RULES.get(code.upper())
+
+
+def build(text: str, path: str, robot: str | None = None) -> Built:
+    """``aouc compile`` of the text on ``robot`` (None: the file's own, else panda),
+    with the safety checks; nothing is written. Raises nothing for a bad file: what
+    went wrong is in the diagnostics."""
+    from ..build import build_source
+
+    res = build_source(text, path, robot=robot)
+    out = Built(list(res.diagnostics))
+    compiled = res.compiled
+    tr = compiled.trajectory if compiled is not None else None
+    if compiled is None or tr is None or compiled.timeline is None:
+        return out
+    out.episodes = _shown(compiled.timeline.episodes, tr)
+    return out
+
+
+def _shown(episodes: tuple[Episode, ...], tr) -> list[Shown]:
+    import numpy as np
+
+    from ..kinematics import load_arm
+
+    arm = load_arm(tr.robot, tr.ee_frame)
+    pos, _ = arm.fk(tr.q)  # compiled trajectories hold exactly the arm's joints
+    t = tr.t
+    if len(t) > 2:
+        vel = np.gradient(pos, t, axis=0)
+        speed = np.linalg.norm(vel, axis=1)
+        acc = np.linalg.norm(np.gradient(vel, t, axis=0), axis=1)
+    else:
+        speed = acc = np.zeros(len(t))
+    out = []
+    for ep, (_, t0, t1) in zip(episodes, tr.episodes, strict=False):
+        win = (t > t0) & (t < t1)
+        out.append(Shown(ep, float(t0), float(t1 - t0),
+                         float(speed[win].max()) if win.any() else 0.0,
+                         float(acc[win].max()) if win.any() else 0.0))
+    return out
