@@ -32,6 +32,7 @@ from .parse import parse
 __all__ = ["FormatResult", "cmd_fmt", "format_file", "format_source", "tokens"]
 
 INDENT = "  "
+_GLUE = "\x00"  # marks a token written with no blank after a word or number
 
 #: The tokens of the grammar (grammar/aou.lark), and the blanks between them.
 _TOKEN = re.compile(r"""
@@ -65,11 +66,14 @@ def tokens(text: str) -> list[tuple[str, str]]:
 
 
 def _statement_text(parts: list[str]) -> str:
-    """The tokens of one statement, spaced canonically."""
+    """The tokens of one statement, spaced canonically. A word or number written glued
+    to the one before (``x1.5``: the word ``x1`` and the number ``.5``) stays glued: the
+    validator reads the two together."""
     out = ""
     prev = ""
     for tok in parts:
-        tight = prev in ("=", "(") or tok in ("=", ")", ",")
+        tight = prev in ("=", "(") or tok in ("=", ")", ",") or tok.startswith(_GLUE)
+        tok = tok.removeprefix(_GLUE)
         if out and not tight:
             out += " "
         out += tok
@@ -128,7 +132,10 @@ def _layout(text: str) -> str:
     parts: list[str] = []
     comment: str | None = None
     toks = tokens(text) + [("newline", "\n")]
+    prev_kind = ""
     for kind, tok in toks:
+        glued = prev_kind in ("word", "quantity") and kind in ("word", "quantity")
+        prev_kind = kind
         if kind == "blank":
             continue
         if kind == "comment":
@@ -146,7 +153,7 @@ def _layout(text: str) -> str:
             depth = max(0, depth + change)
             parts, comment = [], None
         else:
-            parts.append(tok)
+            parts.append(_GLUE + tok if glued else tok)
     out: list[str] = []
     for line in lines:
         if line == "" and (not out or out[-1] == ""):
