@@ -118,6 +118,16 @@ class AouError(Exception):
         return (type(self), (self.diagnostics,))
 
 
+def degree_fix(text: str, at: int, span: Span, n: str, sign: str) -> Fix | None:
+    """`20°` (or `20 °`) as an edit, `20deg`: ``n`` is the number before the sign at
+    offset ``at`` of ``text``, whose span is ``span``."""
+    before = text[:at].rstrip(" \t")
+    if sign not in "°º" or not n or not before.endswith(n):
+        return None
+    col = span.col - (at - (len(before) - len(n)))
+    return Fix(Span(span.path, span.line, col, span.line, span.col + 1), f"{n}deg")
+
+
 def has_errors(diagnostics: list[Diagnostic]) -> bool:
     return any(d.severity is Severity.ERROR for d in diagnostics)
 

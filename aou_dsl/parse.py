@@ -20,7 +20,7 @@ from pathlib import Path
 import lark
 from lark import Lark, Token, Transformer
 
-from .diagnostics import AouError, Fix, Span, diag
+from .diagnostics import AouError, Fix, Span, degree_fix, diag
 from .units import parse_quantity
 
 __all__ = [
@@ -320,8 +320,7 @@ def _unexpected_character(path: str, text: str, err: lark.exceptions.UnexpectedC
     at = err.pos_in_stream
     ch = text[at] if at is not None and at < len(text) else "?"
     span = Span.point(path, err.line, err.column)
-    hint = None
-    fix = None
+    hint = fix = None
     shown = f"`{ch}`"
     if ch == "{":
         hint = "a `{` only opens a `sequence { ... }` block"
@@ -329,22 +328,13 @@ def _unexpected_character(path: str, text: str, err: lark.exceptions.UnexpectedC
         what, hint = _LOOKALIKES[ch]
         shown = f"`{ch}` ({what}, U+{ord(ch):04X})"
         hint = hint.format(n=_number_before(text, at or 0) or "20")
-        fix = _degree_fix(path, text, at or 0, span) if ch in "°º" else None
+        fix = degree_fix(text, at or 0, span, _number_before(text, at or 0), ch)
     elif not ch.isprintable() or ch.isspace():
         shown = f"U+{ord(ch):04X} (an invisible character)"
         hint = "delete it, or replace it with an ordinary space"
     return AouError(diag("S003", f"unexpected character {shown}", span, hint=hint, found=ch,
                          fix=fix))
 
-
-def _degree_fix(path: str, text: str, at: int, span: Span) -> Fix | None:
-    """`20°` (or `20 °`) as an edit: `20deg`."""
-    n = _number_before(text, at)
-    before = text[:at].rstrip(" \t")
-    if not n or not before.endswith(n):
-        return None
-    col = span.col - (at - (len(before) - len(n)))
-    return Fix(Span(path, span.line, col, span.line, span.col + 1), f"{n}deg")
 
 
 #: `1,5s`: a comma between the digits of a number, with what follows it up to its unit.

@@ -120,7 +120,8 @@ def test_there_is_something_to_format() -> None:
 
 
 def test_layout_rules() -> None:
-    text = ("\n\n  behaviour  h:hesitant   # a comment  \n\n\n\nrobot   panda;;goal ( 0.5 ,0,0.3 )\n"
+    text = ("\n\n  behaviour  h:hesitant   # a comment  \n\n\n\n"
+            "robot   panda;;goal ( 0.5 ,0,0.3 )\n"
             "sequence{ approach 0.08m a = 0.09 ; pause 1s }\nsequence {\n\tpause 1s   x2\n"
             "  # inside\n}\n\n")
     assert format_source(text) == (
@@ -180,3 +181,14 @@ def test_cli_check_diff_write(tmp_path: Path) -> None:
     assert r.returncode == 0
     r = _aouc("fmt", str(tmp_path / "missing.aou"), cwd=tmp_path)
     assert r.returncode == 2 and "I501" in r.stderr
+
+
+def test_fmt_imports_nothing_heavy(tmp_path: Path) -> None:
+    """`aouc fmt` is on lint's light path: no numerical library, no editor library."""
+    (tmp_path / "a.aou").write_text("pause  1s\n")
+    code = ("import sys, aou_dsl.cli as c\n"
+            f"c.main(['fmt', '--check', r'{tmp_path}'])\n"
+            "heavy = {'pinocchio', 'toppra', 'pybullet', 'numpy', 'pygls', 'lsprotocol'}\n"
+            "print(sorted(heavy & set(sys.modules)))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.stdout.strip().splitlines()[-1] == "[]"

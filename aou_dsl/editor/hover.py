@@ -8,7 +8,7 @@ import re
 
 from lsprotocol import types
 
-from ..descriptors import REGISTRY, Descriptor
+from ..descriptors import DEFINITIONS, REGISTRY, Descriptor
 from ..diagnostics import Span
 from ..ir import State
 from ..primitives import KINDS
@@ -17,29 +17,7 @@ from .convert import offset_of, to_range
 from .state import Document
 from .text import Tok, at, statement_at, tokens_of
 
-__all__ = ["DEFINITIONS", "descriptor_for", "describe", "hover"]
-
-#: What each descriptor measures, in docs/model.md's words (its table of descriptors).
-DEFINITIONS = {
-    "approach_acceleration": "peak magnitude of the end-effector's translational "
-    "acceleration over all approach episodes (episodes in which the goal distance "
-    "decreases)",
-    "pause_count": "number of pauses: holds with every joint velocity zero",
-    "pause_duration": "how long a pause lasts",
-    "retreat_count": "number of retreat episodes (moving away from the goal) that start "
-    "and end at a pause",
-    "retreat_distance": "distance the end-effector covers in one retreat episode",
-    "retreat_acceleration": "peak magnitude of the translational acceleration over the "
-    "retreat episodes",
-    "horizontal_gaze": "angle between `proj_H(g_0)` and `proj_H(g_i)`, i the pause that "
-    "ends a gaze episode",
-    "vertical_gaze": "the same angle in the vertical plane",
-    "tilt_angle": "amplitude of the end-effector's roll about its forward (z) axis in one "
-    "tilt episode",
-    "tilt_velocity": "the tilt angle divided by the tilt episode's duration",
-    "shiver_amplitude": "peak-to-peak amplitude of the fast oscillation of a redundant "
-    "joint (one the rest of the motion does not use) about its axis",
-}
+__all__ = ["descriptor_for", "describe", "hover"]
 
 _CODE = re.compile(r"\b[SVMCRI]\d{3}\b")
 _WAYS = {"": ("more", "fewer"), "s": ("longer", "shorter"), "m": ("longer", "shorter"),
