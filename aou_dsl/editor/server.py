@@ -12,6 +12,8 @@ Started by ``aouc server`` (stdio). Settings come in the ``initialize`` request'
 from __future__ import annotations
 
 import logging
+import os
+import sys
 from typing import Any
 
 from lsprotocol import types
@@ -56,9 +58,11 @@ class AouServer(LanguageServer):
         doc = self.docs.get(uri)
         if doc is None:
             doc = self.docs[uri] = Document(uri, to_fs_path(uri) or uri)
-        text = self.workspace.get_text_document(uri).source
+        wdoc = self.workspace.get_text_document(uri)
+        text = wdoc.source
         if text != doc.text or doc.lint is None:
             self.update(doc, text)
+        doc.version = wdoc.version  # pygls may run a change's handler after the next one
         return doc
 
     def update(self, doc: Document, text: str) -> None:
@@ -89,14 +93,12 @@ def make_server(robot: str | None = None) -> AouServer:
     def did_open(ls: AouServer, params: types.DidOpenTextDocumentParams) -> None:
         doc = ls.doc(params.text_document.uri)
         doc.closed = False
-        doc.version = params.text_document.version
         ls.publish(doc)
         ls.compiles.request(doc, 0.0, ls.robot)
 
     @ls.feature(types.TEXT_DOCUMENT_DID_CHANGE)
     def did_change(ls: AouServer, params: types.DidChangeTextDocumentParams) -> None:
         doc = ls.doc(params.text_document.uri)
-        doc.version = params.text_document.version
         ls.publish(doc)
         if ls.compile_on_type:
             ls.compiles.request(doc, ls.compile_delay, ls.robot)
@@ -146,6 +148,14 @@ def make_server(robot: str | None = None) -> AouServer:
 
 
 def serve(robot: str | None = None) -> None:
-    """Serve on stdin/stdout until the client says exit."""
+    """Serve on stdin/stdout until the client says exit.
+
+    The protocol gets its own copy of the standard output; the standard output itself
+    then goes to the standard error, so that a library that prints (PyBullet does, from
+    C, when it loads) cannot break a message."""
     logging.basicConfig(level=logging.WARNING)
-    make_server(robot).start_io()
+    protocol_out = os.fdopen(os.dup(sys.stdout.fileno()), "wb", buffering=0)
+    sys.stdout.flush()
+    os.dup2(sys.stderr.fileno(), sys.stdout.fileno())
+    sys.stdout = sys.stderr
+    make_server(robot).start_io(sys.stdin.buffer, protocol_out)
