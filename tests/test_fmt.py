@@ -192,3 +192,12 @@ def test_fmt_imports_nothing_heavy(tmp_path: Path) -> None:
             "print(sorted(heavy & set(sys.modules)))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert out.stdout.strip().splitlines()[-1] == "[]"
+
+
+def test_server_without_the_extra_says_which_to_install() -> None:
+    code = ("import sys\nsys.modules['pygls'] = None\nimport aou_dsl.cli as c\n"
+            "raise SystemExit(c.main(['server']))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         stdin=subprocess.DEVNULL, timeout=60)
+    assert out.returncode == 2
+    assert "lsp extra" in out.stderr and "pip install '.[lsp]'" in out.stderr
