@@ -4,7 +4,9 @@ A compile takes a tenth of a second to a few seconds, so it runs in one worker t
 (the robot models stay loaded there, in this process). Each document has a generation
 that every edit raises: a compile asked for an older generation is skipped if it has
 not started, and its result dropped if it has; only the newest text's diagnostics are
-ever published.
+ever published. The diagnostics go out as soon as the build is done; the compiled
+episodes' figures (for hover) are worked out after, in the same thread. A compile of
+the text and robot last compiled (a save without an edit) reuses that result.
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ class Compiles:
         self._log = log
         self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="aou-compile")
         self._timers: dict[str, asyncio.TimerHandle] = {}
+        self._last: dict[str, tuple[str, str | None, engine.Built]] = {}
 
     def request(self, doc: Document, delay: float, robot: str | None) -> None:
         """Compile ``doc`` as it is now, after ``delay`` seconds without a newer edit."""
@@ -48,36 +51,58 @@ class Compiles:
         if doc.generation != gen or doc.closed:
             return
         text, path = doc.text, doc.path
+        last = self._last.get(doc.uri)
+        if last is not None and last[:2] == (text, robot):
+            self._accept(doc, gen, last[2])
+            return
 
         def job() -> engine.Built | None:
             if doc.generation != gen or doc.closed:  # superseded while queued
                 return None
             return engine.build(text, path, robot)
 
-        fut = self._pool.submit(job)
-        fut.add_done_callback(lambda f: self._back(loop, doc, gen, f))
+        def figures(built: engine.Built) -> engine.Built | None:
+            return engine.shown(built) if doc.generation == gen and not doc.closed else None
 
-    def _back(self, loop: asyncio.AbstractEventLoop, doc: Document, gen: int,
-              fut: Future) -> None:
+        def then(built: engine.Built) -> None:
+            self._last[doc.uri] = (text, robot, built)
+            self._submit(loop, figures, built, lambda b: None)
+
+        self._submit(loop, job, None, lambda b: self._accept(doc, gen, b, then))
+
+    def _submit(self, loop, fn, arg, on_result: Callable) -> None:
+        fut = self._pool.submit(fn, arg) if arg is not None else self._pool.submit(fn)
+        fut.add_done_callback(lambda f: self._back(loop, f, on_result))
+
+    def _back(self, loop: asyncio.AbstractEventLoop, fut: Future, on_result: Callable) -> None:
         """From the worker thread: hand the result to the event loop (gone at exit)."""
         if fut.cancelled() or loop.is_closed():
             return
         try:
-            loop.call_soon_threadsafe(self._finish, doc, gen, fut)
+            loop.call_soon_threadsafe(self._finish, fut, on_result)
         except RuntimeError:  # the loop closed in between: the server is exiting
             pass
 
-    def _finish(self, doc: Document, gen: int, fut: Future) -> None:
+    def _finish(self, fut: Future, on_result: Callable) -> None:
         try:
-            built = fut.result()
+            result = fut.result()
         except Exception:  # noqa: BLE001 - a failed compile must not stop the server
             self._log("aouc server: the compile failed: " + traceback.format_exc())
             return
-        if built is None or doc.generation != gen or doc.closed:
+        if result is not None:
+            on_result(result)
+
+    def _accept(self, doc: Document, gen: int, built: engine.Built,
+                then: Callable[[engine.Built], None] | None = None) -> None:
+        if doc.generation != gen or doc.closed:
             return
-        doc.built = built
-        doc.built_generation = gen
+        doc.built, doc.built_generation = built, gen
         self._done(doc)
+        if then is not None:
+            then(built)
+
+    def forget(self, uri: str) -> None:
+        self._last.pop(uri, None)
 
     def shutdown(self) -> None:
         self._pool.shutdown(wait=False, cancel_futures=True)

@@ -7,8 +7,9 @@ its path (for relative robot files and the diagnostics' spans):
 - :func:`lint`: parse, validate, lay out and judge on the C-V model, as ``aouc lint``;
   pure Python, fast enough to run on every keystroke;
 - :func:`build`: compile, check and measure, as ``aouc compile``, for the compile
-  diagnostics (C-codes) and the compiled episodes; the robot models stay loaded in the
-  process between calls (:func:`aou_dsl.kinematics.load_arm` is cached per process);
+  diagnostics (C-codes); :func:`shown` then adds the compiled episodes' figures. The
+  robot models stay loaded in the process between calls
+  (:func:`aou_dsl.kinematics.load_arm` is cached per process);
 - :func:`syntax`: the syntax tree, or None while the file does not parse;
 - :func:`format_text`: ``aouc fmt``'s output, or None on a syntax error;
 - :func:`rule`: a diagnostic code's registry entry.
@@ -17,7 +18,7 @@ its path (for relative robot files and the diagnostics' spans):
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from ..diagnostics import RULES, AouError, Diagnostic, Rule
 
@@ -26,7 +27,7 @@ if TYPE_CHECKING:
     from ..parse import SyntaxTree
     from ..timeline import Episode
 
-__all__ = ["Built", "Shown", "build", "format_text", "lint", "rule", "syntax"]
+__all__ = ["Built", "Shown", "build", "format_text", "lint", "rule", "shown", "syntax"]
 
 
 @dataclass(frozen=True)
@@ -43,11 +44,12 @@ class Shown:
 
 @dataclass
 class Built:
-    """What :func:`build` found: the build's diagnostics and, when it compiled, each
-    episode as compiled (in timeline order)."""
+    """What :func:`build` found: the build's diagnostics and, once :func:`shown` has
+    run, each episode as compiled (in timeline order)."""
 
     diagnostics: list[Diagnostic] = field(default_factory=list)
     episodes: list[Shown] = field(default_factory=list)
+    _compiled: Any = field(default=None, repr=False)
 
 
 def lint(text: str, path: str) -> FileResult:
@@ -86,13 +88,17 @@ def build(text: str, path: str, robot: str | None = None) -> Built:
     from ..build import build_source
 
     res = build_source(text, path, robot=robot)
-    out = Built(list(res.diagnostics))
-    compiled = res.compiled
+    return Built(list(res.diagnostics), _compiled=res.compiled)
+
+
+def shown(built: Built) -> Built:
+    """Fill ``built.episodes`` from its trajectory (forward kinematics of every sample:
+    done after the diagnostics are out)."""
+    compiled, built._compiled = built._compiled, None
     tr = compiled.trajectory if compiled is not None else None
-    if compiled is None or tr is None or compiled.timeline is None:
-        return out
-    out.episodes = _shown(compiled.timeline.episodes, tr)
-    return out
+    if compiled is not None and tr is not None and compiled.timeline is not None:
+        built.episodes = _shown(compiled.timeline.episodes, tr)
+    return built
 
 
 def _shown(episodes: tuple[Episode, ...], tr) -> list[Shown]:

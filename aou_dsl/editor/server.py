@@ -112,6 +112,7 @@ def make_server(robot: str | None = None) -> AouServer:
         doc = ls.docs.pop(params.text_document.uri, None)
         if doc is not None:
             doc.closed = True
+        ls.compiles.forget(params.text_document.uri)
         ls.text_document_publish_diagnostics(types.PublishDiagnosticsParams(
             uri=params.text_document.uri, diagnostics=[]))
 
