@@ -79,3 +79,22 @@ def test_hover_definitions_are_the_docs_words(name):
     rows = [ln for ln in (ROOT / "docs" / "model.md").read_text().splitlines()
             if re.match(rf"\| \d+ \| `{name}` \|", ln)]
     assert len(rows) == 1 and DEFINITIONS[name] in rows[0]
+
+
+def test_ranges_count_utf16_and_skip_a_byte_order_mark():
+    from lsprotocol import types
+
+    from aou_dsl.diagnostics import Span, diag
+    from aou_dsl.editor.convert import to_lsp
+
+    text = "\ufeffpause 3m\n"
+    (d,) = [d for d in lint_source(text, "x.aou").diagnostics if d.code == "V102"]
+    rng = to_lsp(d, lines_of(text), "x.aou").range
+    assert (rng.start, rng.end) == (types.Position(0, 7), types.Position(0, 9))
+    text = 'robot "😀x"; pause 3m\n'  # the emoji is two UTF-16 code units
+    (d,) = [d for d in lint_source(text, "x.aou").diagnostics if d.code == "V102"]
+    assert to_lsp(d, lines_of(text), "x.aou").range.start == types.Position(0, 19)
+    other = diag("V102", "in the robot file", Span("arm.toml", 7, 3, 7, 9))
+    shown = to_lsp(other, lines_of(text), "x.aou")
+    assert shown.range.start == shown.range.end == types.Position(0, 0)
+    assert shown.message.startswith("arm.toml:7:3: ")

@@ -48,7 +48,8 @@ def _action(doc: Document, d: Diagnostic) -> types.CodeAction:
 def code_actions(doc: Document, rng: types.Range) -> list[types.CodeAction]:
     """A quick fix for each diagnostic at ``rng`` whose hint is an edit."""
     return [_action(doc, d) for d in doc.diagnostics
-            if d.fix is not None and _overlaps(to_range(d.span, doc.lines), rng)]
+            if d.fix is not None and d.fix.span.path == doc.path
+            and _overlaps(to_range(d.span, doc.lines), rng)]
 
 
 def format_edits(doc: Document) -> list[types.TextEdit] | None:

@@ -56,7 +56,8 @@ def _position(lines: list[str], line: int, col: int) -> types.Position:
     text = lines[li]
     if line - 1 > li:  # past the end: the end of the last line
         return types.Position(li, utf16_col(text, len(text)))
-    return types.Position(li, utf16_col(text, min(max(0, col - 1), len(text))))
+    bom = int(li == 0 and text.startswith("\ufeff"))  # aou's columns start after it
+    return types.Position(li, utf16_col(text, min(max(0, col - 1 + bom), len(text))))
 
 
 def to_range(span: Span, lines: list[str]) -> types.Range:
@@ -73,9 +74,15 @@ def offset_of(lines: list[str], pos: types.Position) -> tuple[int, int]:
     return li, char_col(lines[li], pos.character)
 
 
-def to_lsp(d: Diagnostic, lines: list[str]) -> types.Diagnostic:
+def to_lsp(d: Diagnostic, lines: list[str], path: str | None = None) -> types.Diagnostic:
+    """``d`` as LSP's diagnostic; one about another file (``path`` given: a robot file,
+    say) is shown at the document's start, its own place named in the message."""
     message = d.message + (f"\nhint: {d.hint}" if d.hint else "")
+    span = d.span
+    if path is not None and span.path != path:
+        message = f"{span}: {message}" if span.line else f"{span.path}: {message}"
+        span = Span(path, 1, 1, 1, 1)
     return types.Diagnostic(
-        range=to_range(d.span, lines), message=message, severity=SEVERITY[d.severity],
+        range=to_range(span, lines), message=message, severity=SEVERITY[d.severity],
         code=d.code, source="aou",
         code_description=None)

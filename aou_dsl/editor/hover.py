@@ -160,8 +160,8 @@ def _planned(ep) -> str:
 def hover(doc: Document, pos: types.Position) -> types.Hover | None:
     li, col = offset_of(doc.lines, pos)
     line = doc.lines[li]
-    codes = [d.code for d in doc.diagnostics
-             if (d.span.line, d.span.col - 1) <= (li + 1, col) <= (d.span.end_line,
+    codes = [d.code for d in doc.diagnostics if d.span.path == doc.path
+             and (d.span.line, d.span.col - 1) <= (li + 1, col) <= (d.span.end_line,
                                                                    d.span.end_col - 1)]
     toks = tokens_of(line)
     tok = at(toks, col)

@@ -77,7 +77,7 @@ class AouServer(LanguageServer):
             return
         self.text_document_publish_diagnostics(types.PublishDiagnosticsParams(
             uri=doc.uri, version=doc.version,
-            diagnostics=[to_lsp(d, doc.lines) for d in doc.diagnostics]))
+            diagnostics=[to_lsp(d, doc.lines, doc.path) for d in doc.diagnostics]))
 
 
 def make_server(robot: str | None = None) -> AouServer:
