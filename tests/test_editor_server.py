@@ -170,6 +170,16 @@ async def test_compile_diagnostic_after_save(client: LanguageClient):
             break
     (d,) = [d for d in diags if d.code == "C304"]
     assert d.range.start.line == 2
+    for _ in range(100):  # the compiled episodes' figures follow the diagnostics
+        h = await client.text_document_hover_async(types.HoverParams(
+            types.TextDocumentIdentifier(uri), types.Position(2, 2)))
+        if "episodes, compiled" in h.contents.value:
+            break
+        await asyncio.sleep(0.1)
+    assert "episodes, compiled" in h.contents.value
+    (row,) = [ln for ln in h.contents.value.splitlines() if ln.startswith("- retreat")]
+    acc = float(row.split("peak acceleration ")[1].split()[0])
+    assert 0.1 < acc < 50  # the arm peaks lower than the declared 50 m/s^2 (C304)
 
 
 async def test_tilt_too_fast_fix_compiles_clean(client: LanguageClient):
