@@ -336,7 +336,6 @@ def _unexpected_character(path: str, text: str, err: lark.exceptions.UnexpectedC
                          fix=fix))
 
 
-
 #: `1,5s`: a comma between the digits of a number, with what follows it up to its unit.
 _DECIMAL_COMMA = re.compile(r"([+-]?\d+),(\d+([eE][+-]?\d+)?[A-Za-z][A-Za-z0-9]*(/[A-Za-z0-9]+)?"
                             r"(\^[0-9]+)?|\d+([eE][+-]?\d+)?)")
