@@ -142,8 +142,12 @@ def _robot_diagnostics(b, check: bool, collision_check: bool) -> list[Diagnostic
 
 def build_lint(lint: FileResult, *, robot: str | None = None, rate: float | None = None,
                check: bool = True, scene: SceneOptions | None = None,
-               collision_check: bool = True, controller: str | None = None) -> BuildResult:
+               collision_check: bool = True, controller: str | None = None,
+               precompiled: CompileResult | None = None) -> BuildResult:
     """Compile, check and measure a linted file (see the module's docstring).
+
+    ``precompiled``: the compile of ``lint``'s behaviour at the default rate, done
+    already (the language server publishes its diagnostics first), used as it is.
 
     ``collision_check=False`` lets a robot without collision shapes compile; the
     document's ``checks`` then records that self-collision was not checked.
@@ -165,7 +169,8 @@ def build_lint(lint: FileResult, *, robot: str | None = None, rate: float | None
     if has_errors(res.diagnostics):
         return res
     opts = CompileOptions() if rate is None else CompileOptions(rate=rate)
-    res.compiled = compiled = compile_behaviour(b, opts, tl)
+    res.compiled = compiled = precompiled if precompiled is not None and rate is None \
+        else compile_behaviour(b, opts, tl)
     res.diagnostics += compiled.diagnostics
     tr = compiled.trajectory
     if not compiled.ok or tr is None:

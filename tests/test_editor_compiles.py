@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import asyncio
 import threading
+from pathlib import Path
 
 import pytest
 
@@ -12,6 +13,8 @@ pytest.importorskip("lsprotocol", reason="the lsp extra is not installed")
 from aou_dsl.editor import engine  # noqa: E402
 from aou_dsl.editor.compiling import Compiles  # noqa: E402
 from aou_dsl.editor.state import Document  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
 
 
 def _doc(text: str) -> Document:
@@ -31,12 +34,12 @@ def test_a_newer_edit_supersedes_a_running_compile(monkeypatch) -> None:
     built_texts: list[str] = []
     real = engine.build
 
-    def build(text, path, robot=None):
+    def build(text, path, robot=None, first=None):
         built_texts.append(text)
         if len(built_texts) == 1:  # the first compile is slow: an edit comes meanwhile
             started.set()
             release.wait(10)
-        return real(text, path, robot)
+        return real(text, path, robot, first)
 
     monkeypatch.setattr(engine, "build", build)
     published: list[tuple[int, list[str]]] = []
@@ -59,14 +62,16 @@ def test_a_newer_edit_supersedes_a_running_compile(monkeypatch) -> None:
 
     asyncio.run(run())
     assert len(built_texts) == 2  # both ran: the first was already running
-    # only the newest text's result was published; the first one's was dropped
-    assert [gen for gen, _ in published] == [doc.generation]
-    assert doc.compiled is not None
+    # only the newest text's results were published (the compiler's, then the whole
+    # build's); the first text's was dropped
+    assert published and {gen for gen, _ in published} == {doc.generation}
+    assert doc.compiled is not None and "C" not in {c[0] for c in published[-1][1]}
 
 
 def test_queued_compiles_of_old_text_do_not_run(monkeypatch) -> None:
     built_texts: list[str] = []
-    monkeypatch.setattr(engine, "build", lambda text, path, robot=None: (
+    monkeypatch.setattr(engine, "compile_only", lambda *args: None)
+    monkeypatch.setattr(engine, "build", lambda text, *args: (
         built_texts.append(text), engine.Built())[1])
     doc = _doc("pause 1s\n")
 
@@ -81,3 +86,19 @@ def test_queued_compiles_of_old_text_do_not_run(monkeypatch) -> None:
 
     asyncio.run(run())
     assert built_texts == ["pause 5s\n"]
+
+
+@pytest.mark.parametrize("text", [
+    (ROOT / "behaviours" / "hesitant.aou").read_text(),
+    "approach\npause 1s x2\nretreat 0.06m a=50\n",  # C304, C310
+    "tilt 90deg v=500deg/s\n",  # C309: the compile fails
+])
+def test_the_compile_first_then_the_build_says_what_the_build_alone_says(text) -> None:
+    first = engine.compile_only(text, "x.aou")
+    assert first is not None
+    codes = {d.code for d in first.diagnostics}
+    whole = engine.build(text, "x.aou", None, first)
+    alone = engine.build(text, "x.aou")
+    assert [(d.code, d.message, d.span) for d in whole.diagnostics] == \
+        [(d.code, d.message, d.span) for d in alone.diagnostics]
+    assert {c for c in codes if c[0] == "C"} <= {d.code for d in alone.diagnostics}

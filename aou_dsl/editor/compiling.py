@@ -59,7 +59,12 @@ class Compiles:
         def job() -> engine.Built | None:
             if doc.generation != gen or doc.closed:  # superseded while queued
                 return None
-            return engine.build(text, path, robot)
+            first = engine.compile_only(text, path, robot)
+            if first is not None:  # the compiler's diagnostics at once, the checks' after
+                self._hand(loop, lambda: self._accept(doc, gen, first))
+                if doc.generation != gen or doc.closed:
+                    return None
+            return engine.build(text, path, robot, first)
 
         def figures(built: engine.Built) -> engine.Built | None:
             return engine.shown(built) if doc.generation == gen and not doc.closed else None
@@ -75,11 +80,17 @@ class Compiles:
         fut.add_done_callback(lambda f: self._back(loop, f, on_result))
 
     def _back(self, loop: asyncio.AbstractEventLoop, fut: Future, on_result: Callable) -> None:
-        """From the worker thread: hand the result to the event loop (gone at exit)."""
-        if fut.cancelled() or loop.is_closed():
+        """From the worker thread: hand the result to the event loop."""
+        if not fut.cancelled():
+            self._hand(loop, lambda: self._finish(fut, on_result))
+
+    @staticmethod
+    def _hand(loop: asyncio.AbstractEventLoop, fn: Callable[[], None]) -> None:
+        """Run ``fn`` on the event loop, from the worker thread (not at exit)."""
+        if loop.is_closed():
             return
         try:
-            loop.call_soon_threadsafe(self._finish, fut, on_result)
+            loop.call_soon_threadsafe(fn)
         except RuntimeError:  # the loop closed in between: the server is exiting
             pass
 

@@ -6,7 +6,8 @@ its path (for relative robot files and the diagnostics' spans):
 
 - :func:`lint`: parse, validate, lay out and judge on the C-V model, as ``aouc lint``;
   pure Python, fast enough to run on every keystroke;
-- :func:`build`: compile, check and measure, as ``aouc compile``, for the compile
+- :func:`compile_only`, then :func:`build`: the compiler's diagnostics first, then
+  those of the whole ``aouc compile`` (checks and measuring too), for the compile
   diagnostics (C-codes); :func:`shown` then adds the compiled episodes' figures. The
   robot models stay loaded in the process between calls
   (:func:`aou_dsl.kinematics.load_arm` is cached per process);
@@ -27,7 +28,8 @@ if TYPE_CHECKING:
     from ..parse import SyntaxTree
     from ..timeline import Episode
 
-__all__ = ["Built", "Shown", "build", "format_text", "lint", "rule", "shown", "syntax"]
+__all__ = ["Built", "Shown", "build", "compile_only", "format_text", "lint", "rule", "shown",
+           "syntax"]
 
 
 @dataclass(frozen=True)
@@ -50,6 +52,7 @@ class Built:
     diagnostics: list[Diagnostic] = field(default_factory=list)
     episodes: list[Shown] = field(default_factory=list)
     _compiled: Any = field(default=None, repr=False)
+    _lint: Any = field(default=None, repr=False)
 
 
 def lint(text: str, path: str) -> FileResult:
@@ -81,13 +84,37 @@ def rule(code: str) -> Rule | None:
     return RULES.get(code.upper())
 
 
-def build(text: str, path: str, robot: str | None = None) -> Built:
-    """``aouc compile`` of the text on ``robot`` (None: the file's own, else panda),
-    with the safety checks; nothing is written. Raises nothing for a bad file: what
-    went wrong is in the diagnostics."""
-    from ..build import build_source
+def compile_only(text: str, path: str, robot: str | None = None) -> Built | None:
+    """The compile alone (no checks, no measuring): the C-codes of the compiler, sooner
+    than :func:`build`'s, which then reuses the compile. None when there is nothing to
+    compile (lint errors) or another robot than the file's is asked for."""
+    from ..compiler.pipeline import compile_behaviour
+    from ..diagnostics import has_errors
+    from ..linter import lint_source
 
-    res = build_source(text, path, robot=robot)
+    lint = lint_source(text, path)
+    if robot is not None or lint.behaviour is None or lint.timeline is None \
+            or has_errors(lint.diagnostics):
+        return None
+    try:
+        compiled = compile_behaviour(lint.behaviour, timeline=lint.timeline)
+    except AouError:  # said again, in its place, by the whole build
+        return None
+    return Built([*lint.diagnostics, *compiled.diagnostics], _compiled=compiled, _lint=lint)
+
+
+def build(text: str, path: str, robot: str | None = None, first: Built | None = None
+          ) -> Built:
+    """``aouc compile`` of the text on ``robot`` (None: the file's own, else panda),
+    with the safety checks; nothing is written. ``first`` is :func:`compile_only`'s
+    result for the same text and robot, whose compile is used. Raises nothing for a bad
+    file: what went wrong is in the diagnostics."""
+    from ..build import build_lint, build_source
+
+    if first is not None and first._lint is not None:
+        res = build_lint(first._lint, robot=robot, precompiled=first._compiled)
+    else:
+        res = build_source(text, path, robot=robot)
     return Built(list(res.diagnostics), _compiled=res.compiled)
 
 
