@@ -91,6 +91,19 @@ async def _wait(published: list, uri: str, since: int, version: int | None = Non
     raise TimeoutError(uri)
 
 
+async def _settle(pid: int, timeout: float = 300.0) -> None:
+    """Wait until the server has done what it started (the compile an open starts, its
+    checks, the compiled episodes' figures): its CPU time stops growing."""
+    end = time.perf_counter() + timeout
+    (last,) = _cpu_seconds([pid])
+    while time.perf_counter() < end:
+        await asyncio.sleep(0.5)
+        (now,) = _cpu_seconds([pid])
+        if now - last < 0.02:
+            return
+        last = now
+
+
 async def _close(client, drainer) -> None:
     await client.shutdown_async(None)
     client.exit(None)
@@ -108,12 +121,14 @@ async def _typing() -> tuple[list[float], list[float], list[float], float]:
         types.TextDocumentItem(uri=uri, language_id="aou", version=1, text=text)))
     await _wait(published, uri, 0, 1)
     await _wait(published, uri, 1, 1, timeout=300)  # the compile an open starts
-    edits = []
     pid = client._server.pid
+    await _settle(pid)
+    edits = []
     (cpu0,) = _cpu_seconds([pid])
+    digits: dict[int, str] = {}
     for v in range(2, 82):
-        line = 4 + 2 * (v % 90)  # a pause line: 0.3s <-> 0.4s
-        new = "4" if v % 2 else "3"
+        line = 4 + 2 * (v % 90)  # a pause line: 0.3s <-> 0.4s, each edit a change
+        new = digits[line] = "3" if digits.get(line, "3") == "4" else "4"
         n = len(published)
         t = time.perf_counter()
         client.text_document_did_change(types.DidChangeTextDocumentParams(
@@ -147,6 +162,7 @@ async def _saves(n: int = 15) -> list[float]:
         types.TextDocumentItem(uri=uri, language_id="aou", version=1, text=path.read_text())))
     await _wait(published, uri, 0, 1)  # lint
     await _wait(published, uri, 1, 1, timeout=300)  # the first, cold compile
+    await _settle(client._server.pid)
     out = []
     text = path.read_text()
     for v in range(2, n + 2):  # an edit (a comment), then a save: a real compile
@@ -160,7 +176,7 @@ async def _saves(n: int = 15) -> list[float]:
         client.text_document_did_save(types.DidSaveTextDocumentParams(
             types.TextDocumentIdentifier(uri)))
         out.append(await _wait(published, uri, k, v, timeout=120) - t)
-        await asyncio.sleep(0.5)  # the compiled episodes' figures, worked out after
+        await _settle(client._server.pid)  # the checks, the episodes' figures
     await _close(client, drainer)
     return out
 
