@@ -195,7 +195,7 @@ def _in_process() -> tuple[float, float]:
     """The CPU time [s] (median) of the work behind the two slow figures, done in this
     process: lint of the 200-line file, and the warm compile of hesitant. On a busy
     machine the latencies above are several times these; on an idle one, close."""
-    from aou_dsl.editor import engine
+    from aou_dsl.editor import lsp_engine as engine
 
     text = long_file()
     src = (ROOT / "behaviours" / "hesitant.aou").read_text()

@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 
 pytest.importorskip("lsprotocol", reason="the lsp extra is not installed")
-from aou_dsl.editor import engine  # noqa: E402
-from aou_dsl.editor.compiling import Compiles  # noqa: E402
-from aou_dsl.editor.state import Document  # noqa: E402
+from aou_dsl.editor import lsp_engine as engine
+from aou_dsl.editor.compiling import Compiles
+from aou_dsl.editor.state import Document
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -8,12 +8,12 @@ from pathlib import Path
 
 import pytest
 
-from aou_dsl.descriptors import DEFINITIONS, REGISTRY
-from aou_dsl.linter import lint_source
+from aou_dsl.lang.descriptors import DEFINITIONS, REGISTRY
+from aou_dsl.lang.linter import lint_source
 
 pytest.importorskip("lsprotocol", reason="the lsp extra is not installed")
-from aou_dsl.editor.actions import resolve  # noqa: E402
-from aou_dsl.editor.convert import lines_of  # noqa: E402
+from aou_dsl.editor.actions import resolve
+from aou_dsl.editor.convert import lines_of
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -58,7 +58,7 @@ def test_fix_applied_clears_the_diagnostic(text, code, fixed):
 
 
 def test_key_fix_replaces_or_adds_the_key():
-    from aou_dsl.diagnostics import Fix, Span
+    from aou_dsl.core.diagnostics import Fix, Span
 
     lines = ["tilt 90deg v=500deg/s x2  # fast"]
     stmt = Span("x", 1, 1, 1, 27)
@@ -84,7 +84,7 @@ def test_hover_definitions_are_the_docs_words(name):
 def test_ranges_count_utf16_and_skip_a_byte_order_mark():
     from lsprotocol import types
 
-    from aou_dsl.diagnostics import Span, diag
+    from aou_dsl.core.diagnostics import Span, diag
     from aou_dsl.editor.convert import to_lsp
 
     text = "\ufeffpause 3m\n"

@@ -12,9 +12,9 @@ from pathlib import Path
 
 import pytest
 
-from aou_dsl.ir import State
-from aou_dsl.units import UNITS
-from aou_dsl.validate import KEYWORDS
+from aou_dsl.core.units import UNITS
+from aou_dsl.lang.ir import State
+from aou_dsl.lang.validate import KEYWORDS
 
 VSCODE = Path(__file__).resolve().parent.parent / "editors" / "vscode"
 GRAMMAR = json.loads((VSCODE / "syntaxes" / "aou.tmLanguage.json").read_text())

@@ -14,7 +14,7 @@ pytest_lsp = pytest.importorskip("pytest_lsp", reason="pytest-lsp is not install
 from lsprotocol import types  # noqa: E402
 from pytest_lsp import ClientServerConfig, LanguageClient  # noqa: E402
 
-from aou_dsl.linter import lint_source  # noqa: E402
+from aou_dsl.lang.linter import lint_source
 
 ROOT = Path(__file__).resolve().parent.parent
 pytestmark = pytest.mark.asyncio(loop_scope="module")
@@ -197,6 +197,6 @@ async def test_tilt_too_fast_fix_compiles_clean(client: LanguageClient):
     (action,) = actions
     fixed = _apply(text, action.edit.changes[uri])
     assert fixed.startswith("tilt 90deg v=") and "500deg/s" not in fixed
-    from aou_dsl.build import build_source
+    from aou_dsl.build.builder import build_source
 
     assert "C309" not in {x.code for x in build_source(fixed).diagnostics}

@@ -12,9 +12,9 @@ from pathlib import Path
 
 import pytest
 
-from aou_dsl.diagnostics import AouError
-from aou_dsl.fmt import format_source, tokens
-from aou_dsl.linter import lint_source
+from aou_dsl.core.diagnostics import AouError
+from aou_dsl.lang.formatter import format_source, tokens
+from aou_dsl.lang.linter import lint_source
 
 from .langgen import random_cases
 
@@ -40,7 +40,7 @@ def _doc_examples() -> list[tuple[str, str]]:
 
 
 def _generated() -> list[tuple[str, str]]:
-    from aou_dsl.synth import synthesize
+    from aou_dsl.synth.synthesis import synthesize
 
     cases = [(c.stem, c.text) for c in random_cases(150, seed=7)]
     cases += [(f"synth-{s}", synthesize(s, intensity=x, verify=False))
@@ -135,7 +135,7 @@ def test_layout_rules() -> None:
 
 
 def _compiled_bytes(text: str) -> bytes:
-    from aou_dsl.build import build_source
+    from aou_dsl.build.builder import build_source
 
     res = build_source(text, "x.aou", check=False)
     assert res.ok, [d.message for d in res.diagnostics]
@@ -186,7 +186,7 @@ def test_cli_check_diff_write(tmp_path: Path) -> None:
 def test_fmt_imports_nothing_heavy(tmp_path: Path) -> None:
     """`aouc fmt` is on lint's light path: no numerical library, no editor library."""
     (tmp_path / "a.aou").write_text("pause  1s\n")
-    code = ("import sys, aou_dsl.cli as c\n"
+    code = ("import sys, aou_dsl.cli.commands as c\n"
             f"c.main(['fmt', '--check', r'{tmp_path}'])\n"
             "heavy = {'pinocchio', 'toppra', 'pybullet', 'numpy', 'pygls', 'lsprotocol'}\n"
             "print(sorted(heavy & set(sys.modules)))")
@@ -195,7 +195,7 @@ def test_fmt_imports_nothing_heavy(tmp_path: Path) -> None:
 
 
 def test_server_without_the_extra_says_which_to_install() -> None:
-    code = ("import sys\nsys.modules['pygls'] = None\nimport aou_dsl.cli as c\n"
+    code = ("import sys\nsys.modules['pygls'] = None\nimport aou_dsl.cli.commands as c\n"
             "raise SystemExit(c.main(['server']))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          stdin=subprocess.DEVNULL, timeout=60)

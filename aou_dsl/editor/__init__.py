@@ -6,7 +6,7 @@ completion, quick fixes, formatting (``aouc fmt``) and document symbols.
 
 The server needs the ``lsp`` extra (pygls, lsprotocol); nothing here imports them until
 the server starts, so ``import aou_dsl`` and ``aouc lint`` stay light. All access to
-the pipeline goes through :mod:`aou_dsl.editor.engine`.
+the pipeline goes through :mod:`aou_dsl.editor.lsp_engine`.
 """
 
 from __future__ import annotations

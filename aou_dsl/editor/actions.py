@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from lsprotocol import types
 
-from ..diagnostics import Diagnostic, Fix, Span
-from . import engine
+from ..core.diagnostics import Diagnostic, Fix, Span
+from . import lsp_engine as engine
 from .convert import lines_of, to_lsp, to_range, utf16_col
 from .state import Document
 from .text import tokens_of

@@ -16,7 +16,7 @@ import traceback
 from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
 
-from . import engine
+from . import lsp_engine as engine
 from .state import Document
 
 __all__ = ["Compiles"]

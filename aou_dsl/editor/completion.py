@@ -8,11 +8,11 @@ import re
 
 from lsprotocol import types
 
-from ..ir import State
-from ..primitives import KINDS
-from ..robots import ROBOTS
-from ..units import UNITS, Dim, units_for
-from ..validate import KEYWORDS
+from ..core.robot_specs import ROBOTS
+from ..core.units import UNITS, Dim, units_for
+from ..lang.ir import State
+from ..lang.primitives import KINDS
+from ..lang.validate import KEYWORDS
 from .convert import offset_of
 from .state import Document
 from .text import statement_at, tokens_of

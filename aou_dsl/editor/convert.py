@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from lsprotocol import types
 
-from ..diagnostics import Diagnostic, Severity, Span
+from ..core.diagnostics import Diagnostic, Severity, Span
 
 __all__ = ["ENCODING", "SEVERITY", "char_col", "lines_of", "offset_of", "to_lsp", "to_range",
            "utf16_col"]

@@ -8,11 +8,11 @@ import re
 
 from lsprotocol import types
 
-from ..descriptors import DEFINITIONS, REGISTRY, Descriptor
-from ..diagnostics import Span
-from ..ir import State
-from ..primitives import KINDS
-from . import engine
+from ..core.diagnostics import Span
+from ..lang.descriptors import DEFINITIONS, REGISTRY, Descriptor
+from ..lang.ir import State
+from ..lang.primitives import KINDS
+from . import lsp_engine as engine
 from .convert import offset_of, to_range
 from .state import Document
 from .text import Tok, at, statement_at, tokens_of

@@ -20,8 +20,9 @@ from lsprotocol import types
 from pygls.lsp.server import LanguageServer
 from pygls.uris import to_fs_path
 
-from .. import __version__
-from . import actions, completion, engine, hover, symbols
+from ..version import __version__
+from . import actions, completion, hover, symbols
+from . import lsp_engine as engine
 from .compiling import Compiles
 from .convert import ENCODING, lines_of, to_lsp
 from .state import Document

@@ -5,11 +5,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from ..diagnostics import Diagnostic
+from ..core.diagnostics import Diagnostic
 
 if TYPE_CHECKING:
-    from ..linter import FileResult
-    from .engine import Built
+    from ..lang.linter import FileResult
+    from .lsp_engine import Built
 
 __all__ = ["Document"]
 

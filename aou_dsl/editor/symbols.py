@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from lsprotocol import types
 
-from ..diagnostics import Span
-from ..parse import SequenceBlock, Statement
-from . import engine
+from ..core.diagnostics import Span
+from ..lang.parse import SequenceBlock, Statement
+from . import lsp_engine as engine
 from .convert import to_range
 from .state import Document
 
