@@ -8,8 +8,9 @@ Sections: ``build`` (the warm checked build), ``cold`` (cold starts against thei
 floors), ``lint`` (long files, many files), ``jobs`` (``--jobs N``), ``render`` (a 640x480
 video), ``measure`` (60 s at 1 kHz), ``compile`` (below), ``replan`` (a live re-plan,
 ``bench_replan.py``), ``house`` (the warm session: re-lint and recompile; ``--jobs 2``
-against ``--jobs 1``, cold, ``house.py``), ``studio`` (``aouc studio``, ``bench_studio.py``);
-see ``speed.py`` for ``build`` to ``render``. Ratios
+against ``--jobs 1``, cold, ``house.py``), ``studio`` (``aouc studio``, ``bench_studio.py``),
+``editor`` (the language server and ``aouc fmt``, ``bench_editor.py``); see ``speed.py``
+for ``build`` to ``render``. Ratios
 are measured in one run, so they hold on any machine; absolute times are this
 machine's (its cores and load are in the JSON). The JSON lists every figure with its
 goal (null for a figure that only says where the time goes) and whether it is met, and
@@ -40,6 +41,7 @@ from pathlib import Path
 import bench_studio
 import numpy as np
 import speed
+from bench_editor import bench_editor
 from house import bench_house
 from speed import figure, say
 
@@ -181,7 +183,7 @@ def bench_measure() -> None:
 SECTIONS = {"build": speed.bench_build, "cold": speed.bench_cold, "lint": speed.bench_lint,
             "jobs": speed.bench_jobs, "render": speed.bench_render, "measure": bench_measure,
             "compile": bench_compile, "replan": speed.bench_replan, "house": bench_house,
-            "studio": bench_studio.bench_studio}
+            "studio": bench_studio.bench_studio, "editor": bench_editor}
 
 
 def main(argv: list[str]) -> int:

@@ -126,7 +126,8 @@ def test_lint_imports_no_heavy_dependency():
     code = ("import sys, aou_dsl, aou_dsl.cli.commands as c\n"
             "try:\n    c.main(['--help'])\nexcept SystemExit:\n    pass\n"
             f"c.main(['lint', r'{BEHAVIOURS}'])\n"
-            "heavy = {'pinocchio', 'toppra', 'pybullet', 'matplotlib', 'numpy'}\n"
+            "heavy = {'pinocchio', 'toppra', 'pybullet', 'matplotlib', 'numpy', 'pygls',\n"
+            "         'lsprotocol'}\n"
             "heavy &= set(sys.modules)\n"
             "print(sorted(heavy))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)

@@ -143,12 +143,14 @@ def _robot_diagnostics(b, opts: BuildOptions) -> list[Diagnostic]:
         return list(err.diagnostics)
 
 
-def build_lint(lint: FileResult, options: BuildOptions | None = None,
-               **changes: Any) -> BuildResult:
+def build_lint(lint: FileResult, options: BuildOptions | None = None, *,
+               precompiled: CompileResult | None = None, **changes: Any) -> BuildResult:
     """Compile, check and measure a linted file (see the module's docstring).
 
     ``options`` (:class:`~aou_dsl.core.options.BuildOptions`) says how; keyword
     ``changes`` replace some of its fields (``robot="ur5"``, ``check=False``).
+    ``precompiled``: the compile of ``lint``'s behaviour at the default rate, done
+    already (the language server publishes its diagnostics first), used as it is.
     ``collision_check=False`` lets a robot without collision shapes compile; the
     document's ``checks`` then records that self-collision was not checked.
     ``controller`` (``franka``, ``ur``) adds that motion generator's rate and limits to
@@ -172,7 +174,8 @@ def build_lint(lint: FileResult, options: BuildOptions | None = None,
         return res
     copts = CompileOptions(package_dirs=opts.package_dirs) if opts.rate is None else \
         CompileOptions(rate=opts.rate, package_dirs=opts.package_dirs)
-    res.compiled = compiled = compile_behaviour(b, copts, tl)
+    res.compiled = compiled = precompiled if precompiled is not None and opts.rate is None \
+        else compile_behaviour(b, copts, tl)
     res.diagnostics += compiled.diagnostics
     tr = compiled.trajectory
     if not compiled.ok or tr is None:

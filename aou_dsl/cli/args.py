@@ -175,6 +175,19 @@ def _render(p: argparse.ArgumentParser) -> None:
                    help="point looked at (default: halfway from the base to the goal)")
 
 
+def _editor(sub, c: dict[str, argparse.ArgumentParser]) -> None:
+    """``aouc fmt`` and ``aouc server``."""
+    c["fmt"] = fmt = sub.add_parser("fmt", help="lay .aou files out canonically, comments kept")
+    fmt.add_argument("paths", nargs="+", metavar="PATH", help=".aou files or folders")
+    fmt.add_argument("--check", action="store_true",
+                     help="write nothing; exit 1 when a file would change")
+    fmt.add_argument("--diff", action="store_true",
+                     help="write nothing; print the changes, exit 1 when there are some")
+    c["server"] = srv = sub.add_parser(
+        "server", help="the language server for editors, on stdio (needs the `lsp` extra)")
+    _robot(srv)
+
+
 def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     c = {}
     c["lint"] = lint = sub.add_parser(
@@ -286,6 +299,7 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     stu.add_argument("--compare", metavar="OTHER.aou",
                      help="show a second behaviour, ghosted, on the same clock")
     _robot(stu)
+    _editor(sub, c)
     c["rules"] = rules = sub.add_parser("rules", help="list the diagnostic codes, or explain some")
     rules.add_argument("codes", nargs="*", metavar="CODE")
     rules.add_argument("--format", choices=("text", "json"), default="text")

@@ -17,20 +17,14 @@ from collections.abc import Callable, Sequence
 from ..core.codes import C306, C311
 from ..core.diagnostics import RULES, AouError, Diagnostic, Severity, Span
 from ..core.rules import category
+from ..editor import cmd_server
 from .args import EXIT_ERRORS, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, build_parser
-from .report import format_github, format_json, format_suppressed, format_text
+from .fmt import cmd_fmt
+from .report import format_json, format_suppressed
+from .report import print_diagnostics as _print_diags
 from .tools import cmd_robot, cmd_synth
 
 __all__ = ["EXIT_ERRORS", "EXIT_OK", "EXIT_USAGE", "main"]
-
-
-def _print_diags(diags: list[Diagnostic], fmt: str = "text",
-                 sources: dict[str, str] | None = None, stream=None) -> None:
-    stream = stream or sys.stderr
-    for d in diags:
-        text = format_github(d) if fmt == "github" else format_text(
-            d, (sources or {}).get(d.span.path))
-        print(text, file=stream)
 
 
 def _exit_for(diags: list[Diagnostic]) -> int:
@@ -365,6 +359,7 @@ _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "compile": _cmd_compile, "check": _cmd_check, "measure": _cmd_measure,
     "plot": _cmd_plot, "render": _cmd_render, "variants": _cmd_variants,
     "robot": cmd_robot, "synth": cmd_synth, "studio": _cmd_studio,
+    "fmt": cmd_fmt, "server": cmd_server,
 }
 
 

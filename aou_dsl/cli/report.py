@@ -5,10 +5,12 @@ from __future__ import annotations
 import functools
 import json
 import math
+import sys
 
 from ..core.diagnostics import Diagnostic
 
 __all__ = [
+    "print_diagnostics",
     "format_check",
     "format_github",
     "format_json",
@@ -160,3 +162,14 @@ def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = 
                  f"V={m.cv.V:+.2f}")
     lines.append(point)
     return "\n".join(lines)
+
+
+def print_diagnostics(diags: list[Diagnostic], fmt: str = "text",
+                 sources: dict[str, str] | None = None, stream=None) -> None:
+    """Each diagnostic on ``stream`` (standard error), as text with its source line, or
+    as a GitHub annotation."""
+    stream = stream or sys.stderr
+    for d in diags:
+        text = format_github(d) if fmt == "github" else format_text(
+            d, (sources or {}).get(d.span.path))
+        print(text, file=stream)

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.codes import C303, C304, C305, C308, C309, V124
-from ..core.diagnostics import AouError, Diagnostic, diag, has_errors
+from ..core.diagnostics import AouError, Diagnostic, Fix, diag, has_errors
 from ..core.memo import Keyed
 from ..core.trajectory import Trajectory
 from ..lang.ir import Behaviour
@@ -205,7 +205,8 @@ def _too_fast(code: str, fail: TimingFailure, ep: Episode, edit: str | None,
     """C308 or C309: the limit a shiver or a tilt exceeds; the hint is the edit that
     fits (the value the message gives), when there is one."""
     return diag(code, fail.reason, ep.span, hint=f"write `{edit}`" if edit else None,
-                joint=fail.joint, limit=fail.limit, **fields)
+                joint=fail.joint, limit=fail.limit, **fields,
+                fix=Fix(ep.span, edit, edit.split("=")[0]) if edit else None)
 
 
 def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),

@@ -14,6 +14,7 @@ from .rules import RULES, Rule, Severity
 __all__ = [
     "AouError",
     "Diagnostic",
+    "Fix",
     "RULES",
     "Rule",
     "Severity",
@@ -50,6 +51,19 @@ class Span:
 
 
 @dataclass(frozen=True, slots=True)
+class Fix:
+    """A hint that is an edit: write ``text`` in place of the source at ``span``.
+
+    With ``key`` (C308, C309: ``f=1.4Hz``), ``span`` is the statement's and the edit sets
+    that key in it: the written ``key=...`` is replaced, or ``text`` is added after the
+    statement's last argument (the compiler has the statement, not its arguments)."""
+
+    span: Span
+    text: str
+    key: str | None = None
+
+
+@dataclass(frozen=True, slots=True)
 class Diagnostic:
     """One problem found in one place.
 
@@ -60,6 +74,7 @@ class Diagnostic:
         span: where in the source; for trajectories, the file and (line 0) no position.
         hint: how to fix it, where one helps.
         fields: structured data for machine consumers (JSON output).
+        fix: the hint as an edit, where it is one (editors apply it; not printed).
     """
 
     code: str
@@ -68,6 +83,7 @@ class Diagnostic:
     span: Span
     hint: str | None = None
     fields: dict[str, Any] = field(default_factory=dict)
+    fix: Fix | None = None
 
     @property
     def rule(self) -> Rule:
@@ -102,6 +118,16 @@ class AouError(Exception):
         return (type(self), (self.diagnostics,))
 
 
+def degree_fix(text: str, at: int, span: Span, n: str, sign: str) -> Fix | None:
+    """`20°` (or `20 °`) as an edit, `20deg`: ``n`` is the number before the sign at
+    offset ``at`` of ``text``, whose span is ``span``."""
+    before = text[:at].rstrip(" \t")
+    if sign not in "°º" or not n or not before.endswith(n):
+        return None
+    col = span.col - (at - (len(before) - len(n)))
+    return Fix(Span(span.path, span.line, col, span.line, span.col + 1), f"{n}deg")
+
+
 def has_errors(diagnostics: list[Diagnostic]) -> bool:
     return any(d.severity is Severity.ERROR for d in diagnostics)
 
@@ -115,8 +141,9 @@ def diag(
     *,
     hint: str | None = None,
     severity: Severity | None = None,
+    fix: Fix | None = None,
     **fields: Any,
 ) -> Diagnostic:
     """Build a diagnostic of rule ``code``, with the rule's severity unless overridden."""
     rule = RULES[code]
-    return Diagnostic(code, severity or rule.severity, message, span, hint, dict(fields))
+    return Diagnostic(code, severity or rule.severity, message, span, hint, dict(fields), fix)

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field, replace
 from .ir import State
 
 __all__ = [
+    "DEFINITIONS",
     "REGISTRY",
     "Aggregate",
     "Descriptor",
@@ -126,6 +127,29 @@ REGISTRY: dict[str, Descriptor] = {d.name: d for d in (
                abs_tol=0.5, no_effect=(_F,)),
 )}
 
+
+#: What each descriptor measures, in docs/model.md's words (its table of descriptors):
+#: what an editor shows on hover.
+DEFINITIONS = {
+    "approach_acceleration": "peak magnitude of the end-effector's translational "
+    "acceleration over all approach episodes (episodes in which the goal distance "
+    "decreases)",
+    "pause_count": "number of pauses: holds with every joint velocity zero",
+    "pause_duration": "how long a pause lasts",
+    "retreat_count": "number of retreat episodes (moving away from the goal) that start "
+    "and end at a pause",
+    "retreat_distance": "distance the end-effector covers in one retreat episode",
+    "retreat_acceleration": "peak magnitude of the translational acceleration over the "
+    "retreat episodes",
+    "horizontal_gaze": "angle between `proj_H(g_0)` and `proj_H(g_i)`, i the pause that "
+    "ends a gaze episode",
+    "vertical_gaze": "the same angle in the vertical plane",
+    "tilt_angle": "amplitude of the end-effector's roll about its forward (z) axis in one "
+    "tilt episode",
+    "tilt_velocity": "the tilt angle divided by the tilt episode's duration",
+    "shiver_amplitude": "peak-to-peak amplitude of the fast oscillation of a redundant "
+    "joint (one the rest of the motion does not use) about its axis",
+}
 
 _INDEX = {name: i for i, name in enumerate(REGISTRY)}
 

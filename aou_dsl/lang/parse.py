@@ -21,7 +21,7 @@ import lark
 from lark import Lark, Token, Transformer
 
 from ..core.codes import S001, S002, S003
-from ..core.diagnostics import AouError, Span, diag
+from ..core.diagnostics import AouError, Fix, Span, degree_fix, diag
 from ..core.units import parse_quantity
 
 __all__ = [
@@ -321,7 +321,7 @@ def _unexpected_character(path: str, text: str, err: lark.exceptions.UnexpectedC
     at = err.pos_in_stream
     ch = text[at] if at is not None and at < len(text) else "?"
     span = Span.point(path, err.line, err.column)
-    hint = None
+    hint = fix = None
     shown = f"`{ch}`"
     if ch == "{":
         hint = "a `{` only opens a `sequence { ... }` block"
@@ -329,10 +329,12 @@ def _unexpected_character(path: str, text: str, err: lark.exceptions.UnexpectedC
         what, hint = _LOOKALIKES[ch]
         shown = f"`{ch}` ({what}, U+{ord(ch):04X})"
         hint = hint.format(n=_number_before(text, at or 0) or "20")
+        fix = degree_fix(text, at or 0, span, _number_before(text, at or 0), ch)
     elif not ch.isprintable() or ch.isspace():
         shown = f"U+{ord(ch):04X} (an invisible character)"
         hint = "delete it, or replace it with an ordinary space"
-    return AouError(diag(S003, f"unexpected character {shown}", span, hint=hint, found=ch))
+    return AouError(diag(S003, f"unexpected character {shown}", span, hint=hint, found=ch,
+                         fix=fix))
 
 
 #: `1,5s`: a comma between the digits of a number, with what follows it up to its unit.
@@ -357,11 +359,11 @@ def _comma(path: str, text: str, tok: Token) -> AouError | None:
     m = _DECIMAL_COMMA.match(text, start)
     if m and m.start(0) == start and text[at - 1:at].isdigit():
         written, meant = m.group(0), f"{m.group(1)}.{m.group(2)}"
+        where = Span(path, tok.line or 1, (tok.column or 1) - (at - start), tok.line or 1,
+                     (tok.column or 1) + len(written) - (at - start))
         return AouError(diag(
             S001, f"unexpected `,` in `{written}`: the decimal mark is a point",
-            Span(path, tok.line or 1, (tok.column or 1) - (at - start), tok.line or 1,
-                 (tok.column or 1) + len(written) - (at - start)),
-            hint=f"write `{meant}`", found=","))
+            where, hint=f"write `{meant}`", found=",", fix=Fix(where, meant)))
     if _number_before(text, at):
         return AouError(diag(S001, "unexpected `,` after a number", _tok_span(path, tok),
                              hint="commas separate the numbers of a vector, written in "

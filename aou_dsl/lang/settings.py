@@ -14,7 +14,7 @@ from ..core.robot_specs import ROBOT_FILE_TYPES, ROBOTS
 from ..core.units import Dim
 from .ir import DEFAULTS, Effort, Settings
 from .parse import Quantity, Statement, Vector, Word
-from .values import Args, Ctx, did_you_mean, positive, si, split_args
+from .values import Args, Ctx, did_you_mean, fix_word, positive, si, split_args
 
 __all__ = ["MAX_GOAL_DISTANCE", "SETTINGS", "read_settings"]
 
@@ -39,6 +39,7 @@ def _robot(ctx: Ctx, st: Statement, args: Args) -> Any:
         ctx.error(V109, f"unknown robot `{word.text}`: expected one of "
                   f"{', '.join(ROBOTS)}, or a quoted path to a robot file",
                   word.span, hint=did_you_mean(word.text, ROBOTS), found=word.text,
+                  fix=fix_word(word.span, word.text, ROBOTS),
                   valid=list(ROBOTS))
         return None
     return word.text

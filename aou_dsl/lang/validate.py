@@ -18,7 +18,7 @@ from .parse import Colon, SequenceBlock, Statement, SyntaxTree, Word
 from .primitives import KINDS
 from .settings import SETTINGS, read_settings
 from .timeline import Timeline
-from .values import Ctx, Reader, did_you_mean
+from .values import Ctx, Reader, did_you_mean, fix_word
 from .whole_file import MAX_EPISODES, MAX_MOTION_TIME, check_whole
 
 __all__ = ["KEYWORDS", "MAX_EPISODES", "MAX_MOTION_TIME", "Validated", "validate",
@@ -58,7 +58,8 @@ def _header(ctx: Ctx, st: Statement) -> tuple[str | None, State | None]:
     if sw.text not in State.__members__.values():
         ctx.error(V114, f"unknown state `{sw.text}`: expected one of "
                   f"{', '.join(s.value for s in State)}", sw.span,
-                  hint=did_you_mean(sw.text, [s.value for s in State]), found=sw.text)
+                  hint=did_you_mean(sw.text, [s.value for s in State]), found=sw.text,
+                  fix=fix_word(sw.span, sw.text, [s.value for s in State]))
         return name, None
     return name, State(sw.text)
 
@@ -89,7 +90,8 @@ def _block(ctx: Ctx, f: _File, item: SequenceBlock) -> None:
             ctx.error(V101 if st.keyword not in KEYWORDS else V113,
                       f"`{st.keyword}` is not a primitive; a sequence holds only "
                       f"{', '.join(KINDS)}", st.keyword_span,
-                      hint=did_you_mean(st.keyword, KINDS))
+                      hint=did_you_mean(st.keyword, KINDS),
+                      fix=fix_word(st.keyword_span, st.keyword, KINDS))
             continue
         p = _primitive(ctx, st, in_sequence=True)
         if p is not None:
@@ -130,7 +132,8 @@ def _statement(ctx: Ctx, f: _File, st: Statement, first: bool) -> None:
     else:
         ctx.error(V101, f"unknown statement `{st.keyword}`", st.keyword_span,
                   hint=did_you_mean(st.keyword, KEYWORDS) or
-                  f"statements are {', '.join(KEYWORDS)}", found=st.keyword)
+                  f"statements are {', '.join(KEYWORDS)}", found=st.keyword,
+                  fix=fix_word(st.keyword_span, st.keyword, KEYWORDS))
 
 
 def validate_tree(tree: SyntaxTree) -> Validated:

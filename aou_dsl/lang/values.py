@@ -14,11 +14,11 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..core.codes import V102, V103, V104, V105, V111, V112, V113, V116, V118, V123
-from ..core.diagnostics import Diagnostic, Span, diag
+from ..core.diagnostics import Diagnostic, Fix, Span, diag
 from ..core.units import UNITS, Dim, as_unit, suggest_unit, units_for
 from .parse import Colon, KeyVal, Quantity, Statement, Vector, Word
 
-__all__ = ["Ctx", "Reader", "did_you_mean", "si", "split_args"]
+__all__ = ["Ctx", "Reader", "did_you_mean", "fix_word", "si", "split_args"]
 
 _REPEAT = re.compile(r"^x(\d+)$")
 #: What looks like a repeat count but is not a whole number >= 0: `x-1`, `x2b`, and
@@ -36,6 +36,14 @@ def did_you_mean(word: str, choices: Iterable[str]) -> str | None:
 
     close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
     return f"did you mean `{close[0]}`?" if close else None
+
+
+def fix_word(span: Span, word: str, choices: Iterable[str]) -> Fix | None:
+    """:func:`did_you_mean` as an edit of the word at ``span``."""
+    import difflib
+
+    close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
+    return Fix(span, close[0]) if close else None
 
 
 @dataclass
@@ -71,7 +79,8 @@ def si(ctx: Ctx, q: Quantity, dim: Dim, *, what: str, bare_unit: str | None) -> 
         meant = suggest_unit(q.unit, dim)
         ctx.error(V104, f"unknown unit `{q.unit}` in `{q.text}`: expected {_a(dim)} ({fits})",
                   q.span, hint=f"did you mean `{q.text[:-len(q.unit)]}{meant}`?" if meant
-                  else None, found=q.unit)
+                  else None, found=q.unit,
+                  fix=Fix(q.span, f"{q.text[:-len(q.unit)]}{meant}") if meant else None)
         return None
     found_dim, factor = UNITS[q.unit]
     if found_dim is not dim:
@@ -174,19 +183,24 @@ def _bad_count(ctx: Ctx, text: str, span: Span, _: int) -> None:
         hint = f"write `x{int(n)}`"
     else:
         hint = "write e.g. `x2`"
+    fix = Fix(span, f"x{int(n)}") if math.isfinite(n) and n == int(n) and n >= 0 else None
     ctx.error(V116, f"a repeat count is a whole number of episodes, 0 or more: found "
-              f"`{text}`", span, hint=hint, found=text)
+              f"`{text}`", span, hint=hint, found=text, fix=fix)
 
 
 def _key(ctx: Ctx, st: Statement, a: KeyVal, allowed: list[str], out: Args) -> None:
     if a.key not in allowed:
         keys = ", ".join(f"{k}=" for k in allowed) or "no keys"
         hint = did_you_mean(a.key, allowed)
+        at = a.span
+        fix = fix_word(Span(at.path, at.line, at.col, at.line, at.col + len(a.key)), a.key,
+                       allowed)
         if a.key == "for" and st.keyword == "shiver":  # `for` is a word, not a key
             keys += " and `for DURATION`"
             hint = f"write `for {a.value.text}`, with a space, not `=`"
+            fix = Fix(a.span, f"for {a.value.text}")
         ctx.error(V112, f"`{st.keyword}` takes {keys}; found `{a.key}=`", a.span,
-                  hint=hint, found=a.key)
+                  hint=hint, found=a.key, fix=fix)
     elif a.key in out.keys:
         ctx.error(V111, f"`{a.key}=` is given twice", a.span)
     else:
@@ -209,8 +223,9 @@ class Reader:
         self.pos = self.args.positional
         self.count = 1 if self.args.count is None else self.args.count
 
-    def error(self, code: str, message: str, span: Span, hint: str | None = None) -> None:
-        self.ctx.error(code, message, span, hint)
+    def error(self, code: str, message: str, span: Span, hint: str | None = None,
+              fix: Fix | None = None) -> None:
+        self.ctx.error(code, message, span, hint, fix=fix)
 
     def _usage_error(self, what: str, first: object) -> None:
         found = f", found `{first.text}`" if isinstance(first, Quantity | Word) else ""
@@ -263,7 +278,8 @@ class Reader:
             self.pos.remove(unit)  # `1.25 s`: one slip, one diagnostic
             self.error(V103, f"{what} `{q.text}` needs a unit glued to it: found "
                        f"`{q.text} {unit.text}`", q.span.to(unit.span),
-                       hint=f"write `{q.text}{as_unit(unit.text)}`, without a space")
+                       hint=f"write `{q.text}{as_unit(unit.text)}`, without a space",
+                       fix=Fix(q.span.to(unit.span), f"{q.text}{as_unit(unit.text)}"))
             return None
         return si(self.ctx, q, dim, what=what, bare_unit=None)
 
@@ -313,8 +329,21 @@ class Reader:
             if hint and "repeat count" in hint:  # `x 3`: one slip, one diagnostic
                 skip.append(self._after(a))
             self.error(V113, f"unexpected argument `{text}` to `{self.st.keyword}`; "
-                       f"usage: {self.kind.usage}", a.span, hint=hint)
+                       f"usage: {self.kind.usage}", a.span, hint=hint, fix=self._slip_fix(a))
         return len(self.ctx.diags) == self.n_before
+
+    def _slip_fix(self, a: object) -> Fix | None:
+        """:meth:`_slip`'s hint as an edit of the two arguments it joins."""
+        m = re.match(r"write (the repeat count as )?`([^`]*)`, without a space",
+                     self._slip(a) or "")
+        if m is None:
+            return None
+        args = list(self.st.args)
+        i = next((k for k, b in enumerate(args) if b is a), 0)
+        first, last = (a, self._after(a)) if m.group(1) else (args[i - 1] if i else None, a)
+        if first is None or last is None:
+            return None
+        return Fix(first.span.to(last.span), m.group(2))  # type: ignore[attr-defined]
 
     def _slip(self, a: object) -> str | None:
         """What a left-over argument most likely meant: a unit written apart from its

@@ -1,0 +1,65 @@
+"""Quick fixes (a diagnostic's hint, where it is an edit) and whole-file formatting."""
+
+from __future__ import annotations
+
+from lsprotocol import types
+
+from ..core.diagnostics import Diagnostic, Fix, Span
+from . import lsp_engine as engine
+from .convert import lines_of, to_lsp, to_range, utf16_col
+from .state import Document
+from .text import tokens_of
+
+__all__ = ["code_actions", "format_edits", "resolve"]
+
+
+def resolve(fix: Fix, lines: list[str]) -> tuple[Span, str]:
+    """The span to replace and the text to write. A fix with a ``key`` sets that key
+    in the statement at its span: over the written ``key=value``, else after the
+    statement's last argument."""
+    if fix.key is None:
+        return fix.span, fix.text
+    s = fix.span
+    if s.line != s.end_line or not 1 <= s.line <= len(lines):
+        return Span(s.path, s.end_line, s.end_col, s.end_line, s.end_col), " " + fix.text
+    toks = [t for t in tokens_of(lines[s.line - 1]) if s.col - 1 <= t.start < s.end_col - 1]
+    for i, t in enumerate(toks):
+        if t.text == fix.key and i + 2 < len(toks) and toks[i + 1].text == "=":
+            return Span(s.path, s.line, t.start + 1, s.line, toks[i + 2].end + 1), fix.text
+    return Span(s.path, s.line, s.end_col, s.line, s.end_col), " " + fix.text
+
+
+def _overlaps(a: types.Range, b: types.Range) -> bool:
+    return (a.start.line, a.start.character) <= (b.end.line, b.end.character) and \
+        (b.start.line, b.start.character) <= (a.end.line, a.end.character)
+
+
+def _action(doc: Document, d: Diagnostic) -> types.CodeAction:
+    assert d.fix is not None
+    span, text = resolve(d.fix, doc.lines)
+    title = f"{d.code}: write `{text.strip()}`"
+    edit = types.TextEdit(range=to_range(span, doc.lines), new_text=text)
+    return types.CodeAction(
+        title=title, kind=types.CodeActionKind.QuickFix, is_preferred=True,
+        diagnostics=[to_lsp(d, doc.lines)],
+        edit=types.WorkspaceEdit(changes={doc.uri: [edit]}))
+
+
+def code_actions(doc: Document, rng: types.Range) -> list[types.CodeAction]:
+    """A quick fix for each diagnostic at ``rng`` whose hint is an edit."""
+    return [_action(doc, d) for d in doc.diagnostics
+            if d.fix is not None and d.fix.span.path == doc.path
+            and _overlaps(to_range(d.span, doc.lines), rng)]
+
+
+def format_edits(doc: Document) -> list[types.TextEdit] | None:
+    """``aouc fmt``'s output as one edit of the whole document; none when it is already
+    formatted, None while it has a syntax error."""
+    formatted = engine.format_text(doc.text, doc.path)
+    if formatted is None:
+        return None
+    if formatted == doc.text:
+        return []
+    lines = lines_of(doc.text)
+    end = types.Position(len(lines) - 1, utf16_col(lines[-1], len(lines[-1])))
+    return [types.TextEdit(range=types.Range(types.Position(0, 0), end), new_text=formatted)]
