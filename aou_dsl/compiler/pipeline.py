@@ -23,6 +23,7 @@ from ..lang.layout import layout
 from ..lang.primitives import KINDS, MIN_SHIVER_F
 from ..lang.timeline import Episode, Pose, Timeline
 from ..robot.geometry import ReachFrame, reach_frame
+from ..robot.identity import frame_definition
 from ..robot.ik import IKStatus, solve_path
 from ..robot.kinematics import ArmModel
 from ..robot.load import load_arm
@@ -377,4 +378,5 @@ def _sample(arm: ArmModel, b: Behaviour, tl: Timeline,
     episodes = tuple((e.kind, float(bounds[i]), float(bounds[i + 1]))
                      for i, e in enumerate(tl.episodes))
     return Trajectory(t, q, arm.joint_names, spec.name, spec.ee_frame, goal, qd, qdd,
-                      episodes, title=b.name, package_dirs=package_dirs)
+                      episodes, title=b.name, package_dirs=package_dirs,
+                      ee_definition=frame_definition(spec))
