@@ -260,7 +260,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
                         "C304", f"{ep.kind} reaches {fail.achieved:.3g} {unit}, not the "
                         f"declared {fail.wanted:.3g} {unit}: {fail.reason}",
                         ep.span, joint=fail.joint, achieved=fail.achieved,
-                        declared=fail.wanted))
+                        declared=fail.wanted, descriptor=f"{ep.kind}_acceleration"))
             lap("timing")
             segments.append(seg)
             q = ik.q[-1]
