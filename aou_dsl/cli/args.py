@@ -236,7 +236,11 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
         "measure", help="measure the eleven descriptors of a trajectory")
     meas.add_argument("path", metavar="FILE", help="a trajectory .json/.npz, or a .csv")
     _recording(meas)
-    meas.add_argument("--format", choices=("table", "json"), default="table")
+    meas.add_argument("--against", metavar="FILE.aou",
+                      help="judge the motion against this behaviour: each descriptor "
+                      "declared vs measured with its tolerance; exit 1 when one is outside")
+    meas.add_argument("--format", choices=("table", "json", "github"), default="table",
+                      help="github: annotations (with --against)")
     c["robot"] = rob = sub.add_parser(
         "robot", help="show what aou knows or derives of a robot (frames, limits, posture)")
     rob.add_argument("robot", nargs="?", metavar="NAME|PATH",

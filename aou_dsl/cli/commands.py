@@ -206,6 +206,10 @@ def _cmd_measure(args: argparse.Namespace) -> int:
     from ..lang.cv import missing_descriptors
     from .report import format_measured
 
+    if args.against:
+        from .against import cmd_measure_against
+
+        return cmd_measure_against(args, _read_kw(args))
     tr = read_trajectory(args.path, **_read_kw(args))
     m = measure(tr)
     missing = missing_descriptors(tr.goal)  # what the C-V point could not use
