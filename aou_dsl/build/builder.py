@@ -13,7 +13,7 @@ import time
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from ..core.diagnostics import AouError, Diagnostic, Span, diag, has_errors
+from ..core.diagnostics import AouError, Diagnostic, Severity, Span, diag, has_errors
 from ..core.options import BuildOptions, SceneOptions
 from ..lang.linter import FileResult, lint_file, lint_source
 
@@ -163,7 +163,7 @@ def build_lint(lint: FileResult, options: BuildOptions | None = None,
 def _build_lint(lint: FileResult, options: BuildOptions | None, changes: dict
                 ) -> BuildResult:
     from ..compiler.output import document_header
-    from ..compiler.pipeline import CompileOptions, compile_behaviour
+    from ..compiler.pipeline import CompileOptions
     from ..lang.declared import declared
     from ..lang.descriptors import compare
     from ..measuring.measured import measure
@@ -181,22 +181,15 @@ def _build_lint(lint: FileResult, options: BuildOptions | None, changes: dict
         return res
     copts = CompileOptions(package_dirs=opts.package_dirs) if opts.rate is None else \
         CompileOptions(rate=opts.rate, package_dirs=opts.package_dirs)
-    res.compiled = compiled = compile_behaviour(b, copts, tl)
-    res.diagnostics += compiled.diagnostics
-    tr = compiled.trajectory
-    if not compiled.ok or tr is None:
+    attempt, checks = _compile_checked(lint, b, tl, copts, opts)
+    res.compiled = compiled = attempt.compiled
+    res.checks = attempt.checks
+    res.diagnostics += attempt.diagnostics
+    tr = compiled.trajectory if compiled is not None else None
+    if checks is None or compiled is None or tr is None:
         res.seconds = time.perf_counter() - start
         return res
-    checks_json: dict[str, Any] = {"kinematic": "skipped (--no-check)"}
-    if opts.check:
-        from ..robot import load_robot
-
-        checks_json["collision_checked"] = load_robot(b.settings.robot,
-                                                      opts.package_dirs).collision
-        checks_json |= _check(res, copts.rate, opts.scene, opts.controller)
-        if has_errors(res.diagnostics):
-            res.seconds = time.perf_counter() - start
-            return res
+    checks_json: dict[str, Any] = checks
     try:
         res.measured = m = measure(tr.with_(path=lint.path))
     except AouError as err:  # measure refuses to report: this file fails, not the batch
@@ -218,6 +211,73 @@ def _build_lint(lint: FileResult, options: BuildOptions | None, changes: dict
         rate=copts.rate)
     res.seconds = time.perf_counter() - start
     return res
+
+
+def _attempt(lint: FileResult, b, tl, copts, opts: BuildOptions
+             ) -> tuple[BuildResult, dict[str, Any] | None]:
+    """One compile and, unless ``opts.check`` is False, its checks: a result holding
+    their diagnostics, and the document's ``checks`` (None when either failed)."""
+    from ..compiler.pipeline import compile_behaviour
+
+    out = BuildResult(lint.path, lint)
+    out.compiled = compiled = compile_behaviour(b, copts, tl)
+    out.diagnostics += compiled.diagnostics
+    if not compiled.ok or compiled.trajectory is None:
+        return out, None
+    checks: dict[str, Any] = {"kinematic": "skipped (--no-check)"}
+    if opts.check:
+        from ..robot import load_robot
+
+        checks["collision_checked"] = load_robot(b.settings.robot,
+                                                 opts.package_dirs).collision
+        checks |= _check(out, copts.rate, opts.scene, opts.controller)
+        if has_errors(out.diagnostics):
+            return out, None
+    return out, checks
+
+
+def _blames_start(d: Diagnostic) -> bool:
+    """An error another joint solution of the start pose may avoid: the start pose
+    beyond a joint limit, IK at a joint limit on the way, a failed check (links that
+    touch, a joint beyond its range)."""
+    return d.severity is Severity.ERROR and (
+        d.code in ("C302", "C306") or (d.code in ("C301", "C303") and d.fields.get("time")
+                                       == 0.0))
+
+
+def _compile_checked(lint: FileResult, b, tl, copts, opts: BuildOptions
+                     ) -> tuple[BuildResult, dict[str, Any] | None]:
+    """:func:`_attempt`; when it fails in a way the start's joint solution may be to
+    blame, again from each other solution of the start pose
+    (:func:`~aou_dsl.compiler.branches.start_alternatives`) until one passes. When none
+    does, the first failure is said, with what was tried."""
+    from dataclasses import replace
+
+    from ..compiler.branches import start_alternatives
+
+    first, checks = _attempt(lint, b, tl, copts, opts)
+    if checks is not None or not any(_blames_start(d) for d in first.diagnostics):
+        return first, checks
+    tr = first.compiled.trajectory if first.compiled is not None else None
+    seeds = start_alternatives(b, tl, opts.package_dirs, None if tr is None else tr.q[0])
+    for k, seed in enumerate(seeds, 1):
+        other, checks = _attempt(lint, b, tl, replace(copts, start_seed=seed), opts)
+        if checks is not None:
+            checks["start_configuration"] = {
+                "q": list(seed), "why": f"solution {k} of {len(seeds)} other joint "
+                "solutions of the start pose; the first failed: "
+                + "; ".join(d.message for d in first.diagnostics if _blames_start(d))[:300]}
+            return other, checks
+    tried = (f"tried the start pose from {len(seeds)} other joint solution(s) (other IK "
+             "branches and, on a 7-joint arm, other points of its redundancy, from "
+             "postures turned at one joint): none passes" if seeds else
+             "no other joint solution of the start pose was found (IK from postures "
+             "turned at one joint)")
+    first.diagnostics = [Diagnostic(d.code, d.severity, d.message, d.span,
+                                    f"{d.hint}; {tried}" if d.hint else tried,
+                                    {**d.fields, "start_solutions_tried": len(seeds)})
+                         if _blames_start(d) else d for d in first.diagnostics]
+    return first, None
 
 
 def build_source(text: str, path: str = "<string>", options: BuildOptions | None = None,

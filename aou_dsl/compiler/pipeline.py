@@ -57,12 +57,15 @@ DEFAULT_RATE = 250.0  # Hz
 @dataclass(frozen=True)
 class CompileOptions:
     """Options of ``aouc compile``: sample ``rate`` [Hz], IK ``step_*`` sizes, the folders
-    of the robot's ``package://`` meshes."""
+    of the robot's ``package://`` meshes; ``start_seed``, a joint configuration [rad] the
+    start pose is solved from instead of the robot's posture (another IK branch,
+    :mod:`.branches`)."""
 
     rate: float = DEFAULT_RATE
     step_length: float = STEP_LENGTH
     step_angle: float = STEP_ANGLE
     package_dirs: tuple[str, ...] = ()
+    start_seed: tuple[float, ...] | None = None
 
 
 @dataclass
@@ -99,17 +102,20 @@ def _waypoints(ep: Episode, frame: ReachFrame, opts: CompileOptions
     return s, targets
 
 
-def _start_configuration(arm: ArmModel, frame: ReachFrame, pose: Pose):
-    """IK of the start pose, by continuation from the robot's posture. The same reach
-    always starts the same way, so the result is kept for recompilations."""
-    key = (arm.spec.name, arm.frame_id, frame.goal.tobytes(), frame.R0.tobytes(), pose)
-    return _solved_start(Keyed(key, (arm, frame.target(pose))))
+def _start_configuration(arm: ArmModel, frame: ReachFrame, pose: Pose,
+                         seed: tuple[float, ...] | None = None):
+    """IK of the start pose, by continuation from the robot's posture (or from
+    ``seed``). The same reach always starts the same way, so the result is kept for
+    recompilations."""
+    key = (arm.spec.name, arm.frame_id, frame.goal.tobytes(), frame.R0.tobytes(), pose,
+           seed)
+    return _solved_start(Keyed(key, (arm, frame.target(pose), seed)))
 
 
 @functools.lru_cache(maxsize=64)
 def _solved_start(probe: Keyed):
-    arm, target = probe.value
-    return solve_path(arm, [target])
+    arm, target, seed = probe.value
+    return solve_path(arm, [target], None if seed is None else np.array(seed, float))
 
 
 def _ik_diag(ep: Episode, status: IKStatus, t: float, joint: str | None, b: Behaviour,
@@ -203,7 +209,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
     segments: list[PathSegment | JointSegment] = []
     t_planned = 0.0
     start_pose = tl.episodes[0].start if tl.episodes else Pose(b.settings.start)
-    first = _start_configuration(arm, frame, start_pose)
+    first = _start_configuration(arm, frame, start_pose, options.start_seed)
     if first.failure is not None:
         res.diagnostics.append(start_diagnostic(
             arm, frame, b, first.failure, functools.partial(_follows, arm, frame, options)))
