@@ -43,6 +43,8 @@ class BuildResult:
     #: The document but its samples (see :attr:`document`); None when the build failed.
     header: dict | None = None
     seconds: float = 0.0
+    #: With ``fit``: the file's text with the fitted values (None: nothing was fitted).
+    fitted_source: str | None = None
     _document: dict | None = field(default=None, init=False, repr=False, compare=False)
 
     @property
@@ -155,21 +157,25 @@ def build_lint(lint: FileResult, options: BuildOptions | None = None,
     the checks (the robot's joint jerk limit at 1 kHz is always checked)."""
     from ..core.repeats import said_once
 
-    res = _build_lint(lint, options, changes)
+    opts = (options or BuildOptions()).replace(**changes) if changes else (
+        options or BuildOptions())
+    if opts.fit:
+        from .fit_loop import fit_loop
+
+        res = fit_loop(lint, lambda linted: _build_lint(linted, opts))
+    else:
+        res = _build_lint(lint, opts)
     res.diagnostics = said_once(res.diagnostics)
     return res
 
 
-def _build_lint(lint: FileResult, options: BuildOptions | None, changes: dict
-                ) -> BuildResult:
+def _build_lint(lint: FileResult, opts: BuildOptions) -> BuildResult:
     from ..compiler.output import document_header
     from ..compiler.pipeline import CompileOptions
     from ..lang.declared import declared
     from ..lang.descriptors import compare
     from ..measuring.measured import measure
 
-    opts = (options or BuildOptions()).replace(**changes) if changes else (
-        options or BuildOptions())
     start = time.perf_counter()
     res = BuildResult(lint.path, lint, list(lint.diagnostics))
     res.diagnostics += _with_robot(lint, opts.robot)

@@ -12,6 +12,7 @@ import functools
 import math
 import time
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -27,6 +28,7 @@ from ..robot.identity import frame_definition
 from ..robot.ik import IKStatus, solve_path
 from ..robot.kinematics import ArmModel
 from ..robot.load import load_arm
+from .fitting import hint_edit
 from .start import CODES, start_diagnostic
 from .timing import (
     JointSegment,
@@ -226,9 +228,14 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
             seg, shiver_fail = shiver_segment(arm, q, ep.amplitude, ep.f, ep.duration)
             if shiver_fail is not None:
                 f_ok = shiver_fail.wanted
-                edit = f"f={f_ok:g}Hz" if f_ok and f_ok >= MIN_SHIVER_F else None
-                res.diagnostics.append(_too_fast("C308", shiver_fail, ep, edit,
-                                                 max_frequency=f_ok))
+                ok = bool(f_ok and f_ok >= MIN_SHIVER_F)
+                timed = any(getattr(n, "timed", False) for n in b.primitives
+                            if n.span == ep.span)
+                fields: dict[str, Any] = {"max_frequency": f_ok if ok else None,
+                                          "duration": ep.duration if timed else None,
+                                          "f": ep.f}
+                edit = hint_edit(diag("C308", "", ep.span, **fields)) if ok else None
+                res.diagnostics.append(_too_fast("C308", shiver_fail, ep, edit, **fields))
                 return res
             segments.append(seg)
         else:
@@ -250,8 +257,9 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
                 if tilt_fail is not None:
                     v_ok = tilt_fail.wanted
                     edit = f"v={v_ok:g}deg/s" if v_ok else None
-                    res.diagnostics.append(_too_fast("C309", tilt_fail, ep, edit,
-                                                     max_velocity=v_ok))
+                    res.diagnostics.append(_too_fast(
+                        "C309", tilt_fail, ep, edit, max_velocity=v_ok,
+                        declared_velocity=math.degrees(ep.path_length / ep.duration)))
                     return res
             else:
                 seg, fail = time_path(arm, s, ik.q, ep.a, ep.vmax,

@@ -25,7 +25,8 @@ PER_RUN = frozenset({"C313"})
 
 def _key(d: Diagnostic) -> tuple:
     s = d.span
-    return d.code, s.path, s.line, s.col, s.end_line, s.end_col, d.fields.get("check")
+    return (d.code, s.path, s.line, s.col, s.end_line, s.end_col, d.fields.get("check"),
+            d.fields.get("key"))
 
 
 def _rank(d: Diagnostic) -> float:

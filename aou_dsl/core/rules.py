@@ -256,7 +256,19 @@ _RULE_LIST = [
          "URDFs carry no acceleration limits; a robot description file (TOML) beside the URDF "
          "pins them (docs/robots.md says how).",
          "robot z1\napproach\npause 1s"),
+    Rule("C314", "fitted-value", _W,
+         "With --fit, a value the arm cannot give was changed to one it can: the "
+         "statement, the value declared and fitted, the joint and the limit that bind.",
+         "The fitted behaviour keeps its state and the order of its values (docs/robots.md "
+         "gives the rule); --write-fitted writes the file so the change is reviewed.",
+         "robot ur5\nshiver 6deg f=2.5Hz\npause 1s"),
     # --- R: reading trajectories -------------------------------------------------------
+    Rule("C314", "fitted-value", _W,
+         "With --fit, a value the arm cannot give was changed to one it can: the "
+         "statement, the value declared and fitted, the joint and the limit that bind.",
+         "The fitted behaviour keeps its state and the order of its values (docs/robots.md "
+         "gives the rule); --write-fitted writes the file so the change is reviewed.",
+         "robot ur5\nshiver 6deg f=2.5Hz\npause 1s"),
     # --- R: reading trajectories -------------------------------------------------------
     Rule("R401", "bad-trajectory", _E,
          "A trajectory file is not valid: missing keys or columns, non-increasing time, NaN.",
