@@ -118,3 +118,14 @@ def test_write_fitted_writes_the_fitted_file_and_never_over_its_input(tmp_path, 
     assert main(["compile", str(FEARFUL), "--robot", "ur5", "--fit", "--no-check",
                  "--write-fitted", str(FEARFUL), "-o", str(tmp_path / "g.json")]) == 2
     assert main(["compile", str(FEARFUL), "--write-fitted", str(out)]) == 2
+
+
+def test_check_fits_a_behaviour_before_its_replay(tmp_path, capsys):
+    out = tmp_path / "fitted.aou"
+    assert main(["check", str(FEARFUL), "--robot", "ur10", "--no-dynamic"]) == 1
+    capsys.readouterr()
+    assert main(["check", str(FEARFUL), "--robot", "ur10", "--no-dynamic", "--fit",
+                 "--write-fitted", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert " C314 " in err and "f=1.4Hz" in out.read_text()
+    assert main(["check", str(tmp_path / "x.json"), "--fit"]) == 2
