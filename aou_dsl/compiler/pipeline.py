@@ -229,10 +229,10 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
             if shiver_fail is not None:
                 f_ok = shiver_fail.wanted
                 ok = bool(f_ok and f_ok >= MIN_SHIVER_F)
-                timed = any(getattr(n, "timed", False) for n in b.primitives
-                            if n.span == ep.span)
+                node = next((n for n in b.primitives if n.span == ep.span), None)
+                timed = getattr(node, "timed", False)  # its `for`, as written
                 fields: dict[str, Any] = {"max_frequency": f_ok if ok else None,
-                                          "duration": ep.duration if timed else None,
+                                          "duration": node.duration if timed else None,
                                           "f": ep.f}
                 edit = hint_edit(diag("C308", "", ep.span, **fields)) if ok else None
                 res.diagnostics.append(_too_fast("C308", shiver_fail, ep, edit, **fields))
