@@ -149,3 +149,24 @@ def test_the_robot_schema_has_the_keys_a_description_may_have_and_accepts_aous_o
                 {"robot": "ur5", "joint_accel": -1}, {"robot": "ur5", "forward": "up"},
                 {"robot": "ur5", "goal": [1, 2]}, {"robot": "ur5", "colour": "red"}):
         assert _errors(v, bad), bad
+
+
+def test_aouc_measure_of_a_file_on_a_urdf_aou_does_not_know(built, tmp_path, capsys):
+    """The command a user runs: `aouc measure FILE.json --robot URDF`, the Z1's file
+    measured on the Z1's URDF copied out of its package (aou derives another frame for
+    it): the file's own frame is used and the behaviour measures as compiled."""
+    import example_robot_data as erd
+
+    from aou_dsl.cli.commands import main
+
+    sub = "z1_description/urdf/z1.urdf"
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_bytes(open(os.path.join(erd.getModelPath(sub), sub), "rb").read())
+    path = tmp_path / "curious.json"
+    path.write_bytes(encode(built["z1"].document, "json"))
+    assert main(["measure", str(path), "--robot", str(urdf), "--format", "json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    want = built["z1"].document["descriptors"]["measured"]
+    assert out["descriptors"]["horizontal_gaze"] == pytest.approx(want["horizontal_gaze"],
+                                                                  abs=0.05)
+    assert out["cv"]["state"] == "curious"
