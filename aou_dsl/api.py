@@ -51,7 +51,7 @@ def compile(path: Source | None = None, *, source: str | None = None,  # noqa: A
             robot: str | None = None, rate: float | None = None, check: bool = True,
             target_size: float = 0.05, table_height: float | None = 0.0,
             collision_check: bool = True, controller: str | None = None,
-            package_dirs: Sequence[Source] = (),
+            package_dirs: Sequence[Source] = (), fit: bool = False,
             options: BuildOptions | None = None) -> BuildResult:
     """Lint, compile, check and measure one behaviour.
 
@@ -66,6 +66,8 @@ def compile(path: Source | None = None, *, source: str | None = None,  # noqa: A
         controller: ``"franka"`` or ``"ur"``: also check that motion generator's rate and
             published limits (joint jerk at 1 kHz against the robot's is always checked).
         package_dirs: folders searched first for the robot's ``package://`` meshes.
+        fit: change what the arm cannot give to what it can (C314 warnings; the
+            result's ``fitted_source`` is the fitted file).
         options: all of the above in one :class:`~aou_dsl.core.options.BuildOptions`
             (when given, the other keywords are not read).
 
@@ -76,7 +78,7 @@ def compile(path: Source | None = None, *, source: str | None = None,  # noqa: A
     if options is None:
         options = BuildOptions(
             robot=robot, rate=rate, check=check, collision_check=collision_check,
-            controller=controller, package_dirs=package_dirs_of(package_dirs),
+            controller=controller, package_dirs=package_dirs_of(package_dirs), fit=fit,
             scene=SceneOptions(target_size=target_size, table_height=table_height))
     if source is not None:
         return build_source(source, os.fspath(path) if path is not None else "<string>",

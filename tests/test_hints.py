@@ -38,14 +38,13 @@ def _at(text: str, d) -> str:
 
 def _apply(text: str, d) -> str:
     """The file with the diagnostic's hint `write `k=VALUE`` applied to its statement."""
-    m = re.fullmatch(r"write `(\w+)=([0-9.]+)([A-Za-z/]+)`", d.hint or "")
+    from aou_dsl.compiler.fitting import apply_edit
+
+    m = re.fullmatch(r"write `((\w+)=([0-9.]+)([A-Za-z/]+)( for [0-9.]+s)?)`", d.hint or "")
     assert m, d.hint
-    key, value, unit = m.groups()
-    lines = text.split("\n")
-    i = d.span.line - 1
-    lines[i], n = re.subn(rf"\b{key}=\S+", f"{key}={value}{unit}", lines[i])
-    assert n == 1, lines[i]
-    return "\n".join(lines)
+    fixed = apply_edit(text, d.span, m.group(1))
+    assert fixed != text
+    return fixed
 
 
 def _next_up(x: float) -> float:

@@ -370,3 +370,22 @@ def test_the_robots_page_is_what_the_report_script_writes():
     out = subprocess.run([sys.executable, str(ROOT / "tools" / "robots_report.py"),
                           "--check"], capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
+
+
+def test_every_robot_of_example_robot_data_is_in_the_arms_table():
+    """The generated table (tools/every_arm.py) has one row per entry of the data
+    package, built-in arms with the status it is given, and every entry a status."""
+    import example_robot_data.robots_loader as rl
+
+    sys.path.insert(0, str(ROOT / "tools"))
+    try:
+        from every_arm import every_arm
+    finally:
+        sys.path.remove(str(ROOT / "tools"))
+    rows = [ln for ln in every_arm({"panda": "built in: P"}) if ln.startswith("| `")]
+    names = [ln.split("`")[1] for ln in rows]
+    assert names == sorted(rl.ROBOTS)
+    by = dict(zip(names, rows, strict=True))
+    assert by["panda"].endswith("| fixed | 7 | built in: P |")
+    assert "free-flying" in by["a1"] and "not a fixed-base arm" in by["a1"]
+    assert all(r.split("|")[-2].strip() for r in rows)  # every entry has a status

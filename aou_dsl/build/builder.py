@@ -13,8 +13,8 @@ import time
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from ..core.codes import C305, C306, C310, C311
-from ..core.diagnostics import AouError, Diagnostic, Span, diag, has_errors
+from ..core.codes import C301, C302, C303, C304, C305, C306, C310, C311
+from ..core.diagnostics import AouError, Diagnostic, Severity, Span, diag, has_errors
 from ..core.options import BuildOptions, SceneOptions
 from ..lang.linter import FileResult, lint_file, lint_source
 
@@ -45,6 +45,8 @@ class BuildResult:
     #: The document but its samples (see :attr:`document`); None when the build failed.
     header: dict | None = None
     seconds: float = 0.0
+    #: With ``fit``: the file's text with the fitted values (None: nothing was fitted).
+    fitted_source: str | None = None
     _document: dict | None = field(default=None, init=False, repr=False, compare=False)
 
     @property
@@ -143,26 +145,39 @@ def _robot_diagnostics(b, opts: BuildOptions) -> list[Diagnostic]:
         return list(err.diagnostics)
 
 
-def build_lint(lint: FileResult, options: BuildOptions | None = None, *,
-               precompiled: CompileResult | None = None, **changes: Any) -> BuildResult:
-    """Compile, check and measure a linted file (see the module's docstring).
+def build_lint(lint: FileResult, options: BuildOptions | None = None,
+               **changes: Any) -> BuildResult:
+    """Compile, check and measure a linted file (see the module's docstring). What the
+    compiler says once per repeat of a statement is said once, with the count
+    (:func:`~aou_dsl.core.repeats.said_once`).
 
     ``options`` (:class:`~aou_dsl.core.options.BuildOptions`) says how; keyword
     ``changes`` replace some of its fields (``robot="ur5"``, ``check=False``).
-    ``precompiled``: the compile of ``lint``'s behaviour at the default rate, done
-    already (the language server publishes its diagnostics first), used as it is.
     ``collision_check=False`` lets a robot without collision shapes compile; the
     document's ``checks`` then records that self-collision was not checked.
     ``controller`` (``franka``, ``ur``) adds that motion generator's rate and limits to
     the checks (the robot's joint jerk limit at 1 kHz is always checked)."""
+    from ..core.repeats import said_once
+
+    opts = (options or BuildOptions()).replace(**changes) if changes else (
+        options or BuildOptions())
+    if opts.fit:
+        from .fit_loop import fit_loop
+
+        res = fit_loop(lint, lambda linted: _build_lint(linted, opts))
+    else:
+        res = _build_lint(lint, opts)
+    res.diagnostics = said_once(res.diagnostics)
+    return res
+
+
+def _build_lint(lint: FileResult, opts: BuildOptions) -> BuildResult:
     from ..compiler.output import document_header
-    from ..compiler.pipeline import CompileOptions, compile_behaviour
+    from ..compiler.pipeline import CompileOptions
     from ..lang.declared import declared
     from ..lang.descriptors import compare
     from ..measuring.measured import measure
 
-    opts = (options or BuildOptions()).replace(**changes) if changes else (
-        options or BuildOptions())
     start = time.perf_counter()
     res = BuildResult(lint.path, lint, list(lint.diagnostics))
     res.diagnostics += _with_robot(lint, opts.robot)
@@ -174,23 +189,15 @@ def build_lint(lint: FileResult, options: BuildOptions | None = None, *,
         return res
     copts = CompileOptions(package_dirs=opts.package_dirs) if opts.rate is None else \
         CompileOptions(rate=opts.rate, package_dirs=opts.package_dirs)
-    res.compiled = compiled = precompiled if precompiled is not None and opts.rate is None \
-        else compile_behaviour(b, copts, tl)
-    res.diagnostics += compiled.diagnostics
-    tr = compiled.trajectory
-    if not compiled.ok or tr is None:
+    attempt, checks = _compile_checked(lint, b, tl, copts, opts)
+    res.compiled = compiled = attempt.compiled
+    res.checks = attempt.checks
+    res.diagnostics += attempt.diagnostics
+    tr = compiled.trajectory if compiled is not None else None
+    if checks is None or compiled is None or tr is None:
         res.seconds = time.perf_counter() - start
         return res
-    checks_json: dict[str, Any] = {"kinematic": "skipped (--no-check)"}
-    if opts.check:
-        from ..robot import load_robot
-
-        checks_json["collision_checked"] = load_robot(b.settings.robot,
-                                                      opts.package_dirs).collision
-        checks_json |= _check(res, copts.rate, opts.scene, opts.controller)
-        if has_errors(res.diagnostics):
-            res.seconds = time.perf_counter() - start
-            return res
+    checks_json: dict[str, Any] = checks
     try:
         res.measured = m = measure(tr.with_(path=lint.path))
     except AouError as err:  # measure refuses to report: this file fails, not the batch
@@ -198,7 +205,10 @@ def build_lint(lint: FileResult, options: BuildOptions | None = None, *,
         res.seconds = time.perf_counter() - start
         return res
     res.declared = want = declared(b, tl)
+    explained = {d.fields.get("descriptor") for d in res.diagnostics if d.code == C304}
     for mm in compare(want, m.descriptors):
+        if mm.name in explained:  # C304 said why the arm gives less than declared
+            continue
         res.diagnostics.append(diag(
             C310, f"{mm.name}: declared {_fmt(mm.declared)}, measured {_fmt(mm.measured)} "
             "on the compiled trajectory", _span_of(b, mm.name), descriptor=mm.name,
@@ -209,6 +219,73 @@ def build_lint(lint: FileResult, options: BuildOptions | None = None, *,
         rate=copts.rate)
     res.seconds = time.perf_counter() - start
     return res
+
+
+def _attempt(lint: FileResult, b, tl, copts, opts: BuildOptions
+             ) -> tuple[BuildResult, dict[str, Any] | None]:
+    """One compile and, unless ``opts.check`` is False, its checks: a result holding
+    their diagnostics, and the document's ``checks`` (None when either failed)."""
+    from ..compiler.pipeline import compile_behaviour
+
+    out = BuildResult(lint.path, lint)
+    out.compiled = compiled = compile_behaviour(b, copts, tl)
+    out.diagnostics += compiled.diagnostics
+    if not compiled.ok or compiled.trajectory is None:
+        return out, None
+    checks: dict[str, Any] = {"kinematic": "skipped (--no-check)"}
+    if opts.check:
+        from ..robot import load_robot
+
+        checks["collision_checked"] = load_robot(b.settings.robot,
+                                                 opts.package_dirs).collision
+        checks |= _check(out, copts.rate, opts.scene, opts.controller)
+        if has_errors(out.diagnostics):
+            return out, None
+    return out, checks
+
+
+def _blames_start(d: Diagnostic) -> bool:
+    """An error another joint solution of the start pose may avoid: the start pose
+    beyond a joint limit, IK at a joint limit on the way, a failed check (links that
+    touch, a joint beyond its range)."""
+    return d.severity is Severity.ERROR and (
+        d.code in (C302, C306) or (d.code in (C301, C303) and d.fields.get("time")
+                                       == 0.0))
+
+
+def _compile_checked(lint: FileResult, b, tl, copts, opts: BuildOptions
+                     ) -> tuple[BuildResult, dict[str, Any] | None]:
+    """:func:`_attempt`; when it fails in a way the start's joint solution may be to
+    blame, again from each other solution of the start pose
+    (:func:`~aou_dsl.compiler.branches.start_alternatives`) until one passes. When none
+    does, the first failure is said, with what was tried."""
+    from dataclasses import replace
+
+    from ..compiler.branches import start_alternatives
+
+    first, checks = _attempt(lint, b, tl, copts, opts)
+    if checks is not None or not any(_blames_start(d) for d in first.diagnostics):
+        return first, checks
+    tr = first.compiled.trajectory if first.compiled is not None else None
+    seeds = start_alternatives(b, tl, opts.package_dirs, None if tr is None else tr.q[0])
+    for k, seed in enumerate(seeds, 1):
+        other, checks = _attempt(lint, b, tl, replace(copts, start_seed=seed), opts)
+        if checks is not None:
+            checks["start_configuration"] = {
+                "q": list(seed), "why": f"solution {k} of {len(seeds)} other joint "
+                "solutions of the start pose; the first failed: "
+                + "; ".join(d.message for d in first.diagnostics if _blames_start(d))[:300]}
+            return other, checks
+    tried = (f"tried the start pose from {len(seeds)} other joint solution(s) (other IK "
+             "branches and, on a 7-joint arm, other points of its redundancy, from "
+             "postures turned at one joint): none passes" if seeds else
+             "no other joint solution of the start pose was found (IK from postures "
+             "turned at one joint)")
+    first.diagnostics = [Diagnostic(d.code, d.severity, d.message, d.span,
+                                    f"{d.hint}; {tried}" if d.hint else tried,
+                                    {**d.fields, "start_solutions_tried": len(seeds)})
+                         if _blames_start(d) else d for d in first.diagnostics]
+    return first, None
 
 
 def build_source(text: str, path: str = "<string>", options: BuildOptions | None = None,

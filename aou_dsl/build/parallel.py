@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING, Any
 from ..core.codes import I505
 from ..core.diagnostics import AouError
 from ..core.options import BuildOptions
+from ..core.repeats import once_per_run
 from .pool import BuildPool, _pack, default_jobs, encoded
 from .session import Session
 
@@ -46,7 +47,8 @@ __all__ = ["BuildPool", "build_many", "build_text", "default_jobs", "encoded", "
 def build_many(paths: Iterable[str], options: BuildOptions | None = None, jobs: int = 1,
                *, cluster: Any = None, pool: BuildPool | None = None,
                encode: str | None = None) -> Iterator[BuildResult]:
-    """Build every path with ``build_file(path, options)``; results in input order.
+    """Build every path with ``build_file(path, options)``; results in input order. A
+    robot's own warnings (C313) come with the first file that meets them only.
 
     Args:
         paths: ``.aou`` files.
@@ -60,8 +62,12 @@ def build_many(paths: Iterable[str], options: BuildOptions | None = None, jobs: 
             encode each document in it, for :func:`write_result` (the writing that is
             left to this process is then copying bytes).
     """
-    paths = list(paths)
-    opts = options or BuildOptions()
+    yield from once_per_run(_build_many(list(paths), options or BuildOptions(), jobs,
+                                        cluster, pool, encode))
+
+
+def _build_many(paths: list[str], opts: BuildOptions, jobs: int, cluster: Any,
+                pool: BuildPool | None, encode: str | None) -> Iterator[BuildResult]:
     if cluster is not None:
         yield from _on_cluster(paths, opts, cluster, encode)
     elif pool is not None:

@@ -151,6 +151,14 @@ def _recording(p: argparse.ArgumentParser) -> None:
                    "position (for a recording without a goal)")
 
 
+def _fit(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--fit", action="store_true",
+                   help="change what the arm cannot give (accelerations, shiver frequency, "
+                   "tilt speed) to what it can, keeping the state; each change a C314 warning")
+    p.add_argument("--write-fitted", metavar="PATH.aou",
+                   help="with --fit: write the fitted behaviour there (one input)")
+
+
 def _scene(p: argparse.ArgumentParser) -> None:
     p.add_argument("--target-size", type=LENGTH, default=0.05, metavar="M",
                    help="edge of the target cube at the goal, in metres (default 0.05)")
@@ -220,10 +228,12 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     _collision(comp)
     _controller(comp)
     _scene(comp)
+    _fit(comp)
     c["check"] = chk = sub.add_parser(
         "check", help="replay a behaviour or trajectory in PyBullet and report every check")
     chk.add_argument("path", metavar="FILE", help="a .aou file or a trajectory file")
     chk.add_argument("--format", choices=("text", "json"), default="text")
+    _fit(chk)
     chk.add_argument("--no-dynamic", action="store_true",
                      help="kinematic checks only (skip the physics replay)")
     _collision(chk)
@@ -259,7 +269,11 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
         "measure", help="measure the eleven descriptors of a trajectory")
     meas.add_argument("path", metavar="FILE", help="a trajectory .json/.npz, or a .csv")
     _recording(meas)
-    meas.add_argument("--format", choices=("table", "json"), default="table")
+    meas.add_argument("--against", metavar="FILE.aou",
+                      help="judge the motion against this behaviour: each descriptor "
+                      "declared vs measured with its tolerance; exit 1 when one is outside")
+    meas.add_argument("--format", choices=("table", "json", "github"), default="table",
+                      help="github: annotations (with --against)")
     c["robot"] = rob = sub.add_parser(
         "robot", help="show what aou knows or derives of a robot (frames, limits, posture)")
     rob.add_argument("robot", nargs="?", metavar="NAME|PATH",

@@ -161,7 +161,12 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     options = BuildOptions(robot=args.robot, rate=args.rate, check=not args.no_check,
                            scene=SceneOptions(**_scene_kw(args)),
                            collision_check=not args.no_collision_check,
-                           controller=args.controller, package_dirs=_package_dirs(args))
+                           controller=args.controller, package_dirs=_package_dirs(args),
+                           fit=args.fit)
+    if args.write_fitted and (len(inputs) != 1 or not args.fit):
+        from .fitted import fitted_usage
+
+        return fitted_usage("compile")
     results = build_many(sources, options, args.jobs or default_jobs(), cluster=args.cluster,
                          encode=fmt)  # the workers encode; this process writes bytes
     worst = EXIT_OK
@@ -182,6 +187,10 @@ def _cmd_compile(args: argparse.Namespace) -> int:
               f"{len(tr.t)} samples, compiled in {res.seconds:.2f} s{note}", file=sys.stderr)
         if has_errors(res.diagnostics):
             worst = max(worst, EXIT_ERRORS)
+        if args.write_fitted:
+            from .fitted import write_fitted
+
+            worst = max(worst, write_fitted(args.write_fitted, res, sources))
     return worst
 
 
@@ -192,6 +201,10 @@ def _cmd_check(args: argparse.Namespace) -> int:
     from ..api import check, read_trajectory
     from .report import format_check
 
+    if args.fit or args.write_fitted:
+        from .fitted import check_fitted
+
+        return check_fitted(args, _read_kw(args))
     tr = read_trajectory(args.path, **_read_kw(args))
     from ..robot import robot_diagnostics
 
@@ -232,6 +245,10 @@ def _cmd_measure(args: argparse.Namespace) -> int:
     from ..lang.cv import missing_descriptors
     from .report import format_measured
 
+    if args.against:
+        from .against import cmd_measure_against
+
+        return cmd_measure_against(args, _read_kw(args))
     tr = read_trajectory(args.path, **_read_kw(args))
     m = measure(tr)
     missing = missing_descriptors(tr.goal)  # what the C-V point could not use

@@ -63,6 +63,18 @@ def with_samples(header: dict, tr) -> dict:
             gc.enable()
 
 
+def _robot_keys(tr) -> dict:
+    """What another tool needs to recompute the hand pose from the file: where the
+    end-effector frame is, and which robot (its URDF's path and SHA-256)."""
+    from ..robot.identity import frame_definition, robot_identity
+    from ..robot.load import load_robot
+
+    loaded = load_robot(tr.robot, tr.package_dirs)
+    frame = tr.ee_definition or frame_definition(loaded.spec)
+    return {"ee_frame_definition": frame.to_json(),
+            "robot_identity": robot_identity(tr.robot, loaded)}
+
+
 def document_header(result, *, measured: dict, declared: dict, cv: dict,
                     checks: dict | None = None, rate: float) -> dict:
     """The trajectory document of a :class:`~.pipeline.CompileResult` but its samples."""
@@ -75,6 +87,7 @@ def document_header(result, *, measured: dict, declared: dict, cv: dict,
         "state": b.state.value if b.state else None,
         "robot": tr.robot,
         "ee_frame": tr.ee_frame,
+        **_robot_keys(tr),
         "joint_names": list(tr.joint_names),
         "goal": {"position": list(tr.goal)},
         "rate": rate,
@@ -102,8 +115,10 @@ def encode(doc: dict, fmt: str) -> bytes:
         # Comment lines carry what a CSV has no column for; readers skip `#` lines.
         goal = ",".join(repr(float(x)) for x in doc["goal"]["position"])
         lines = [f"# format: {doc['format']}", f"# robot: {doc['robot']}",
-                 f"# ee_frame: {doc['ee_frame']}", f"# goal: {goal}",
-                 ",".join(["t", *doc["joint_names"]])]
+                 f"# ee_frame: {doc['ee_frame']}", f"# goal: {goal}"]
+        lines += [f"# {k}: {json.dumps(doc[k], separators=(',', ':'))}"
+                  for k in ("ee_frame_definition", "robot_identity") if k in doc]
+        lines.append(",".join(["t", *doc["joint_names"]]))
         lines += [",".join(repr(v) for v in [t, *row]) for t, row in zip(doc["t"], doc["q"],
                                                                            strict=True)]
         return ("\n".join(lines) + "\n").encode()

@@ -21,12 +21,14 @@ from ..core.memo import Keyed
 from ..core.trajectory import Trajectory
 from ..lang.ir import Behaviour
 from ..lang.layout import layout
-from ..lang.primitives import KINDS, MIN_SHIVER_F, Timing
+from ..lang.primitives import KINDS, MIN_SHIVER_F, Shiver, Timing
 from ..lang.timeline import Episode, Pose, Timeline
 from ..robot.geometry import ReachFrame, reach_frame
+from ..robot.identity import frame_definition
 from ..robot.ik import IKStatus, solve_path
 from ..robot.kinematics import ArmModel
 from ..robot.load import load_arm
+from .fitting import hint_edit
 from .start import CODES, start_diagnostic
 from .timing import (
     JointSegment,
@@ -57,12 +59,15 @@ DEFAULT_RATE = 250.0  # Hz
 @dataclass(frozen=True)
 class CompileOptions:
     """Options of ``aouc compile``: sample ``rate`` [Hz], IK ``step_*`` sizes, the folders
-    of the robot's ``package://`` meshes."""
+    of the robot's ``package://`` meshes; ``start_seed``, a joint configuration [rad] the
+    start pose is solved from instead of the robot's posture (another IK branch,
+    :mod:`.branches`)."""
 
     rate: float = DEFAULT_RATE
     step_length: float = STEP_LENGTH
     step_angle: float = STEP_ANGLE
     package_dirs: tuple[str, ...] = ()
+    start_seed: tuple[float, ...] | None = None
 
 
 @dataclass
@@ -132,17 +137,20 @@ def _timed(probe: Keyed):
     return time_path(arm, s, q_path, ep.a, ep.vmax, cartesian=KINDS[ep.kind].translation)
 
 
-def _start_configuration(arm: ArmModel, frame: ReachFrame, pose: Pose):
-    """IK of the start pose, by continuation from the robot's posture. The same reach
-    always starts the same way, so the result is kept for recompilations."""
-    key = (arm.spec.name, arm.frame_id, frame.goal.tobytes(), frame.R0.tobytes(), pose)
-    return _solved_start(Keyed(key, (arm, frame.target(pose))))
+def _start_configuration(arm: ArmModel, frame: ReachFrame, pose: Pose,
+                         seed: tuple[float, ...] | None = None):
+    """IK of the start pose, by continuation from the robot's posture (or from
+    ``seed``). The same reach always starts the same way, so the result is kept for
+    recompilations."""
+    key = (arm.spec.name, arm.frame_id, frame.goal.tobytes(), frame.R0.tobytes(), pose,
+           seed)
+    return _solved_start(Keyed(key, (arm, frame.target(pose), seed)))
 
 
 @functools.lru_cache(maxsize=64)
 def _solved_start(probe: Keyed):
-    arm, target = probe.value
-    return solve_path(arm, [target])
+    arm, target, seed = probe.value
+    return solve_path(arm, [target], None if seed is None else np.array(seed, float))
 
 
 def _ik_diag(ep: Episode, status: IKStatus, t: float, joint: str | None, b: Behaviour,
@@ -237,7 +245,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
     segments: list[PathSegment | JointSegment] = []
     t_planned = 0.0
     start_pose = tl.episodes[0].start if tl.episodes else Pose(b.settings.start)
-    first = _start_configuration(arm, frame, start_pose)
+    first = _start_configuration(arm, frame, start_pose, options.start_seed)
     if first.failure is not None:
         res.diagnostics.append(start_diagnostic(
             arm, frame, b, first.failure, functools.partial(_follows, arm, frame, options)))
@@ -254,9 +262,15 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
             seg, shiver_fail = shiver_segment(arm, q, ep.amplitude, ep.f, ep.duration)
             if shiver_fail is not None:
                 f_ok = shiver_fail.wanted
-                edit = f"f={f_ok:g}Hz" if f_ok and f_ok >= MIN_SHIVER_F else None
+                ok = bool(f_ok and f_ok >= MIN_SHIVER_F)
+                node = next((n for n in b.primitives if n.span == ep.span), None)
+                timed = isinstance(node, Shiver) and node.timed  # its `for`, as written
+                max_f = f_ok if ok else None
+                dur = node.duration if isinstance(node, Shiver) and timed else None
+                edit = hint_edit(diag(C308, "", ep.span, max_frequency=max_f, duration=dur,
+                                      f=ep.f)) if ok else None
                 res.diagnostics.append(_too_fast(C308, shiver_fail, ep, edit,
-                                                 max_frequency=f_ok))
+                                                 max_frequency=max_f, duration=dur, f=ep.f))
                 return res
             segments.append(seg)
         else:
@@ -278,8 +292,9 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
                 if tilt_fail is not None:
                     v_ok = tilt_fail.wanted
                     edit = f"v={v_ok:g}deg/s" if v_ok else None
-                    res.diagnostics.append(_too_fast(C309, tilt_fail, ep, edit,
-                                                     max_velocity=v_ok))
+                    res.diagnostics.append(_too_fast(
+                        C309, tilt_fail, ep, edit, max_velocity=v_ok,
+                        declared_velocity=math.degrees(ep.path_length / ep.duration)))
                     return res
             else:
                 seg, fail = _timed_path(arm, frame, ep, q, options, s, ik.q)
@@ -293,7 +308,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
                         C304, f"{ep.kind} reaches {fail.achieved:.3g} {unit}, not the "
                         f"declared {fail.wanted:.3g} {unit}: {fail.reason}",
                         ep.span, joint=fail.joint, achieved=fail.achieved,
-                        declared=fail.wanted))
+                        declared=fail.wanted, descriptor=f"{ep.kind}_acceleration"))
             lap("timing")
             segments.append(seg)
             q = ik.q[-1]
@@ -411,4 +426,5 @@ def _sample(arm: ArmModel, b: Behaviour, tl: Timeline,
     episodes = tuple((e.kind, float(bounds[i]), float(bounds[i + 1]))
                      for i, e in enumerate(tl.episodes))
     return Trajectory(t, q, arm.joint_names, spec.name, spec.ee_frame, goal, qd, qdd,
-                      episodes, title=b.name, package_dirs=package_dirs)
+                      episodes, title=b.name, package_dirs=package_dirs,
+                      ee_definition=frame_definition(spec))

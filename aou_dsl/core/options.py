@@ -53,6 +53,8 @@ class BuildOptions:
         scene: the scene the checks use (its ``package_dirs`` are this object's).
         collision_check: False accepts a robot without collision shapes (C312).
         controller: ``"franka"`` or ``"ur"``: that motion generator's limits are checked too.
+        fit: change what the arm cannot give to what it can (``--fit``; the rule is in
+            :mod:`aou_dsl.compiler.fitting`), each change a C314 warning.
     """
 
     robot: str | None = None
@@ -62,6 +64,7 @@ class BuildOptions:
     scene: SceneOptions = field(default_factory=SceneOptions)
     collision_check: bool = True
     controller: str | None = None
+    fit: bool = False
 
     def __post_init__(self) -> None:
         dirs = package_dirs(self.package_dirs)

@@ -256,9 +256,9 @@ _RULE_LIST = [
     Rule("C310", "descriptor-mismatch", _W,
          "A descriptor measured on the compiled trajectory differs from the declared one "
          "by more than its tolerance (docs/measure.md).",
-         "The motion does not show what the file declares; usually a joint limit slowed it "
-         "(see C304).",
-         "approach a=50   # the joints cannot accelerate the hand that fast"),
+         "The motion does not show what the file declares. A value a joint limit kept "
+         "from it is said once, by C304, not again here.",
+         "approach a=2 v=0.01   # the speed cap is reached before the acceleration"),
     Rule("C311", "jerk-limit", _E,
          "The trajectory, sampled at the controller's rate, needs more joint jerk than the "
          "robot (or the controller named by --controller) allows.",
@@ -276,7 +276,19 @@ _RULE_LIST = [
          "URDFs carry no acceleration limits; a robot description file (TOML) beside the URDF "
          "pins them (docs/robots.md says how).",
          "robot z1\napproach\npause 1s"),
+    Rule("C314", "fitted-value", _W,
+         "With --fit, a value the arm cannot give was changed to one it can: the "
+         "statement, the value declared and fitted, the joint and the limit that bind.",
+         "The fitted behaviour keeps its state and the order of its values (docs/robots.md "
+         "gives the rule); --write-fitted writes the file so the change is reviewed.",
+         "robot ur5\nshiver 6deg f=2.5Hz\npause 1s"),
     # --- R: reading trajectories -------------------------------------------------------
+    Rule("C314", "fitted-value", _W,
+         "With --fit, a value the arm cannot give was changed to one it can: the "
+         "statement, the value declared and fitted, the joint and the limit that bind.",
+         "The fitted behaviour keeps its state and the order of its values (docs/robots.md "
+         "gives the rule); --write-fitted writes the file so the change is reviewed.",
+         "robot ur5\nshiver 6deg f=2.5Hz\npause 1s"),
     # --- R: reading trajectories -------------------------------------------------------
     Rule("R401", "bad-trajectory", _E,
          "A trajectory file is not valid: missing keys or columns, non-increasing time, NaN.",
@@ -317,6 +329,12 @@ _RULE_LIST = [
          "tell a shiver from tilts by its speed profile; it is reported as neither.",
          "Sample the recording, or compile, at 6 samples per cycle or more.",
          "a 5 Hz shiver in a trajectory sampled at 20 Hz"),
+    Rule("R408", "outside-tolerance", _E,
+         "A recording (or trajectory) measured against a behaviour file (`aouc measure REC "
+         "--against FILE.aou`) shows a descriptor outside its tolerance of the declared one.",
+         "The motion the robot ran is not the one the file declares; in a lab's CI the run "
+         "fails. docs/measure.md gives each descriptor's tolerance.",
+         "a recording whose pauses last half as long as the file declares"),
     Rule("I501", "cannot-read", _E,
          "An input file or folder cannot be read (missing, a directory, permissions, encoding).",
          "Nothing can be checked or compiled.",

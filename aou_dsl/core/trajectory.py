@@ -14,7 +14,34 @@ import numpy as np
 from .codes import R402
 from .diagnostics import AouError, Span, diag
 
-__all__ = ["Trajectory"]
+__all__ = ["FrameDefinition", "Trajectory"]
+
+
+@dataclass(frozen=True)
+class FrameDefinition:
+    """Where an end-effector frame is on its robot: welded to the link ``parent`` at
+    ``xyz`` [m], turned by ``rpy`` (roll, pitch, yaw [rad], the URDF's convention). A
+    frame that is a link of the URDF is its own parent at zero.
+
+    Attributes:
+        name: the frame's name (``ee_frame`` of the trajectory).
+        parent: the URDF link it is welded to.
+        xyz: its origin in the parent link's frame [m], shape (3,).
+        rpy: its rotation from the parent link's frame [rad], shape (3,).
+    """
+
+    name: str
+    parent: str
+    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    @property
+    def is_link(self) -> bool:
+        """Whether the frame is the parent link itself (nothing to add to a model)."""
+        return self.name == self.parent and not any(self.xyz) and not any(self.rpy)
+
+    def to_json(self) -> dict:
+        return {"parent": self.parent, "xyz": list(self.xyz), "rpy": list(self.rpy)}
 
 
 @dataclass(frozen=True, eq=False)
@@ -35,6 +62,8 @@ class Trajectory:
         path: where it was read from, for diagnostics; title: a name for figures.
         package_dirs: folders that hold the robot's ``package://`` meshes, when its URDF
             needs them (absolute paths).
+        ee_definition: where ``ee_frame`` is on the robot, when the file says (a frame
+            aou added to an arm it knew, read back on an arm loaded from its URDF).
     """
 
     t: np.ndarray
@@ -49,6 +78,7 @@ class Trajectory:
     path: str = "<memory>"
     title: str = ""
     package_dirs: tuple[str, ...] = ()
+    ee_definition: FrameDefinition | None = None
 
     @property
     def duration(self) -> float:

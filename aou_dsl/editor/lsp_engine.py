@@ -123,7 +123,7 @@ def build(text: str, path: str, robot: str | None = None, first: Built | None = 
     from ..build.builder import build_lint
 
     if first is not None and first._lint is not None:
-        res = build_lint(first._lint, robot=robot, precompiled=first._compiled)
+        res = build_lint(first._lint, robot=robot)  # its IK and timing are kept: not solved again
     else:
         res = _session("compile").build(text, path, robot=robot)
     return Built(list(res.diagnostics), _compiled=res.compiled)

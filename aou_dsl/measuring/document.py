@@ -16,8 +16,9 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from ..core.codes import R401
 from ..core.diagnostics import AouError, Span, diag
+from ..core.trajectory import FrameDefinition
 
-__all__ = ["FORMAT", "Goal", "Header", "read_header"]
+__all__ = ["FORMAT", "Document", "FrameDef", "Goal", "Header", "RobotIdentity", "read_header"]
 
 FORMAT = "aou-trajectory/1"
 Finite = Annotated[float, Field(allow_inf_nan=False)]
@@ -30,6 +31,30 @@ class Goal(BaseModel):
     model_config = ConfigDict(extra="allow")
 
     position: tuple[Finite, Finite, Finite]
+
+
+class FrameDef(BaseModel):
+    """Where the end-effector frame is: welded to the URDF link ``parent`` at ``xyz``
+    [m], turned by ``rpy`` [rad] (the URDF's roll, pitch, yaw). A link of the URDF is its
+    own parent at zero."""
+
+    model_config = ConfigDict(extra="allow")
+
+    parent: str = Field(min_length=1)
+    xyz: tuple[Finite, Finite, Finite]
+    rpy: tuple[Finite, Finite, Finite]
+
+
+class RobotIdentity(BaseModel):
+    """Which robot: its name (as the ``robot`` key), the URDF's path as it was given (a
+    built-in arm's: inside example-robot-data's ``robots`` folder) and the SHA-256 of the
+    URDF's text (hex; empty when it could not be read)."""
+
+    model_config = ConfigDict(extra="allow")
+
+    name: str = Field(min_length=1)
+    urdf: str
+    sha256: str = Field(pattern=r"^([0-9a-f]{64})?$")
 
 
 class Header(BaseModel):
@@ -47,6 +72,8 @@ class Header(BaseModel):
     generator: str = ""
     rate: Positive | None = None  # Hz, of a compiled file
     duration: Positive | None = None  # s
+    ee_frame_definition: FrameDef | None = None
+    robot_identity: RobotIdentity | None = None
 
     @field_validator("goal", mode="before")
     @classmethod
@@ -57,6 +84,60 @@ class Header(BaseModel):
     @property
     def goal_position(self) -> tuple[float, float, float] | None:
         return None if self.goal is None else self.goal.position
+
+    @property
+    def frame_definition(self) -> FrameDefinition | None:
+        """Where ``ee_frame`` is, when the file names the frame and defines it."""
+        d = self.ee_frame_definition
+        if d is None or not self.ee_frame:
+            return None
+        return FrameDefinition(self.ee_frame, d.parent, d.xyz, d.rpy)
+
+
+Row = list[Finite]
+
+
+class Episode(BaseModel):
+    """One episode of the compiler's timeline [s]."""
+
+    model_config = ConfigDict(extra="allow")
+
+    kind: str
+    t_start: Finite
+    t_end: Finite
+
+
+class Descriptors(BaseModel):
+    """The declared and the measured descriptors, by name (null: absent)."""
+
+    model_config = ConfigDict(extra="allow")
+
+    declared: dict[str, Finite | None]
+    measured: dict[str, Finite | None]
+
+
+class Document(Header):
+    """A whole trajectory document as ``aouc compile`` writes it (JSON; the NPZ's
+    ``header.json`` is this but the samples). Its JSON Schema ships with the package
+    (``aou_dsl/schemas/trajectory.schema.json``)."""
+
+    behaviour: str
+    state: str | None
+    ee_frame: str
+    goal: Goal
+    generator: str
+    rate: Positive
+    duration: Positive
+    ee_frame_definition: FrameDef
+    robot_identity: RobotIdentity
+    descriptors: Descriptors
+    cv: dict[str, Any]
+    episodes: list[Episode]
+    checks: dict[str, Any]
+    t: list[Finite] = Field(min_length=1)
+    q: list[Row] = Field(min_length=1)
+    qd: list[Row]
+    qdd: list[Row]
 
 
 def _message(errors: list[Any], doc: dict) -> str:

@@ -140,7 +140,7 @@ def _checked(rec: Trajectory, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]
 def _context(rec: Trajectory) -> tuple[Context, list[Boundary], np.ndarray, np.ndarray]:
     """The per-sample signals of a trajectory and its boundaries; also the joints'
     noise and resolution."""
-    arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs)
+    arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
     cols = rec.columns(arm.joint_names)
     t, q = _checked(rec, cols)
     q, _ = unwrap(q)

@@ -64,7 +64,7 @@ def check_units(rec: Trajectory, angle_unit: str | None, time_unit: str | None,
     wrong = [f"--{flag} {unit}" for flag, unit, right in
              (("angle-unit", angle_unit, "rad"), ("time-unit", time_unit, "s"))
              if unit not in (None, right)]
-    arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs)
+    arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
     if trusted and wrong and _as_written(rec, arm, where):
         raise AouError(diag(R404, f"aou wrote this file, in radians and seconds: "
                             f"{' and '.join(wrong)} would misread it", Span.whole_file(

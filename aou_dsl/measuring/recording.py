@@ -135,7 +135,8 @@ def _from_document(doc: dict, header: Header, t: Any, q: Any, where: Where) -> T
     _check_arrays(t, q, names, where)
     title = header.behaviour or os.path.splitext(os.path.basename(path))[0]
     return Trajectory(t, q, names, header.robot, header.ee_frame, header.goal_position,
-                      path=path, title=title, **_optional(doc, q))
+                      path=path, title=title, ee_definition=header.frame_definition,
+                      **_optional(doc, q))
 
 
 def read_json(path: str, text: str, own_goal: bool = True) -> Trajectory:
@@ -331,7 +332,7 @@ def final_goal(rec: Trajectory) -> tuple[float, float, float]:
     from ..robot.batch_fk import batch_fk
     from ..robot.load import load_arm
 
-    arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs)
+    arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
     cols = rec.columns(arm.joint_names)
     pos, _ = batch_fk(arm, np.asarray(rec.q, float)[-1:, cols])
     return (float(pos[0, 0]), float(pos[0, 1]), float(pos[0, 2]))

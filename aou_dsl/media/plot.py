@@ -79,7 +79,7 @@ def profile_data(rec: Trajectory) -> ProfileData:
     from ..robot.batch_fk import batch_fk
     from ..robot.load import load_arm
 
-    arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs)
+    arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
     cols = rec.columns(arm.joint_names)
     t = np.asarray(rec.t, float)
     q = np.asarray(rec.q, float)[:, cols]

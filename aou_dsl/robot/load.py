@@ -23,6 +23,7 @@ from ..core.codes import C312, R402, V109
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..core.options import package_dirs as package_dirs_of
 from ..core.robot_specs import ROBOT_FILE_TYPES, ROBOTS, UNSOURCED, RobotSpec, is_robot_file
+from ..core.trajectory import FrameDefinition
 from .assemble import assemble, filled_velocities
 from .kinematics import ArmModel, arm_model, frame_id
 from .model import Robot, gaze_of, reduced_model
@@ -174,9 +175,14 @@ def scene_urdf(robot: str, *, visuals: bool = False, package_dirs: Sequence[str]
 
 @functools.cache
 def load_arm(robot: str, ee_frame: str | None = None,
-             package_dirs: tuple[str, ...] = ()) -> ArmModel:
+             package_dirs: tuple[str, ...] = (),
+             frame: FrameDefinition | None = None) -> ArmModel:
     """The arm of ``robot`` (a built-in name or a robot file's path), its kinematics built
     from the URDF's joints alone (no mesh is read), once per process.
+
+    ``frame``, when given, defines ``ee_frame`` (a trajectory file's
+    ``ee_frame_definition``): the frame is placed as it says, so a file compiled for an
+    arm aou knew, with a frame aou added, measures on the same arm loaded from its URDF.
 
     Raises:
         AouError: V109 for an unknown robot or a robot file aou cannot use (I501 when it
@@ -184,6 +190,10 @@ def load_arm(robot: str, ee_frame: str | None = None,
     """
     r = load_robot(robot, package_dirs)
     arm = arm_model(r.spec, r.model, no_effort=r.no_effort)
+    if frame is not None and not frame.is_link and (ee_frame in (None, frame.name)):
+        from .identity import with_frame
+
+        return with_frame(arm, frame, f"<robot {robot}>")
     if ee_frame is None or ee_frame == r.spec.ee_frame:
         return arm
     fid = frame_id(r.model, ee_frame)

@@ -144,7 +144,7 @@ def controller_checks(motion: CompileResult | Trajectory, controller: str | None
     ctrl = get(controller)
     hz = float(rate or ctrl.rate)
     tr = _trajectory(motion)
-    arm = load_arm(tr.robot, tr.ee_frame, tr.package_dirs)
+    arm = load_arm(tr.robot, tr.ee_frame, tr.package_dirs, tr.ee_definition)
     if not ctrl.drives(arm.spec.name):
         return [Check("controller", False, detail=f"{ctrl.title} does not drive "
                       f"`{arm.spec.name}`")]

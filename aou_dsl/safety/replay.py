@@ -98,7 +98,7 @@ def replay(tr: Trajectory, *, options: SceneOptions | None = None,
     Raises:
         AouError: R402 when the trajectory lacks a joint of the robot.
     """
-    arm = load_arm(tr.robot, tr.ee_frame, tr.package_dirs)
+    arm = load_arm(tr.robot, tr.ee_frame, tr.package_dirs, tr.ee_definition)
     cols = tr.columns(arm.joint_names)
     t, q = tr.t, np.ascontiguousarray(tr.q[:, cols], dtype=float)
     if tr.qd is not None and tr.qdd is not None:

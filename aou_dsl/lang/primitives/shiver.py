@@ -27,6 +27,8 @@ class Shiver(Node):
     f: float
     duration: float
     count: int = 1
+    #: Whether the statement says `for` (else ``duration`` is the default).
+    timed: bool = False
 
 
 #: Slowest shiver [Hz]: a shiver is a fast tremor. Slower, its swings are slow rolls
@@ -89,7 +91,8 @@ class ShiverKind(Kind):
                              "shiver duration")
         if r.done() and amp is not None:
             node = Shiver(span=r.st.span, amplitude=amp, f=f or DEFAULTS["shiver_f"],
-                          duration=dur or DEFAULTS["shiver_duration"], count=r.count)
+                          duration=dur or DEFAULTS["shiver_duration"], count=r.count,
+                          timed=dur is not None)
             if dur is not None:
                 _lengthened(r, node)
             return node

@@ -1,0 +1,82 @@
+"""``--fit``: build, and where the arm cannot give a declared value, change it by the
+rule of :mod:`aou_dsl.compiler.fitting` and build again, until nothing is left to fit.
+
+Each change is a C314 warning at its statement ("declared -> fitted", the joint and the
+limit that bind); the fitted file's text is kept (``fitted_source``, written by
+``--write-fitted``) and the document lists the changes (``fitted``). A fit that would
+make the file express another state than the one it declares is not made: the build
+stays refused, and a C314 says why.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import replace
+from typing import Any
+
+from ..compiler.fitting import FITTED, Change, apply, plan
+from ..core.codes import C314
+from ..core.diagnostics import Diagnostic, diag
+from ..core.repeats import said_once
+from ..lang.linter import FileResult, lint_source
+
+__all__ = ["MAX_ROUNDS", "fit_loop"]
+
+#: Builds at most, the first included.
+MAX_ROUNDS = 4
+
+
+def _warning(c: Change) -> Diagnostic:
+    what = c.descriptor or {"f": "shiver frequency", "for": "shiver duration",
+                            "a": "acceleration", "v": "tilt velocity"}[c.key]
+    was = f"{c.declared}{c.unit}" if c.declared else "the default"
+    binds = f"{c.joint}'s {c.limit or 'acceleration'} limit" if c.joint else "the arm"
+    return diag(C314, f"{what}: declared {was} -> fitted {c.fitted}{c.unit} "
+                f"(`{c.text}`): {binds} binds", c.span, key=c.key, declared=c.declared,
+                fitted=c.fitted, unit=c.unit, joint=c.joint, limit=c.limit,
+                descriptor=c.descriptor)
+
+
+def fit_loop(lint: FileResult, build: Callable[[FileResult], Any]) -> Any:
+    """``build(lint)``, then rounds of :func:`~aou_dsl.compiler.fitting.plan` and
+    ``build`` of the changed text (at most :data:`MAX_ROUNDS` builds)."""
+    res = build(lint)
+    text, b = lint.source, lint.behaviour
+    if text is None or b is None:
+        return res
+    state = b.state
+    first: dict[tuple, float] = {}
+    made: dict[tuple, Change] = {}
+    for _ in range(MAX_ROUNDS - 1):
+        todo = [d for d in said_once(res.diagnostics) if d.code in FITTED]
+        changes = plan(todo, first)
+        if not changes:
+            break
+        new_text = apply(text, changes)
+        new_lint = lint_source(new_text, lint.path)
+        if not new_lint.ok or (state is not None and (
+                new_lint.cv is None or new_lint.cv.state != state)):
+            found = new_lint.cv.state.value if new_lint.cv is not None else "errors"
+            res.diagnostics.append(diag(
+                C314, f"not fitted: the changes ({', '.join(c.text for c in changes)}) "
+                f"would make the file express `{found}`, not "
+                f"`{state.value if state else 'what it does'}`", b.span))
+            return res
+        for c in changes:
+            key = (c.span.line, c.span.col, c.key)
+            try:
+                first.setdefault(key, float(c.declared))
+            except ValueError:
+                first.setdefault(key, math.nan)
+            made[key] = replace(c, declared=made[key].declared) if key in made else c
+        text, res = new_text, build(new_lint)
+    if made:
+        res.diagnostics += [_warning(c) for c in made.values()]
+        res.fitted_source = text
+        if res.header is not None:
+            res.header = res.header | {"fitted": [
+                {"line": c.span.line, "key": c.key, "declared": c.declared,
+                 "fitted": c.fitted, "unit": c.unit, "joint": c.joint, "limit": c.limit,
+                 "descriptor": c.descriptor} for c in made.values()]}
+    return res

@@ -1,0 +1,61 @@
+"""``aouc measure REC --against FILE.aou``: a recording judged against the behaviour it
+should show (:mod:`aou_dsl.measuring.verdict`), as a table, JSON or GitHub annotations;
+exit 1 when a descriptor is outside its tolerance."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ..core.diagnostics import Diagnostic
+from .args import EXIT_ERRORS, EXIT_OK
+from .report import format_github, format_json, format_text
+
+__all__ = ["cmd_measure_against", "format_verdict"]
+
+
+def _v(v: float | int | None) -> str:
+    return "absent" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
+
+
+def format_verdict(verdict) -> str:
+    """The table: each descriptor declared and measured, its tolerance, pass or FAIL; the
+    C-V point of each; how many pass."""
+    lines = [f"{verdict.path} against {verdict.against} (robot {verdict.robot})"]
+    if verdict.goal_from_file:
+        lines.append("  (the recording has no goal: measured at the behaviour's)")
+    lines.append(f"  {'descriptor':24s} {'declared':>10s} {'measured':>10s} "
+                 f"{'tolerance':>11s}  {'unit':6s} result")
+    for r in verdict.rows:
+        tol = "-" if r.tolerance is None else (
+            "exact" if r.tolerance == 0 else f"+-{r.tolerance:.3g}")
+        lines.append(f"  {r.name:24s} {_v(r.declared):>10s} {_v(r.measured):>10s} "
+                     f"{tol:>11s}  {r.unit:6s} {'pass' if r.ok else 'FAIL'}")
+    for side, cv in (("declared", verdict.declared_cv), ("measured", verdict.measured_cv)):
+        lines.append(f"  C-V {side}: C={cv.C:+.2f} V={cv.V:+.2f} -> {cv.state.value}")
+    n = sum(r.ok for r in verdict.rows)
+    lines.append(f"  {n} of {len(verdict.rows)} descriptors within tolerance")
+    return "\n".join(lines)
+
+
+def cmd_measure_against(args: argparse.Namespace, read_kw: dict) -> int:
+    """Run ``aouc measure PATH --against FILE.aou`` (``read_kw``: how to read PATH)."""
+    from ..api import read_trajectory
+    from ..lang.linter import lint_file
+    from ..measuring.verdict import judge
+
+    lint = lint_file(args.against)
+    verdict = judge(read_trajectory(args.path, **read_kw), lint)
+    outside: list[Diagnostic] = verdict.outside()
+    sources = {lint.path: lint.source or ""}
+    if args.format == "json":
+        print(format_json(verdict.to_json() | {
+            "diagnostics": [d.to_json() for d in verdict.diagnostics + outside]}))
+    elif args.format == "github":
+        for d in verdict.diagnostics + outside:
+            print(format_github(d))
+    else:
+        print(format_verdict(verdict))
+        for d in verdict.diagnostics + outside:
+            print(format_text(d, sources.get(d.span.path)), file=sys.stderr)
+    return EXIT_ERRORS if outside else EXIT_OK

@@ -1,0 +1,188 @@
+"""Fitting a behaviour to an arm (``--fit``): which values to change, and by how much.
+
+Where the arm cannot give a declared value, the compiler says so with the value that
+fits (C304: the peak acceleration the joints allow; C308: the highest shiver frequency;
+C309: the fastest tilt). :func:`plan` turns those into :class:`Change`s of the file's
+text, by this rule:
+
+- Change only what the arm refused, at the statement it refused; nothing else.
+- A shiver's frequency is not one of the eleven descriptors: a shiver too fast is made
+  slower (``f=``) at the same amplitude, and its ``for`` lengthened to the 3 cycles a
+  shiver lasts at least (what the compiler would do anyway, said in the file). No
+  descriptor changes.
+- A descriptor the arm cannot reach (an acceleration, a tilt velocity) is compressed
+  toward the arm's peak ``cap`` by one increasing map, :func:`compress`: values up to
+  90 % of the peak stay, higher ones approach the peak without reaching it
+  (``k + w d / (d + w)``, ``k`` 90 % of the peak, ``w`` the other 10 %, ``d`` how far the
+  value is above ``k``). Two files
+  that differ only in that value are fitted to values in the same order (the map is
+  strictly increasing), so a Part B variant pair keeps its contrast.
+- Fitted descriptors are written with 4 significant digits, a shiver's frequency with 3,
+  rounded toward what fits.
+
+The builder applies the changes, compiles again (a fitted value can land a little
+off the arm's real peak; the rule is applied again from the declared value with the new
+peak) and keeps the fit only when the file still expresses its declared state.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+from ..core.codes import C304, C308, C309
+from ..core.diagnostics import Diagnostic, Span
+
+__all__ = ["KNEE", "Change", "apply", "apply_edit", "compress", "hint_edit", "plan"]
+
+#: Fraction of the arm's peak below which a declared value is never changed.
+KNEE = 0.9
+#: The codes whose values :func:`plan` fits.
+FITTED = (C304, C308, C309)
+
+
+@dataclass(frozen=True)
+class Change:
+    """One value of one statement changed.
+
+    Attributes:
+        span: the statement.
+        key: ``a``, ``f``, ``v`` or ``for``.
+        declared: the value as written (``2``, absent as ``""``); fitted: as now written.
+        unit: the unit written after the fitted value.
+        joint, limit: what binds (the joint, and which of its limits).
+        descriptor: the descriptor the value sets (None: none, e.g. a shiver's ``f``).
+    """
+
+    span: Span
+    key: str
+    declared: str
+    fitted: str
+    unit: str
+    joint: str | None
+    limit: str | None
+    descriptor: str | None
+
+    @property
+    def text(self) -> str:
+        return f"{self.key}={self.fitted}{self.unit}" if self.key != "for" else \
+            f"for {self.fitted}{self.unit}"
+
+
+def compress(x: float, cap: float, knee: float = KNEE) -> float:
+    """``x`` brought under ``cap`` by a strictly increasing map: unchanged up to
+    ``knee * cap``, then approaching ``cap`` (never reaching it)."""
+    k = knee * cap
+    if x <= k:
+        return x
+    w, over = cap - k, x - k
+    return k + w * over / (over + w)  # slope 1 at the knee, then ever flatter
+
+
+def _down(x: float, digits: int = 3) -> str:
+    """``x`` with ``digits`` significant digits, rounded down."""
+    if x <= 0:
+        return f"{x:g}"
+    e = math.floor(math.log10(x)) - digits + 1
+    return f"{math.floor(x / 10 ** e + 1e-9) * 10 ** e:.{max(0, -e)}f}".rstrip("0").rstrip(".")
+
+
+def _up(x: float) -> str:
+    """``x`` with 3 significant digits, rounded up."""
+    e = math.floor(math.log10(x)) - 2
+    return f"{math.ceil(x / 10 ** e - 1e-9) * 10 ** e:.{max(0, -e)}f}".rstrip("0").rstrip(".")
+
+
+def _shiver(d: Diagnostic) -> list[tuple[str, str, str, str | None]]:
+    """``(key, fitted, unit, descriptor)`` of a shiver too fast: its highest frequency,
+    and, when the statement says `for`, one of the 3 cycles it then lasts at least."""
+    f_ok = d.fields.get("max_frequency")
+    if not f_ok:
+        return []
+    out: list[tuple[str, str, str, str | None]] = [("f", _down(f_ok), "Hz", None)]
+    runs = d.fields.get("duration")  # None: the statement has no `for`
+    if runs is not None and round(runs * float(_down(f_ok))) < 3:
+        out.append(("for", _up(3.0 / float(_down(f_ok))), "s", None))
+    return out
+
+
+def hint_edit(d: Diagnostic) -> str | None:
+    """Every change a C308 needs, as one edit (``f=1.4Hz for 2.15s``)."""
+    parts = _shiver(d)
+    return " ".join(f"{k}={v}{u}" if k != "for" else f"for {v}{u}" for k, v, u, _ in parts) \
+        or None
+
+
+def plan(diagnostics: list[Diagnostic], declared: dict[tuple, float]) -> list[Change]:
+    """The changes that fit what ``diagnostics`` refuse. ``declared`` holds, by
+    ``(line, col, key)`` of the statement, the value first declared where an earlier
+    round changed it (the rule is applied from it, not from the fitted value)."""
+    out = []
+    for d in diagnostics:
+        joint, limit = d.fields.get("joint"), d.fields.get("limit")
+        if d.code == C304 and d.fields.get("achieved"):
+            x = declared.get(_at(d, "a"), float(d.fields["declared"]))
+            fitted = _down(compress(x, float(d.fields["achieved"])), 4)
+            out.append(Change(d.span, "a", f"{x:g}", fitted, "", joint,
+                              limit or "acceleration", d.fields.get("descriptor")))
+        elif d.code == C308:
+            was = {"f": d.fields.get("f"), "for": d.fields.get("duration")}
+            for key, value, unit, desc in _shiver(d):
+                w = was.get(key)
+                out.append(Change(d.span, key, "" if w is None else f"{w:.3g}", value, unit,
+                                  joint, limit, desc))
+        elif d.code == C309 and d.fields.get("max_velocity"):
+            v = declared.get(_at(d, "v"), d.fields.get("declared_velocity"))
+            cap = float(d.fields["max_velocity"])
+            fitted = _down(compress(float(v), cap) if v else cap, 4)
+            out.append(Change(d.span, "v", "" if v is None else f"{v:g}", fitted, "deg/s",
+                              joint, limit, "tilt_velocity"))
+    return out
+
+
+def _at(d: Diagnostic, key: str) -> tuple[int, int, str]:
+    return d.span.line, d.span.col, key
+
+
+_KEY = {"a": r"a=\S+", "f": r"f=\S+", "v": r"v=\S+", "for": r"for\s+\S+"}
+
+
+def apply(text: str, changes: list[Change]) -> str:
+    """``text`` with each change made in its statement: the key's value replaced, or
+    the key added after the statement's first words (its keyword and its positional
+    value). Statements are edited from the last to the first, so spans stay valid."""
+    lines = text.split("\n")
+    by_line: dict[tuple[int, int, int], list[Change]] = {}
+    for c in changes:
+        by_line.setdefault((c.span.line, c.span.col, c.span.end_col), []).append(c)
+    for (line, col, end), group in sorted(by_line.items(), reverse=True):
+        row = lines[line - 1]
+        stop = end - 1 if end > col else len(row)
+        stmt = row[col - 1:stop]
+        for c in group:
+            stmt = _edit(stmt, c)
+        lines[line - 1] = row[:col - 1] + stmt + row[stop:]
+    return "\n".join(lines)
+
+
+def _edit(stmt: str, c: Change) -> str:
+    pattern = re.compile(rf"(?<![\w=]){_KEY[c.key]}")
+    if pattern.search(stmt):
+        return pattern.sub(c.text, stmt, count=1)
+    words = stmt.split(" ")
+    at = 1 if len(words) > 1 and re.match(r"^[-+.\d]", words[1] if len(words) > 1 else "") \
+        and words[0] not in ("gaze",) else 0
+    if words[0] == "gaze":
+        at = 2
+    return " ".join([*words[:at + 1], c.text, *words[at + 1:]])
+
+
+def apply_edit(text: str, span: Span, edit: str) -> str:
+    """``text`` with the edit of a hint (``f=1.4Hz for 2.15s``, ``a=1.2``) made in the
+    statement at ``span``."""
+    changes = []
+    for m in re.finditer(r"(for)\s+([-+.\d]+)(\S*)|(\w+)=([-+.\deE]+)(\S*)", edit):
+        key, value, unit = (m[1], m[2], m[3]) if m[1] else (m[4], m[5], m[6])
+        changes.append(Change(span, key, "", value, unit, None, None, None))
+    return apply(text, changes)
