@@ -99,7 +99,7 @@ def _direction(ctx: Ctx, st: Statement, args: Args) -> Any:
                       f"`{q.text}`", q.span)
             return None
         comps.append(q.value)
-    norm = math.sqrt(sum(c * c for c in comps))
+    norm = math.hypot(*comps)  # scaled: no overflow for large components
     if not math.isfinite(norm) or norm == 0:
         ctx.error("V105", "`from` must be a finite, non-zero vector", vec.span)
         return None
