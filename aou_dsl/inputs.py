@@ -22,7 +22,7 @@ import stat
 from .diagnostics import AouError, Span, diag
 
 __all__ = ["ENV_BYTES", "ENV_SAMPLES", "LIMITS", "check_regular", "input_limit",
-           "max_samples", "read_input", "read_input_text", "too_many_samples"]
+           "max_samples", "read_input", "read_input_text", "size_text", "too_many_samples"]
 
 _MB = 1 << 20
 #: kind -> (bound [bytes], the code of a file over it, what a file of the kind is).
@@ -106,14 +106,19 @@ def check_regular(path: str, what: str = "") -> None:
         raise _not_regular(path, what, mode)
 
 
+def size_text(n: float) -> str:
+    """``n`` bytes in words: `3.2 MB`, `10,240 bytes`."""
+    return f"{n / _MB:.1f} MB" if n >= 0.1 * _MB else f"{int(n):,} bytes"
+
+
 def _too_large(path: str, kind: str, size: int | None) -> AouError:
     limit, code, noun = LIMITS[kind]
     bound = input_limit(kind)
-    found = f" ({size / _MB:.1f} MB)" if size is not None else ""
+    found = f" ({size_text(size)})" if size is not None else ""
     return AouError(diag(code, f"`{path}` is larger{found} than aou reads of {noun} "
-                         f"({bound / _MB:g} MB)", Span.whole_file(path),
+                         f"({size_text(bound)})", Span.whole_file(path),
                          hint=f"if the file is right, raise the bound: set {ENV_BYTES} "
-                              f"(e.g. {ENV_BYTES}={max(2 * bound // _MB, 1)})",
+                              f"(in MB, e.g. {ENV_BYTES}={max(2 * bound // _MB, 1)})",
                          limit=bound, default=limit, variable=ENV_BYTES))
 
 
@@ -163,12 +168,13 @@ def read_input_text(path: str, kind: str, what: str = "") -> str:
     return decode(read_input(path, kind, what), path, what)
 
 
-def too_many_samples(path: str, found: int | str, span: Span | None = None) -> AouError:
+def too_many_samples(path: str, found: int | str, source: str = "") -> AouError:
     """R410 for a recording of more samples than :func:`max_samples`; ``found`` says how
-    many (or what claims how many)."""
+    many, ``source`` what says so."""
     bound = max_samples()
-    return AouError(diag("R410", f"`{path}` has {found} samples; aou reads at most "
-                         f"{bound:,}", span or Span.whole_file(path),
+    found = f"{found:,}" if isinstance(found, int) else found
+    return AouError(diag("R410", f"`{path}` has {found} samples{source}; aou reads at most "
+                         f"{bound:,}", Span.whole_file(path),
                          hint=f"if the recording is right, raise the bound: set "
                               f"{ENV_SAMPLES} (e.g. {ENV_SAMPLES}={2 * bound}), or "
                               "resample it", limit=bound, variable=ENV_SAMPLES))

@@ -12,7 +12,7 @@ from pathlib import Path
 from .cv import CANONICAL, DEFAULT_WEIGHTS, CVPoint, CVWeights, composition, effort_to_cv, infer
 from .descriptors import REGISTRY
 from .diagnostics import AouError, Diagnostic, Severity, Span, diag, has_errors
-from .files import read_text
+from .inputs import read_input_text
 from .ir import Behaviour
 from .layout import episode_values, nominal_values
 from .parse import parse
@@ -163,7 +163,7 @@ def lint_source(text: str, path: str = "<string>", *,
 def read_source(path: str) -> str:
     """Read a source file as UTF-8 (a leading byte-order mark dropped), or raise an
     :class:`AouError` with an I501."""
-    return read_text(path)
+    return read_input_text(path, "behaviour")
 
 
 #: Extensions of the trajectories aou writes and reads: given where a behaviour is

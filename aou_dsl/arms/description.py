@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..diagnostics import AouError, Span, diag
-from ..files import read_text
+from ..inputs import read_input_text
 
 __all__ = ["KEYS", "Description", "read_description"]
 
@@ -164,7 +164,7 @@ def read_description(path: str) -> Description:
         AouError: I501 when it cannot be read; V109 for what does not fit, at its line.
     """
     path = os.path.abspath(path)
-    text = read_text(path, "the robot file")
+    text = read_input_text(path, "robot", "the robot file")
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

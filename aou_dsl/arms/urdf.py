@@ -25,7 +25,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from ..diagnostics import AouError, Span, diag
-from ..files import read_text
+from ..inputs import read_input_text
 
 __all__ = ["CONTINUOUS_RANGE", "GAZE_FRAME", "Joint", "Urdf", "gaze_rpy", "kinematic_xml",
            "gaze_offset", "read_urdf", "resolve_uri", "scene_xml", "unlimited"]
@@ -137,7 +137,7 @@ def read_urdf(path: str) -> Urdf:
         AouError: I501 when it cannot be read, V109 when it is not a URDF aou can use.
     """
     path = os.path.abspath(path)
-    text = read_text(path, "the robot file")
+    text = read_input_text(path, "robot", "the robot file")
     try:
         root = ET.fromstring(text)
         if root.tag != "robot":
