@@ -249,6 +249,34 @@ def chain(n: int, **kw) -> bytes:
     return urdf(links, [(f"j{i}", "revolute", f"l{i}", f"l{i + 1}") for i in range(n)], **kw)
 
 
+def panda_urdf() -> str:
+    """The Panda's URDF as example-robot-data ships it."""
+    import os
+
+    from aou_dsl.arms.load import _data_path
+    from aou_dsl.robots import ROBOTS
+
+    with open(_data_path(ROBOTS["panda"].urdf), encoding="utf-8") as fh:
+        text = fh.read()
+    assert os.path.basename(ROBOTS["panda"].urdf) == "panda.urdf"
+    return text
+
+
+def panda_with(joint: str, attr: str, value: str) -> bytes:
+    """The Panda's URDF with ``attr`` of joint ``joint``'s <limit> (or <axis> for
+    ``xyz``) set to ``value``."""
+    import re
+
+    text = panda_urdf()
+    start = text.index(f'<joint name="{joint}"')
+    end = text.index("</joint>", start)
+    block = text[start:end]
+    tag = "axis" if attr == "xyz" else "limit"
+    new = re.sub(rf'(<{tag}[^>]*\b{attr}=")[^"]*(")', rf"\g<1>{value}\g<2>", block)
+    assert new != block or value in block, (joint, attr)
+    return (text[:start] + new + text[end:]).encode()
+
+
 def robot_cases() -> list[Case]:
     """Robot files: broken trees, oversize, values the URDF and TOML formats allow but no
     arm has, escapes from a package."""
@@ -270,23 +298,30 @@ def robot_cases() -> list[Case]:
         (f"j{i}", "revolute", f"a{2 * i}", f"a{2 * i + 1}") for i in range(1000)]))
     add("urdf-chain-1000", chain(1000))
     add("urdf-chain-100", chain(100))
-    for label, lim in (("velocity-0", 'lower="-2" upper="2" velocity="0" effort="50"'),
-                       ("velocity-neg", 'lower="-2" upper="2" velocity="-1" effort="50"'),
-                       ("lower-gt-upper", 'lower="2" upper="-2" velocity="2" effort="50"'),
-                       ("effort-0", 'lower="-2" upper="2" velocity="2" effort="0"'),
-                       ("effort-neg", 'lower="-2" upper="2" velocity="2" effort="-5"'),
-                       ("limit-nan", 'lower="nan" upper="2" velocity="2" effort="50"'),
-                       ("limit-1e308", 'lower="-1e308" upper="1e308" velocity="1e308" '
-                                       'effort="1e308"'),
-                       ("limit-words", 'lower="low" upper="2" velocity="2" effort="50"')):
-        add(f"urdf-{label}", chain(6, limit=lim))
-    for label, ax in (("zero", "0 0 0"), ("1e308", "1e308 0 0"), ("nan", "nan 0 1"),
-                      ("tiny", "1e-320 0 0")):
-        add(f"urdf-axis-{label}", chain(6, axis=ax))
-    add("urdf-mesh-folder", chain(6, mesh="meshes"), meshes="dir")
-    add("urdf-mesh-fifo", chain(6, mesh="m.stl"), **{"m.stl": "fifo"})
-    add("urdf-package-escape", chain(6, mesh="package://arm/../../../../etc/passwd"))
-    add("urdf-package-escape-abs", chain(6, mesh="package://arm//etc/passwd"))
+    for label, attr, value in (("velocity-0", "velocity", "0"),
+                               ("velocity-neg", "velocity", "-1"),
+                               ("lower-gt-upper", "lower", "2.9"),
+                               ("effort-0", "effort", "0"), ("effort-neg", "effort", "-5"),
+                               ("limit-nan", "lower", "nan"), ("upper-inf", "upper", "inf"),
+                               ("velocity-1e308", "velocity", "1e308"),
+                               ("limit-words", "lower", "low"),
+                               ("axis-zero", "xyz", "0 0 0"), ("axis-1e308", "xyz", "1e308 0 0"),
+                               ("axis-nan", "xyz", "nan 0 1"), ("axis-tiny", "xyz", "1e-320 0 0")):
+        add(f"urdf-{label}", panda_with("panda_joint4", attr, value))
+    def mesh(uri: str) -> bytes:  # every collision mesh of the Panda at ``uri``
+        import re
+
+        return re.sub(r'(<collision>\s*<geometry>\s*<mesh filename=")[^"]*', rf"\g<1>{uri}",
+                      panda_urdf()).encode()
+
+    out.append(Case("urdf-mesh-folder", {"arm.urdf": mesh("meshes"), "meshes": "dir",
+                                         "a.aou": b'robot "arm.urdf"\napproach\npause 1s\n'},
+                    ["compile", "{d}/a.aou", "-o", "{d}/out.json"]))
+    out.append(Case("urdf-mesh-fifo", {"arm.urdf": mesh("m.stl"), "m.stl": "fifo",
+                                       "a.aou": b'robot "arm.urdf"\napproach\npause 1s\n'},
+                    ["compile", "{d}/a.aou", "-o", "{d}/out.json"]))
+    add("urdf-package-escape", mesh("package://arm/../../../../etc/passwd"))
+    add("urdf-package-escape-abs", mesh("package://arm//etc/passwd"))
     add("urdf-not-xml", b"<robot" * 1000)
     add("urdf-billion-laughs", b'<?xml version="1.0"?><!DOCTYPE r [<!ENTITY a "aaaaaaaaaa">'
         + b"".join(f'<!ENTITY a{i} "{"&a" + (str(i - 1) if i else "") + ";" * 1}'
@@ -310,7 +345,8 @@ def robot_cases() -> list[Case]:
         "toml-goal-huge": b'urdf = "u.urdf"\ngoal = [1e308, 0, 0]\n',
         "toml-ee-roll-huge": b'urdf = "u.urdf"\nee_roll = 1e308\n',
         "toml-ee-offset-huge": b'urdf = "u.urdf"\nee_offset = 1e308\n',
-        "toml-from-tiny": b'urdf = "u.urdf"\nfrom = [1e-320, 0, 0]\n',
+        "toml-from-zero": b'urdf = "u.urdf"\nfrom = [0, 0, 0.0]\n',
+        "toml-from-huge": b'urdf = "u.urdf"\nfrom = [1e308, 1e308, 1e308]\n',
         "toml-arm-joints-many": b'urdf = "u.urdf"\narm_joints = [' +
                                 b", ".join(b'"j%d"' % i for i in range(5000)) + b"]\n",
         "toml-self-urdf": b'urdf = "arm.toml"\n',

@@ -94,6 +94,11 @@ def _check_names(urdf: Urdf, pins: dict[str, Any], joints: tuple[str, ...], wher
         if pins.get(key) and pins[key] not in urdf.links and pins[key] != GAZE_FRAME:
             raise _bad(urdf, where, f"`{key}` `{pins[key]}` is not a link of "
                        f"`{os.path.basename(urdf.path)}`")
+    for pair in pins.get("allowed_contacts") or ():
+        for link in pair:
+            if link not in urdf.links:
+                raise _bad(urdf, where, f"`allowed_contacts` names `{link}`, which is not a "
+                           f"link of `{os.path.basename(urdf.path)}`")
     if pins.get("shiver_joint") and pins["shiver_joint"] not in joints:
         raise _bad(urdf, where, f"`shiver_joint` `{pins['shiver_joint']}` is not an arm "
                    f"joint ({', '.join(joints)})")

@@ -66,6 +66,13 @@ def arm_joints(urdf: Urdf) -> tuple[str, ...]:
     if not out:
         raise AouError(diag("V109", f"`{_base(urdf)}` has no joint that moves an arm",
                             Span.whole_file(urdf.path)))
+    from .sanity import MAX_ARM_JOINTS
+
+    if len(out) > MAX_ARM_JOINTS:
+        raise AouError(diag("V132", f"`{_base(urdf)}`: an arm of {len(out)} joints; aou "
+                            f"moves arms of at most {MAX_ARM_JOINTS}", Span.whole_file(urdf.path),
+                            hint="name the arm's joints with `arm_joints = [...]` in a robot "
+                                 "description file (.toml) beside the URDF"))
     return tuple(out)
 
 

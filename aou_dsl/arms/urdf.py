@@ -151,7 +151,11 @@ def read_urdf(path: str) -> Urdf:
         raise _bad(path, f"`{os.path.basename(path)}` has no links")
     colliding = frozenset(el.get("name", "") for el in root.findall("link")
                           if el.find("collision") is not None)
-    return Urdf(path, text, joints, links, colliding)
+    urdf = Urdf(path, text, joints, links, colliding)
+    from .sanity import check_urdf
+
+    check_urdf(urdf)
+    return urdf
 
 
 def _package_dirs(package: str, folder: str, extra: Sequence[str]) -> list[str]:
@@ -176,21 +180,22 @@ def _package_dirs(package: str, folder: str, extra: Sequence[str]) -> list[str]:
 
 def resolve_uri(uri: str, folder: str, package_dirs: Sequence[str] = ()) -> str | None:
     """The absolute path of a mesh ``uri`` written in a URDF that lives in ``folder``;
-    None when no file is found (see the module's docstring for the search)."""
+    None when no regular file is found (a folder or a FIFO is none; see the module's
+    docstring for the search)."""
     if uri.startswith("file://"):
         uri = uri[len("file://"):]
     if not uri.startswith("package://"):
         path = uri if os.path.isabs(uri) else os.path.join(folder, uri)
-        return os.path.normpath(path) if os.path.exists(path) else None
+        return os.path.normpath(path) if os.path.isfile(path) else None
     package, _, rest = uri[len("package://"):].partition("/")
     for d in _package_dirs(package, folder, package_dirs):
-        if os.path.exists(os.path.join(d, rest)):
+        if os.path.isfile(os.path.join(d, rest)):
             return os.path.normpath(os.path.join(d, rest))
     parts = [package, *rest.split("/")]
     for base in [*package_dirs, folder, *_parents(folder)]:
         for k in range(len(parts) - 1):
             path = os.path.join(base, *parts[k:])
-            if os.path.exists(path):
+            if os.path.isfile(path):
                 return os.path.normpath(os.path.abspath(path))
     return None
 
