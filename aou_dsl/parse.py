@@ -21,7 +21,7 @@ import lark
 from lark import Lark, Token, Transformer
 
 from .diagnostics import AouError, Span, diag
-from .units import parse_quantity
+from .units import lookalike_digit, parse_quantity
 
 __all__ = [
     "Colon",
@@ -329,29 +329,11 @@ def _unexpected_character(path: str, text: str, err: lark.exceptions.UnexpectedC
         shown = f"`{ch}` ({what}, U+{ord(ch):04X})"
         hint = hint.format(n=_number_before(text, at or 0) or "20")
     elif ch.isdecimal() or ch in "．":  # a look-alike digit: `１０s`, `0.٣m`
-        shown, hint = _lookalike_digit(text, at or 0)
+        shown, hint = lookalike_digit(text, at or 0)
     elif not ch.isprintable() or ch.isspace():
         shown = f"U+{ord(ch):04X} (an invisible character)"
         hint = "delete it, or replace it with an ordinary space"
     return AouError(diag("S003", f"unexpected character {shown}", span, hint=hint, found=ch))
-
-
-def _lookalike_digit(text: str, at: int) -> tuple[str, str]:
-    """What to show and to write for a digit that is not ASCII at ``at``: the number
-    around it in ASCII digits (`１０s` -> `10s`)."""
-    import unicodedata
-
-    ch = text[at]
-    start, end = at, at
-    while start > 0 and (text[start - 1].isalnum() or text[start - 1] in "．.+-"):
-        start -= 1
-    while end < len(text) and (text[end].isalnum() or text[end] in "．./^"):
-        end += 1
-    meant = "".join(str(unicodedata.decimal(c)) if c.isdecimal() else
-                    "." if c == "．" else c for c in text[start:end])
-    name = unicodedata.name(ch, "a digit").lower()
-    return (f"`{ch}` ({name}, U+{ord(ch):04X}, a look-alike of a digit)",
-            f"write `{meant}`: numbers are written with the digits 0-9")
 
 
 #: `1,5s`: a comma between the digits of a number, with what follows it up to its unit.

@@ -325,7 +325,7 @@ _RULE_LIST = [
          "aou reads a recording whole into memory; a bound keeps a wrong file (a disk "
          "image, a stream) from taking the machine's memory. Set AOU_MAX_INPUT_MB or "
          "AOU_MAX_SAMPLES to read larger ones.",
-         "aouc measure huge.csv   # a CSV of 3,000,000 rows"),
+         "aouc measure huge.npz   # its q.npy claims 1,000,000,000 samples"),
     Rule("I501", "cannot-read", _E,
          "An input file or folder cannot be read (missing, a directory, permissions, encoding).",
          "Nothing can be checked or compiled.",

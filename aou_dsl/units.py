@@ -10,7 +10,8 @@ import enum
 import math
 import re
 
-__all__ = ["RANGE", "Dim", "UNITS", "as_unit", "parse_quantity", "suggest_unit", "units_for"]
+__all__ = ["RANGE", "Dim", "UNITS", "as_unit", "lookalike_digit", "parse_quantity", "suggest_unit",
+           "units_for"]
 
 
 class Dim(enum.StrEnum):
@@ -138,3 +139,21 @@ def suggest_unit(unit: str, dim: Dim) -> str | None:
     close = difflib.get_close_matches(unit.lower(), [u.lower() for u in fits], n=1,
                                       cutoff=0.6)
     return next((u for u in fits if close and u.lower() == close[0]), None)
+
+
+def lookalike_digit(text: str, at: int) -> tuple[str, str]:
+    """What to show and to write for a digit that is not ASCII at ``at``: the number
+    around it in ASCII digits (`１０s` -> `10s`)."""
+    import unicodedata
+
+    ch = text[at]
+    start, end = at, at
+    while start > 0 and (text[start - 1].isalnum() or text[start - 1] in "．.+-"):
+        start -= 1
+    while end < len(text) and (text[end].isalnum() or text[end] in "．./^"):
+        end += 1
+    meant = "".join(str(unicodedata.decimal(c)) if c.isdecimal() else
+                    "." if c == "．" else c for c in text[start:end])
+    name = unicodedata.name(ch, "a digit").lower()
+    return (f"`{ch}` ({name}, U+{ord(ch):04X}, a look-alike of a digit)",
+            f"write `{meant}`: numbers are written with the digits 0-9")

@@ -53,7 +53,8 @@ def csv_bytes(t, q, *, goal: str | None = ",".join(map(str, GOAL)), robot="panda
               names=PANDA, extra: str = "") -> bytes:
     head = f"# robot: {robot}\n" if robot else ""
     head += f"# goal: {goal}\n" if goal is not None else ""
-    rows = "\n".join(",".join(repr(float(v)) for v in (ti, *qi)) for ti, qi in zip(t, q))
+    rows = "\n".join(",".join(repr(float(v)) for v in (ti, *qi))
+                     for ti, qi in zip(t, q, strict=True))
     return (head + extra + "t," + ",".join(names) + "\n" + rows + "\n").encode()
 
 

@@ -18,6 +18,7 @@ import os
 import posixpath
 import xml.etree.ElementTree as ET
 from collections.abc import Iterable
+from typing import Any
 
 from ..diagnostics import AouError, Span, diag
 from .urdf import Joint, Urdf
@@ -38,7 +39,7 @@ _MAX_LIMIT, _MAX_EFFORT = 1e4, 1e7
 
 
 def _bad(urdf: Urdf, message: str, hint: str | None = None, code: str = "V109",
-         **fields: object) -> AouError:
+         **fields: Any) -> AouError:
     return AouError(diag(code, f"`{os.path.basename(urdf.path)}`: {message}",
                          Span.whole_file(urdf.path), hint=hint, **fields))
 

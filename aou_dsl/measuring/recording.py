@@ -27,8 +27,8 @@ import numpy as np
 from ..diagnostics import AouError, Severity, Span, diag
 from ..files import decode
 from ..inputs import input_limit, max_samples, read_input, too_many_samples
-from .bounded import MAX_JOINT_VALUE, csv_rows, npz_members, numbers, parse_json
 from ..trajectory import Trajectory
+from .bounded import MAX_JOINT_VALUE, csv_rows, npz_members, numbers, parse_json
 from .document import Header, read_header
 from .locate import Where, json_span
 from .plausible import ANGLE_UNITS, TIME_UNITS, check_units
