@@ -17,6 +17,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import tokenize
 import zipfile
 from typing import Any
 
@@ -140,7 +141,8 @@ def _npy(path: str, name: str, data: bytes, joints: int) -> np.ndarray:
         read_header = fmt.read_array_header_2_0 if version >= (2, 0) else \
             fmt.read_array_header_1_0
         shape, fortran, dtype = read_header(fh)
-    except (ValueError, SyntaxError, RecursionError, MemoryError, TypeError) as exc:
+    except (ValueError, SyntaxError, RecursionError, MemoryError, TypeError, KeyError,
+            IndexError, tokenize.TokenError) as exc:  # numpy parses the header as Python
         raise _bad(path, f"not an aou NPZ trajectory: `{name}` has no header numpy reads "
                    f"({str(exc)[:80]})") from None
     if dtype.kind not in "iuf" or dtype.hasobject:
