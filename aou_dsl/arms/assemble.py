@@ -224,15 +224,17 @@ def _reach(spec: RobotSpec, model: Any, urdf: Urdf, pins: dict, src: dict,
                                        f"{SAMPLES} sampled configurations")
         if all(k in pins for k in keys):
             return replace(spec, **{k: pins[k] for k in keys}), model, None
+        from .derive import Budget
+
         rolls = (spec.ee_roll,) if "ee_roll" in pins else ROLLS
-        first = None
+        first, budget = None, Budget()
         for roll in rolls:
             m = model if roll == spec.ee_roll else _gazing(
                 urdf, spec.arm_joints, velocity,
                 (spec.ee_link or spec.ee_frame, spec.forward, spec.ee_offset, roll))
             trial = replace(spec, ee_roll=roll, ee_frame=GAZE_FRAME if roll else spec.ee_frame,
                             ee_link=spec.ee_link or (spec.ee_frame if roll else ""))
-            done = _search(trial, m, pins, src, test)
+            done = _search(trial, m, pins, src, test, budget)
             first = first or done
             if done[2]:
                 if roll:
@@ -245,13 +247,13 @@ def _reach(spec: RobotSpec, model: Any, urdf: Urdf, pins: dict, src: dict,
             test.close()
 
 
-def _search(spec: RobotSpec, model: Any, pins: dict, src: dict, test: Any
+def _search(spec: RobotSpec, model: Any, pins: dict, src: dict, test: Any, budget: Any
             ) -> tuple[RobotSpec, Any, bool]:
     from ..kinematics import arm_model
     from .derive import find_reach
 
     found = find_reach(arm_model(spec, model), pins.get("goal"), pins.get("start_direction"),
-                       pins.get("posture"), test)
+                       pins.get("posture"), test, budget)
     for k in ("goal", "start_direction", "posture"):
         if k not in pins:
             src[k] = found.how
