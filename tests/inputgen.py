@@ -465,10 +465,13 @@ def snapshot(folder: str) -> dict[str, tuple[str, bytes | None]]:
     return out
 
 
-def run_cli(argv: list[str], env: dict[str, str], timeout: float = 30.0,
-            memory: int = 2 << 30) -> tuple[int | None, str]:
+def run_cli(argv: list[str], env: dict[str, str], timeout: float = 90.0,
+            memory: int = 2 << 30, cpu: int = 30) -> tuple[int | None, str]:
     """``python -m aou_dsl ARGV`` in a subprocess limited to ``memory`` bytes of address
-    space; (exit code or None on a timeout, stderr + stdout)."""
+    space and ``cpu`` seconds of processor time (a busy loop is killed there, exit
+    -SIGXCPU), and waited for ``timeout`` seconds of wall time (a process blocked on a
+    FIFO uses no processor; the wall bound is wider for a machine shared with other
+    work); (exit code or None on a timeout, stderr + stdout)."""
     import os
     import resource
     import subprocess
@@ -476,6 +479,7 @@ def run_cli(argv: list[str], env: dict[str, str], timeout: float = 30.0,
 
     def limit() -> None:
         resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+        resource.setrlimit(resource.RLIMIT_CPU, (cpu, cpu + 1))
 
     full = {**os.environ, **env, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
     try:

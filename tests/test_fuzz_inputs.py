@@ -3,8 +3,9 @@ recordings (CSV, JSON, NPZ), special files, robot files (URDF trees and sizes, T
 and types). The generators (tests/inputgen.py) are written from the promises.
 
 Every command run must: exit 1 or 2 with a diagnostic code printed, print no traceback
-and no "internal error", end within 30 s, stay within 2 GB of address space, change no
-input and leave no temporary file. In-process runs must raise nothing but AouError.
+and no "internal error", use at most 30 s of processor time and end within 90 s of wall
+time (the machine may be shared), stay within 2 GB of address space, change no input and
+leave no temporary file. In-process runs must raise nothing but AouError.
 
 The default run is bounded (a seeded sample); the slow run takes every case and many
 more generated files.
@@ -55,8 +56,8 @@ def _run(case: gen.Case, tmp_path: Path) -> None:
     tmp.mkdir()
     argv = gen.materialise(case, str(folder))
     before = gen.snapshot(str(folder))
-    rc, out = gen.run_cli(argv, {**case.env, "TMPDIR": str(tmp)}, timeout=30.0)
-    assert rc is not None, f"{case.name}: no answer within 30 s"
+    rc, out = gen.run_cli(argv, {**case.env, "TMPDIR": str(tmp)})
+    assert rc is not None, f"{case.name}: no answer within 90 s"
     assert "Traceback" not in out and "internal error" not in out, (case.name, out[-2000:])
     assert rc in _valid_exit(case), (case.name, rc, out[-1000:])
     if rc:
