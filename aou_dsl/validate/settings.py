@@ -54,7 +54,9 @@ def _robot_file(ctx: Ctx, word: Word) -> str | None:
     folder = os.path.dirname(ctx.path) if not ctx.path.startswith("<") else ""
     path = text if os.path.isabs(text) else os.path.normpath(os.path.join(folder, text))
     if not os.path.isfile(path):
-        ctx.error("V109", f"robot file `{text}` not found (looked for `{path}`)", word.span,
+        what = "is not a regular file (a folder, a FIFO or a device)" \
+            if os.path.exists(path) else "not found"
+        ctx.error("V109", f"robot file `{text}` {what} (looked for `{path}`)", word.span,
                   hint="a relative path starts from the folder of the .aou file",
                   found=text)
         return None
