@@ -315,3 +315,13 @@ def test_a_recording_goal_default_is_kept(tmp_path):
     t, q = motion()
     rec = read_recording(_write(tmp_path, "ok.csv", csv_bytes(t, q)))
     assert rec.goal == GOAL and rec.q.shape == q.shape
+
+
+@pytest.mark.parametrize("name,meant", [("franka", "panda"), ("ur5e", "ur5"),
+                                        ("pnda", "panda")])
+def test_an_unknown_robot_is_answered_with_the_name_aou_uses(name, meant):
+    """`robot franka` (the maker's name) and `robot pnda` (a slip) both say which
+    built-in arm was meant."""
+    (d,) = [d for d in lint_source(f"robot {name}\napproach\npause 1s", "t.aou").diagnostics
+            if d.code == "V109"]
+    assert f"`{meant}`" in (d.hint or "")

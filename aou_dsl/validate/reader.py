@@ -17,7 +17,7 @@ from ..diagnostics import Diagnostic, Span, diag
 from ..parse import Colon, KeyVal, Quantity, Statement, Vector, Word
 from ..units import RANGE, UNITS, Dim, as_unit, suggest_unit, units_for
 
-__all__ = ["Ctx", "Reader", "did_you_mean", "si", "split_args"]
+__all__ = ["Ctx", "Reader", "did_you_mean", "robot_hint", "si", "split_args"]
 
 _REPEAT = re.compile(r"^x(\d+)$")
 #: What looks like a repeat count but is not a whole number >= 0: `x-1`, `x2b`, and
@@ -35,6 +35,22 @@ def did_you_mean(word: str, choices: Iterable[str]) -> str | None:
 
     close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
     return f"did you mean `{close[0]}`?" if close else None
+
+
+#: Other names people give the built-in arms (the maker, the arm's other models).
+_ROBOT_NAMES = {"franka": "panda", "fr3": "panda", "franka_panda": "panda", "emika": "panda",
+                "ur5e": "ur5", "ur3e": "ur3", "ur10e": "ur10", "universal_robots": "ur5",
+                "xarm": "xarm7", "ufactory": "xarm7", "gen3": "kinova", "jaco": "kinova",
+                "unitree": "z1"}
+
+
+def robot_hint(name: str, choices: Iterable[str]) -> str | None:
+    """"did you mean" for an unknown robot: by another name of a built-in arm (`franka`
+    is the Panda), else by spelling."""
+    meant = _ROBOT_NAMES.get(name.lower().replace("-", "_"))
+    if meant in choices:
+        return f"did you mean `{meant}`? aou calls that arm `{meant}`"
+    return did_you_mean(name, choices)
 
 
 @dataclass

@@ -13,7 +13,7 @@ from ..ir import DEFAULTS, Effort, Settings
 from ..parse import Quantity, Statement, Vector, Word
 from ..robots import ROBOT_FILE_TYPES, ROBOTS
 from ..units import Dim
-from .reader import Args, Ctx, did_you_mean, positive, si, split_args
+from .reader import Args, Ctx, positive, robot_hint, si, split_args
 
 __all__ = ["MAX_GOAL_DISTANCE", "SETTINGS", "read_settings"]
 
@@ -37,7 +37,7 @@ def _robot(ctx: Ctx, st: Statement, args: Args) -> Any:
     if word.text not in ROBOTS:
         ctx.error("V109", f"unknown robot `{word.text}`: expected one of "
                   f"{', '.join(ROBOTS)}, or a quoted path to a robot file",
-                  word.span, hint=did_you_mean(word.text, ROBOTS), found=word.text,
+                  word.span, hint=robot_hint(word.text, ROBOTS), found=word.text,
                   valid=list(ROBOTS))
         return None
     return word.text
