@@ -325,3 +325,33 @@ def test_an_unknown_robot_is_answered_with_the_name_aou_uses(name, meant):
     (d,) = [d for d in lint_source(f"robot {name}\napproach\npause 1s", "t.aou").diagnostics
             if d.code == "V109"]
     assert f"`{meant}`" in (d.hint or "")
+
+
+def test_aouc_robot_says_when_the_collision_meshes_are_missing(tmp_path):
+    """A URDF whose collision meshes cannot be found does not pass as having collision
+    geometry without a word: the text names the first missing mesh and the way out."""
+    from aou_dsl.arms.describe import describe_robot
+
+    path = _write(tmp_path, "nomesh.urdf", panda_urdf().encode())
+    doc, text = describe_robot(path)
+    assert doc["collision_geometry"] and doc["missing_meshes"]
+    assert "not found" in text and "--package-dir" in text and "--no-check" in text
+
+
+@pytest.mark.slow
+def test_the_reach_search_of_an_arm_nothing_fits_is_bounded(tmp_path, monkeypatch):
+    """Six joints stacked on one axis fit no reach: the search stops after its budget
+    of tries (it took hundreds, minutes of IK) and says the reach was not found."""
+    from aou_dsl.arms import derive
+    from aou_dsl.arms.load import load_robot
+
+    tries = []
+    probe = derive._probe
+
+    def counted(*args, **kw):
+        tries.append(1)
+        return probe(*args, **kw)
+
+    monkeypatch.setattr(derive, "_probe", counted)
+    robot = load_robot(_write(tmp_path, "stack.urdf", chain(6)))
+    assert robot.reach_ok is False and 0 < len(tries) <= derive.MAX_PROBES
