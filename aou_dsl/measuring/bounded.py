@@ -3,9 +3,9 @@ take the machine's memory, each bounded and each failure an R-diagnostic:
 
 - :func:`parse_json`: a document nested too deeply, or holding a number of thousands of
   digits, is R401 (not a RecursionError);
-- :func:`csv_rows`: a field longer than the csv module's limit (an unclosed quote reads
+- :func:`csv_table`: a field longer than the csv module's limit (an unclosed quote reads
   the rest of the file as one field) is R401 at its row; more rows than
-  :func:`~aou_dsl.inputs.max_samples` is R410;
+  :func:`~aou_dsl.inputs.max_samples` is R410; the rows become numbers a chunk at a time;
 - :func:`npz_members`: only stored or deflated members that are not encrypted; each
   ``.npy`` header read on its own (its size bounded), the shape it claims checked against
   the samples bound and against the bytes that are there, before an array is made;
@@ -26,7 +26,7 @@ import numpy as np
 from ..diagnostics import AouError, Span, diag
 from ..inputs import max_samples, size_text, too_many_samples
 
-__all__ = ["MAX_JOINT_VALUE", "numbers", "csv_rows", "npz_members", "parse_json"]
+__all__ = ["MAX_JOINT_VALUE", "csv_table", "npz_members", "numbers", "parse_json"]
 
 #: Largest joint position [rad or m, or deg before its unit is known] read as one: a
 #: value beyond is no joint position in any unit (1e308 at every sample is not a pose).
@@ -61,27 +61,75 @@ def parse_json(path: str, text: str) -> Any:
                    .split(";")[0]) from None
 
 
-def csv_rows(path: str, lines: list[str]) -> list[tuple[int, list[str]]]:
-    """The rows of a CSV that are not comments: (line number, cells).
+#: Rows converted to numbers at once: the cells of a chunk are strings only meanwhile.
+_CHUNK = 20_000
+
+
+def csv_table(path: str, lines: list[str]
+              ) -> tuple[tuple[int, list[str]], np.ndarray, np.ndarray]:
+    """The header row of a CSV (its line, its cells), the line of each sample and the
+    samples as numbers, shape (N, columns). Comment rows (``#``) are skipped. The rows are
+    converted a chunk at a time, so that a long recording is held as numbers, not as
+    millions of strings.
 
     Raises:
-        AouError: R401 at the row whose field is longer than the csv module reads;
-            R410 when there are more rows than the samples bound.
+        AouError: R401 for an empty file, a row of another width or a cell that is no
+            number (at its row), and at the row whose field is longer than the csv
+            module reads; R410 when there are more rows than the samples bound.
     """
     bound = max_samples()
     reader = csv.reader(lines)
-    rows: list[tuple[int, list[str]]] = []
+    header: tuple[int, list[str]] | None = None
+    at: list[int] = []
+    chunks: list[np.ndarray] = []
+    chunk: list[list[str]] = []
     try:
         for r in reader:
-            if r and not r[0].startswith("#"):
-                rows.append((reader.line_num, r))
-                if len(rows) > bound + 1:  # the header and the samples
-                    raise too_many_samples(path, f"more than {bound:,}")  # rows, so far
+            if not r or r[0].startswith("#"):
+                continue
+            if header is None:
+                header = (reader.line_num, [h.strip() for h in r])
+                continue
+            if len(r) != len(header[1]):
+                line = reader.line_num
+                raise _bad(path, f"row {line} has {len(r)} columns; the header has "
+                           f"{len(header[1])}", span=Span.point(path, line, 1))
+            at.append(reader.line_num)
+            chunk.append(r)
+            if len(at) > bound:
+                raise too_many_samples(path, f"more than {bound:,}")  # rows, so far
+            if len(chunk) == _CHUNK:
+                chunks.append(_floats(path, chunk, at[-len(chunk):], header[1], lines))
+                chunk = []
     except csv.Error as exc:
         line = reader.line_num
         raise _bad(path, f"row {line}: {exc}; a field this long is no number (is a quote "
                    "left open?)", span=Span.point(path, line, 1)) from None
-    return rows
+    if header is None:
+        raise _bad(path, "the CSV file is empty")
+    if chunk:
+        chunks.append(_floats(path, chunk, at[-len(chunk):], header[1], lines))
+    values = np.vstack(chunks) if chunks else np.zeros((0, len(header[1])))
+    return header, np.asarray(at, dtype=np.int64), values
+
+
+def _floats(path: str, rows: list[list[str]], at: list[int], header: list[str],
+            lines: list[str]) -> np.ndarray:
+    """The cells of ``rows`` (at lines ``at``) as numbers; R401 at the first that is
+    none."""
+    try:
+        return np.array(rows, dtype=float)
+    except ValueError:
+        pass
+    for line, r in zip(at, rows, strict=True):
+        for j, cell in enumerate(r):
+            try:
+                float(cell)
+            except ValueError:
+                col = 1 if '"' in lines[line - 1] else len(",".join(r[:j] + [""])) + 1
+                raise _bad(path, f"row {line}, column `{header[j]}`: `{cell}` is not a "
+                           "number", span=Span.point(path, line, col)) from None
+    raise _bad(path, "a row holds a value that is not a number")  # not reached
 
 
 def numbers(values: Any) -> np.ndarray | None:

@@ -28,7 +28,7 @@ from ..diagnostics import AouError, Severity, Span, diag
 from ..files import decode
 from ..inputs import input_limit, max_samples, read_input, too_many_samples
 from ..trajectory import Trajectory
-from .bounded import MAX_JOINT_VALUE, csv_rows, npz_members, numbers, parse_json
+from .bounded import MAX_JOINT_VALUE, csv_table, npz_members, numbers, parse_json
 from .document import Header, read_header
 from .locate import Where, json_span
 from .plausible import ANGLE_UNITS, TIME_UNITS, check_units
@@ -200,23 +200,6 @@ def _comments(lines: list[str]) -> dict[str, str]:
     return out
 
 
-def _csv_values(path: str, rows: list[tuple[int, list[str]]], header: list[str],
-                lines: list[str]) -> np.ndarray:
-    values = np.full((len(rows), len(header)), np.nan)
-    for i, (line, r) in enumerate(rows):
-        if len(r) != len(header):
-            raise _bad(path, f"row {line} has {len(r)} columns; the header has "
-                       f"{len(header)}", span=Span.point(path, line, 1), row=line)
-        for j, cell in enumerate(r):
-            try:
-                values[i, j] = float(cell)
-            except ValueError:
-                col = 1 if '"' in lines[line - 1] else len(",".join(r[:j] + [""])) + 1
-                raise _bad(path, f"row {line}, column `{header[j]}`: `{cell}` is not a "
-                           "number", span=Span.point(path, line, col), row=line) from None
-    return values
-
-
 def _csv_goal(path: str, text: str, lines: list[str]) -> tuple[float, float, float]:
     """The ``# goal: X,Y,Z`` comment: three finite numbers within the goal's bound."""
     from .document import MAX_GOAL
@@ -242,15 +225,11 @@ def _read_csv(path: str, text: str, robot: str | None,
     and whether aou wrote the file."""
     lines = text.removeprefix("\ufeff").splitlines()
     notes = _comments([ln for ln in lines if ln.startswith("#")])
-    rows = csv_rows(path, lines)
-    if not rows:
-        raise _bad(path, "the CSV file is empty")
-    header = [h.strip() for h in rows[0][1]]
+    (header_line, header), at, values = csv_table(path, lines)
     if header[0] != "t":
         raise _bad(path, f"the first column must be `t`, found `{header[0]}`",
                    hint="a header row `t,joint_a,joint_b,...` names the columns",
-                   span=Span.point(path, rows[0][0], 1))
-    values = _csv_values(path, rows[1:], header, lines)
+                   span=Span.point(path, header_line, 1))
     robot = robot or notes.get("robot")
     if not robot:
         raise AouError(diag("I501", f"cannot read `{path}` as a recording without its robot: "
@@ -261,7 +240,7 @@ def _read_csv(path: str, text: str, robot: str | None,
     ee = ee_frame or (notes.get("ee_frame") if notes.get("ee_frame") not in (None, "None")
                       else None)
     names = tuple(header[1:])
-    where = Where(path, lines=[line for line, _ in rows[1:]])
+    where = Where(path, lines=at.tolist())
     _check_arrays(values[:, 0], values[:, 1:], names, where)
     title = os.path.splitext(os.path.basename(path))[0]
     rec = Trajectory(values[:, 0], values[:, 1:], names, robot, ee,

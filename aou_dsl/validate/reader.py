@@ -48,7 +48,7 @@ def robot_hint(name: str, choices: Iterable[str]) -> str | None:
     """"did you mean" for an unknown robot: by another name of a built-in arm (`franka`
     is the Panda), else by spelling."""
     meant = _ROBOT_NAMES.get(name.lower().replace("-", "_"))
-    if meant in choices:
+    if meant is not None and meant in choices:
         return f"did you mean `{meant}`? aou calls that arm `{meant}`"
     return did_you_mean(name, choices)
 
