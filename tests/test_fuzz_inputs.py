@@ -149,10 +149,12 @@ def _read_mutants(count: int, seed: int, tmp_path: Path) -> int:
     return refused
 
 
+@pytest.mark.filterwarnings("error::RuntimeWarning")  # numpy's warnings are no diagnostic
 def test_mutated_recordings_read_or_are_refused(tmp_path):
     assert _read_mutants(150, SEED, tmp_path) > 0
 
 
 @pytest.mark.slow
+@pytest.mark.filterwarnings("error::RuntimeWarning")
 def test_many_mutated_recordings_read_or_are_refused(tmp_path):
     assert _read_mutants(1500, SEED + 1, tmp_path) > 0

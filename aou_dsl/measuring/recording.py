@@ -369,6 +369,7 @@ def read_recording(path: str, *, robot: str | None = None,
     if goal is not None and not isinstance(goal, str):
         changes["goal"] = tuple(float(x) for x in goal)
     rec = rec.with_(**changes) if changes else rec
+    _check_clock(rec.t, where)  # before the units are judged: they divide by the steps
     rec = check_units(rec, angle_unit, time_unit, trusted, where)
     _check_clock(rec.t, where)
     if isinstance(goal, str):
