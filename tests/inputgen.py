@@ -255,8 +255,8 @@ def panda_urdf() -> str:
     """The Panda's URDF as example-robot-data ships it."""
     import os
 
-    from aou_dsl.arms.load import _data_path
-    from aou_dsl.robots import ROBOTS
+    from aou_dsl.core.robot_specs import ROBOTS
+    from aou_dsl.robot.load import _data_path
 
     with open(_data_path(ROBOTS["panda"].urdf), encoding="utf-8") as fh:
         text = fh.read()

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from aou_dsl.diagnostics import RULES, AouError
+from aou_dsl.core.diagnostics import RULES, AouError
 
 from . import inputgen as gen
 
@@ -83,8 +83,8 @@ def test_every_hostile_input_fails_cleanly(case, tmp_path):
 def _lint_then_compile(texts: list[str], compiles: int, tmp_path: Path) -> None:
     """Lint never raises; a diagnostic always has a registered code and a span on its
     file; the first ``compiles`` files that lint clean compile without raising."""
-    from aou_dsl.build import build_source
-    from aou_dsl.linter import lint_source
+    from aou_dsl.build.builder import build_source
+    from aou_dsl.lang.linter import lint_source
 
     left = compiles
     for k, text in enumerate(texts):

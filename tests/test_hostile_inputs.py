@@ -8,10 +8,10 @@ import re
 import numpy as np
 import pytest
 
-from aou_dsl.arms.description import read_description
-from aou_dsl.arms.urdf import read_urdf, resolve_uri
-from aou_dsl.linter import lint_source
+from aou_dsl.lang.linter import lint_source
 from aou_dsl.measuring.recording import read_recording
+from aou_dsl.robot.description import read_description
+from aou_dsl.robot.urdf import read_urdf, resolve_uri
 
 from .conftest import fails_with
 from .inputgen import (
@@ -254,7 +254,7 @@ def test_package_paths_that_leave_their_package_are_v131(tmp_path, uri):
     'allowed_contacts = [["l1", "nolink"]]', "x = " + "[" * 5000 + "]" * 5000,
     "ee_offset = " + "9" * 5000])
 def test_robot_descriptions_out_of_range_are_v109(tmp_path, text):
-    from aou_dsl.arms.load import load_robot
+    from aou_dsl.robot.load import load_robot
 
     _write(tmp_path, "u.urdf", chain(6))
     path = _write(tmp_path, "arm.toml", f'urdf = "u.urdf"\n{text}\n'.encode())
@@ -273,9 +273,9 @@ def test_a_mesh_that_is_a_folder_or_a_fifo_is_no_mesh(tmp_path):
 def test_the_vendors_panda_urdf_compiles_as_a_user_urdf(tmp_path):
     """example-robot-data's own panda.urdf, given as a user's URDF: its fingers touch by a
     hair in every pose, so they are allowed to, as on the built-in arm."""
-    from aou_dsl.arms.load import _data_path, load_robot
-    from aou_dsl.build import build_source
-    from aou_dsl.robots import ROBOTS
+    from aou_dsl.build.builder import build_source
+    from aou_dsl.core.robot_specs import ROBOTS
+    from aou_dsl.robot.load import _data_path, load_robot
 
     path = _data_path(ROBOTS["panda"].urdf)
     assert ("panda_leftfinger", "panda_rightfinger") in load_robot(path).spec.allowed_contacts
@@ -330,7 +330,7 @@ def test_an_unknown_robot_is_answered_with_the_name_aou_uses(name, meant):
 def test_aouc_robot_says_when_the_collision_meshes_are_missing(tmp_path):
     """A URDF whose collision meshes cannot be found does not pass as having collision
     geometry without a word: the text names the first missing mesh and the way out."""
-    from aou_dsl.arms.describe import describe_robot
+    from aou_dsl.robot.summary import describe_robot
 
     path = _write(tmp_path, "nomesh.urdf", panda_urdf().encode())
     doc, text = describe_robot(path)
@@ -342,8 +342,8 @@ def test_aouc_robot_says_when_the_collision_meshes_are_missing(tmp_path):
 def test_the_reach_search_of_an_arm_nothing_fits_is_bounded(tmp_path, monkeypatch):
     """Six joints stacked on one axis fit no reach: the search stops after its budget
     of tries (it took hundreds, minutes of IK) and says the reach was not found."""
-    from aou_dsl.arms import derive
-    from aou_dsl.arms.load import load_robot
+    from aou_dsl.robot import derive
+    from aou_dsl.robot.load import load_robot
 
     tries = []
     probe = derive._probe

@@ -5,7 +5,7 @@ take the machine's memory, each bounded and each failure an R-diagnostic:
   digits, is R401 (not a RecursionError);
 - :func:`csv_table`: a field longer than the csv module's limit (an unclosed quote reads
   the rest of the file as one field) is R401 at its row; more rows than
-  :func:`~aou_dsl.inputs.max_samples` is R410; the rows become numbers a chunk at a time;
+  :func:`~aou_dsl.core.inputs.max_samples` is R410; the rows become numbers a chunk at a time;
 - :func:`npz_members`: only stored or deflated members that are not encrypted; each
   ``.npy`` header read on its own (its size bounded), the shape it claims checked against
   the samples bound and against the bytes that are there, before an array is made;
@@ -23,8 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from ..diagnostics import AouError, Span, diag
-from ..inputs import max_samples, size_text, too_many_samples
+from ..core.diagnostics import AouError, Span, diag
+from ..core.inputs import max_samples, size_text, too_many_samples
 
 __all__ = ["MAX_JOINT_VALUE", "csv_table", "npz_members", "numbers", "parse_json"]
 
@@ -172,7 +172,7 @@ def _read_member(path: str, zf: zipfile.ZipFile, name: str, limit: int) -> bytes
 
 
 def _too_large(path: str, name: str, size: str, limit: int) -> AouError:
-    from ..inputs import ENV_BYTES
+    from ..core.inputs import ENV_BYTES
 
     return AouError(diag("R410", f"`{name}` in `{path}` unpacks to {size}; aou reads at "
                          f"most {size_text(limit)} of a trajectory", Span.whole_file(path),
