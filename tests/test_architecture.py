@@ -60,7 +60,7 @@ def _lint_codes(text: str) -> set[str]:
     return {d.code for d in lint_source(text, "example.aou").diagnostics}
 
 
-FRONT_END = [c for c in RULES if c[0] in "SVM"]
+FRONT_END = [c for c in RULES if c[0] in "SVM" and not RULES[c].example.startswith("aouc ")]
 
 
 @pytest.mark.parametrize("code", FRONT_END)
@@ -102,17 +102,36 @@ def test_each_compiler_rule_example_triggers_its_own_code(code, tmp_path, monkey
         (d.code, d.message) for d in res.diagnostics])
 
 
-@pytest.mark.parametrize("code", [c for c in RULES if c[0] in "RI"])
+def _fixtures(folder) -> None:
+    """The files the command examples name, made as their comments describe them."""
+    import numpy as np
+
+    from .inputgen import json_doc, motion, npy_claiming, npz_of, panda_urdf
+
+    (folder / "empty").mkdir()
+    (folder / "a.aou").write_text("pause 1s\n")
+    (folder / "huge.aou").write_text("pause 1s\n" + "# padding\n" * 210_000)  # 2.1 MB
+    escape = re.sub(r'filename="package://[^"]*"',
+                    'filename="package://arm/../../../etc/passwd"', panda_urdf(), count=1)
+    (folder / "escape.urdf").write_text(escape)
+    t, q = motion()
+    assert json_doc(t, q)["robot"] == "panda"
+    (folder / "huge.npz").write_bytes(npz_of(t, q, q_npy=npy_claiming((10**9, 7))))
+    assert np.isfinite(q).all()
+
+
+@pytest.mark.parametrize("code", [c for c in RULES if c[0] in "RI" or c[0] == "V"
+                                  and RULES[c].example.startswith("aouc ")])
 def test_each_reading_and_usage_rule_example_triggers_its_own_code(code, tmp_path, capsys,
                                                                     monkeypatch):
-    """R and I examples are inputs or commands; running them reports that very code."""
+    """R and I examples (and V examples that are commands on robot files or large files)
+    are inputs or commands; running them reports that very code."""
     from aou_dsl.cli.commands import main
 
     example = RULES[code].example
     if example.startswith("aouc "):
-        (tmp_path / "empty").mkdir()
-        (tmp_path / "a.aou").write_text("pause 1s\n")
-        argv = shlex.split(example)[1:]
+        _fixtures(tmp_path)
+        argv = shlex.split(example, comments=True)[1:]
     elif example.startswith("{"):
         (tmp_path / "x.json").write_text(example)
         argv = ["measure", str(tmp_path / "x.json")]
@@ -123,5 +142,6 @@ def test_each_reading_and_usage_rule_example_triggers_its_own_code(code, tmp_pat
         pytest.skip(f"{code}'s example is measured in test_measure.py")
     monkeypatch.chdir(tmp_path)
     main(argv)
-    err = capsys.readouterr().err
+    out = capsys.readouterr()
+    err = out.err + out.out  # lint reports on stdout, the other commands on stderr
     assert f" {code} " in err or f"{code} [" in err, err

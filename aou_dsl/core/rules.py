@@ -196,6 +196,28 @@ _RULE_LIST = [
          "over the first and out over the last), longer than written.",
          "The behaviour lasts longer than the file says: at 1 Hz a shiver lasts at least 3 s.",
          "shiver 5deg f=1Hz for 1s"),
+    Rule("V130", "value-out-of-range", _E,
+         "A number lies outside the range the language takes for its kind of value: "
+         "lengths up to 100 m, durations up to 1 h, angles up to one turn (360 deg), "
+         "speeds from 1e-7 to 10 m/s, accelerations from 1e-7 to 1000 m/s^2, angular "
+         "speeds from 1e-5 to 10000 deg/s, frequencies up to 100 Hz.",
+         "Such a value is a typo, or a number at the float limits that no stage of the "
+         "compiler could use (a tilt of 1e160 deg, a speed of 1e-155 m/s).",
+         "tilt 1e160deg"),
+    Rule("V131", "package-escape", _E,
+         "A mesh path of a robot's URDF leaves its package: a `package://NAME/...` path "
+         "with `..` steps that climb out of the package's folder.",
+         "A package path names a file inside that package; one that climbs out of it "
+         "could make aou read any file of the machine.",
+         "aouc robot escape.urdf   # <mesh filename=\"package://arm/../../../etc/passwd\"/>"),
+    Rule("V132", "input-too-large", _E,
+         "A `.aou` file or a robot file (URDF, robot description) is larger than aou "
+         "reads (1 MB for a `.aou` file, 16 MB for a robot file), or a URDF has more "
+         "links or joints than aou loads (1000), or a longer arm (32 joints).",
+         "aou reads a whole file before checking it: a bound keeps a wrong file (a log, a "
+         "disk image) from taking the machine's memory. Set AOU_MAX_INPUT_MB to read "
+         "larger files.",
+         "aouc lint huge.aou   # a 2 MB file"),
     # --- M: the C-V model --------------------------------------------------------------
     Rule("M201", "state-mismatch", _W,
          "The state inferred from the behaviour's primitives differs from the declared one.",
@@ -335,6 +357,13 @@ _RULE_LIST = [
          "The motion the robot ran is not the one the file declares; in a lab's CI the run "
          "fails. docs/measure.md gives each descriptor's tolerance.",
          "a recording whose pauses last half as long as the file declares"),
+    Rule("R410", "recording-too-large", _E,
+         "A trajectory or recording is larger than aou reads: over 256 MB, or more "
+         "samples than 2,000,000 (its header or its rows say how many).",
+         "aou reads a recording whole into memory; a bound keeps a wrong file (a disk "
+         "image, a stream) from taking the machine's memory. Set AOU_MAX_INPUT_MB or "
+         "AOU_MAX_SAMPLES to read larger ones.",
+         "aouc measure huge.npz   # its q.npy claims 1,000,000,000 samples"),
     Rule("I501", "cannot-read", _E,
          "An input file or folder cannot be read (missing, a directory, permissions, encoding).",
          "Nothing can be checked or compiled.",

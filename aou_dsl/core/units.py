@@ -10,7 +10,8 @@ import enum
 import math
 import re
 
-__all__ = ["Dim", "UNITS", "as_unit", "parse_quantity", "suggest_unit", "units_for"]
+__all__ = ["RANGE", "Dim", "UNITS", "as_unit", "lookalike_digit", "parse_quantity", "suggest_unit",
+           "units_for"]
 
 
 class Dim(enum.StrEnum):
@@ -54,6 +55,22 @@ SI_UNIT: dict[Dim, str] = {
     Dim.ACCEL: "m/s^2",
     Dim.ANGULAR_SPEED: "rad/s",
     Dim.FREQUENCY: "Hz",
+}
+
+#: The magnitudes [SI] the language takes, per dimension: (least above zero, greatest).
+#: Wider than any behaviour aou compiles (ten minutes of motion, a 3 m reach, one turn);
+#: a value outside is a typo, or a number at the float limits that no stage could use
+#: (V130). A rate under its least would make a motion of years (V110 says so for slow
+#: ones above it). Zero, signs and the small values that cannot be seen (V123) are each
+#: statement's own rules.
+RANGE: dict[Dim, tuple[float, float]] = {
+    Dim.LENGTH: (0.0, 100.0),
+    Dim.TIME: (0.0, 3600.0),
+    Dim.ANGLE: (0.0, 2.0 * math.pi),
+    Dim.SPEED: (1e-7, 10.0),
+    Dim.ACCEL: (1e-7, 1000.0),
+    Dim.ANGULAR_SPEED: (math.radians(1e-5), math.radians(10000.0)),
+    Dim.FREQUENCY: (0.0, 100.0),
 }
 
 _QUANTITY = re.compile(r"^([+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)(.*)$")
@@ -122,3 +139,21 @@ def suggest_unit(unit: str, dim: Dim) -> str | None:
     close = difflib.get_close_matches(unit.lower(), [u.lower() for u in fits], n=1,
                                       cutoff=0.6)
     return next((u for u in fits if close and u.lower() == close[0]), None)
+
+
+def lookalike_digit(text: str, at: int) -> tuple[str, str]:
+    """What to show and to write for a digit that is not ASCII at ``at``: the number
+    around it in ASCII digits (`１０s` -> `10s`)."""
+    import unicodedata
+
+    ch = text[at]
+    start, end = at, at
+    while start > 0 and (text[start - 1].isalnum() or text[start - 1] in "．.+-"):
+        start -= 1
+    while end < len(text) and (text[end].isalnum() or text[end] in "．./^"):
+        end += 1
+    meant = "".join(str(unicodedata.decimal(c)) if c.isdecimal() else
+                    "." if c == "．" else c for c in text[start:end])
+    name = unicodedata.name(ch, "a digit").lower()
+    return (f"`{ch}` ({name}, U+{ord(ch):04X}, a look-alike of a digit)",
+            f"write `{meant}`: numbers are written with the digits 0-9")

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from ..core.codes import I501, I503, M201, M202, M203, M204
 from ..core.diagnostics import AouError, Diagnostic, Severity, Span, diag, has_errors
-from ..core.files import read_text
+from ..core.inputs import read_input_text
 from ..core.rules import Category, category
 from .cv import CANONICAL, DEFAULT_WEIGHTS, CVPoint, CVWeights, composition, effort_to_cv, infer
 from .descriptors import REGISTRY
@@ -165,7 +165,7 @@ def lint_source(text: str, path: str = "<string>", *,
 def read_source(path: str) -> str:
     """Read a source file as UTF-8 (a leading byte-order mark dropped), or raise an
     :class:`AouError` with an I501."""
-    return read_text(path)
+    return read_input_text(path, "behaviour")
 
 
 #: Extensions of the trajectories aou writes and reads: given where a behaviour is

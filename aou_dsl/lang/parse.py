@@ -22,7 +22,7 @@ from lark import Lark, Token, Transformer
 
 from ..core.codes import S001, S002, S003
 from ..core.diagnostics import AouError, Fix, Span, degree_fix, diag
-from ..core.units import parse_quantity
+from ..core.units import lookalike_digit, parse_quantity
 
 __all__ = [
     "Colon",
@@ -330,6 +330,8 @@ def _unexpected_character(path: str, text: str, err: lark.exceptions.UnexpectedC
         shown = f"`{ch}` ({what}, U+{ord(ch):04X})"
         hint = hint.format(n=_number_before(text, at or 0) or "20")
         fix = degree_fix(text, at or 0, span, _number_before(text, at or 0), ch)
+    elif ch.isdecimal() or ch in "．":  # a look-alike digit: `１０s`, `0.٣m`
+        shown, hint = lookalike_digit(text, at or 0)
     elif not ch.isprintable() or ch.isspace():
         shown = f"U+{ord(ch):04X} (an invisible character)"
         hint = "delete it, or replace it with an ordinary space"

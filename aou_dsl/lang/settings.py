@@ -14,7 +14,7 @@ from ..core.robot_specs import ROBOT_FILE_TYPES, ROBOTS
 from ..core.units import Dim
 from .ir import DEFAULTS, Effort, Settings
 from .parse import Quantity, Statement, Vector, Word
-from .values import Args, Ctx, did_you_mean, fix_word, positive, si, split_args
+from .values import Args, Ctx, fix_word, positive, robot_hint, si, split_args
 
 __all__ = ["MAX_GOAL_DISTANCE", "SETTINGS", "read_settings"]
 
@@ -38,7 +38,7 @@ def _robot(ctx: Ctx, st: Statement, args: Args) -> Any:
     if word.text not in ROBOTS:
         ctx.error(V109, f"unknown robot `{word.text}`: expected one of "
                   f"{', '.join(ROBOTS)}, or a quoted path to a robot file",
-                  word.span, hint=did_you_mean(word.text, ROBOTS), found=word.text,
+                  word.span, hint=robot_hint(word.text, ROBOTS), found=word.text,
                   fix=fix_word(word.span, word.text, ROBOTS),
                   valid=list(ROBOTS))
         return None
@@ -56,7 +56,9 @@ def _robot_file(ctx: Ctx, word: Word) -> str | None:
     folder = os.path.dirname(ctx.path) if not ctx.path.startswith("<") else ""
     path = text if os.path.isabs(text) else os.path.normpath(os.path.join(folder, text))
     if not os.path.isfile(path):
-        ctx.error(V109, f"robot file `{text}` not found (looked for `{path}`)", word.span,
+        what = "is not a regular file (a folder, a FIFO or a device)" \
+            if os.path.exists(path) else "not found"
+        ctx.error(V109, f"robot file `{text}` {what} (looked for `{path}`)", word.span,
                   hint="a relative path starts from the folder of the .aou file",
                   found=text)
         return None
@@ -101,7 +103,7 @@ def _direction(ctx: Ctx, st: Statement, args: Args) -> Any:
                       f"`{q.text}`", q.span)
             return None
         comps.append(q.value)
-    norm = math.sqrt(sum(c * c for c in comps))
+    norm = math.hypot(*comps)  # scaled: no overflow for large components
     if not math.isfinite(norm) or norm == 0:
         ctx.error(V105, "`from` must be a finite, non-zero vector", vec.span)
         return None

@@ -13,12 +13,12 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..core.codes import V102, V103, V104, V105, V111, V112, V113, V116, V118, V123
+from ..core.codes import V102, V103, V104, V105, V110, V111, V112, V113, V116, V118, V123, V130
 from ..core.diagnostics import Diagnostic, Fix, Span, diag
-from ..core.units import UNITS, Dim, as_unit, suggest_unit, units_for
+from ..core.units import RANGE, UNITS, Dim, as_unit, suggest_unit, units_for
 from .parse import Colon, KeyVal, Quantity, Statement, Vector, Word
 
-__all__ = ["Ctx", "Reader", "did_you_mean", "fix_word", "si", "split_args"]
+__all__ = ["Ctx", "Reader", "did_you_mean", "fix_word", "robot_hint", "si", "split_args"]
 
 _REPEAT = re.compile(r"^x(\d+)$")
 #: What looks like a repeat count but is not a whole number >= 0: `x-1`, `x2b`, and
@@ -44,6 +44,22 @@ def fix_word(span: Span, word: str, choices: Iterable[str]) -> Fix | None:
 
     close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
     return Fix(span, close[0]) if close else None
+
+
+#: Other names people give the built-in arms (the maker, the arm's other models).
+_ROBOT_NAMES = {"franka": "panda", "fr3": "panda", "franka_panda": "panda", "emika": "panda",
+                "ur5e": "ur5", "ur3e": "ur3", "ur10e": "ur10", "universal_robots": "ur5",
+                "xarm": "xarm7", "ufactory": "xarm7", "gen3": "kinova", "jaco": "kinova",
+                "unitree": "z1"}
+
+
+def robot_hint(name: str, choices: Iterable[str]) -> str | None:
+    """"did you mean" for an unknown robot: by another name of a built-in arm (`franka`
+    is the Panda), else by spelling."""
+    meant = _ROBOT_NAMES.get(name.lower().replace("-", "_"))
+    if meant is not None and meant in choices:
+        return f"did you mean `{meant}`? aou calls that arm `{meant}`"
+    return did_you_mean(name, choices)
 
 
 @dataclass
@@ -74,7 +90,7 @@ def si(ctx: Ctx, q: Quantity, dim: Dim, *, what: str, bare_unit: str | None) -> 
                       q.span, hint=f"write e.g. `{q.text}{units_for(dim)[0]}`",
                       expected=str(dim), found=q.text)
             return None
-        return q.value * UNITS[bare_unit][1]
+        return in_range(ctx, q, q.value * UNITS[bare_unit][1], dim, bare_unit, what)
     if q.unit not in UNITS:
         meant = suggest_unit(q.unit, dim)
         ctx.error(V104, f"unknown unit `{q.unit}` in `{q.text}`: expected {_a(dim)} ({fits})",
@@ -88,11 +104,27 @@ def si(ctx: Ctx, q: Quantity, dim: Dim, *, what: str, bare_unit: str | None) -> 
                   f"`{q.text}`",
                   q.span, expected=str(dim), found=str(found_dim))
         return None
-    value = q.value * factor
+    return in_range(ctx, q, q.value * factor, dim, q.unit, what)
+
+
+def in_range(ctx: Ctx, q: Quantity, value: float, dim: Dim, unit: str, what: str
+             ) -> float | None:
+    """``value`` [SI] when it is finite and its magnitude is zero or within the
+    language's :data:`~aou_dsl.core.units.RANGE` for ``dim``; else None and V105 or V130
+    (the bounds shown in ``unit``, the unit written)."""
     if not math.isfinite(value):
         ctx.error(V105, f"{what} must be a finite number, found `{q.text}`", q.span)
         return None
-    return value
+    least, most = RANGE[dim]
+    if value == 0 or least <= abs(value) <= most:
+        return value
+    factor = UNITS[unit][1]
+    span = f"up to {most / factor:.6g} {unit}" if least == 0 else \
+        f"from {least / factor:.6g} {unit} to {most / factor:.6g} {unit}"
+    ctx.error(V130, f"{what} `{q.text}` is out of range: the language takes {_a(dim)} "
+              f"{span}", q.span, hint=f"write a value {span}", found=q.text, least=least,
+              greatest=most, unit=unit)
+    return None
 
 
 def positive(ctx: Ctx, value: float | None, q: Quantity, what: str) -> float | None:
@@ -127,7 +159,11 @@ def split_args(ctx: Ctx, st: Statement, allowed: Iterable[str], repeat: bool) ->
         elif isinstance(a, Word) and repeat and _REPEAT.match(a.text):
             if out.count is not None:
                 ctx.error(V116, f"`{st.keyword}` has two repeat counts", a.span)
-            out.count = int(a.text[1:])
+            if len(a.text) > 10:  # past Python's int-string limit and any bound
+                ctx.error(V110, f"a repeat count of {len(a.text) - 1} digits; at most "
+                          "1000 episodes are allowed", a.span, found=a.text[:12] + "...")
+            else:
+                out.count = int(a.text[1:])
         elif isinstance(a, Word) and a.text == "for" and st.keyword == "shiver":
             nxt = args[i + 1] if i + 1 < len(args) else None
             if not isinstance(nxt, Quantity):

@@ -18,11 +18,18 @@ from ..core.codes import R401
 from ..core.diagnostics import AouError, Span, diag
 from ..core.trajectory import FrameDefinition
 
-__all__ = ["FORMAT", "Document", "FrameDef", "Goal", "Header", "RobotIdentity", "read_header"]
+__all__ = ["FORMAT", "MAX_GOAL", "Document", "FrameDef", "Goal", "Header", "RobotIdentity",
+           "read_header"]
 
 FORMAT = "aou-trajectory/1"
+#: Furthest a goal coordinate may lie from the robot's base [m]: no arm reaches further,
+#: and a goal in millimetres (550, 0, 250) is caught.
+MAX_GOAL = 10.0
 Finite = Annotated[float, Field(allow_inf_nan=False)]
-Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
+# Numbers are JSON numbers: not booleans, not texts that look like numbers (strict).
+Coordinate = Annotated[float, Field(strict=True, allow_inf_nan=False, ge=-MAX_GOAL,
+                                    le=MAX_GOAL)]
+Positive = Annotated[float, Field(strict=True, gt=0.0, allow_inf_nan=False)]
 
 
 class Goal(BaseModel):
@@ -30,7 +37,7 @@ class Goal(BaseModel):
 
     model_config = ConfigDict(extra="allow")
 
-    position: tuple[Finite, Finite, Finite]
+    position: tuple[Coordinate, Coordinate, Coordinate]
 
 
 class FrameDef(BaseModel):
@@ -64,7 +71,7 @@ class Header(BaseModel):
 
     format: Literal["aou-trajectory/1"]
     robot: str = Field(min_length=1)
-    joint_names: list[str] = Field(min_length=1)
+    joint_names: list[str] = Field(min_length=1, max_length=1000)
     behaviour: str | None = None
     state: str | None = None
     ee_frame: str | None = None
@@ -153,7 +160,8 @@ def _message(errors: list[Any], doc: dict) -> str:
     if any(e["loc"][0] == "goal" for e in errors):  # one part for the goal, in aou's words
         found = json.dumps(doc.get("goal"))
         parts.insert(0, "`goal` must be {\"position\": [x, y, z]}, three finite numbers "
-                        f"in metres; found {found[:60]}{'...' if len(found) > 60 else ''}")
+                        f"in metres within {MAX_GOAL:g} m of the base; found {found[:60]}"
+                        f"{'...' if len(found) > 60 else ''}")
     more = f" (and {len(parts) - 3} more)" if len(parts) > 3 else ""
     return "; ".join(parts[:3]) + more
 

@@ -18,19 +18,18 @@ Errors point at the row, the sample or the header field where they are (:mod:`.l
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 import os
-import zipfile
 from typing import Any
 
 import numpy as np
 
 from ..core.codes import I501, R401, R405
 from ..core.diagnostics import AouError, Severity, Span, diag
-from ..core.files import decode, read_bytes
+from ..core.files import decode
+from ..core.inputs import input_limit, max_samples, read_input, too_many_samples
 from ..core.trajectory import Trajectory
+from .bounded import MAX_JOINT_VALUE, csv_table, npz_members, numbers, parse_json
 from .document import Header, read_header
 from .locate import Where, json_span
 from .plausible import ANGLE_UNITS, TIME_UNITS, check_units
@@ -64,12 +63,14 @@ def _check_arrays(t: np.ndarray, q: np.ndarray, names: tuple[str, ...], where: W
         i = int(np.argmax(bad))
         raise _bad(path, f"{where.label(i)}: the time is not a finite number",
                    span=where.span(i, "t"), sample=i)
-    bad_rows = ~np.isfinite(q).all(axis=1)
+    bad_rows = ~(np.isfinite(q) & (np.abs(q) <= MAX_JOINT_VALUE)).all(axis=1)
     if bad_rows.any():
         i = int(np.argmax(bad_rows))
-        k = int(np.argmax(~np.isfinite(q[i])))
-        raise _bad(path, f"{where.label(i)} (t={t[i]:g}): joint `{names[k]}` is not a finite "
-                   "number", span=where.span(i, "q", k), sample=i, joint=names[k])
+        k = int(np.argmax(~(np.isfinite(q[i]) & (np.abs(q[i]) <= MAX_JOINT_VALUE))))
+        what = "not a finite number" if not np.isfinite(q[i, k]) else \
+            f"{q[i, k]:g}, beyond any joint position (at most {MAX_JOINT_VALUE:g})"
+        raise _bad(path, f"{where.label(i)} (t={t[i]:g}): joint `{names[k]}` is {what}",
+                   span=where.span(i, "q", k), sample=i, joint=names[k])
 
 
 def _check_clock(t: np.ndarray, where: Where) -> None:
@@ -88,11 +89,18 @@ def _optional(doc: dict, q: np.ndarray) -> dict:
         qdd = np.asarray(doc.get("qdd") if doc.get("qdd") is not None else [], dtype=float)
         if qd.shape == q.shape and qdd.shape == q.shape:
             out["qd"], out["qdd"] = qd, qdd
+        episodes = doc.get("episodes") or ()
+        if len(episodes) > MAX_EPISODES:
+            return {}  # no compiled file has so many: measure from q alone
         out["episodes"] = tuple((str(e["kind"]), float(e["t_start"]), float(e["t_end"]))
-                                for e in doc.get("episodes") or ())
+                                for e in episodes)
     except (TypeError, ValueError, KeyError):
         return {}  # malformed extras: measure from q alone
     return out
+
+
+#: Most episodes a trajectory's ``episodes`` list is read with (lint allows 1000).
+MAX_EPISODES = 1000
 
 
 def _number_at(values: Any, where: Where, key: str, i: int) -> AouError:
@@ -103,9 +111,7 @@ def _number_at(values: Any, where: Where, key: str, i: int) -> AouError:
             return _bad(where.path, f"{where.label(k)} of `q` is not a list of joint values",
                         span=where.span(k, key), sample=k)
         for j, v in enumerate(row):
-            try:
-                float(v)
-            except (TypeError, ValueError):
+            if numbers([v]) is None or isinstance(v, list | tuple):
                 what = f"joint column {j}" if key == "q" else "the time"
                 return _bad(where.path, f"{where.label(k)}: {what} is {json.dumps(v)[:40]}, "
                             "not a number", span=where.span(k, key, j if key == "q" else None),
@@ -124,14 +130,17 @@ def _from_document(doc: dict, header: Header, t: Any, q: Any, where: Where) -> T
         if len(row) != len(names):
             raise _bad(path, f"{where.label(i)} has {len(row)} values; `joint_names` has "
                        f"{len(names)}", span=where.span(i), sample=i)
-    try:
-        t = np.asarray(t, dtype=float)
-    except (TypeError, ValueError):
-        raise _number_at(list(t) if isinstance(t, list) else [t], where, "t", 0) from None
-    try:
-        q = np.asarray(rows, dtype=float).reshape(len(rows), len(names))
-    except (TypeError, ValueError):
-        raise _number_at(rows, where, "q", 0) from None
+    if len(rows) > max_samples():
+        raise too_many_samples(path, len(rows))
+    t_values, q_values = numbers(t), numbers(rows)
+    if t_values is None:
+        raise _number_at(list(t) if isinstance(t, list | np.ndarray) else [t], where, "t", 0)
+    if q_values is None:
+        raise _number_at(rows, where, "q", 0)
+    if q_values.ndim != 2:
+        raise _bad(path, f"`q` has shape {q_values.shape}; expected ({len(rows)}, "
+                   f"{len(names)}): one list of joint values per time")
+    t, q = t_values, q_values
     _check_arrays(t, q, names, where)
     title = header.behaviour or os.path.splitext(os.path.basename(path))[0]
     return Trajectory(t, q, names, header.robot, header.ee_frame, header.goal_position,
@@ -152,11 +161,7 @@ def read_npz(path: str, data: bytes, own_goal: bool = True) -> Trajectory:
 
 def _json(path: str, text: str, own_goal: bool) -> tuple[Trajectory, Header]:
     text = text.removeprefix("\ufeff")
-    try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise AouError(diag(R401, f"not valid JSON: {exc.msg}",
-                            Span.point(path, exc.lineno, exc.colno))) from None
+    doc = parse_json(path, text)
     header = read_header(path, doc, own_goal=own_goal, text=text)
     missing = [k for k in ("t", "q") if k not in doc]
     if missing:
@@ -172,17 +177,7 @@ def _json(path: str, text: str, own_goal: bool) -> tuple[Trajectory, Header]:
 
 
 def _npz(path: str, data: bytes, own_goal: bool) -> tuple[Trajectory, Header]:
-    try:
-        with zipfile.ZipFile(io.BytesIO(data)) as zf:
-            doc = json.loads(zf.read("header.json"))
-            arrays = {}
-            for key in ("t", "q", "qd", "qdd"):
-                if f"{key}.npy" in zf.namelist():
-                    arrays[key] = np.lib.format.read_array(io.BytesIO(zf.read(f"{key}.npy")),
-                                                           allow_pickle=False)
-    except (zipfile.BadZipFile, KeyError, ValueError, OSError) as exc:
-        raise _bad(path, f"not an aou NPZ trajectory: {exc}",
-                   hint="an NPZ of aou holds t.npy, q.npy and header.json") from None
+    doc, arrays = npz_members(path, data, input_limit("recording"))
     if "t" not in arrays or "q" not in arrays:
         raise _bad(path, "not an aou NPZ trajectory: `t.npy` or `q.npy` is missing")
     header = read_header(path, doc, own_goal=own_goal)
@@ -207,21 +202,22 @@ def _comments(lines: list[str]) -> dict[str, str]:
     return out
 
 
-def _csv_values(path: str, rows: list[tuple[int, list[str]]], header: list[str],
-                lines: list[str]) -> np.ndarray:
-    values = np.full((len(rows), len(header)), np.nan)
-    for i, (line, r) in enumerate(rows):
-        if len(r) != len(header):
-            raise _bad(path, f"row {line} has {len(r)} columns; the header has "
-                       f"{len(header)}", span=Span.point(path, line, 1), row=line)
-        for j, cell in enumerate(r):
-            try:
-                values[i, j] = float(cell)
-            except ValueError:
-                col = 1 if '"' in lines[line - 1] else len(",".join(r[:j] + [""])) + 1
-                raise _bad(path, f"row {line}, column `{header[j]}`: `{cell}` is not a "
-                           "number", span=Span.point(path, line, col), row=line) from None
-    return values
+def _csv_goal(path: str, text: str, lines: list[str]) -> tuple[float, float, float]:
+    """The ``# goal: X,Y,Z`` comment: three finite numbers within the goal's bound."""
+    from .document import MAX_GOAL
+
+    line = next((k + 1 for k, ln in enumerate(lines) if ln.lstrip("#").strip().lower()
+                 .startswith("goal")), 1)
+    try:
+        xyz = tuple(float(x) for x in text.split(","))
+    except ValueError:
+        xyz = ()
+    if len(xyz) != 3 or not all(abs(v) <= MAX_GOAL for v in xyz):  # NaN fails too
+        raise _bad(path, f"the `# goal:` comment must be X,Y,Z: three finite numbers in "
+                   f"metres, each within {MAX_GOAL:g} m of the base; found `{text}`",
+                   span=Span.point(path, line, 1), hint="write e.g. `# goal: 0.55,0,0.25`, "
+                   "or leave the line out and give --goal")
+    return xyz  # type: ignore[return-value]
 
 
 def _read_csv(path: str, text: str, robot: str | None,
@@ -231,30 +227,22 @@ def _read_csv(path: str, text: str, robot: str | None,
     and whether aou wrote the file."""
     lines = text.removeprefix("\ufeff").splitlines()
     notes = _comments([ln for ln in lines if ln.startswith("#")])
-    rows = [(k + 1, r) for k, r in enumerate(csv.reader(lines)) if r and not r[0].startswith("#")]
-    if not rows:
-        raise _bad(path, "the CSV file is empty")
-    header = [h.strip() for h in rows[0][1]]
+    (header_line, header), at, values = csv_table(path, lines)
     if header[0] != "t":
         raise _bad(path, f"the first column must be `t`, found `{header[0]}`",
                    hint="a header row `t,joint_a,joint_b,...` names the columns",
-                   span=Span.point(path, rows[0][0], 1))
-    values = _csv_values(path, rows[1:], header, lines)
+                   span=Span.point(path, header_line, 1))
     robot = robot or notes.get("robot")
     if not robot:
         raise AouError(diag(I501, f"cannot read `{path}` as a recording without its robot: "
                             "the CSV does not say which robot made it (no `# robot:` line)",
                             Span.whole_file(path), hint="give --robot NAME|PATH"))
-    if goal is None and notes.get("goal"):
-        try:
-            goal = tuple(float(x) for x in notes["goal"].split(","))  # type: ignore[assignment]
-        except ValueError:
-            raise _bad(path, f"the `# goal:` comment must be X,Y,Z, found "
-                       f"`{notes['goal']}`") from None
+    if goal is None and "goal" in notes:
+        goal = _csv_goal(path, notes["goal"], lines)
     ee = ee_frame or (notes.get("ee_frame") if notes.get("ee_frame") not in (None, "None")
                       else None)
     names = tuple(header[1:])
-    where = Where(path, lines=[line for line, _ in rows[1:]])
+    where = Where(path, lines=at.tolist())
     _check_arrays(values[:, 0], values[:, 1:], names, where)
     title = os.path.splitext(os.path.basename(path))[0]
     rec = Trajectory(values[:, 0], values[:, 1:], names, robot, ee,
@@ -318,7 +306,7 @@ def _format(path: str) -> tuple[str, bytes]:
         raise _unread(path, "a ROS 2 bag (a folder)" if bag else "a folder")
     if ext in _NOT_READ:
         raise _unread(path, _NOT_READ[ext])
-    data = read_bytes(path)
+    data = read_input(path, "recording")
     if ext.lstrip(".") in FORMATS:
         return ext.lstrip("."), data
     fmt = _sniff(data)
@@ -380,9 +368,12 @@ def read_recording(path: str, *, robot: str | None = None,
         where = Where(path, text=text if fmt == "json" else None)
     changes: dict[str, Any] = {k: v for k, v in (("robot", robot), ("ee_frame", ee_frame),
                                                  ("package_dirs", tuple(package_dirs))) if v}
+    if robot and robot != rec.robot and not ee_frame:
+        changes["ee_frame"] = None  # the file's frame is its own robot's: use the new one's
     if goal is not None and not isinstance(goal, str):
         changes["goal"] = tuple(float(x) for x in goal)
     rec = rec.with_(**changes) if changes else rec
+    _check_clock(rec.t, where)  # before the units are judged: they divide by the steps
     rec = check_units(rec, angle_unit, time_unit, trusted, where)
     _check_clock(rec.t, where)
     if isinstance(goal, str):

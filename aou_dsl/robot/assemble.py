@@ -95,6 +95,11 @@ def _check_names(urdf: Urdf, pins: dict[str, Any], joints: tuple[str, ...], wher
         if pins.get(key) and pins[key] not in urdf.links and pins[key] != GAZE_FRAME:
             raise _bad(urdf, where, f"`{key}` `{pins[key]}` is not a link of "
                        f"`{os.path.basename(urdf.path)}`")
+    for pair in pins.get("allowed_contacts") or ():
+        for link in pair:
+            if link not in urdf.links:
+                raise _bad(urdf, where, f"`allowed_contacts` names `{link}`, which is not a "
+                           f"link of `{os.path.basename(urdf.path)}`")
     if pins.get("shiver_joint") and pins["shiver_joint"] not in joints:
         raise _bad(urdf, where, f"`shiver_joint` `{pins['shiver_joint']}` is not an arm "
                    f"joint ({', '.join(joints)})")
@@ -220,15 +225,17 @@ def _reach(spec: RobotSpec, model: Any, urdf: Urdf, pins: dict, src: dict,
                                        f"{SAMPLES} sampled configurations")
         if all(k in pins for k in keys):
             return replace(spec, **{k: pins[k] for k in keys}), model, None
+        from .derive import Budget
+
         rolls = (spec.ee_roll,) if "ee_roll" in pins else ROLLS
-        first = None
+        first, budget = None, Budget()
         for roll in rolls:
             m = model if roll == spec.ee_roll else _gazing(
                 urdf, spec.arm_joints, velocity,
                 (spec.ee_link or spec.ee_frame, spec.forward, spec.ee_offset, roll))
             trial = replace(spec, ee_roll=roll, ee_frame=GAZE_FRAME if roll else spec.ee_frame,
                             ee_link=spec.ee_link or (spec.ee_frame if roll else ""))
-            done = _search(trial, m, pins, src, test)
+            done = _search(trial, m, pins, src, test, budget)
             first = first or done
             if done[2]:
                 if roll:
@@ -241,13 +248,13 @@ def _reach(spec: RobotSpec, model: Any, urdf: Urdf, pins: dict, src: dict,
             test.close()
 
 
-def _search(spec: RobotSpec, model: Any, pins: dict, src: dict, test: Any
+def _search(spec: RobotSpec, model: Any, pins: dict, src: dict, test: Any, budget: Any
             ) -> tuple[RobotSpec, Any, bool]:
     from .derive import find_reach
     from .kinematics import arm_model
 
     found = find_reach(arm_model(spec, model), pins.get("goal"), pins.get("start_direction"),
-                       pins.get("posture"), test)
+                       pins.get("posture"), test, budget)
     for k in ("goal", "start_direction", "posture"):
         if k not in pins:
             src[k] = found.how

@@ -14,9 +14,12 @@ from __future__ import annotations
 import math
 import os
 
-from ..core.codes import V109
+from ..core.codes import V109, V132
 from ..core.diagnostics import AouError, Span, diag
-from .urdf import Joint, Urdf
+from .urdf_model import Joint, Urdf
+
+#: Most joints of the arm aou moves.
+MAX_ARM_JOINTS = 32
 
 __all__ = ["arm_joints", "ee_link", "is_gripper"]
 
@@ -67,6 +70,12 @@ def arm_joints(urdf: Urdf) -> tuple[str, ...]:
     if not out:
         raise AouError(diag(V109, f"`{_base(urdf)}` has no joint that moves an arm",
                             Span.whole_file(urdf.path)))
+
+    if len(out) > MAX_ARM_JOINTS:
+        raise AouError(diag(V132, f"`{_base(urdf)}`: an arm of {len(out)} joints; aou "
+                            f"moves arms of at most {MAX_ARM_JOINTS}", Span.whole_file(urdf.path),
+                            hint="name the arm's joints with `arm_joints = [...]` in a robot "
+                                 "description file (.toml) beside the URDF"))
     return tuple(out)
 
 

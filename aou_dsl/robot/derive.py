@@ -51,6 +51,22 @@ SEEDS = 8
 POOL = 400
 #: Reaches read off the pool when no goal of the grid passes.
 POOL_REACHES = 60
+#: Most default reaches tried for one robot, over every goal, direction, seed and turn of
+#: the hand: the built-in arms' URDFs need 8 to 16; an arm that no reach fits stops here
+#: instead of trying hundreds (minutes of IK).
+MAX_PROBES = 64
+
+
+class Budget:
+    """How many more reaches the search may try (:data:`MAX_PROBES` at first)."""
+
+    def __init__(self, left: int = MAX_PROBES):
+        self.left = left
+
+    def take(self) -> bool:
+        """One more try, when any is left."""
+        self.left -= 1
+        return self.left >= 0
 #: Every joint origin past the second stays this high above the table [m].
 TABLE_CLEARANCE = 0.02
 _AXES = ("x", "y", "z")
@@ -268,14 +284,16 @@ def _seeds(arm: ArmModel, pool: np.ndarray, goal: tuple, direction: tuple
 
 def find_reach(arm: ArmModel, goal: tuple[float, float, float] | None = None,
                start_direction: tuple[float, float, float] | None = None,
-               posture: tuple[float, ...] | None = None, collides: Collides = None
-               ) -> Reach:
+               posture: tuple[float, ...] | None = None, collides: Collides = None,
+               budget: Budget | None = None) -> Reach:
     """The default reach of ``arm`` (see the module's docstring); pinned values are kept.
 
     ``arm`` is the robot with its limits; its ``spec.posture`` is ignored. ``collides``
     tells a configuration that touches itself or the table (None: joint origins must stay
-    above the table instead).
+    above the table instead). ``budget`` bounds the reaches tried (shared by the calls
+    of one robot's search).
     """
+    budget = budget or Budget()
     pool = _pool(arm, posture)
     goals = [goal] if goal is not None else _goals(arm, pool[0])
     dirs = [start_direction] if start_direction is not None else list(DIRECTIONS)
@@ -283,9 +301,9 @@ def find_reach(arm: ArmModel, goal: tuple[float, float, float] | None = None,
         return Reach(goals[0], dirs[0], tuple(float(x) for x in pool[0]), False, 0.0,
                      f"not searched: {arm.n} arm joints cannot hold the position, the "
                      "line of sight and the roll of the hand at once (6 are needed)")
-    best = _grid(arm, pool, goals, dirs, collides)
+    best = _grid(arm, pool, goals, dirs, collides, budget)
     if best is None and goal is None and start_direction is None:
-        best = _from_pool(arm, pool, collides)
+        best = _from_pool(arm, pool, collides, budget)
     if best is None:
         return Reach(goals[0], dirs[0], tuple(float(x) for x in pool[0]), False, 0.0,
                      "derived: no goal, direction and seed tried passes the default reach")
@@ -299,14 +317,16 @@ def find_reach(arm: ArmModel, goal: tuple[float, float, float] | None = None,
 _Best = tuple[int, float, np.ndarray, tuple, tuple]
 
 
-def _grid(arm: ArmModel, pool: np.ndarray, goals: list, dirs: list, collides: Collides
-          ) -> _Best | None:
+def _grid(arm: ArmModel, pool: np.ndarray, goals: list, dirs: list, collides: Collides,
+          budget: Budget) -> _Best | None:
     """The best reach over the goals and directions, stopping at the first goal and
     direction where every path passes."""
     best: _Best | None = None
     for g in goals:
         for u in dirs:
             for seed in _seeds(arm, pool, g, u):
+                if not budget.take():
+                    return best
                 trial = replace(arm, spec=replace(arm.spec, posture=tuple(seed)))
                 passed, score, q0 = _probe(trial, g, u, collides)
                 if passed >= 0 and (best is None or (passed, score) > best[:2]):
@@ -316,7 +336,8 @@ def _grid(arm: ArmModel, pool: np.ndarray, goals: list, dirs: list, collides: Co
     return best
 
 
-def _from_pool(arm: ArmModel, pool: np.ndarray, collides: Collides) -> _Best | None:
+def _from_pool(arm: ArmModel, pool: np.ndarray, collides: Collides, budget: Budget
+               ) -> _Best | None:
     """For an arm whose front is not +x, or whose reach the grid misses: reaches read
     off the pool's configurations, each looking down at a goal 0.30 m ahead of its hand
     (at least 8 cm above the table), tried from that very configuration."""
@@ -328,6 +349,8 @@ def _from_pool(arm: ArmModel, pool: np.ndarray, collides: Collides) -> _Best | N
         g = p + 0.30 * f
         if g[2] < 0.08 or f[2] > -0.1 or (collides is not None and collides(q)):
             continue
+        if not budget.take():
+            break
         goal = tuple(round(float(c), 3) for c in g)
         u = tuple(round(float(c), 3) for c in -f)
         trial = replace(arm, spec=replace(arm.spec, posture=tuple(q)))

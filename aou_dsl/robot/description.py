@@ -37,7 +37,7 @@ from typing import Any
 
 from ..core.codes import V109
 from ..core.diagnostics import AouError, Span, diag
-from ..core.files import read_text
+from ..core.inputs import read_input_text
 
 __all__ = ["KEYS", "Description", "read_description"]
 
@@ -50,6 +50,18 @@ _NAMES = ("ee_frame", "shiver_joint", "forward")
 KEYS = ("urdf", "robot", "package_dirs", "arm_joints", "posture", "allowed_contacts",
         "sources", *_NAMES, *_VEC3, *_RATES, *_SCALARS, *_ANGLES)
 FORWARD = ("+x", "-x", "+y", "-y", "+z", "-z")
+#: The ranges numbers may take: key -> (least, greatest, least included, in words).
+_RANGES: dict[str, tuple[float, float, bool, str]] = {
+    "velocity_scale": (0.0, 1.0, False, "a fraction above 0 and at most 1"),
+    "accel_scale": (0.0, 1.0, False, "a fraction above 0 and at most 1"),
+    "limit_margin": (0.0, 1.0, True, "a number from 0 to 1 [rad]"),
+    "ee_offset": (0.0, 2.0, True, "a number from 0 to 2 [m]"),
+    "ee_roll": (-2 * math.pi, 2 * math.pi, True, "a number from -2 pi to 2 pi [rad]"),
+}
+#: Greatest joint rate (velocity, acceleration, jerk) a description may give.
+_MAX_RATE = 1e7
+#: Greatest posture angle [rad] and goal coordinate [m].
+_MAX_POSTURE, _MAX_GOAL = 100.0, 10.0
 
 
 @dataclass(frozen=True)
@@ -120,30 +132,33 @@ def _check(key: str, value: Any) -> tuple[Any, str | None]:
 
 
 def _check_number(key: str, value: Any) -> tuple[Any, str | None]:
-    if key in _ANGLES:
-        ok = isinstance(value, int | float) and not isinstance(value, bool) \
-            and math.isfinite(value)
-        return (float(value), None) if ok else (None, "must be a number [rad]")
-    if key in _SCALARS:
-        ok = isinstance(value, int | float) and not isinstance(value, bool) and value >= 0
-        return (float(value), None) if ok else (None, "must be a number >= 0")
+    if key in _RANGES:
+        low, high, closed, words = _RANGES[key]
+        ok = isinstance(value, int | float) and not isinstance(value, bool) and \
+            math.isfinite(value) and (low <= value if closed else low < value) and \
+            value <= high
+        return (float(value), None) if ok else (None, f"must be {words}")
     if key in _RATES:
         if isinstance(value, int | float) and not isinstance(value, bool):
             value = [value]
         nums = _numbers(value)
-        if nums is None or not nums or min(nums) <= 0:
-            return None, "must be a positive number, or a list of them (one per arm joint)"
+        if nums is None or not nums or min(nums) <= 0 or max(nums) > _MAX_RATE:
+            return None, (f"must be a positive number up to {_MAX_RATE:g}, or a list of "
+                          "them (one per arm joint)")
         return (nums[0] if len(nums) == 1 else tuple(nums)), None
     nums = _numbers(value)
     if key == "posture":
-        return (tuple(nums), None) if nums else (None, "must be a list of numbers [rad]")
+        ok = bool(nums) and max(abs(v) for v in nums or [0]) <= _MAX_POSTURE
+        return (tuple(nums or ()), None) if ok else (None, "must be a list of numbers [rad]")
     if nums is None or len(nums) != 3:
         return None, "must be a list of 3 numbers"
     if key == "from":
-        norm = math.sqrt(sum(v * v for v in nums))
-        if norm == 0:
-            return None, "must not be zero"
-        nums = [v / norm for v in nums]
+        norm = math.hypot(*nums)
+        if norm == 0 or not math.isfinite(norm):
+            return None, "must be a direction: 3 numbers, not all zero"
+        return tuple(v / norm for v in nums), None
+    if max(abs(v) for v in nums) > _MAX_GOAL:
+        return None, f"must be 3 numbers [m], each within {_MAX_GOAL:g} m of the base"
     return tuple(nums), None
 
 
@@ -165,7 +180,7 @@ def read_description(path: str) -> Description:
         AouError: I501 when it cannot be read; V109 for what does not fit, at its line.
     """
     path = os.path.abspath(path)
-    text = read_text(path, "the robot file")
+    text = read_input_text(path, "robot", "the robot file")
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -173,6 +188,11 @@ def read_description(path: str) -> Description:
         line = int(m.group(1)) if m else 1
         raise AouError(diag(V109, f"robot description `{os.path.basename(path)}` is not "
                             f"valid TOML: {exc}", Span(path, line, 1, line, 2))) from None
+    except (RecursionError, ValueError) as exc:  # nested too deeply; a 5000-digit number
+        what = "nested too deeply" if isinstance(exc, RecursionError) else \
+            "holds a number too long to read"
+        raise AouError(diag(V109, f"robot description `{os.path.basename(path)}` {what}",
+                            Span.whole_file(path))) from None
     return _checked(path, text, doc)
 
 

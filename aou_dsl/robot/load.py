@@ -34,11 +34,11 @@ __all__ = ["Robot", "load_arm", "load_robot", "robot_diagnostics", "scene_urdf",
 
 def unknown_robot(robot: str, span: Span) -> Diagnostic:
     """V109 for a name that is neither a built-in arm nor a robot file."""
-    from ..lang.values import did_you_mean
+    from ..lang.values import robot_hint
 
     return diag(V109, f"unknown robot `{robot}`: expected one of {', '.join(ROBOTS)}, "
                 f"or a quoted path to a robot file ({' or '.join(ROBOT_FILE_TYPES)})", span,
-                hint=did_you_mean(robot, ROBOTS), found=robot, valid=list(ROBOTS))
+                hint=robot_hint(robot, ROBOTS), found=robot, valid=list(ROBOTS))
 
 
 def load_robot(robot: str, package_dirs: Sequence[str] = ()) -> Robot:

@@ -63,8 +63,13 @@ class Scene:
                                         physicsClientId=self.client)
         except pb.error as exc:
             self.close()
-            raise AouError(diag(V109, f"PyBullet cannot load robot `{self.robot}`: {exc}",
-                                Span.whole_file(urdf))) from None
+            # blame the file the user has, not aou's copy
+            user = load_robot(self.robot, self.options.package_dirs)
+            raise AouError(diag(V109, f"PyBullet cannot load robot `{self.robot}` (its "
+                                f"collision shapes or meshes): {exc}",
+                                Span.whole_file(user.description or user.urdf.path),
+                                hint="check the meshes the URDF names: each must be a mesh "
+                                     "file PyBullet reads (.stl, .obj, .dae)")) from None
         #: The arm's joint names, in the order of :meth:`set_arm`'s ``q``.
         self.arm_joints: tuple[str, ...] = spec.arm_joints
         self.joint_index: dict[str, int] = {}

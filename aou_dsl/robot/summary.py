@@ -79,6 +79,7 @@ def describe_robot(robot: str, package_dirs: tuple[str, ...] = ()
         "ee_link": spec.ee_link or None,
         "joints": _joints(r),
         "collision_geometry": r.collision,
+        "missing_meshes": _missing_meshes(r),
         "reach_found": r.reach_ok,
         "sources": {k: spec.source(k) for k in _ORDER if spec.source(k)},
         "warnings": [{"code": d.code, "message": d.message, "hint": d.hint}
@@ -86,6 +87,13 @@ def describe_robot(robot: str, package_dirs: tuple[str, ...] = ()
         "toml": robot_toml(r),
     }
     return doc, _text(doc)
+
+
+def _missing_meshes(r: Any) -> list[str]:
+    """The mesh paths of the URDF that name no regular file (the checks need them)."""
+    from .urdf import scene_xml
+
+    return scene_xml(r.urdf, r.package_dirs, None, visuals=False)[1]
 
 
 def _text(doc: dict[str, Any]) -> str:
@@ -106,7 +114,11 @@ def _text(doc: dict[str, Any]) -> str:
             f"    {j['name']} ({j['type']}): [{j['lower']:.4g}, {j['upper']:.4g}] rad, "
             f"{j['velocity']:.4g} rad/s ({j['velocity_source']}), "
             f"{j['acceleration']:g} rad/s^2, {jerk}, effort {effort}")
-    lines.append(f"  collision geometry: {'yes' if doc['collision_geometry'] else 'NO'}")
+    missing = doc["missing_meshes"]
+    lines.append(f"  collision geometry: {'yes' if doc['collision_geometry'] else 'NO'}" + (
+        f", but {len(missing)} mesh file(s) not found, first `{missing[0]}`: compiling "
+        "needs them (give their package's folder with --package-dir), or compile with "
+        "--no-check" if missing and doc["collision_geometry"] else ""))
     if doc["reach_found"] is False:
         lines.append("  default reach: NOT FOUND (pin goal, from and posture)")
     for w in doc["warnings"]:

@@ -22,79 +22,15 @@ import math
 import os
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 from ..core.codes import V109
 from ..core.diagnostics import AouError, Span, diag
-from ..core.files import read_text
+from ..core.inputs import read_input_text
+from .sanity import check_urdf
+from .urdf_model import CONTINUOUS_RANGE, GAZE_FRAME, MOVING, Gaze, Joint, Urdf
 
-__all__ = ["CONTINUOUS_RANGE", "GAZE_FRAME", "Joint", "Urdf", "gaze_rpy", "kinematic_xml",
-           "gaze_offset", "read_urdf", "resolve_uri", "scene_xml", "unlimited"]
-
-#: Position range [rad] a continuous joint is given, either way from zero: one turn.
-CONTINUOUS_RANGE = 2.0 * math.pi
-#: Name of the frame aou adds when the end-effector link's z axis is not its forward axis.
-GAZE_FRAME = "aou_ee"
-#: ``(ee_link, forward, offset [m], roll [rad])`` of the frame aou adds.
-Gaze = tuple[str, str, float, float]
-#: Joint types aou can move.
-MOVING = ("revolute", "continuous", "prismatic")
-
-
-@dataclass(frozen=True)
-class Joint:
-    """One ``<joint>`` of a URDF. Limits are None where the file gives none."""
-
-    name: str
-    type: str
-    parent: str
-    child: str
-    xyz: tuple[float, float, float]
-    rpy: tuple[float, float, float]
-    axis: tuple[float, float, float]
-    lower: float | None
-    upper: float | None
-    velocity: float | None
-    effort: float | None
-
-    @property
-    def moving(self) -> bool:
-        return self.type in MOVING
-
-
-@dataclass(frozen=True)
-class Urdf:
-    """A parsed URDF.
-
-    Attributes:
-        path: the file, absolute.
-        text: its content.
-        joints: every joint, in file order.
-        links: every link name, in file order.
-        collision_links: the links with at least one ``<collision>`` element.
-    """
-
-    path: str
-    text: str
-    joints: tuple[Joint, ...]
-    links: tuple[str, ...]
-    collision_links: frozenset[str]
-
-    @property
-    def root(self) -> str:
-        """The link no joint has as its child."""
-        children = {j.child for j in self.joints}
-        return next(link for link in self.links if link not in children)
-
-    def joint(self, name: str) -> Joint:
-        return next(j for j in self.joints if j.name == name)
-
-    def children(self, link: str) -> list[Joint]:
-        return [j for j in self.joints if j.parent == link]
-
-    def parent_joint(self, link: str) -> Joint | None:
-        return next((j for j in self.joints if j.child == link), None)
-
+__all__ = ["CONTINUOUS_RANGE", "GAZE_FRAME", "MOVING", "Gaze", "Joint", "Urdf", "gaze_rpy",
+           "kinematic_xml", "gaze_offset", "read_urdf", "resolve_uri", "scene_xml", "unlimited"]
 
 def _bad(path: str, message: str, hint: str | None = None) -> AouError:
     return AouError(diag(V109, message, Span.whole_file(path), hint=hint))
@@ -138,7 +74,7 @@ def read_urdf(path: str) -> Urdf:
         AouError: I501 when it cannot be read, V109 when it is not a URDF aou can use.
     """
     path = os.path.abspath(path)
-    text = read_text(path, "the robot file")
+    text = read_input_text(path, "robot", "the robot file")
     try:
         root = ET.fromstring(text)
         if root.tag != "robot":
@@ -152,7 +88,9 @@ def read_urdf(path: str) -> Urdf:
         raise _bad(path, f"`{os.path.basename(path)}` has no links")
     colliding = frozenset(el.get("name", "") for el in root.findall("link")
                           if el.find("collision") is not None)
-    return Urdf(path, text, joints, links, colliding)
+    urdf = Urdf(path, text, joints, links, colliding)
+    check_urdf(urdf)
+    return urdf
 
 
 def _package_dirs(package: str, folder: str, extra: Sequence[str]) -> list[str]:
@@ -177,21 +115,22 @@ def _package_dirs(package: str, folder: str, extra: Sequence[str]) -> list[str]:
 
 def resolve_uri(uri: str, folder: str, package_dirs: Sequence[str] = ()) -> str | None:
     """The absolute path of a mesh ``uri`` written in a URDF that lives in ``folder``;
-    None when no file is found (see the module's docstring for the search)."""
+    None when no regular file is found (a folder or a FIFO is none; see the module's
+    docstring for the search)."""
     if uri.startswith("file://"):
         uri = uri[len("file://"):]
     if not uri.startswith("package://"):
         path = uri if os.path.isabs(uri) else os.path.join(folder, uri)
-        return os.path.normpath(path) if os.path.exists(path) else None
+        return os.path.normpath(path) if os.path.isfile(path) else None
     package, _, rest = uri[len("package://"):].partition("/")
     for d in _package_dirs(package, folder, package_dirs):
-        if os.path.exists(os.path.join(d, rest)):
+        if os.path.isfile(os.path.join(d, rest)):
             return os.path.normpath(os.path.join(d, rest))
     parts = [package, *rest.split("/")]
     for base in [*package_dirs, folder, *_parents(folder)]:
         for k in range(len(parts) - 1):
             path = os.path.join(base, *parts[k:])
-            if os.path.exists(path):
+            if os.path.isfile(path):
                 return os.path.normpath(os.path.abspath(path))
     return None
 

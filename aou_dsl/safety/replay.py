@@ -25,10 +25,11 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..core.codes import R410
 from ..core.options import SceneOptions
 from ..core.trajectory import Trajectory
 from ..robot.load import load_arm
@@ -100,7 +101,9 @@ def replay(tr: Trajectory, *, options: SceneOptions | None = None,
     """
     arm = load_arm(tr.robot, tr.ee_frame, tr.package_dirs, tr.ee_definition)
     cols = tr.columns(arm.joint_names)
-    t, q = tr.t, np.ascontiguousarray(tr.q[:, cols], dtype=float)
+    _bound(tr)
+    t0 = float(tr.t[0])  # the replay runs from 0 (the arm at rest at the first sample)
+    t, q = tr.t - t0, np.ascontiguousarray(tr.q[:, cols], dtype=float)
     if tr.qd is not None and tr.qdd is not None:
         qd, qdd = tr.qd[:, cols], tr.qdd[:, cols]
     else:
@@ -122,8 +125,24 @@ def replay(tr: Trajectory, *, options: SceneOptions | None = None,
     if dynamic:
         dyn_check, report.dynamic = _dynamic(scene, arm, t, q, qd)
         report.checks.append(dyn_check)
+    report.checks = [c if c.time is None else replace(c, time=round(c.time + t0, 6))
+                     for c in report.checks]  # times on the file's own clock
     return report
 
+
+def _bound(tr: Trajectory) -> None:
+    """Refuse (R410) a trajectory whose replay at :data:`PHYSICS_RATE` would take more
+    steps than a recording may have samples: the work is bounded by the time it spans."""
+    from ..core.diagnostics import AouError, Span, diag
+    from ..core.inputs import ENV_SAMPLES, max_samples
+
+    longest = max_samples() / PHYSICS_RATE
+    if tr.duration > longest:
+        raise AouError(diag(
+            R410, f"`{tr.path}` spans {tr.duration:.6g} s; a check replays at most "
+            f"{longest:g} s ({max_samples():,} steps at {PHYSICS_RATE:g} Hz)",
+            Span.whole_file(tr.path), hint=f"check a part of it, or raise the bound with "
+            f"{ENV_SAMPLES}; are the times in seconds?", limit=longest, variable=ENV_SAMPLES))
 
 #: Where the target cube waits when a trajectory has no goal [m].
 _AWAY = (0.0, 0.0, -100.0)
