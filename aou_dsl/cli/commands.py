@@ -15,14 +15,14 @@ import sys
 from collections.abc import Callable, Sequence
 
 from ..core.codes import C306, C311
-from ..core.diagnostics import RULES, AouError, Diagnostic, Severity, Span
+from ..core.diagnostics import AouError, Diagnostic, Severity, Span
 from ..core.rules import category
 from ..editor import cmd_server
 from .args import EXIT_ERRORS, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, build_parser
 from .fmt import cmd_fmt
 from .report import format_json, format_suppressed
 from .report import print_diagnostics as _print_diags
-from .tools import cmd_robot, cmd_synth
+from .tools import cmd_robot, cmd_rules, cmd_synth
 
 __all__ = ["EXIT_ERRORS", "EXIT_OK", "EXIT_USAGE", "main"]
 
@@ -97,28 +97,6 @@ def _cmd_lint(args: argparse.Namespace) -> int:
         return EXIT_USAGE
     if counts[Severity.ERROR] or (args.strict and counts[Severity.WARNING]):
         return EXIT_ERRORS
-    return EXIT_OK
-
-
-def _cmd_rules(args: argparse.Namespace) -> int:
-    wanted = [c.upper() for c in args.codes]
-    unknown = [c for c in wanted if c not in RULES]
-    if unknown:
-        print(f"aouc: unknown rule code(s): {', '.join(unknown)}; `aouc rules` lists them",
-              file=sys.stderr)
-        return EXIT_USAGE
-    rules = [RULES[c] for c in wanted] if wanted else list(RULES.values())
-    if args.format == "json":
-        print(format_json([{"code": r.code, "name": r.name, "severity": str(r.severity),
-                            "what": r.what, "why": r.why, "example": r.example}
-                           for r in rules]))
-        return EXIT_OK
-    for r in rules:
-        if wanted:
-            print(f"{r.code} {r.name} [{r.severity}]\n  what: {r.what}\n  why: {r.why}\n"
-                  f"  example:\n" + "\n".join(f"    {ln}" for ln in r.example.splitlines()))
-        else:
-            print(f"{r.code}  {r.name:<28} {r.severity:<8} {r.what}")
     return EXIT_OK
 
 
@@ -372,7 +350,7 @@ def _cmd_studio(args: argparse.Namespace) -> int:
 
 
 _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
-    "lint": _cmd_lint, "rules": _cmd_rules, "explain": _cmd_explain,
+    "lint": _cmd_lint, "rules": cmd_rules, "explain": _cmd_explain,
     "compile": _cmd_compile, "check": _cmd_check, "measure": _cmd_measure,
     "plot": _cmd_plot, "render": _cmd_render, "variants": _cmd_variants,
     "robot": cmd_robot, "synth": cmd_synth, "studio": _cmd_studio,

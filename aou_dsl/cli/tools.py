@@ -7,12 +7,12 @@ import argparse
 import sys
 
 from ..core.codes import V109
-from ..core.diagnostics import AouError, Diagnostic, Span, diag
+from ..core.diagnostics import RULES, AouError, Diagnostic, Span, diag
 from ..version import __version__
-from .args import EXIT_ERRORS, EXIT_OK, usage_error
+from .args import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, usage_error
 from .report import format_json, format_text
 
-__all__ = ["cmd_robot", "cmd_synth"]
+__all__ = ["cmd_robot", "cmd_rules", "cmd_synth"]
 
 
 #: Names people call the built-in arms by: ``aouc robot franka`` suggests ``panda``.
@@ -118,4 +118,27 @@ def cmd_synth(args: argparse.Namespace) -> int:
         return EXIT_OK
     write_atomic(args.output, text.encode(), inputs=reads)
     print(f"wrote {args.output}", file=sys.stderr)
+    return EXIT_OK
+
+
+def cmd_rules(args: argparse.Namespace) -> int:
+    """``aouc rules [CODE...]``: the registry, or some of its rules in full."""
+    wanted = [c.upper() for c in args.codes]
+    unknown = [c for c in wanted if c not in RULES]
+    if unknown:
+        print(f"aouc: unknown rule code(s): {', '.join(unknown)}; `aouc rules` lists them",
+              file=sys.stderr)
+        return EXIT_USAGE
+    rules = [RULES[c] for c in wanted] if wanted else list(RULES.values())
+    if args.format == "json":
+        print(format_json([{"code": r.code, "name": r.name, "severity": str(r.severity),
+                            "what": r.what, "why": r.why, "example": r.example}
+                           for r in rules]))
+        return EXIT_OK
+    for r in rules:
+        if wanted:
+            print(f"{r.code} {r.name} [{r.severity}]\n  what: {r.what}\n  why: {r.why}\n"
+                  f"  example:\n" + "\n".join(f"    {ln}" for ln in r.example.splitlines()))
+        else:
+            print(f"{r.code}  {r.name:<28} {r.severity:<8} {r.what}")
     return EXIT_OK

@@ -29,6 +29,7 @@ from ..robot.ik import IKStatus, solve_path
 from ..robot.kinematics import ArmModel
 from ..robot.load import load_arm
 from .fitting import hint_edit
+from .reuse import solved_path, timed_path
 from .start import CODES, start_diagnostic
 from .timing import (
     JointSegment,
@@ -36,7 +37,6 @@ from .timing import (
     TimingFailure,
     shiver_segment,
     tilt_segment,
-    time_path,
 )
 
 __all__ = [
@@ -102,39 +102,6 @@ def _waypoints(ep: Episode, frame: ReachFrame, opts: CompileOptions
         f = si / ep.path_length
         targets.append(frame.target(a.lerp(b, f)))
     return s, targets
-
-
-def _motion_key(arm: ArmModel, frame: ReachFrame, ep: Episode, q: np.ndarray,
-                options: CompileOptions) -> tuple:
-    """What one motion episode's IK and timing depend on: the arm, the reach, the
-    episode's path and bounds (not its place in the file), where it starts."""
-    return (arm.spec.name, arm.frame_id, frame.goal.tobytes(), frame.R0.tobytes(), ep.kind,
-            ep.start, ep.end, ep.a, ep.vmax, ep.plane, q.tobytes(), options.step_length,
-            options.step_angle, options.package_dirs)
-
-
-def _solved_path(arm, frame, ep, q, options, targets):
-    """IK of an episode's waypoints from ``q``; kept for recompilations (a changed pause
-    or another statement leaves the other episodes' paths as they were)."""
-    return _solved(Keyed(_motion_key(arm, frame, ep, q, options), (arm, targets, q)))
-
-
-@functools.lru_cache(maxsize=256)
-def _solved(probe: Keyed):
-    arm, targets, q = probe.value
-    return solve_path(arm, targets, q)
-
-
-def _timed_path(arm, frame, ep, q, options, s, q_path):
-    """:func:`time_path` of an episode's solved path; kept like :func:`_solved_path`."""
-    key = (*_motion_key(arm, frame, ep, q, options), "timed")
-    return _timed(Keyed(key, (arm, s, q_path, ep)))
-
-
-@functools.lru_cache(maxsize=256)
-def _timed(probe: Keyed):
-    arm, s, q_path, ep = probe.value
-    return time_path(arm, s, q_path, ep.a, ep.vmax, cartesian=KINDS[ep.kind].translation)
 
 
 def _start_configuration(arm: ArmModel, frame: ReachFrame, pose: Pose,
@@ -275,7 +242,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
             segments.append(seg)
         else:
             s, targets = _waypoints(ep, frame, options)
-            ik = _solved_path(arm, frame, ep, q, options, targets)
+            ik = solved_path(arm, frame, ep, q, options, targets)
             lap("ik")
             if ik.failure is not None:
                 f = ik.failure
@@ -297,7 +264,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
                         declared_velocity=math.degrees(ep.path_length / ep.duration)))
                     return res
             else:
-                seg, fail = _timed_path(arm, frame, ep, q, options, s, ik.q)
+                seg, fail = timed_path(arm, frame, ep, q, options, s, ik.q)
                 if seg is None:
                     reason = fail.reason if fail is not None else "no time law"
                     res.diagnostics.append(diag(C305, f"{ep.kind}: {reason}", ep.span))
