@@ -7,6 +7,7 @@ A code is a stage letter plus three digits:
 - ``M`` the Commitment-Vigilance model (lint's judgement of a valid file),
 - ``C`` compilation (layout, geometry, IK, timing, simulation check),
 - ``R`` reading trajectories (``aouc measure``),
+- ``D`` behaviours as Dynamic Movement Primitives (``--format dmp``, ``aouc dmp``),
 - ``I`` input/output and usage.
 
 Codes are never reused; a retired code stays in :data:`RULES` as an alias. Every
@@ -256,6 +257,38 @@ _RULE_LIST = [
          "URDFs carry no acceleration limits; a robot description file (TOML) beside the URDF "
          "pins them (docs/robots.md says how).",
          "robot z1\napproach\npause 1s"),
+    # --- D: behaviours as Dynamic Movement Primitives ------------------------------------
+    Rule("D601", "dmp-needs-episodes", _E,
+         "Only a compiled trajectory (with the compiler's episodes and goal) can become a "
+         "sequence of DMPs; a recording carries neither.",
+         "Each DMP is one rest-to-rest episode; without the episodes there are no parts.",
+         "aouc dmp export recording.csv   # a recording: compile the .aou file instead"),
+    Rule("D602", "bad-dmp-file", _E,
+         "A `.dmp` folder's manifest is not an `aou-dmp/1` sequence, or a part it names is "
+         "missing.",
+         "The sequence cannot be rolled out.",
+         "aouc dmp roll a.aou --goal 0.5,0,0.3   # a .aou file is not a .dmp folder"),
+    Rule("D603", "rollout-unreachable", _E,
+         "The arm cannot follow the rolled-out motion: a pose is out of reach, needs a "
+         "joint past its limit, or passes a singularity.",
+         "The goal moved too far for this arm; move it less or compile for the new goal.",
+         "aouc dmp roll hesitant.dmp --goal 2,0,0.3   # far out of the Panda's reach"),
+    Rule("D604", "rollout-beyond-limit", _E,
+         "The rolled-out motion fails a safety check; the message names the check, the "
+         "joint, the value and the limit (joint velocity, acceleration, collision...).",
+         "A faster tempo or a larger motion needs more of the arm than it has; such a "
+         "motion is not safe to send.",
+         "aouc dmp roll fearful.dmp --goal 0.5,0,0.3 --time-scale 0.25"),
+    Rule("D605", "rollout-off-rule", _W,
+         "A descriptor measured on the rolled-out motion is not what its scaling rule "
+         "predicts, within the descriptor's tolerance.",
+         "The adapted motion would not mean what the behaviour means.",
+         "a rollout whose pauses no longer read as pauses"),
+    Rule("D606", "blend-beyond-limit", _E,
+         "A goal changed in the middle of a motion would need more than the declared peak "
+         "acceleration (plus 10 %) or more than the arm's limits.",
+         "The blend is refused rather than sent: the arm keeps its goal.",
+         "a goal moved 30 cm during a fast retreat"),
     # --- R: reading trajectories -------------------------------------------------------
     # --- R: reading trajectories -------------------------------------------------------
     Rule("R401", "bad-trajectory", _E,

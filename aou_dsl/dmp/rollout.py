@@ -1,0 +1,259 @@
+"""Rolling a DMP sequence out to a new goal, tempo and intensity, keeping its meaning.
+
+The scaling rules (docs/dmp.md):
+
+- **Goal.** The arm starts where the sequence starts; the goal moves. The whole motion
+  is mapped by the similarity about the start position that takes the old goal to the
+  new one: a rotation ``R`` (the smallest turning the old line from start to goal into
+  the new) and a scale ``s`` (the ratio of the two lengths). Each motion's start and goal
+  poses are mapped so, its position weights become ``s R W`` and its orientation weights
+  ``R W``: the DMP then rolls out exactly the mapped motion. Distances scale by ``s``;
+  the gaze stays locked on the new goal; gaze, tilt and shiver angles are unchanged.
+- **Tempo.** A time scale ``K`` multiplies every DMP's ``execution_time_`` and every
+  hold: pause durations scale by ``K``, tilt velocities by ``1 / K``, and accelerations
+  by ``s / K^2``. A pinned acceleration keeps its value: that motion's own time scale is
+  ``sqrt(s)`` instead. A shiver keeps its frequency (the arm's limits allow it) and
+  lasts ``K`` times as many whole cycles (at least 3).
+- **Intensity.** The descriptors the study found to change how strongly the state reads
+  (the synthesis' spans, docs/synthesis.md) move with the intensity without a re-plan:
+  a pause's hold, a motion's time scale (its acceleration), a shiver's amplitude. Counts
+  and distances are the parts themselves: changing them needs a re-plan.
+
+The DMPs are rolled out every millisecond; what the DMP misses of its goal at its
+execution time (under 0.3 mm) is faded in over the motion by a quintic, so every motion
+ends exactly at rest at its goal. The result is sampled at the sequence's rate.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..diagnostics import AouError, Span, diag
+from .export import DmpSequence
+
+__all__ = ["Rollout", "predict", "roll", "similarity"]
+
+_WHERE = Span.whole_file("<dmp>")
+_ACCEL = {"approach": "approach_acceleration", "retreat": "retreat_acceleration"}
+
+
+@dataclass
+class Rollout:
+    """A sequence rolled out: the hand's poses on one clock, and what it should measure.
+
+    Attributes:
+        t: sample times [s], shape (N,); pos (N, 3) [m], quat (N, 4) ``(w, x, y, z)``.
+        part: the index of the part each sample belongs to, shape (N,).
+        shiver: the shiver joint's offset [rad] and its two derivatives, shape (3, N).
+        parts: ``(kind, t_start, t_end)`` of every part.
+        goal: the goal [m]; scale, rotation: the similarity (``s``, ``R`` (3, 3)).
+        time_scale, intensity, pinned: as asked.
+        predicted: the descriptors the scaling rules predict.
+    """
+
+    t: np.ndarray
+    pos: np.ndarray
+    quat: np.ndarray
+    part: np.ndarray
+    shiver: np.ndarray
+    parts: list[tuple[str, float, float]]
+    goal: tuple[float, float, float]
+    scale: float
+    rotation: np.ndarray
+    time_scale: float
+    intensity: float
+    pinned: tuple[str, ...] = ()
+    predicted: dict[str, Any] = field(default_factory=dict)
+
+
+def similarity(start: np.ndarray, old: np.ndarray, new: np.ndarray
+               ) -> tuple[float, np.ndarray]:
+    """Scale and rotation (3, 3) of the similarity about ``start`` taking ``old`` to ``new``."""
+    u, w = np.asarray(old) - start, np.asarray(new) - start
+    s = float(np.linalg.norm(w) / np.linalg.norm(u))
+    a, b = u / np.linalg.norm(u), w / np.linalg.norm(w)
+    axis = np.cross(a, b)
+    sin, cos = float(np.linalg.norm(axis)), float(a @ b)
+    if sin < 1e-12:
+        return s, np.eye(3)
+    k = axis / sin
+    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    angle = math.atan2(sin, cos)
+    return s, np.eye(3) + math.sin(angle) * kx + (1 - math.cos(angle)) * kx @ kx
+
+
+def _factors(seq: DmpSequence, intensity: float | None) -> dict[str, float]:
+    """Multipliers of the descriptors an intensity moves without a re-plan."""
+    from ..descriptors import REGISTRY
+    from ..ir import State
+    from ..synth import SPANS
+
+    if intensity is None or seq.state is None:
+        return {}
+    state = State(seq.state)
+    out = {}
+    for d in REGISTRY.values():
+        span = SPANS.get(state, {}).get((d.kind, d.key))
+        if span is None or d.is_count or d.kind == "retreat" and d.key == "distance":
+            continue
+        if d.kind == "gaze" or d.kind == "tilt":
+            continue  # an angle is the parts' geometry: a re-plan
+        out[d.name] = span ** (d.stronger[state] * 2.0 * (intensity - seq.intensity))
+    return out
+
+
+def predict(seq: DmpSequence, s: float, k: float, factors: dict[str, float],
+            pinned: tuple[str, ...]) -> dict[str, Any]:
+    """The descriptors the scaling rules predict from the sequence's measured ones."""
+    out = dict(seq.descriptors)
+
+    def times(name: str, f: float) -> None:
+        if out.get(name) is not None:
+            out[name] = out[name] * f
+
+    for name in _ACCEL.values():
+        f = factors.get(name, 1.0)
+        times(name, f if name in pinned else s * f / k ** 2)
+    times("pause_duration", k * factors.get("pause_duration", 1.0))
+    times("retreat_distance", s)
+    times("tilt_velocity", 1.0 / k)
+    times("shiver_amplitude", factors.get("shiver_amplitude", 1.0))
+    return out
+
+
+def _map_pose(pose: np.ndarray, p0: np.ndarray, s: float, r: np.ndarray) -> np.ndarray:
+    import pytransform3d.rotations as pr
+
+    q = pr.concatenate_quaternions(pr.quaternion_from_matrix(r), pose[3:])
+    return np.concatenate([p0 + s * r @ (pose[:3] - p0), q])
+
+
+def _quintic(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The quintics from rest to (1, 0, 0) and to (0, 1, 0) in value, slope, curvature."""
+    return (10 * x ** 3 - 15 * x ** 4 + 6 * x ** 5, -4 * x ** 3 + 7 * x ** 4 - 3 * x ** 5)
+
+
+def _roll_move(dmp: Any, start: np.ndarray, goal: np.ndarray, s: float, r: np.ndarray,
+               duration: float) -> tuple[np.ndarray, np.ndarray]:
+    """One motion rolled out every millisecond to ``duration``: times and poses (n, 7)."""
+    import pytransform3d.rotations as pr
+
+    d = copy.deepcopy(dmp)
+    wp, wr = d.forcing_term_pos.weights_.copy(), d.forcing_term_rot.weights_.copy()
+    d.execution_time_ = duration
+    d.forcing_term_pos.weights_ = s * r @ wp
+    d.forcing_term_rot.weights_ = r @ wr
+    d.dt_ = 0.001
+    d.configure(start_y=start, goal_y=goal)
+    t, y = d.open_loop(run_t=duration)
+    t = np.asarray(t) - t[0]
+    y = np.asarray(y, dtype=float)
+    x = np.clip(t / duration, 0.0, 1.0)
+    h0, h1 = _quintic(x)
+    dt = float(t[-1] - t[-2])
+    miss, v_end = goal[:3] - y[-1, :3], (y[-1, :3] - y[-2, :3]) / dt
+    y[:, :3] += np.outer(h0, miss) - np.outer(h1 * duration, v_end)
+    turn = pr.compact_axis_angle_from_quaternion(
+        pr.concatenate_quaternions(goal[3:], pr.q_conj(y[-1, 3:])))
+    for i in range(len(t)):
+        y[i, 3:] = pr.concatenate_quaternions(
+            pr.quaternion_from_compact_axis_angle(h0[i] * turn), y[i, 3:])
+    return t, y
+
+
+def _shiver(tau: np.ndarray, amplitude: float, f: float, duration: float) -> np.ndarray:
+    from ..compiler.oscillation import shiver_offset
+
+    x, xd, xdd, _ = shiver_offset(tau, amplitude, f, duration)
+    return np.vstack([x, xd, xdd])
+
+
+def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
+         time_scale: float = 1.0, intensity: float | None = None,
+         pinned: tuple[str, ...] = (), rate: float | None = None) -> Rollout:
+    """Roll ``seq`` out (see the module's docstring).
+
+    Args:
+        goal: the new goal [m] (default: the sequence's).
+        time_scale: ``K`` in [0.25, 4].
+        intensity: in [0, 1] (default: the sequence's own).
+        pinned: accelerations to keep (``approach_acceleration``,
+            ``retreat_acceleration``).
+        rate: sample rate [Hz] (default: the sequence's).
+
+    Raises:
+        AouError: I504 for a value out of range.
+    """
+    from scipy.interpolate import CubicSpline
+
+    _check(time_scale, intensity, pinned)
+    p0 = seq.parts[0].start[:3]
+    new_goal = tuple(float(x) for x in (goal if goal is not None else seq.goal))
+    s, r = similarity(p0, np.asarray(seq.goal), np.asarray(new_goal))
+    factors = _factors(seq, intensity)
+    rate = rate or seq.rate
+    plans: list[tuple[str, float, Any]] = []
+    for p in seq.parts:
+        start, end = _map_pose(p.start, p0, s, r), _map_pose(p.end, p0, s, r)
+        if p.dmp is not None:
+            name = _ACCEL.get(p.kind)
+            f = factors.get(name, 1.0) if name else 1.0
+            k = math.sqrt(s / f) if name in pinned else time_scale / math.sqrt(f)
+            tt, yy = _roll_move(p.dmp, start, end, s, r, k * p.duration)
+            plans.append((p.kind, float(tt[-1]), CubicSpline(tt, yy, axis=0)))
+        elif p.kind == "shiver":
+            cycles = max(3, int(round(p.values["cycles"] * time_scale)))
+            amp = math.radians(p.values["amplitude"]) * factors.get("shiver_amplitude", 1.0)
+            freq = p.values["frequency"]
+            plans.append(("shiver", cycles / freq, (start, amp, freq)))
+        else:
+            dur = p.duration * time_scale * factors.get("pause_duration", 1.0)
+            plans.append((p.kind, dur, start))
+    total = sum(d for _, d, _ in plans)
+    t = np.append(np.arange(0.0, total, 1.0 / rate), total)
+    if len(t) > 1 and t[-1] - t[-2] < 1e-9:
+        t = t[:-1]
+    pos, quat = np.empty((len(t), 3)), np.empty((len(t), 4))
+    which = np.empty(len(t), dtype=int)
+    shiver = np.zeros((3, len(t)))
+    spans, t0 = [], 0.0
+    for k, (kind, dur, plan) in enumerate(plans):
+        t1 = t0 + dur
+        sel = (t >= t0) & ((t < t1) if k < len(plans) - 1 else (t <= t1 + 1e-9))
+        tau = np.clip(t[sel] - t0, 0.0, dur)
+        which[sel] = k
+        if isinstance(plan, CubicSpline):
+            y = plan(tau)
+            pos[sel] = y[:, :3]
+            quat[sel] = y[:, 3:] / np.linalg.norm(y[:, 3:], axis=1, keepdims=True)
+        elif kind == "shiver":
+            pos[sel], quat[sel] = plan[0][:3], plan[0][3:]
+            shiver[:, sel] = _shiver(tau, plan[1], plan[2], dur)
+        else:
+            pos[sel], quat[sel] = plan[:3], plan[3:]
+        spans.append((kind, t0, t1))
+        t0 = t1
+    predicted = predict(seq, s, time_scale, factors, pinned)
+    return Rollout(t, pos, quat, which, shiver, spans, new_goal,  # type: ignore[arg-type]
+                   s, r, time_scale, seq.intensity if intensity is None else intensity,
+                   tuple(pinned), predicted)
+
+
+def _check(time_scale: float, intensity: float | None, pinned: tuple[str, ...]) -> None:
+    if not (isinstance(time_scale, int | float) and 0.25 <= time_scale <= 4.0):
+        raise AouError(diag("I504", f"the time scale must be a number in [0.25, 4], found "
+                            f"{time_scale!r}", _WHERE))
+    if intensity is not None and not (isinstance(intensity, int | float)
+                                      and 0.0 <= intensity <= 1.0):
+        raise AouError(diag("I504", f"the intensity must be a number in [0, 1], found "
+                            f"{intensity!r}", _WHERE))
+    bad = [p for p in pinned if p not in _ACCEL.values()]
+    if bad:
+        raise AouError(diag("I504", f"only accelerations can be pinned "
+                            f"({', '.join(_ACCEL.values())}), found {', '.join(bad)}",
+                            _WHERE))
