@@ -297,11 +297,17 @@ def _cmd_variants(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _cmd_dmp(args: argparse.Namespace) -> int:
+    from .dmp.cli import cmd_dmp
+
+    return cmd_dmp(args)
+
+
 _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "lint": _cmd_lint, "rules": _cmd_rules, "explain": _cmd_explain,
     "compile": _cmd_compile, "check": _cmd_check, "measure": _cmd_measure,
     "plot": _cmd_plot, "render": _cmd_render, "variants": _cmd_variants,
-    "robot": cmd_robot, "synth": cmd_synth,
+    "robot": cmd_robot, "synth": cmd_synth, "dmp": _cmd_dmp,
 }
 
 
@@ -326,6 +332,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.command in ("plot", "render", "variants") and exc.name:
             print(f"aouc: this command needs the media extra ({exc.name} is missing): "
                   "pip install '.[media]' in aou's folder (the one with pyproject.toml)",
+                  file=sys.stderr)
+            return EXIT_USAGE
+        if (args.command == "dmp" or getattr(args, "format", None) == "dmp") and exc.name:
+            print(f"aouc: this command needs the dmp extra ({exc.name} is missing): "
+                  "pip install '.[dmp]' in aou's folder (the one with pyproject.toml)",
                   file=sys.stderr)
             return EXIT_USAGE
         return _internal(exc, args.debug)

@@ -181,10 +181,10 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     comp.add_argument("-o", "--output", metavar="FILE|DIR",
                       help="output file, or folder (files found in a folder keep their "
                       "path below it; default: the current folder)")
-    comp.add_argument("--format", choices=("json", "csv", "npz", "mcap", "yaml"),
+    comp.add_argument("--format", choices=("json", "csv", "npz", "mcap", "yaml", "dmp"),
                       help="output format (default: from -o's extension, else json); mcap: "
                       "a ROS 2 bag (a folder) with one JointTrajectory, yaml: the same "
-                      "message as YAML (docs/ros2.md)")
+                      "message as YAML (docs/ros2.md); dmp: a folder of DMPs (docs/dmp.md)")
     comp.add_argument("--rate", type=RATE, metavar="HZ", help="sample rate in Hz (default 250)")
     _robot(comp)
     comp.add_argument("-j", "--jobs", type=int_in(0, 256), default=1, metavar="N",
@@ -264,6 +264,9 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
                      help="skip the compile that fits the values to the arm")
     syn.add_argument("-o", "--output", metavar="FILE.aou",
                      help="output file (default: standard output)")
+    from .dmp.cli import add_parser as dmp_parser
+
+    c["dmp"] = dmp_parser(sub)
     c["rules"] = rules = sub.add_parser("rules", help="list the diagnostic codes, or explain some")
     rules.add_argument("codes", nargs="*", metavar="CODE")
     rules.add_argument("--format", choices=("text", "json"), default="text")

@@ -29,9 +29,9 @@ __all__ = ["FORMATS", "SAMPLE_KEYS", "document_header", "encode", "output_paths"
            "trajectory_document", "with_samples", "write_atomic",
            "write_output"]
 
-FORMATS = ("json", "csv", "npz", "mcap", "yaml")
-#: Formats whose output is a folder (a ROS 2 bag), not a file.
-FOLDER_FORMATS = ("mcap",)
+FORMATS = ("json", "csv", "npz", "mcap", "yaml", "dmp")
+#: Formats whose output is a folder (a ROS 2 bag; DMPs, aou_dsl.dmp), not a file.
+FOLDER_FORMATS = ("mcap", "dmp")
 
 
 #: The keys of a trajectory document that hold its samples, one list entry per sample.
@@ -130,7 +130,11 @@ def write_output(path: str, doc: dict, fmt: str, *, inputs: list[str] | tuple = 
     Raises:
         AouError: I502 when it cannot be written.
     """
-    if fmt in FOLDER_FORMATS:
+    if fmt == "dmp":
+        from ..dmp.cli import write_document
+
+        write_document(path, doc, inputs=inputs)
+    elif fmt in FOLDER_FORMATS:
         from .ros import write_bag
 
         write_bag(doc, path, inputs=inputs)
@@ -168,7 +172,7 @@ def output_paths(inputs: list[tuple[str, str | None]], output: str | None, fmt: 
         raise AouError(diag("I502", f"several inputs need -o to be a folder, found "
                             f"`{output}`", Span.whole_file(output)))
     folder = output if (many or is_dir) else None
-    suffix = "" if fmt in FOLDER_FORMATS else f".{fmt}"
+    suffix = "" if fmt == "mcap" else f".{fmt}"
     dests = []
     for src, root in inputs:
         rel = os.path.relpath(src, root) if root is not None else os.path.basename(src)

@@ -111,7 +111,7 @@ def _move_values(pos: np.ndarray, quat: np.ndarray, acc: np.ndarray) -> dict[str
 
 
 def to_dmp(trajectory: Any, *, intensity: float = 0.5, behaviour: str | None = None,
-           state: str | None = None) -> DmpSequence:
+           state: str | None = None, descriptors: dict | None = None) -> DmpSequence:
     """The DMP sequence of a compiled trajectory (see the module's docstring).
 
     Args:
@@ -120,6 +120,7 @@ def to_dmp(trajectory: Any, *, intensity: float = 0.5, behaviour: str | None = N
         intensity: the intensity it expresses, in [0, 1] (the shipped and synthesized
             files at 0.5 are the study's stimuli).
         behaviour, state: recorded in the manifest.
+        descriptors: the trajectory's measured descriptors, when known (else measured).
 
     Raises:
         AouError: D601 when the trajectory has no episodes or no goal (a recording).
@@ -163,7 +164,7 @@ def to_dmp(trajectory: Any, *, intensity: float = 0.5, behaviour: str | None = N
             part.kind = "pause" if kind not in MOVES else kind
             part.end = pose0
         parts.append(part)
-    measured = measure(tr).descriptors.to_json()
+    measured = descriptors or measure(tr).descriptors.to_json()
     return DmpSequence(tr.robot, tr.ee_frame, tuple(arm.joint_names),
                        tuple(float(x) for x in tr.goal),  # type: ignore[arg-type]
                        q[0].copy(), arm.spec.shiver_joint, _rate(tr.t),

@@ -48,6 +48,36 @@ def _rot(quat: np.ndarray) -> np.ndarray:
     return np.array([pr.matrix_from_quaternion(q) for q in quat])
 
 
+def _follow(arm: Any, pos: np.ndarray, rot: np.ndarray, q: np.ndarray
+            ) -> tuple[np.ndarray, int, str]:
+    """Damped least squares along dense poses, each solve warm-started from the last, with
+    no pull toward a posture (a pull at every millisecond would swing the null space):
+    the redundancy moves only as the hand does. Returns the joint path (N, n), and the
+    index of the first pose it could not follow (-1: none) with why."""
+    import pinocchio as pin
+
+    model, data, fid = arm.model, arm.model.createData(), arm.frame_id
+    out = np.empty((len(pos), arm.n))
+    damped = 1e-8 * np.eye(6)
+    for i in range(len(pos)):
+        target = pin.SE3(rot[i], pos[i])
+        for _ in range(30):
+            pin.computeJointJacobians(model, data, q)
+            dm = pin.updateFramePlacement(model, data, fid).actInv(target)
+            err = pin.log6(dm).vector
+            if float(np.abs(err).max()) < 1e-9:
+                break
+            je = -pin.Jlog6(dm.inverse()) @ pin.getFrameJacobian(model, data, fid, pin.LOCAL)
+            q = q - je.T @ np.linalg.solve(je @ je.T + damped, err)
+        if float(np.abs(err).max()) > 1e-6:
+            return out[:i], i, "a pose lies outside the robot's workspace"
+        outside = (q < arm.lower) | (q > arm.upper)
+        if outside.any():
+            return out[:i], i, f"{arm.joint_names[int(np.argmax(outside))]} past its limit"
+        out[i] = q
+    return out, -1, ""
+
+
 def to_trajectory(seq: DmpSequence, ro: Rollout, where: Span) -> Any:
     """The joint trajectory of ``ro``.
 
@@ -60,27 +90,17 @@ def to_trajectory(seq: DmpSequence, ro: Rollout, where: Span) -> Any:
 
     arm = load_arm(seq.robot, seq.ee_frame)
     rot = _rot(ro.quat)
-    q = np.empty((len(ro.t), arm.n))
-    prev = np.asarray(seq.q_start, dtype=float)
-    i = 0
-    while i < len(ro.t):
-        k = ro.part[i]
-        j = i
-        while j < len(ro.t) and ro.part[j] == k:
-            j += 1
-        kind = ro.parts[k][0]
-        idx = range(i, j) if kind not in ("pause", "shiver") else range(i, i + 1)
-        res = solve_path(arm, [(ro.pos[n], rot[n]) for n in idx], prev)
-        if not res.ok:
-            assert res.failure is not None
-            n = idx[res.failure.index]
-            joint = f" ({res.failure.joint})" if res.failure.joint else ""
-            raise AouError(diag("D603", f"the arm cannot follow the rolled-out {kind} at "
-                                f"t={ro.t[n]:.3f}s: {res.failure.status.value}{joint}",
-                                where, time=float(ro.t[n]), joint=res.failure.joint))
-        q[i:j] = res.q if kind not in ("pause", "shiver") else res.q[0]
-        prev = q[j - 1].copy()
-        i = j
+    # The start as the compiler reaches it: by continuation from the arm's posture.
+    first = solve_path(arm, [(ro.pos[0], rot[0])])
+    if not first.ok:
+        assert first.failure is not None
+        raise AouError(diag("D603", "the arm cannot reach the rolled-out start: "
+                            f"{first.failure.status.value}", where, time=0.0))
+    q, bad, why = _follow(arm, ro.pos, rot, first.q[0].copy())
+    if bad >= 0:
+        kind = ro.parts[ro.part[bad]][0]
+        raise AouError(diag("D603", f"the arm cannot follow the rolled-out {kind} at "
+                            f"t={ro.t[bad]:.3f}s: {why}", where, time=float(ro.t[bad])))
     qd = np.gradient(q, ro.t, axis=0)
     qdd = np.gradient(qd, ro.t, axis=0)
     js = arm.joint_names.index(seq.shiver_joint)

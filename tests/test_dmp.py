@@ -1,0 +1,137 @@
+"""Behaviours as DMPs: the round trip through a DMP keeps the motion and its meaning, the
+scaling rules hold when the goal and the tempo change, and the files are the library's."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+pytest.importorskip("movement_primitives")
+
+import aou_dsl  # noqa: E402
+from aou_dsl.descriptors import REGISTRY  # noqa: E402
+from aou_dsl.diagnostics import AouError  # noqa: E402
+from aou_dsl.dmp import read_dmp, solve, to_dmp, write_dmp  # noqa: E402
+from aou_dsl.kinematics import load_arm  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def hesitant():
+    build = aou_dsl.compile("behaviours/hesitant.aou")
+    assert build.ok
+    return build, to_dmp(build.trajectory, state="hesitant")
+
+
+def _pose_error(a, b) -> tuple[float, float]:
+    """Worst hand position [mm] and orientation [deg] difference of two trajectories."""
+    arm = load_arm(a.robot, a.ee_frame)
+    pa, ra = arm.fk(a.q)
+    pb, rb = arm.fk(np.interp(a.t, b.t, b.q[:, 0])[:, None] * 0 + np.array(
+        [np.interp(a.t, b.t, b.q[:, j]) for j in range(b.q.shape[1])]).T)
+    ang = [math.degrees(math.acos(max(-1.0, min(1.0, (np.trace(x.T @ y) - 1) / 2))))
+           for x, y in zip(ra, rb, strict=True)]
+    return 1000 * float(np.linalg.norm(pa - pb, axis=1).max()), max(ang)
+
+
+def _within(name, want, got, slack=1.0) -> bool:
+    if want is None or got is None:
+        return want is None and got is None
+    return abs(got - want) <= slack * REGISTRY[name].tolerance(want) + 1e-9
+
+
+def test_same_goal_and_tempo_reproduces_the_compiled_motion(hesitant):
+    """Rolled out at its own goal and tempo, the hand stays within 1 mm and 0.5 deg of
+    the compiled trajectory, and the motion passes the safety checks."""
+    build, seq = hesitant
+    out = solve(seq)
+    assert out.ok, [d.message for d in out.diagnostics]
+    mm, deg = _pose_error(build.trajectory, out.trajectory)
+    assert mm < 1.0 and deg < 0.5, (mm, deg)
+    m = out.measured.descriptors
+    for name in ("pause_count", "pause_duration", "retreat_count", "retreat_distance",
+                 "retreat_acceleration"):
+        assert _within(name, build.measured.descriptors[name], m[name]), name
+
+
+@pytest.mark.parametrize("goal, k", [((0.60, 0.05, 0.25), 1.5), ((0.50, -0.04, 0.30), 0.8)])
+def test_moved_goal_and_time_scale_follow_the_scaling_rules(hesitant, goal, k):
+    """Goal moved by up to 10 cm and the tempo scaled: pauses last K times as long,
+    accelerations are amplitude / K^2 times as high, counts stay (each within its
+    tolerance, measured on the rolled-out motion, which passes the safety checks)."""
+    build, seq = hesitant
+    assert np.linalg.norm(np.subtract(goal, seq.goal)) <= 0.1
+    out = solve(seq, goal=goal, time_scale=k)
+    assert out.trajectory is not None and not [d for d in out.diagnostics
+                                               if d.code in ("D603", "D604")]
+    src, m, s = build.measured.descriptors, out.measured.descriptors, out.rollout.scale
+    assert m["pause_count"] == src["pause_count"]
+    assert m["retreat_count"] == src["retreat_count"]
+    assert _within("pause_duration", src["pause_duration"] * k, m["pause_duration"])
+    assert _within("approach_acceleration", src["approach_acceleration"] * s / k ** 2,
+                   m["approach_acceleration"])
+    assert _within("retreat_distance", src["retreat_distance"] * s, m["retreat_distance"])
+
+
+def test_pinned_acceleration_is_kept_when_the_goal_moves(hesitant):
+    """A pinned approach acceleration keeps its value at a goal 8 cm further away."""
+    build, seq = hesitant
+    out = solve(seq, goal=(0.63, 0.0, 0.25), pinned=("approach_acceleration",), check=False)
+    assert out.rollout.scale > 1.1
+    assert _within("approach_acceleration", build.measured.descriptors["approach_acceleration"],
+                   out.measured.descriptors["approach_acceleration"])
+
+
+def test_intensity_moves_pauses_without_a_replan(hesitant):
+    """Hesitance reads stronger with longer pauses: at intensity 1 a pause is the
+    synthesis' span (1.5x) longer than at 0.5, rolled from the same DMPs."""
+    build, seq = hesitant
+    out = solve(seq, intensity=1.0, check=False)
+    assert _within("pause_duration", 1.5 * build.measured.descriptors["pause_duration"],
+                   out.measured.descriptors["pause_duration"])
+
+
+def test_unreachable_goal_is_refused_with_a_code(hesitant):
+    """A goal far out of reach is refused (D603), not rolled out."""
+    _, seq = hesitant
+    out = solve(seq, goal=(1.5, 0.0, 0.25), check=False)
+    assert not out.ok and {d.code for d in out.diagnostics} == {"D603"}
+
+
+def test_written_folder_reads_back_to_the_same_rollout(hesitant, tmp_path):
+    """write_dmp then read_dmp gives a sequence that rolls out to the same poses."""
+    from aou_dsl.dmp.rollout import roll
+
+    _, seq = hesitant
+    write_dmp(str(tmp_path / "h.dmp"), seq)
+    back = read_dmp(str(tmp_path / "h.dmp"))
+    a, b = roll(seq, goal=(0.6, 0.0, 0.25)), roll(back, goal=(0.6, 0.0, 0.25))
+    assert np.allclose(a.pos, b.pos, atol=1e-9) and np.allclose(a.t, b.t)
+
+
+def test_a_folder_that_is_not_a_sequence_is_refused(tmp_path):
+    """A manifest of another format is D602; a missing folder I501."""
+    (tmp_path / "x.dmp").mkdir()
+    (tmp_path / "x.dmp" / "manifest.json").write_text('{"format": "other"}')
+    with pytest.raises(AouError) as err:
+        read_dmp(str(tmp_path / "x.dmp"))
+    assert err.value.diagnostics[0].code == "D602"
+    with pytest.raises(AouError) as err:
+        read_dmp(str(tmp_path / "missing.dmp"))
+    assert err.value.diagnostics[0].code == "I501"
+
+
+def test_cli_compile_then_roll(tmp_path, capsys):
+    """`aouc compile --format dmp` writes the folder; `aouc dmp roll` rolls it to a new
+    goal and writes a trajectory that `aouc measure` reads."""
+    from aou_dsl.cli import main
+
+    out = tmp_path / "c.dmp"
+    assert main(["compile", "behaviours/confident.aou", "-o", str(out)]) == 0
+    assert (out / "manifest.json").is_file()
+    rolled = tmp_path / "r.json"
+    assert main(["dmp", "roll", str(out), "--goal", "0.58,0.03,0.27", "--time-scale", "1.2",
+                 "-o", str(rolled)]) == 0
+    assert "pause_duration" in capsys.readouterr().out
+    assert main(["measure", str(rolled)]) == 0
