@@ -43,6 +43,9 @@ class DmpPart:
         values: what the part shows: ``distance`` [m], ``peak_acceleration`` [m/s^2],
             ``turn`` [deg] (rotation of the hand from start to end), ``amplitude`` [deg,
             peak to peak], ``frequency`` [Hz], ``cycles``.
+        lead: for a motion, the time from the DMP's start to the episode's [s]: the DMP
+            is held at rest that long before and about as long after
+            (:data:`aou_dsl.dmp.fit.PAD`), so it runs ``duration + 2 lead`` in all.
     """
 
     kind: str
@@ -51,6 +54,7 @@ class DmpPart:
     end: np.ndarray
     dmp: Any = None
     values: dict[str, float] = field(default_factory=dict)
+    lead: float = 0.0
 
 
 @dataclass
@@ -155,7 +159,8 @@ def to_dmp(trajectory: Any, *, intensity: float = 0.5, behaviour: str | None = N
         part = DmpPart(kind, float(e - a), pose0, pose1)
         if kind in MOVES and i1 - i0 >= 3:
             t = tr.t[i0:i1 + 1] - tr.t[i0]
-            part.dmp = fit_pose_dmp(t, pos[i0:i1 + 1], quat[i0:i1 + 1])
+            part.dmp, lead = fit_pose_dmp(t, pos[i0:i1 + 1], quat[i0:i1 + 1])
+            part.lead = lead + float(tr.t[i0] - a)
             part.values = _move_values(pos[i0:i1 + 1], quat[i0:i1 + 1], acc[i0:i1 + 1])
         elif kind == "shiver":
             part.end = pose0

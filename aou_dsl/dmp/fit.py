@@ -18,14 +18,21 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["ALPHA_Y", "BETA_Y", "WEIGHTS_PER_SECOND", "fit_pose_dmp", "quaternions",
+__all__ = ["ALPHA_Y", "BETA_Y", "PAD", "WEIGHTS_PER_SECOND", "fit_pose_dmp", "quaternions",
            "weights_for"]
 
 #: Gains of the transformation system (position and orientation alike).
 ALPHA_Y = 4.0
 BETA_Y = ALPHA_Y / 4.0
 #: Basis functions per second of motion, per dimension (at least 10).
-WEIGHTS_PER_SECOND = 100.0
+WEIGHTS_PER_SECOND = 250.0
+#: Rest added before and after each motion [s]. A fit is a smoothing: it spreads the few
+#: milliseconds in which the compiled acceleration switches on and off over about three
+#: basis functions, so the fitted motion starts a little before its episode and stops a
+#: little after. Fitted from rest to rest with this margin, the DMP starts and ends at
+#: rest (zero velocity and acceleration) instead of stopping with half its deceleration
+#: left; a rollout lays the margins over the neighbouring parts (:mod:`.rollout`).
+PAD = 5.0 / WEIGHTS_PER_SECOND
 
 
 def weights_for(duration: float) -> int:
@@ -55,13 +62,24 @@ def _lwr(term: Any, t: np.ndarray, force: np.ndarray) -> np.ndarray:
     return (num / den[:, None]).T
 
 
-def fit_pose_dmp(t: np.ndarray, pos: np.ndarray, quat: np.ndarray, dt: float = 0.001) -> Any:
+def fit_pose_dmp(t: np.ndarray, pos: np.ndarray, quat: np.ndarray, dt: float = 0.001
+                 ) -> tuple[Any, float]:
     """A ``CartesianDMP`` of the pose path ``pos`` (N, 3) [m], ``quat`` (N, 4) at times
-    ``t`` (N,) [s, from 0], at rest at both ends; ``dt`` is the step of its rollouts [s]."""
+    ``t`` (N,) [s, from 0], at rest at both ends, held :data:`PAD` before and after (its
+    execution time is the path's duration plus ``2 PAD``); ``dt`` is the step of its
+    rollouts [s]. Returns the DMP and the time from its start to the path's [s]."""
     from movement_primitives.dmp import CartesianDMP
     from movement_primitives.dmp._cartesian_dmp import determine_forces_quaternion
     from movement_primitives.dmp._dmp import determine_forces
 
+    step = float(np.median(np.diff(t)))
+    n_pad = max(1, int(round(PAD / step)))
+    lead = t[0] - step * np.arange(n_pad, 0, -1)
+    tail = t[-1] + step * np.arange(1, n_pad + 1)
+    t = np.concatenate([lead, t, tail]) - lead[0]
+    pos = np.concatenate([np.repeat(pos[:1], n_pad, 0), pos, np.repeat(pos[-1:], n_pad, 0)])
+    quat = np.concatenate([np.repeat(quat[:1], n_pad, 0), quat,
+                           np.repeat(quat[-1:], n_pad, 0)])
     duration = float(t[-1] - t[0])
     dmp = CartesianDMP(execution_time=duration, dt=dt, n_weights_per_dim=weights_for(duration),
                        int_dt=0.001, alpha_y=ALPHA_Y, beta_y=BETA_Y)
@@ -73,4 +91,4 @@ def fit_pose_dmp(t: np.ndarray, pos: np.ndarray, quat: np.ndarray, dt: float = 0
     dmp.forcing_term_rot.weights_[:] = _lwr(dmp.forcing_term_rot, t, fr)
     dmp.configure(start_y=np.concatenate([pos[0], quat[0]]),
                   goal_y=np.concatenate([pos[-1], quat[-1]]))
-    return dmp
+    return dmp, n_pad * step

@@ -56,7 +56,7 @@ def manifest(seq: DmpSequence) -> dict[str, Any]:
             "file": f"parts/{k:02d}-{p.kind}.json" if p.dmp is not None else None,
             "start": {"position": p.start[:3].tolist(), "quaternion": p.start[3:].tolist()},
             "end": {"position": p.end[:3].tolist(), "quaternion": p.end[3:].tolist()},
-            "values": p.values})
+            "lead": p.lead, "values": p.values})
     return {"format": FORMAT, "behaviour": seq.behaviour, "state": seq.state,
             "intensity": seq.intensity, "robot": seq.robot, "ee_frame": seq.ee_frame,
             "joint_names": list(seq.joint_names), "goal": {"position": list(seq.goal)},
@@ -158,4 +158,4 @@ def _part(path: str, e: dict) -> DmpPart:
             raise _bad(path, f"its part `{e['file']}` is missing")
         dmp = read_json(name)
     return DmpPart(e["kind"], float(e["duration"]), pose(e["start"]), pose(e["end"]), dmp,
-                   {k: float(v) for k, v in e["values"].items()})
+                   {k: float(v) for k, v in e["values"].items()}, float(e.get("lead", 0.0)))

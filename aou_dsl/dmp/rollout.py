@@ -21,7 +21,10 @@ The scaling rules (docs/dmp.md):
 
 The DMPs are rolled out every millisecond; what the DMP misses of its goal at its
 execution time (under 0.3 mm) is faded in over the motion by a quintic, so every motion
-ends exactly at rest at its goal. The result is sampled at the sequence's rate.
+ends exactly at rest at its goal. Each motion's DMP runs from a little before its slot
+to a little after (its lead-in and run-out, :data:`aou_dsl.dmp.fit.PAD`); the hand's pose
+is the start pose moved by every motion's displacement, so these margins overlap their
+neighbours smoothly. The result is sampled at the sequence's rate.
 """
 
 from __future__ import annotations
@@ -40,6 +43,9 @@ __all__ = ["Rollout", "predict", "roll", "similarity"]
 
 _WHERE = Span.whole_file("<dmp>")
 _ACCEL = {"approach": "approach_acceleration", "retreat": "retreat_acceleration"}
+#: Step of the DMPs' rollouts [s] (the library integrates orientation every millisecond
+#: within it); the rollout is then sampled at the sequence's rate through a cubic spline.
+ROLL_DT = 0.002
 
 
 @dataclass
@@ -54,6 +60,8 @@ class Rollout:
         goal: the goal [m]; scale, rotation: the similarity (``s``, ``R`` (3, 3)).
         time_scale, intensity, pinned: as asked.
         predicted: the descriptors the scaling rules predict.
+        offset: when the sequence's first part starts on this clock [s] (the lead-in
+            of a first motion is rest before it).
     """
 
     t: np.ndarray
@@ -69,6 +77,7 @@ class Rollout:
     intensity: float
     pinned: tuple[str, ...] = ()
     predicted: dict[str, Any] = field(default_factory=dict)
+    offset: float = 0.0
 
 
 def similarity(start: np.ndarray, old: np.ndarray, new: np.ndarray
@@ -148,7 +157,7 @@ def _roll_move(dmp: Any, start: np.ndarray, goal: np.ndarray, s: float, r: np.nd
     d.execution_time_ = duration
     d.forcing_term_pos.weights_ = s * r @ wp
     d.forcing_term_rot.weights_ = r @ wr
-    d.dt_ = 0.001
+    d.dt_ = ROLL_DT
     d.configure(start_y=start, goal_y=goal)
     t, y = d.open_loop(run_t=duration)
     t = np.asarray(t) - t[0]
@@ -160,9 +169,11 @@ def _roll_move(dmp: Any, start: np.ndarray, goal: np.ndarray, s: float, r: np.nd
     y[:, :3] += np.outer(h0, miss) - np.outer(h1 * duration, v_end)
     turn = pr.compact_axis_angle_from_quaternion(
         pr.concatenate_quaternions(goal[3:], pr.q_conj(y[-1, 3:])))
-    for i in range(len(t)):
-        y[i, 3:] = pr.concatenate_quaternions(
-            pr.quaternion_from_compact_axis_angle(h0[i] * turn), y[i, 3:])
+    half = 0.5 * np.outer(h0, turn)  # the rotation vectors' halves, (n, 3)
+    angle = np.linalg.norm(half, axis=1)
+    sinc = np.where(angle > 1e-12, np.sin(angle) / np.maximum(angle, 1e-300), 1.0)
+    fade = np.column_stack([np.cos(angle), half * sinc[:, None]])
+    y[:, 3:] = _qmul(fade, y[:, 3:])
     return t, y
 
 
@@ -189,59 +200,112 @@ def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
     Raises:
         AouError: I504 for a value out of range.
     """
-    from scipy.interpolate import CubicSpline
-
     _check(time_scale, intensity, pinned)
     p0 = seq.parts[0].start[:3]
     new_goal = tuple(float(x) for x in (goal if goal is not None else seq.goal))
     s, r = similarity(p0, np.asarray(seq.goal), np.asarray(new_goal))
     factors = _factors(seq, intensity)
+    plans = _plans(seq, p0, s, r, time_scale, factors, pinned)
+    first, last = plans[0], plans[-1]
+    # The first motion's lead-in and the last one's run-out are rest of their own.
+    offset = first.t0 - first.begin if first.spline is not None else 0.0
+    for plan in plans:
+        plan.t0 += offset
+        plan.begin += offset
+    total = max(last.t0 + last.duration, last.begin + last.runs)
     rate = rate or seq.rate
-    plans: list[tuple[str, float, Any]] = []
+    t = np.append(np.arange(0.0, total, 1.0 / rate), total)
+    if len(t) > 1 and t[-1] - t[-2] < 1e-9:
+        t = t[:-1]
+    pos, quat = _compose(t, plans, _map_pose(seq.parts[0].start, p0, s, r))
+    which = np.zeros(len(t), dtype=int)
+    shiver = np.zeros((3, len(t)))
+    spans = []
+    for k, plan in enumerate(plans):
+        t1 = plan.t0 + plan.duration
+        which[t >= plan.t0] = k
+        spans.append((plan.kind, plan.t0, t1))
+        if plan.kind == "shiver":
+            sel = (t >= plan.t0) & (t <= t1)
+            shiver[:, sel] = _shiver(t[sel] - plan.t0, plan.amplitude, plan.freq,
+                                     plan.duration)
+    predicted = predict(seq, s, time_scale, factors, pinned)
+    return Rollout(t, pos, quat, which, shiver, spans, new_goal,  # type: ignore[arg-type]
+                   s, r, time_scale, seq.intensity if intensity is None else intensity,
+                   tuple(pinned), predicted, offset)
+
+
+@dataclass
+class _Plan:
+    """One part on the rollout's clock: its slot ``[t0, t0 + duration]``; a motion's DMP
+    rolled out from ``begin`` for ``runs`` seconds (``spline`` of its pose, from its
+    ``start``); a shiver's amplitude [rad] and frequency [Hz]."""
+
+    kind: str
+    t0: float
+    duration: float
+    begin: float = 0.0
+    runs: float = 0.0
+    spline: Any = None
+    start: Any = None
+    amplitude: float = 0.0
+    freq: float = 0.0
+
+
+def _plans(seq: DmpSequence, p0: np.ndarray, s: float, r: np.ndarray, time_scale: float,
+           factors: dict[str, float], pinned: tuple[str, ...]) -> list[_Plan]:
+    """Every part on one clock, each motion rolled out."""
+    from scipy.interpolate import CubicSpline
+
+    plans, t0 = [], 0.0
     for p in seq.parts:
-        start, end = _map_pose(p.start, p0, s, r), _map_pose(p.end, p0, s, r)
+        start = _map_pose(p.start, p0, s, r)
         if p.dmp is not None:
             name = _ACCEL.get(p.kind)
             f = factors.get(name, 1.0) if name else 1.0
             k = math.sqrt(s / f) if name in pinned else time_scale / math.sqrt(f)
-            tt, yy = _roll_move(p.dmp, start, end, s, r, k * p.duration)
-            plans.append((p.kind, float(tt[-1]), CubicSpline(tt, yy, axis=0)))
+            end = _map_pose(p.end, p0, s, r)
+            tt, yy = _roll_move(p.dmp, start, end, s, r, k * p.dmp.execution_time_)
+            plans.append(_Plan(p.kind, t0, k * p.duration, t0 - k * p.lead, float(tt[-1]),
+                               CubicSpline(tt, yy, axis=0), start))
         elif p.kind == "shiver":
             cycles = max(3, int(round(p.values["cycles"] * time_scale)))
-            amp = math.radians(p.values["amplitude"]) * factors.get("shiver_amplitude", 1.0)
             freq = p.values["frequency"]
-            plans.append(("shiver", cycles / freq, (start, amp, freq)))
+            amp = math.radians(p.values["amplitude"]) * factors.get("shiver_amplitude", 1.0)
+            plans.append(_Plan("shiver", t0, cycles / freq, amplitude=amp, freq=freq))
         else:
             dur = p.duration * time_scale * factors.get("pause_duration", 1.0)
-            plans.append((p.kind, dur, start))
-    total = sum(d for _, d, _ in plans)
-    t = np.append(np.arange(0.0, total, 1.0 / rate), total)
-    if len(t) > 1 and t[-1] - t[-2] < 1e-9:
-        t = t[:-1]
-    pos, quat = np.empty((len(t), 3)), np.empty((len(t), 4))
-    which = np.empty(len(t), dtype=int)
-    shiver = np.zeros((3, len(t)))
-    spans, t0 = [], 0.0
-    for k, (kind, dur, plan) in enumerate(plans):
-        t1 = t0 + dur
-        sel = (t >= t0) & ((t < t1) if k < len(plans) - 1 else (t <= t1 + 1e-9))
-        tau = np.clip(t[sel] - t0, 0.0, dur)
-        which[sel] = k
-        if isinstance(plan, CubicSpline):
-            y = plan(tau)
-            pos[sel] = y[:, :3]
-            quat[sel] = y[:, 3:] / np.linalg.norm(y[:, 3:], axis=1, keepdims=True)
-        elif kind == "shiver":
-            pos[sel], quat[sel] = plan[0][:3], plan[0][3:]
-            shiver[:, sel] = _shiver(tau, plan[1], plan[2], dur)
-        else:
-            pos[sel], quat[sel] = plan[:3], plan[3:]
-        spans.append((kind, t0, t1))
-        t0 = t1
-    predicted = predict(seq, s, time_scale, factors, pinned)
-    return Rollout(t, pos, quat, which, shiver, spans, new_goal,  # type: ignore[arg-type]
-                   s, r, time_scale, seq.intensity if intensity is None else intensity,
-                   tuple(pinned), predicted)
+            plans.append(_Plan(p.kind, t0, dur))
+        t0 += plans[-1].duration
+    return plans
+
+
+def _qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Products of quaternions ``(w, x, y, z)`` row by row, shapes (N, 4)."""
+    aw, ax, ay, az = a.T
+    bw, bx, by, bz = b.T
+    return np.stack([aw * bw - ax * bx - ay * by - az * bz,
+                     aw * bx + ax * bw + ay * bz - az * by,
+                     aw * by - ax * bz + ay * bw + az * bx,
+                     aw * bz + ax * by - ay * bx + az * bw], axis=1)
+
+
+def _compose(t: np.ndarray, plans: list[_Plan], start: np.ndarray
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """The hand's pose at ``t``: the start pose moved by every motion's displacement so
+    far (positions added, rotations applied in the base frame in turn), so that a
+    motion's lead-in and run-out may overlap its neighbours'."""
+    pos = np.tile(start[:3], (len(t), 1))
+    quat = np.tile(start[3:], (len(t), 1))
+    for plan in plans:
+        if plan.spline is None:
+            continue
+        y = plan.spline(np.clip(t - plan.begin, 0.0, plan.runs))
+        pos += y[:, :3] - plan.start[:3]
+        q = y[:, 3:] / np.linalg.norm(y[:, 3:], axis=1, keepdims=True)
+        inv = plan.start[3:] * np.array([1.0, -1.0, -1.0, -1.0])
+        quat = _qmul(_qmul(q, np.tile(inv, (len(t), 1))), quat)
+    return pos, quat
 
 
 def _check(time_scale: float, intensity: float | None, pinned: tuple[str, ...]) -> None:

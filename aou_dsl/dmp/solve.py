@@ -108,9 +108,6 @@ def to_trajectory(seq: DmpSequence, ro: Rollout, where: Span) -> Any:
     q[:, js] += ro.shiver[0]
     qd[shaking, js] = ro.shiver[1, shaking]
     qdd[shaking, js] = ro.shiver[2, shaking]
-    for n in np.flatnonzero(np.isin(ro.part, [k for k, p in enumerate(ro.parts)
-                                              if p[0] == "pause"])):
-        qd[n] = qdd[n] = 0.0
     return Trajectory(ro.t, q, tuple(arm.joint_names), seq.robot, seq.ee_frame, ro.goal,
                       qd, qdd, tuple(ro.parts), where.path, seq.behaviour)
 
