@@ -42,18 +42,23 @@ def _within(name, want, got, slack=1.0) -> bool:
     return abs(got - want) <= slack * REGISTRY[name].tolerance(want) + 1e-9
 
 
-def test_same_goal_and_tempo_reproduces_the_compiled_motion(hesitant):
-    """Rolled out at its own goal and tempo, the hand stays within 1 mm and 0.5 deg of
-    the compiled trajectory, and the motion passes the safety checks."""
-    build, seq = hesitant
+@pytest.mark.parametrize("name, robot", [
+    ("confident", "panda"), ("curious", "panda"), ("hesitant", "panda"),
+    ("fearful", "panda"), ("inactive", "panda"), ("hesitant", "ur5"), ("curious", "ur5")])
+def test_same_goal_and_tempo_reproduces_the_compiled_motion(name, robot):
+    """Rolled out at its own goal and tempo, a shipped behaviour's hand stays within 1 mm
+    and 0.5 deg of the compiled trajectory, passes the safety checks, and measures every
+    descriptor as the compiled trajectory does, within the descriptor's tolerance."""
+    from aou_dsl.descriptors import compare
+
+    build = aou_dsl.compile(f"behaviours/{name}.aou", robot=robot)
+    assert build.ok
+    seq = to_dmp(build.trajectory, state=name)
     out = solve(seq)
     assert out.ok, [d.message for d in out.diagnostics]
     mm, deg = _pose_error(build.trajectory, out.trajectory, out.rollout.offset)
     assert mm < 1.0 and deg < 0.5, (mm, deg)
-    m = out.measured.descriptors
-    for name in ("pause_count", "pause_duration", "retreat_count", "retreat_distance",
-                 "retreat_acceleration"):
-        assert _within(name, build.measured.descriptors[name], m[name]), name
+    assert compare(build.measured.descriptors, out.measured.descriptors) == []
 
 
 @pytest.mark.parametrize("goal, k", [((0.60, 0.05, 0.25), 1.5), ((0.50, -0.04, 0.30), 0.8)])

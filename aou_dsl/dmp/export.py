@@ -160,7 +160,7 @@ def to_dmp(trajectory: Any, *, intensity: float = 0.5, behaviour: str | None = N
         if kind in MOVES and i1 - i0 >= 3:
             t = tr.t[i0:i1 + 1] - tr.t[i0]
             part.dmp, lead = fit_pose_dmp(t, pos[i0:i1 + 1], quat[i0:i1 + 1])
-            part.lead = lead + float(tr.t[i0] - a)
+            part.lead = lead - float(tr.t[i0] - a)
             part.values = _move_values(pos[i0:i1 + 1], quat[i0:i1 + 1], acc[i0:i1 + 1])
         elif kind == "shiver":
             part.end = pose0
