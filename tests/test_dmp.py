@@ -141,3 +141,21 @@ def test_cli_compile_then_roll(tmp_path, capsys):
                  "-o", str(rolled)]) == 0
     assert "pause_duration" in capsys.readouterr().out
     assert main(["measure", str(rolled)]) == 0
+
+
+def test_goal_changed_mid_motion_blends_within_the_declared_peak(hesitant):
+    """The goal moves 7 cm while the second approach runs: the blended motion passes the
+    safety checks, and its approach peak is within 10 % of the larger of the peaks the
+    scaling rules give toward either goal."""
+    from aou_dsl.dmp.blend import change_goal
+    from aou_dsl.dmp.rollout import roll
+
+    _, seq = hesitant
+    goal = (0.60, 0.05, 0.25)
+    ro = roll(seq)
+    t0, t1 = [(a, b) for k, a, b in ro.parts if k == "approach"][1]
+    out = change_goal(seq, 0.5 * (t0 + t1), goal)
+    assert out.ok, [d.message for d in out.diagnostics]
+    toward = [roll(seq, goal=g).predicted["approach_acceleration"] for g in (seq.goal, goal)]
+    assert out.measured.descriptors["approach_acceleration"] <= 1.1 * max(toward)
+    assert out.measured.descriptors["pause_count"] == seq.descriptors["pause_count"]

@@ -186,7 +186,8 @@ def _shiver(tau: np.ndarray, amplitude: float, f: float, duration: float) -> np.
 
 def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
          time_scale: float = 1.0, intensity: float | None = None,
-         pinned: tuple[str, ...] = (), rate: float | None = None) -> Rollout:
+         pinned: tuple[str, ...] = (), rate: float | None = None,
+         stretch: dict[int, float] | None = None, cache: dict | None = None) -> Rollout:
     """Roll ``seq`` out (see the module's docstring).
 
     Args:
@@ -196,6 +197,9 @@ def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
         pinned: accelerations to keep (``approach_acceleration``,
             ``retreat_acceleration``).
         rate: sample rate [Hz] (default: the sequence's).
+        stretch: extra time scale of some motions, by part index (a blend slows the
+            motion that carries it, :mod:`.blend`).
+        cache: motions already rolled out, reused (a dict the caller keeps).
 
     Raises:
         AouError: I504 for a value out of range.
@@ -205,7 +209,8 @@ def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
     new_goal = tuple(float(x) for x in (goal if goal is not None else seq.goal))
     s, r = similarity(p0, np.asarray(seq.goal), np.asarray(new_goal))
     factors = _factors(seq, intensity)
-    plans = _plans(seq, p0, s, r, time_scale, factors, pinned)
+    plans = _plans(seq, p0, s, r, time_scale, factors, pinned, stretch or {},
+                   {} if cache is None else cache)
     first, last = plans[0], plans[-1]
     # The first motion's lead-in and the last one's run-out are rest of their own.
     offset = first.t0 - first.begin if first.spline is not None else 0.0
@@ -253,21 +258,27 @@ class _Plan:
 
 
 def _plans(seq: DmpSequence, p0: np.ndarray, s: float, r: np.ndarray, time_scale: float,
-           factors: dict[str, float], pinned: tuple[str, ...]) -> list[_Plan]:
+           factors: dict[str, float], pinned: tuple[str, ...], stretch: dict[int, float],
+           cache: dict) -> list[_Plan]:
     """Every part on one clock, each motion rolled out."""
     from scipy.interpolate import CubicSpline
 
     plans, t0 = [], 0.0
-    for p in seq.parts:
+    for i, p in enumerate(seq.parts):
         start = _map_pose(p.start, p0, s, r)
         if p.dmp is not None:
             name = _ACCEL.get(p.kind)
             f = factors.get(name, 1.0) if name else 1.0
             k = math.sqrt(s / f) if name in pinned else time_scale / math.sqrt(f)
+            k *= stretch.get(i, 1.0)
             end = _map_pose(p.end, p0, s, r)
-            tt, yy = _roll_move(p.dmp, start, end, s, r, k * p.dmp.execution_time_)
-            plans.append(_Plan(p.kind, t0, k * p.duration, t0 - k * p.lead, float(tt[-1]),
-                               CubicSpline(tt, yy, axis=0), start))
+            key = (i, s, r.tobytes(), k)
+            if key not in cache:
+                tt, yy = _roll_move(p.dmp, start, end, s, r, k * p.dmp.execution_time_)
+                cache[key] = (float(tt[-1]), CubicSpline(tt, yy, axis=0))
+            runs, spline = cache[key]
+            plans.append(_Plan(p.kind, t0, k * p.duration, t0 - k * p.lead, runs, spline,
+                               start))
         elif p.kind == "shiver":
             cycles = max(3, int(round(p.values["cycles"] * time_scale)))
             freq = p.values["frequency"]
