@@ -159,3 +159,29 @@ def test_goal_changed_mid_motion_blends_within_the_declared_peak(hesitant):
     toward = [roll(seq, goal=g).predicted["approach_acceleration"] for g in (seq.goal, goal)]
     assert out.measured.descriptors["approach_acceleration"] <= 1.1 * max(toward)
     assert out.measured.descriptors["pause_count"] == seq.descriptors["pause_count"]
+
+
+def test_intensity_changed_while_running_keeps_the_motion_continuous(hesitant):
+    """Hesitance raised to intensity 1 during the first pause: the motion before the
+    change is the one already running, the later pauses are 1.5x longer, and the joint
+    accelerations change by no more from sample to sample than they do without a
+    change (continuous q, qd, qdd)."""
+    from aou_dsl.diagnostics import Span
+    from aou_dsl.dmp.live import change_intensity
+    from aou_dsl.dmp.rollout import roll
+    from aou_dsl.dmp.solve import to_trajectory
+
+    _, seq = hesitant
+    before = roll(seq)
+    pause = next((a, b) for k, a, b in before.parts if k == "pause")
+    at = 0.5 * sum(pause)
+    after = change_intensity(seq, at, 1.0)
+    n = int(np.searchsorted(before.t, pause[1]))
+    assert np.allclose(after.pos[:n], before.pos[:n], atol=1e-12)
+    holds = [b - a for k, a, b in after.parts if k == "pause"]
+    assert holds[0] == pytest.approx(pause[1] - pause[0])
+    assert holds[1] == pytest.approx(1.5 * holds[0], rel=1e-6)
+    where = Span.whole_file("<test>")
+    steps = [np.abs(np.diff(to_trajectory(seq, ro, where).qdd, axis=0)).max()
+             for ro in (before, after)]
+    assert steps[1] <= 1.05 * steps[0]

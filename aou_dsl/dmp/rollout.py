@@ -187,7 +187,8 @@ def _shiver(tau: np.ndarray, amplitude: float, f: float, duration: float) -> np.
 def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
          time_scale: float = 1.0, intensity: float | None = None,
          pinned: tuple[str, ...] = (), rate: float | None = None,
-         stretch: dict[int, float] | None = None, cache: dict | None = None) -> Rollout:
+         stretch: dict[int, float] | None = None, cache: dict | None = None,
+         since: int = 0) -> Rollout:
     """Roll ``seq`` out (see the module's docstring).
 
     Args:
@@ -200,6 +201,8 @@ def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
         stretch: extra time scale of some motions, by part index (a blend slows the
             motion that carries it, :mod:`.blend`).
         cache: motions already rolled out, reused (a dict the caller keeps).
+        since: the intensity applies from this part on; earlier parts keep the
+            sequence's own (a running behaviour changes intensity, :mod:`.live`).
 
     Raises:
         AouError: I504 for a value out of range.
@@ -210,7 +213,7 @@ def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
     s, r = similarity(p0, np.asarray(seq.goal), np.asarray(new_goal))
     factors = _factors(seq, intensity)
     plans = _plans(seq, p0, s, r, time_scale, factors, pinned, stretch or {},
-                   {} if cache is None else cache)
+                   {} if cache is None else cache, since)
     first, last = plans[0], plans[-1]
     # The first motion's lead-in and the last one's run-out are rest of their own.
     offset = first.t0 - first.begin if first.spline is not None else 0.0
@@ -258,13 +261,14 @@ class _Plan:
 
 
 def _plans(seq: DmpSequence, p0: np.ndarray, s: float, r: np.ndarray, time_scale: float,
-           factors: dict[str, float], pinned: tuple[str, ...], stretch: dict[int, float],
-           cache: dict) -> list[_Plan]:
+           new_factors: dict[str, float], pinned: tuple[str, ...],
+           stretch: dict[int, float], cache: dict, since: int = 0) -> list[_Plan]:
     """Every part on one clock, each motion rolled out."""
     from scipy.interpolate import CubicSpline
 
     plans, t0 = [], 0.0
     for i, p in enumerate(seq.parts):
+        factors = new_factors if i >= since else {}
         start = _map_pose(p.start, p0, s, r)
         if p.dmp is not None:
             name = _ACCEL.get(p.kind)
