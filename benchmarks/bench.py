@@ -7,7 +7,8 @@
 Sections: ``build`` (the warm checked build), ``cold`` (cold starts against their import
 floors), ``lint`` (long files, many files), ``jobs`` (``--jobs N``), ``render`` (a 640x480
 video), ``measure`` (60 s at 1 kHz), ``compile`` (below), ``replan`` (a live re-plan,
-``bench_replan.py``); see ``speed.py`` for all but ``measure`` and ``compile``. Ratios
+``bench_replan.py``), ``dmp`` (behaviours as DMPs, ``bench_dmp.py``); see ``speed.py`` for
+all but ``measure``, ``compile`` and ``dmp``. Ratios
 are measured in one run, so they hold on any machine; absolute times are this
 machine's (its cores and load are in the JSON). The JSON lists every figure with its
 goal (null for a figure that only says where the time goes) and whether it is met, and
@@ -35,6 +36,7 @@ import sys
 import time
 from pathlib import Path
 
+import bench_dmp
 import numpy as np
 import speed
 from speed import figure, say
@@ -176,7 +178,7 @@ def bench_measure() -> None:
 
 SECTIONS = {"build": speed.bench_build, "cold": speed.bench_cold, "lint": speed.bench_lint,
             "jobs": speed.bench_jobs, "render": speed.bench_render, "measure": bench_measure,
-            "compile": bench_compile, "replan": speed.bench_replan}
+            "compile": bench_compile, "replan": speed.bench_replan, "dmp": bench_dmp.bench_dmp}
 
 
 def main(argv: list[str]) -> int:

@@ -23,11 +23,14 @@ __all__ = ["change_intensity"]
 def change_intensity(seq: DmpSequence, at: float, intensity: float, **options: Any
                      ) -> Rollout:
     """The rollout of ``seq`` (``options`` as :func:`~aou_dsl.dmp.rollout.roll`) whose
-    intensity becomes ``intensity`` after the part running at ``at`` [s] ends.
+    intensity becomes ``intensity`` after the part running at ``at`` [s] ends. Pass the
+    ``cache`` the running rollout was made with: only the motions whose time scale the
+    intensity changes are then rolled out again.
 
     Raises:
         AouError: I504 for an intensity or option out of range.
     """
+    options.setdefault("cache", {})
     running = roll(seq, **options)
     after = next((k + 1 for k, (_, t0, t1) in enumerate(running.parts) if t0 <= at < t1),
                  len(seq.parts))
