@@ -262,12 +262,12 @@ _RULE_LIST = [
          "Only a compiled trajectory (with the compiler's episodes and goal) can become a "
          "sequence of DMPs; a recording carries neither.",
          "Each DMP is one rest-to-rest episode; without the episodes there are no parts.",
-         "aouc dmp export recording.csv   # a recording: compile the .aou file instead"),
+         "aou_dsl.dmp.to_dmp(aou_dsl.read_trajectory('arm.csv', robot='panda'))"),
     Rule("D602", "bad-dmp-file", _E,
          "A `.dmp` folder's manifest is not an `aou-dmp/1` sequence, or a part it names is "
          "missing.",
          "The sequence cannot be rolled out.",
-         "aouc dmp roll a.aou --goal 0.5,0,0.3   # a .aou file is not a .dmp folder"),
+         'x.dmp/manifest.json: {"format": "aou-trajectory/1"}'),
     Rule("D603", "rollout-unreachable", _E,
          "The arm cannot follow the rolled-out motion: a pose is out of reach, needs a "
          "joint past its limit, or passes a singularity.",
@@ -278,7 +278,7 @@ _RULE_LIST = [
          "joint, the value and the limit (joint velocity, acceleration, collision...).",
          "A faster tempo or a larger motion needs more of the arm than it has; such a "
          "motion is not safe to send.",
-         "aouc dmp roll fearful.dmp --goal 0.5,0,0.3 --time-scale 0.25"),
+         "aouc dmp roll fearful.dmp --time-scale 0.25   # its 2 m/s^2 retreat at 32 m/s^2"),
     Rule("D605", "rollout-off-rule", _W,
          "A descriptor measured on the rolled-out motion is not what its scaling rule "
          "predicts, within the descriptor's tolerance.",

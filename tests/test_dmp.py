@@ -4,6 +4,7 @@ scaling rules hold when the goal and the tempo change, and the files are the lib
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,6 +16,8 @@ from aou_dsl.descriptors import REGISTRY  # noqa: E402
 from aou_dsl.diagnostics import AouError  # noqa: E402
 from aou_dsl.dmp import read_dmp, solve, to_dmp, write_dmp  # noqa: E402
 from aou_dsl.kinematics import load_arm  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
 
 
 @pytest.fixture(scope="module")
@@ -185,3 +188,45 @@ def test_intensity_changed_while_running_keeps_the_motion_continuous(hesitant):
     steps = [np.abs(np.diff(to_trajectory(seq, ro, where).qdd, axis=0)).max()
              for ro in (before, after)]
     assert steps[1] <= 1.05 * steps[0]
+
+
+@pytest.mark.parametrize("code", ["D603", "D604"])
+def test_each_rollout_rule_example_triggers_its_own_code(code, tmp_path, capsys, monkeypatch):
+    """`aouc rules D603|D604` show commands; run on the shipped behaviour they name,
+    compiled to a .dmp folder, each reports that very code and exits 1."""
+    import shlex
+
+    from aou_dsl.cli import main
+    from aou_dsl.diagnostics import RULES
+
+    argv = shlex.split(RULES[code].example.split("#")[0])[1:]
+    name = argv[2].removesuffix(".dmp")
+    monkeypatch.chdir(tmp_path)
+    assert main(["compile", str(ROOT / "behaviours" / f"{name}.aou"),
+                 "-o", f"{name}.dmp"]) == 0
+    capsys.readouterr()
+    assert main(argv) == 1
+    assert f" {code} " in capsys.readouterr().err
+
+
+def test_bad_dmp_rule_example_triggers_its_own_code(tmp_path, capsys):
+    """D602's example, a manifest of another format, is refused with D602 (exit 1)."""
+    import json as _json
+
+    from aou_dsl.cli import main
+    from aou_dsl.diagnostics import RULES
+
+    where, text = RULES["D602"].example.split(": ", 1)
+    (tmp_path / where).parent.mkdir()
+    (tmp_path / where).write_text(text)
+    assert _json.loads(text)["format"] != "aou-dmp/1"
+    assert main(["dmp", "roll", str(tmp_path / "x.dmp")]) == 1
+    assert " D602 " in capsys.readouterr().err
+
+
+def test_recording_cannot_become_dmps():
+    """D601: a trajectory without the compiler's episodes (a recording) is refused."""
+    build = aou_dsl.compile("behaviours/confident.aou")
+    with pytest.raises(AouError) as err:
+        to_dmp(build.trajectory.with_(episodes=()))
+    assert err.value.diagnostics[0].code == "D601"
