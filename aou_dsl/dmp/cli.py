@@ -10,13 +10,13 @@ import argparse
 import sys
 from typing import Any
 
-import numpy as np
-
 __all__ = ["add_parser", "cmd_dmp", "rolled_document", "trajectory_of", "write_document"]
 
 
 def trajectory_of(doc: dict, path: str = "<document>") -> Any:
     """The :class:`~aou_dsl.trajectory.Trajectory` of a trajectory document."""
+    import numpy as np
+
     from ..trajectory import Trajectory
 
     arr = {k: np.asarray(doc[k], dtype=float) for k in ("t", "q", "qd", "qdd")}
@@ -73,9 +73,9 @@ def add_parser(sub: Any) -> argparse.ArgumentParser:
                      metavar="K", help="durations times K, accelerations over K^2 (default 1)")
     dmp.add_argument("--intensity", type=number(0.0, 1.0, what="an intensity"),
                      metavar="I", help="in [0, 1] (default: the behaviour's own)")
-    dmp.add_argument("--pin", action="append", default=[],
-                     choices=("approach_acceleration", "retreat_acceleration"),
-                     help="keep this acceleration whatever the goal (repeatable)")
+    dmp.add_argument("--pin", action="append", default=[], choices=("approach", "retreat"),
+                     help="keep the peak acceleration of these motions whatever the goal "
+                     "(repeatable)")
     dmp.add_argument("-o", "--output", metavar="FILE",
                      help="write the solved trajectory (.json, .csv, .npz)")
     dmp.add_argument("--no-check", action="store_true", help="skip the safety replay")
@@ -90,6 +90,7 @@ def cmd_dmp(args: argparse.Namespace) -> int:
     from ..compiler.output import encode
     from ..files import write_atomic
     from ..report import format_text
+    from ..synth_recipe import descriptor
     from .manifest import read_dmp
     from .solve import solve
 
@@ -100,7 +101,8 @@ def cmd_dmp(args: argparse.Namespace) -> int:
         return 2
     seq = read_dmp(args.path)
     out = solve(seq, path=args.path, check=not args.no_check, goal=args.goal,
-                time_scale=args.time_scale, intensity=args.intensity, pinned=tuple(args.pin))
+                time_scale=args.time_scale, intensity=args.intensity,
+                pinned=tuple(descriptor(kind, "peak_acceleration").name for kind in args.pin))
     for d in out.diagnostics:
         print(format_text(d), file=sys.stderr)
     if not out.ok or out.measured is None:

@@ -27,19 +27,20 @@ __all__ = ["FORMAT", "PARAMETERS", "manifest", "read_dmp", "write_dmp"]
 FORMAT = "aou-dmp/1"
 
 #: Which DMP parameter controls each descriptor (docs/dmp.md, the scaling rules).
+#: By the descriptor's kind and episode key ("" for a count).
 PARAMETERS = {
-    "approach_acceleration": "execution_time_ of each approach (peak ~ amplitude / time^2); "
-                             "forcing weights scaled with the amplitude",
-    "retreat_acceleration": "execution_time_ of each retreat, as above",
-    "retreat_distance": "start_y/goal_y and forcing weights (amplitude scaling)",
-    "pause_duration": "the hold's duration",
-    "pause_count": "the parts (fixed)",
-    "retreat_count": "the parts (fixed)",
-    "horizontal_gaze": "rotation of start_y/goal_y and weights about the goal (kept)",
-    "vertical_gaze": "as horizontal_gaze",
-    "tilt_angle": "the orientation goal_y (kept)",
-    "tilt_velocity": "execution_time_ of each tilt",
-    "shiver_amplitude": "the oscillation's amplitude",
+    ("approach", "peak_acceleration"): "execution_time_ of each approach (peak ~ amplitude "
+                                       "/ time^2); forcing weights scaled with the amplitude",
+    ("retreat", "peak_acceleration"): "execution_time_ of each retreat, as above",
+    ("retreat", "distance"): "start_y/goal_y and forcing weights (amplitude scaling)",
+    ("pause", "duration"): "the hold's duration",
+    ("pause", ""): "the parts (fixed)",
+    ("retreat", ""): "the parts (fixed)",
+    ("gaze", "horizontal"): "rotation of start_y/goal_y and weights about the goal (kept)",
+    ("gaze", "vertical"): "rotation of start_y/goal_y and weights about the goal (kept)",
+    ("tilt", "angle"): "the orientation goal_y (kept)",
+    ("tilt", "velocity"): "execution_time_ of each tilt",
+    ("shiver", "amplitude"): "the oscillation's amplitude",
 }
 
 
@@ -62,7 +63,13 @@ def manifest(seq: DmpSequence) -> dict[str, Any]:
             "joint_names": list(seq.joint_names), "goal": {"position": list(seq.goal)},
             "q_start": seq.q_start.tolist(), "shiver_joint": seq.shiver_joint,
             "rate": seq.rate, "duration": seq.duration, "quaternion_order": "w, x, y, z",
-            "descriptors": seq.descriptors, "parameters": PARAMETERS, "parts": parts}
+            "descriptors": seq.descriptors, "parameters": _parameters(), "parts": parts}
+
+
+def _parameters() -> dict[str, str]:
+    from ..synth_recipe import descriptor
+
+    return {descriptor(kind, key).name: text for (kind, key), text in PARAMETERS.items()}
 
 
 def write_dmp(path: str, seq: DmpSequence, *, inputs: Any = ()) -> None:

@@ -42,7 +42,17 @@ from .export import DmpSequence
 __all__ = ["Rollout", "predict", "roll", "similarity"]
 
 _WHERE = Span.whole_file("<dmp>")
-_ACCEL = {"approach": "approach_acceleration", "retreat": "retreat_acceleration"}
+
+
+def _name(kind: str, key: str) -> str:
+    """The descriptor read from ``kind`` episodes by ``key`` (the registry's name)."""
+    from ..synth_recipe import descriptor
+
+    return descriptor(kind, key).name
+
+
+#: The moving kinds whose peak acceleration is a descriptor, and its name.
+_ACCEL = {kind: _name(kind, "peak_acceleration") for kind in ("approach", "retreat")}
 #: Step of the DMPs' rollouts [s] (the library integrates orientation every millisecond
 #: within it); the rollout is then sampled at the sequence's rate through a cubic spline.
 ROLL_DT = 0.002
@@ -128,10 +138,11 @@ def predict(seq: DmpSequence, s: float, k: float, factors: dict[str, float],
     for name in _ACCEL.values():
         f = factors.get(name, 1.0)
         times(name, f if name in pinned else s * f / k ** 2)
-    times("pause_duration", k * factors.get("pause_duration", 1.0))
-    times("retreat_distance", s)
-    times("tilt_velocity", 1.0 / k)
-    times("shiver_amplitude", factors.get("shiver_amplitude", 1.0))
+    hold, shake = _name("pause", "duration"), _name("shiver", "amplitude")
+    times(hold, k * factors.get(hold, 1.0))
+    times(_name("retreat", "distance"), s)
+    times(_name("tilt", "velocity"), 1.0 / k)
+    times(shake, factors.get(shake, 1.0))
     return out
 
 
@@ -195,8 +206,8 @@ def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
         goal: the new goal [m] (default: the sequence's).
         time_scale: ``K`` in [0.25, 4].
         intensity: in [0, 1] (default: the sequence's own).
-        pinned: accelerations to keep (``approach_acceleration``,
-            ``retreat_acceleration``).
+        pinned: the peak accelerations to keep, by descriptor name (of the approach,
+            the retreat).
         rate: sample rate [Hz] (default: the sequence's).
         stretch: extra time scale of some motions, by part index (a blend slows the
             motion that carries it, :mod:`.blend`).
@@ -286,10 +297,11 @@ def _plans(seq: DmpSequence, p0: np.ndarray, s: float, r: np.ndarray, time_scale
         elif p.kind == "shiver":
             cycles = max(3, int(round(p.values["cycles"] * time_scale)))
             freq = p.values["frequency"]
-            amp = math.radians(p.values["amplitude"]) * factors.get("shiver_amplitude", 1.0)
+            amp = math.radians(p.values["amplitude"]) * factors.get(
+                _name("shiver", "amplitude"), 1.0)
             plans.append(_Plan("shiver", t0, cycles / freq, amplitude=amp, freq=freq))
         else:
-            dur = p.duration * time_scale * factors.get("pause_duration", 1.0)
+            dur = p.duration * time_scale * factors.get(_name("pause", "duration"), 1.0)
             plans.append(_Plan(p.kind, t0, dur))
         t0 += plans[-1].duration
     return plans
