@@ -132,13 +132,16 @@ def test_a_folder_that_is_not_a_sequence_is_refused(tmp_path):
 
 
 def test_cli_compile_then_roll(tmp_path, capsys):
-    """`aouc compile --format dmp` writes the folder; `aouc dmp roll` rolls it to a new
-    goal and writes a trajectory that `aouc measure` reads."""
+    """`aouc compile --format dmp` writes the folder (a second compile replaces it, never
+    writes inside it); `aouc dmp roll` rolls it to a new goal and writes a trajectory that
+    `aouc measure` reads."""
     from aou_dsl.cli import main
 
     out = tmp_path / "c.dmp"
     assert main(["compile", "behaviours/confident.aou", "-o", str(out)]) == 0
     assert (out / "manifest.json").is_file()
+    assert main(["compile", "behaviours/confident.aou", "-o", str(out)]) == 0  # replaced
+    assert sorted(p.name for p in out.iterdir()) == ["manifest.json", "parts"]
     rolled = tmp_path / "r.json"
     assert main(["dmp", "roll", str(out), "--goal", "0.58,0.03,0.27", "--time-scale", "1.2",
                  "-o", str(rolled)]) == 0

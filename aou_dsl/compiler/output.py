@@ -161,7 +161,7 @@ def output_paths(inputs: list[tuple[str, str | None]], output: str | None, fmt: 
     """
     many = len(inputs) > 1 or any(root is not None for _, root in inputs)
     is_dir = output is not None and (output.endswith(os.sep) or (
-        os.path.isdir(output) and not is_bag(output)))
+        os.path.isdir(output) and not is_bag(output) and not output.endswith(".dmp")))
     if fmt is None:
         ext = os.path.splitext(output or "")[1].lstrip(".")
         fmt = ext if output and not many and not is_dir and ext else "json"

@@ -25,14 +25,14 @@ __all__ = ["ALPHA_Y", "BETA_Y", "PAD", "WEIGHTS_PER_SECOND", "fit_pose_dmp", "qu
 ALPHA_Y = 4.0
 BETA_Y = ALPHA_Y / 4.0
 #: Basis functions per second of motion, per dimension (at least 10).
-WEIGHTS_PER_SECOND = 250.0
+WEIGHTS_PER_SECOND = 400.0
 #: Rest added before and after each motion [s]. A fit is a smoothing: it spreads the few
 #: milliseconds in which the compiled acceleration switches on and off over about three
 #: basis functions, so the fitted motion starts a little before its episode and stops a
 #: little after. Fitted from rest to rest with this margin, the DMP starts and ends at
 #: rest (zero velocity and acceleration) instead of stopping with half its deceleration
 #: left; a rollout lays the margins over the neighbouring parts (:mod:`.rollout`).
-PAD = 5.0 / WEIGHTS_PER_SECOND
+PAD = 3.0 / WEIGHTS_PER_SECOND
 
 
 def weights_for(duration: float) -> int:
