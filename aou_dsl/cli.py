@@ -334,7 +334,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                   "pip install '.[media]' in aou's folder (the one with pyproject.toml)",
                   file=sys.stderr)
             return EXIT_USAGE
-        if (args.command == "dmp" or getattr(args, "format", None) == "dmp") and exc.name:
+        if exc.name and exc.name.split(".")[0] in ("movement_primitives", "pytransform3d"):
             print(f"aouc: this command needs the dmp extra ({exc.name} is missing): "
                   "pip install '.[dmp]' in aou's folder (the one with pyproject.toml)",
                   file=sys.stderr)

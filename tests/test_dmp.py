@@ -233,3 +233,19 @@ def test_recording_cannot_become_dmps():
     with pytest.raises(AouError) as err:
         to_dmp(build.trajectory.with_(episodes=()))
     assert err.value.diagnostics[0].code == "D601"
+
+
+def test_without_the_extra_the_command_names_it(tmp_path, capsys, monkeypatch):
+    """With movement_primitives missing, `aouc compile --format dmp` says which extra to
+    install (exit 2) and writes nothing."""
+    import sys
+
+    from aou_dsl.cli import main
+
+    for name in ("movement_primitives", "movement_primitives.dmp", "movement_primitives.io",
+                 "pytransform3d", "pytransform3d.rotations"):
+        monkeypatch.setitem(sys.modules, name, None)
+    out = tmp_path / "c.dmp"
+    assert main(["compile", "behaviours/confident.aou", "-o", str(out)]) == 2
+    assert "pip install '.[dmp]'" in capsys.readouterr().err
+    assert not out.exists() and list(tmp_path.iterdir()) == []
