@@ -277,15 +277,14 @@ def _plans(seq: DmpSequence, p0: np.ndarray, s: float, r: np.ndarray, time_scale
     """Every part on one clock, each motion rolled out."""
     from scipy.interpolate import CubicSpline
 
+    ks = [_time_scale(p, s, time_scale, new_factors if i >= since else {}, pinned)
+          * stretch.get(i, 1.0) for i, p in enumerate(seq.parts)]
     plans, t0 = [], 0.0
     for i, p in enumerate(seq.parts):
         factors = new_factors if i >= since else {}
         start = _map_pose(p.start, p0, s, r)
         if p.dmp is not None:
-            name = _ACCEL.get(p.kind)
-            f = factors.get(name, 1.0) if name else 1.0
-            k = math.sqrt(s / f) if name in pinned else time_scale / math.sqrt(f)
-            k *= stretch.get(i, 1.0)
+            k = ks[i]
             end = _map_pose(p.end, p0, s, r)
             key = (i, s, r.tobytes(), k)
             if key not in cache:
@@ -302,9 +301,23 @@ def _plans(seq: DmpSequence, p0: np.ndarray, s: float, r: np.ndarray, time_scale
             plans.append(_Plan("shiver", t0, cycles / freq, amplitude=amp, freq=freq))
         else:
             dur = p.duration * time_scale * factors.get(_name("pause", "duration"), 1.0)
-            plans.append(_Plan(p.kind, t0, dur))
+            # A motion's fitted tails reach into a hold by about half its margin, and
+            # stretch with its time scale: the hold gives back what the stretch adds.
+            dur += sum(0.5 * seq.parts[j].lead * (ks[j] - 1.0) for j in (i - 1, i + 1)
+                       if 0 <= j < len(seq.parts) and seq.parts[j].dmp is not None)
+            plans.append(_Plan(p.kind, t0, max(dur, 0.0)))
         t0 += plans[-1].duration
     return plans
+
+
+def _time_scale(p: Any, s: float, time_scale: float, factors: dict[str, float],
+                pinned: tuple[str, ...]) -> float:
+    """The time scale of part ``p``'s DMP (1 for a part without one)."""
+    if p.dmp is None:
+        return 1.0
+    name = _ACCEL.get(p.kind)
+    f = factors.get(name, 1.0) if name else 1.0
+    return math.sqrt(s / f) if name in pinned else time_scale / math.sqrt(f)
 
 
 def _qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
