@@ -3,7 +3,7 @@
 Everything ``aouc`` does goes through these functions; the command line only parses
 arguments, calls them, prints and maps exit codes. A problem of the input is never an
 exception from ``lint`` or ``compile``: it is a diagnostic in the result. ``check`` and
-``measure`` raise :class:`~aou_dsl.diagnostics.AouError` (with its diagnostics) when
+``measure`` raise :class:`~aou_dsl.core.diagnostics.AouError` (with its diagnostics) when
 their input cannot be read.
 
 Example::
@@ -21,13 +21,13 @@ from __future__ import annotations
 import os
 from typing import TYPE_CHECKING, Any
 
-from .build import BuildResult, build_file, build_source
-from .linter import FileResult, lint_file, lint_paths, lint_source
+from .build.builder import BuildResult, build_file, build_source
+from .lang.linter import FileResult, lint_file, lint_paths, lint_source
 
 if TYPE_CHECKING:
-    from .measuring.descriptors import Measured
+    from .core.trajectory import Trajectory
+    from .measuring.measured import Measured
     from .safety.replay import CheckReport
-    from .trajectory import Trajectory
 
 __all__ = ["check", "compile", "lint", "lint_paths", "measure", "read_trajectory"]
 
@@ -62,10 +62,10 @@ def compile(path: Source | None = None, *, source: str | None = None,  # noqa: A
             published limits (joint jerk at 1 kHz against the robot's is always checked).
 
     Returns:
-        A :class:`~aou_dsl.build.BuildResult`: ``ok``, ``diagnostics``, ``trajectory``,
+        A :class:`~aou_dsl.build.builder.BuildResult`: ``ok``, ``diagnostics``, ``trajectory``,
         ``declared`` and ``measured`` descriptors, the output ``document``.
     """
-    from .safety.scene import SceneOptions
+    from .core.options import SceneOptions
 
     scene = SceneOptions(target_size=target_size, table_height=table_height)
     options: dict[str, Any] = {"robot": robot, "rate": rate, "check": check, "scene": scene,
@@ -86,14 +86,14 @@ def read_trajectory(path: Source, *, robot: str | None = None,
     ``robot``); a ``.aou`` file is compiled. ``goal`` (or ``"final"``: the end-effector's
     last position) and ``ee_frame`` override the file's; ``angle_unit="deg"`` and
     ``time_unit="ms"`` read a recording in those units (docs/measure.md)."""
-    from .build import load_motion
+    from .build.builder import load_motion
 
     return load_motion(os.fspath(path), robot=robot, goal=goal, ee_frame=ee_frame,
                        angle_unit=angle_unit, time_unit=time_unit)
 
 
 def _trajectory(what: Trajectory | Source, **options: Any) -> Trajectory:
-    from .trajectory import Trajectory
+    from .core.trajectory import Trajectory
 
     return what if isinstance(what, Trajectory) else read_trajectory(what, **options)
 
@@ -101,7 +101,7 @@ def _trajectory(what: Trajectory | Source, **options: Any) -> Trajectory:
 def measure(what: Trajectory | Source, **options: Any) -> Measured:
     """The eleven descriptors of a trajectory (or of a file, read with
     :func:`read_trajectory`'s ``options``), its episodes and its C-V point."""
-    from .measuring.descriptors import measure as measure_trajectory
+    from .measuring.measured import measure as measure_trajectory
 
     return measure_trajectory(_trajectory(what, **options))
 
@@ -116,9 +116,9 @@ def check(what: Trajectory | Source, *, dynamic: bool = True, target_size: float
     samples as a ``joint_trajectory_controller`` does) is checked too when ``controller``
     is named, or when the trajectory carries velocities (a compiled one); a recording of
     positions alone is too noisy for a third derivative unless asked."""
-    from .controllers import controller_checks
+    from .core.options import SceneOptions
+    from .safety.controllers import controller_checks
     from .safety.replay import replay
-    from .safety.scene import SceneOptions
 
     scene = SceneOptions(target_size=target_size, table_height=table_height)
     tr = _trajectory(what, **options)

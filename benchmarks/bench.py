@@ -47,7 +47,7 @@ BEHAVIOURS = ["confident", "curious", "hesitant", "fearful", "inactive"]
 
 def _cold(path: Path) -> float:
     code = ("import time; t = time.perf_counter()\n"
-            "from aou_dsl.linter import lint_file\n"
+            "from aou_dsl.lang.linter import lint_file\n"
             "from aou_dsl.compiler.pipeline import compile_behaviour\n"
             f"r = compile_behaviour(lint_file({str(path)!r}).behaviour)\n"
             "assert r.ok\n"
@@ -69,8 +69,8 @@ def _errors(arm, q: np.ndarray, pos: np.ndarray, goal: np.ndarray) -> tuple[floa
 def _by_hand(res, arm) -> tuple[float, np.ndarray, np.ndarray]:
     """The path sampled with linear timing; IK by PyBullet per sample. Returns the time
     [s] and the joint path, plus the targets it was asked for."""
-    from aou_dsl.safety.scene import Scene
-    from aou_dsl.timeline import Pose
+    from aou_dsl.lang.timeline import Pose
+    from aou_dsl.robot.scene import Scene
 
     tr, tl, frame = res.trajectory, res.timeline, res.frame
     targets = []
@@ -109,8 +109,8 @@ def _quat(r: np.ndarray) -> list[float]:
 
 def bench_compile(repeat: int = 15) -> None:
     from aou_dsl.compiler.pipeline import compile_behaviour, target_path
-    from aou_dsl.kinematics import load_arm
-    from aou_dsl.linter import lint_file
+    from aou_dsl.lang.linter import lint_file
+    from aou_dsl.robot.load import load_arm
 
     say("compile (panda, 250 Hz)")
     say(f"{'behaviour':<10}{'cold s':>8}{'warm ms':>9}{'motion s':>9}{'RTF':>7}"
@@ -157,8 +157,8 @@ def bench_compile(repeat: int = 15) -> None:
 
 def bench_measure() -> None:
     from aou_dsl.compiler.pipeline import CompileOptions, compile_behaviour
-    from aou_dsl.linter import load
-    from aou_dsl.measuring.descriptors import measure
+    from aou_dsl.lang.linter import load
+    from aou_dsl.measuring.measured import measure
 
     text = "approach a=0.05\npause 2s x14\nretreat 0.05m a=0.1 x8\ngaze horizontal 15deg x4\n"
     b, _ = load(text, "long.aou")

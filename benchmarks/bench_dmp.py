@@ -7,7 +7,7 @@
   (the running part finishes, later parts take the new intensity: the motions whose time
   scale changes are rolled out again, the rest kept from the running rollout, and the
   whole solved by inverse kinematics), and by today's live re-plan
-  (:class:`aou_dsl.live.Regulator`: a synthesized, compiled, checked plan, warm, joined
+  (:class:`aou_dsl.live.regulator.Regulator`: a synthesized, compiled, checked plan, warm, joined
   by a jerk-limited transition). Time
   of each, and smoothness over the second after the change: the largest joint jerk
   (third differences at the sample rate) and the largest step of a joint acceleration
@@ -33,13 +33,13 @@ def _smoothness(t: np.ndarray, qdd: np.ndarray, t0: float) -> tuple[float, float
 
 def bench_dmp() -> None:
     import aou_dsl
-    from aou_dsl.diagnostics import Span
+    from aou_dsl.core.diagnostics import Span
     from aou_dsl.dmp import to_dmp
     from aou_dsl.dmp.live import change_intensity
     from aou_dsl.dmp.rollout import roll
     from aou_dsl.dmp.solve import to_trajectory
-    from aou_dsl.ir import State
-    from aou_dsl.live import Regulator
+    from aou_dsl.lang.ir import State
+    from aou_dsl.live.regulator import Regulator
 
     build = aou_dsl.compile(str(HESITANT))
     seq = to_dmp(build.trajectory, state="hesitant",

@@ -2,7 +2,7 @@
 
     python benchmarks/bench_replan.py [ROBOT] [REPEATS]
 
-A :class:`aou_dsl.live.Regulator` has its plans made once (cold: synthesis, compile and
+A :class:`aou_dsl.live.regulator.Regulator` has its plans made once (cold: synthesis, compile and
 the safety checks of the whole plan; printed too). Then, REPEATS times (default 20), the
 arm starts a confident reach, and at a different instant of it, while it moves, the
 estimate turns hesitant: the re-plan from that state (q, qd, qdd) is timed. Warm means
@@ -22,8 +22,8 @@ import numpy as np
 
 
 def main(argv: list[str]) -> int:
-    from aou_dsl.ir import State
-    from aou_dsl.live import Regulator
+    from aou_dsl.lang.ir import State
+    from aou_dsl.live.regulator import Regulator
 
     robot = argv[0] if argv else "panda"
     repeats = int(argv[1]) if len(argv) > 1 else 20

@@ -112,10 +112,10 @@ def _median_ms(fn, repeat: int, cpu: list[float] | None = None) -> tuple[float, 
 
 
 def bench_build(repeat: int = 15) -> None:
-    from aou_dsl.build import CHECK_RATE, build_file
+    from aou_dsl.build.builder import CHECK_RATE, build_file
     from aou_dsl.compiler.pipeline import DEFAULT_RATE, compile_behaviour, sample
-    from aou_dsl.linter import lint_file
-    from aou_dsl.measuring.descriptors import measure
+    from aou_dsl.lang.linter import lint_file
+    from aou_dsl.measuring.measured import measure
     from aou_dsl.safety.replay import replay
 
     say("warm checked build of behaviours/hesitant.aou (lint, compile, safety replay, "
@@ -175,7 +175,7 @@ def _compile_dependencies(out: str) -> list[str]:
             "                seen.append(full)\n"
             "    return mod\n"
             "builtins.__import__ = spy\n"
-            "from aou_dsl.cli import main\n"
+            "from aou_dsl.cli.commands import main\n"
             f"main(['compile', {str(HESITANT)!r}, '-o', {out!r}])\n"
             "print(' '.join(seen))\n")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
@@ -231,7 +231,7 @@ def bench_cold(repeat: int = 7) -> None:
 
 _LINT_ONE = ("import sys, time\n"
              "t = time.perf_counter()\n"
-             "from aou_dsl.cli import main\n"
+             "from aou_dsl.cli.commands import main\n"
              "import contextlib, io\n"
              "out = io.StringIO()\n"
              "with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):\n"
@@ -328,8 +328,8 @@ def _ceiling(cores: int) -> float:
 
 
 def bench_jobs(copies: int = 3, rounds: int = 5) -> None:
+    from aou_dsl.build.parallel import BuildPool, build_many, default_jobs
     from aou_dsl.compiler.output import encode
-    from aou_dsl.parallel import BuildPool, build_many, default_jobs
 
     cores = default_jobs()
     say(f"`aouc compile --jobs {cores}`: a warm pool against one process "
@@ -378,7 +378,7 @@ def bench_jobs(copies: int = 3, rounds: int = 5) -> None:
 def bench_render() -> None:
     import resource
 
-    from aou_dsl.build import build_file
+    from aou_dsl.build.builder import build_file
     from aou_dsl.media.render import render_video
 
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()

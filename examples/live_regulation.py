@@ -2,7 +2,7 @@
 
 A simulated perception loop runs for a minute at 10 Hz. Its uncertainty estimate drifts
 from certain to frightened and back, with noise; each tick it goes to an
-``aou_dsl.live.Regulator`` together with the arm's state (here the arm follows its
+``aou_dsl.live.regulator.Regulator`` together with the arm's state (here the arm follows its
 trajectory exactly). The regulator re-plans only when the expressed state or intensity
 changes by more than its hysteresis; every re-plan starts at the arm's state, so the
 motion has no jump. When a reach ends, the loop starts a new one (``restart=True``).
@@ -26,8 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
-from aou_dsl.ir import State
-from aou_dsl.live import Hysteresis, Regulator
+from aou_dsl.lang.ir import State
+from aou_dsl.live.regulator import Hysteresis, Regulator
 
 DURATION = 60.0  # s
 TICK = 0.1  # s: the perception loop's period

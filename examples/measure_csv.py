@@ -1,7 +1,7 @@
 """Measure a CSV recording: the way a trajectory of a real arm would be checked.
 
 Compiles the study's hesitant behaviour (``behaviours/hesitant.aou``) to a CSV file with
-the command-line entry ``aou_dsl.cli.main`` (the same as ``aouc compile ... -o X.csv``).
+the command-line entry ``aou_dsl.cli.commands.main`` (the same as ``aouc compile ... -o X.csv``).
 Its rows hold only sample times and joint positions, like a log recorded on a robot.
 A CSV that aou writes also names its robot, end-effector frame and goal in ``#`` comment
 lines above the columns, so ``aouc measure hesitant.csv`` needs nothing more; a log from
@@ -25,7 +25,7 @@ import tempfile
 from pathlib import Path
 
 import aou_dsl
-from aou_dsl.cli import main as aouc
+from aou_dsl.cli.commands import main as aouc
 
 ROOT = Path(__file__).resolve().parent.parent
 BEHAVIOUR = ROOT / "behaviours" / "hesitant.aou"

@@ -18,7 +18,7 @@ def behaviours_dir() -> Path:
 def fails_with(code: str, fn, *args, **kw):
     """The one diagnostic of the AouError ``fn(*args, **kw)`` raises, checked to be
     ``code``."""
-    from aou_dsl.diagnostics import AouError
+    from aou_dsl.core.diagnostics import AouError
 
     with pytest.raises(AouError) as err:
         fn(*args, **kw)

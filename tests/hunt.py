@@ -1,7 +1,7 @@
 """Hunt for files the linter accepts but the compiler gets wrong.
 
 Generates valid files over the whole language (``langgen``), lints and compiles each one
-in-process through the command line's entry point ``aou_dsl.cli.main``, measures the
+in-process through the command line's entry point ``aou_dsl.cli.commands.main``, measures the
 trajectory with the independent ``oracle`` and compares the oracle's reading, the
 document's ``descriptors.measured`` and its ``descriptors.declared`` with what the file
 declares. Writes a report and saves every wrong or crashing file with its expectation and
@@ -57,8 +57,8 @@ class Outcome:
 
 
 def cli(argv: list[str]) -> tuple[int, str]:
-    """Run ``aou_dsl.cli.main`` in-process; return (exit status, stdout + stderr)."""
-    from aou_dsl.cli import main
+    """Run ``aou_dsl.cli.commands.main`` in-process; return (exit status, stdout + stderr)."""
+    from aou_dsl.cli.commands import main
 
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):

@@ -10,8 +10,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from aou_dsl.kinematics import load_arm
-from aou_dsl.trajectory import Trajectory
+from aou_dsl.core.trajectory import Trajectory
+from aou_dsl.robot.load import load_arm
 
 RATE = 250.0
 

@@ -8,9 +8,9 @@ import sys
 
 import pytest
 
-from aou_dsl.descriptors import REGISTRY
-from aou_dsl.diagnostics import RULES
-from aou_dsl.linter import lint_source
+from aou_dsl.core.diagnostics import RULES
+from aou_dsl.lang.descriptors import REGISTRY
+from aou_dsl.lang.linter import lint_source
 
 from .conftest import ROOT
 
@@ -86,8 +86,8 @@ def test_each_compiler_rule_example_triggers_its_own_code(code, tmp_path, monkey
     with its collision shapes removed."""
     import re
 
-    from aou_dsl.arms.load import scene_urdf
-    from aou_dsl.build import build_source
+    from aou_dsl.build.builder import build_source
+    from aou_dsl.robot.load import scene_urdf
 
     example = RULES[code].example
     for name in re.findall(r'robot "([^"]+)"', example):
@@ -104,7 +104,7 @@ def test_each_compiler_rule_example_triggers_its_own_code(code, tmp_path, monkey
 def test_each_reading_and_usage_rule_example_triggers_its_own_code(code, tmp_path, capsys,
                                                                     monkeypatch):
     """R and I examples are inputs or commands; running them reports that very code."""
-    from aou_dsl.cli import main
+    from aou_dsl.cli.commands import main
 
     example = RULES[code].example
     if example.startswith("aouc "):

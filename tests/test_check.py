@@ -6,11 +6,11 @@ import json
 import numpy as np
 import pytest
 
-from aou_dsl.cli import EXIT_ERRORS, EXIT_OK, main
-from aou_dsl.kinematics import load_arm
+from aou_dsl.cli.commands import EXIT_ERRORS, EXIT_OK, main
+from aou_dsl.core.trajectory import Trajectory
+from aou_dsl.robot.load import load_arm
+from aou_dsl.robot.scene import Scene
 from aou_dsl.safety.replay import replay
-from aou_dsl.safety.scene import Scene
-from aou_dsl.trajectory import Trajectory
 
 from .conftest import BEHAVIOURS
 from .synth import Synth

@@ -6,8 +6,8 @@ import sys
 
 import pytest
 
-from aou_dsl.cli import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, main
-from aou_dsl.diagnostics import RULES
+from aou_dsl.cli.commands import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, main
+from aou_dsl.core.diagnostics import RULES
 
 from .conftest import BEHAVIOURS, INVALID
 
@@ -58,7 +58,7 @@ def test_mismatch_warning_names_inferred_point_and_pulling_primitives(capsys, tm
 
 
 def test_effort_line_contradicting_declared_state_warns(tmp_path):
-    from aou_dsl.linter import lint_file
+    from aou_dsl.lang.linter import lint_file
 
     f = tmp_path / "e.aou"
     f.write_text("behaviour e : fearful\neffort W=-1 T=-1 S=-1 F=1\n"
@@ -123,7 +123,7 @@ def test_every_rule_has_kebab_name_and_texts():
 def test_lint_imports_no_heavy_dependency():
     """`import aou_dsl`, `aouc --help` and the lint path stay clear of pinocchio, toppra, pybullet,
     matplotlib (and numpy): linting a folder in CI has to start fast."""
-    code = ("import sys, aou_dsl, aou_dsl.cli as c\n"
+    code = ("import sys, aou_dsl, aou_dsl.cli.commands as c\n"
             "try:\n    c.main(['--help'])\nexcept SystemExit:\n    pass\n"
             f"c.main(['lint', r'{BEHAVIOURS}'])\n"
             "heavy = {'pinocchio', 'toppra', 'pybullet', 'matplotlib', 'numpy'}\n"

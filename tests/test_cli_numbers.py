@@ -13,8 +13,8 @@ import math
 
 import pytest
 
-from aou_dsl.cli import main
-from aou_dsl.cli_args import build_parser
+from aou_dsl.cli.args import build_parser
+from aou_dsl.cli.commands import main
 
 BAD = ("0", "-1", "nan", "NaN", "inf", "-inf", "1e308", "-1e308", "99999999999999999999",
        "20000x20000", "", "1,2", "x")

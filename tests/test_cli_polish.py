@@ -14,9 +14,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from aou_dsl.cli import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, main
-from aou_dsl.diagnostics import AouError
-from aou_dsl.files import atomic, check_output, write_atomic
+from aou_dsl.cli.commands import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, main
+from aou_dsl.core.diagnostics import AouError
+from aou_dsl.core.files import atomic, check_output, write_atomic
 
 from .conftest import BEHAVIOURS
 
@@ -153,7 +153,7 @@ def test_a_robot_given_on_the_command_line_is_pointed_at_there(tmp_path, capsys)
 
 
 def test_a_built_in_robot_is_named_not_its_installed_urdf():
-    from aou_dsl.arms import robot_diagnostics
+    from aou_dsl.robot import robot_diagnostics
 
     (d,) = robot_diagnostics("ur5")
     assert d.code == "C313" and d.span.path == "<robot ur5>"

@@ -9,7 +9,7 @@ import tomllib
 
 import pytest
 
-from aou_dsl.cli import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, main
+from aou_dsl.cli.commands import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, main
 
 from .conftest import BEHAVIOURS
 
@@ -101,7 +101,7 @@ def test_a_variant_that_would_not_lint_is_said_at_the_statement_of_the_base(tmp_
 def test_an_error_pickles_whole_so_a_worker_can_send_it():
     import pickle
 
-    from aou_dsl.diagnostics import AouError, Span, diag
+    from aou_dsl.core.diagnostics import AouError, Span, diag
 
     err = AouError([diag("R406", "a peak the joints cannot make", Span.whole_file("a.json")),
                     diag("I501", "cannot read `b`", Span.whole_file("b"))])
@@ -113,8 +113,8 @@ def test_an_error_pickles_whole_so_a_worker_can_send_it():
 def test_a_file_whose_measurement_fails_fails_alone(tmp_path, capsys, monkeypatch):
     """When measure refuses to report on one file's motion, that file fails with measure's
     diagnostic and nothing written for it; the files after it are still built."""
-    import aou_dsl.measuring.descriptors as descriptors
-    from aou_dsl.diagnostics import AouError, Span, diag
+    import aou_dsl.measuring.measured as descriptors
+    from aou_dsl.core.diagnostics import AouError, Span, diag
 
     real = descriptors.measure
 

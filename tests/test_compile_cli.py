@@ -7,7 +7,7 @@ import shutil
 import numpy as np
 import pytest
 
-from aou_dsl.cli import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, main
+from aou_dsl.cli.commands import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, main
 
 from .conftest import BEHAVIOURS
 

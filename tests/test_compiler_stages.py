@@ -7,16 +7,16 @@ import math
 import numpy as np
 import pytest
 
-from aou_dsl.compiler.geometry import reach_frame, rotation_angles
-from aou_dsl.compiler.ik import IKStatus, solve_path
 from aou_dsl.compiler.output import encode, output_paths
 from aou_dsl.compiler.pipeline import _clock, compile_behaviour
 from aou_dsl.compiler.timing import TimeLaw, limit_ratios, time_path
-from aou_dsl.diagnostics import AouError
-from aou_dsl.files import write_atomic
-from aou_dsl.kinematics import load_arm
-from aou_dsl.linter import lint_source
-from aou_dsl.timeline import Pose
+from aou_dsl.core.diagnostics import AouError
+from aou_dsl.core.files import write_atomic
+from aou_dsl.lang.linter import lint_source
+from aou_dsl.lang.timeline import Pose
+from aou_dsl.robot.geometry import reach_frame, rotation_angles
+from aou_dsl.robot.ik import IKStatus, solve_path
+from aou_dsl.robot.load import load_arm
 
 GOAL = (0.55, 0.0, 0.25)
 FROM = (-0.6, 0.0, 0.8)

@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from aou_dsl.cv import (
+from aou_dsl.lang.cv import (
     CANONICAL,
     CANONICAL_EFFORT,
     Composition,
@@ -16,8 +16,8 @@ from aou_dsl.cv import (
     effort_to_cv,
     infer,
 )
-from aou_dsl.ir import State
-from aou_dsl.linter import lint_file
+from aou_dsl.lang.ir import State
+from aou_dsl.lang.linter import lint_file
 
 from .conftest import BEHAVIOURS
 
@@ -107,8 +107,8 @@ def test_adding_vigilance_primitives_never_lowers_vigilance(c, pauses, explore, 
 def test_composition_of_a_sequence_reads_what_the_episodes_do():
     """Pause time and retreat distance add up; gazes count their angle from the line of
     sight; a negative approach moves away from the goal and counts as a retreat."""
-    from aou_dsl.layout import episode_values
-    from aou_dsl.linter import load_validated
+    from aou_dsl.lang.layout import episode_values
+    from aou_dsl.lang.linter import load_validated
 
     v = load_validated("sequence {\n pause 1s x2\n retreat 2cm\n pause 1.5s\n retreat 3cm\n"
                        " pause 1s\n gaze horizontal 20deg\n gaze horizontal -20deg\n"
@@ -122,7 +122,7 @@ def test_composition_of_a_sequence_reads_what_the_episodes_do():
 def test_a_negative_approach_is_not_confident():
     """`sequence { approach -0.8m }` moves away from the goal: it cannot read as
     confident (the model classifies motion by what it does)."""
-    from aou_dsl.linter import lint_source
+    from aou_dsl.lang.linter import lint_source
 
     r = lint_source("start 0.15m\nsequence { approach -0.5m }")
     assert r.ok and r.cv is not None

@@ -12,10 +12,10 @@ import pytest
 pytest.importorskip("movement_primitives")
 
 import aou_dsl  # noqa: E402
-from aou_dsl.descriptors import REGISTRY  # noqa: E402
-from aou_dsl.diagnostics import AouError  # noqa: E402
-from aou_dsl.dmp import read_dmp, solve, to_dmp, write_dmp  # noqa: E402
-from aou_dsl.kinematics import load_arm  # noqa: E402
+from aou_dsl.core.diagnostics import AouError
+from aou_dsl.dmp import read_dmp, solve, to_dmp, write_dmp
+from aou_dsl.lang.descriptors import REGISTRY
+from aou_dsl.robot.load import load_arm
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -52,7 +52,7 @@ def test_same_goal_and_tempo_reproduces_the_compiled_motion(name, robot):
     """Rolled out at its own goal and tempo, a shipped behaviour's hand stays within 1 mm
     and 0.5 deg of the compiled trajectory, passes the safety checks, and measures every
     descriptor as the compiled trajectory does, within the descriptor's tolerance."""
-    from aou_dsl.descriptors import compare
+    from aou_dsl.lang.descriptors import compare
 
     build = aou_dsl.compile(f"behaviours/{name}.aou", robot=robot)
     assert build.ok
@@ -73,7 +73,7 @@ def test_moved_goal_and_time_scale_follow_the_scaling_rules(hesitant, name, move
     one, within its tolerance (pauses K times as long, accelerations s / K^2 times as
     high, distances s times, angles and counts kept), and the motion passes the safety
     checks; or it is refused with a code naming the limit (D603, D604)."""
-    from aou_dsl.descriptors import compare
+    from aou_dsl.lang.descriptors import compare
 
     build, seq = hesitant
     if name != "hesitant":
@@ -147,7 +147,7 @@ def test_cli_compile_then_roll(tmp_path, capsys):
     """`aouc compile --format dmp` writes the folder (a second compile replaces it, never
     writes inside it); `aouc dmp roll` rolls it to a new goal and writes a trajectory that
     `aouc measure` reads."""
-    from aou_dsl.cli import main
+    from aou_dsl.cli.commands import main
 
     out = tmp_path / "c.dmp"
     assert main(["compile", "behaviours/confident.aou", "-o", str(out)]) == 0
@@ -184,7 +184,7 @@ def test_intensity_changed_while_running_keeps_the_motion_continuous(hesitant):
     change is the one already running, the later pauses are 1.5x longer, and the joint
     accelerations change by no more from sample to sample than they do without a
     change (continuous q, qd, qdd)."""
-    from aou_dsl.diagnostics import Span
+    from aou_dsl.core.diagnostics import Span
     from aou_dsl.dmp.live import change_intensity
     from aou_dsl.dmp.rollout import roll
     from aou_dsl.dmp.solve import to_trajectory
@@ -211,8 +211,8 @@ def test_each_rollout_rule_example_triggers_its_own_code(code, tmp_path, capsys,
     compiled to a .dmp folder, each reports that very code and exits 1."""
     import shlex
 
-    from aou_dsl.cli import main
-    from aou_dsl.diagnostics import RULES
+    from aou_dsl.cli.commands import main
+    from aou_dsl.core.diagnostics import RULES
 
     argv = shlex.split(RULES[code].example.split("#")[0])[1:]
     name = argv[2].removesuffix(".dmp")
@@ -228,8 +228,8 @@ def test_bad_dmp_rule_example_triggers_its_own_code(tmp_path, capsys):
     """D602's example, a manifest of another format, is refused with D602 (exit 1)."""
     import json as _json
 
-    from aou_dsl.cli import main
-    from aou_dsl.diagnostics import RULES
+    from aou_dsl.cli.commands import main
+    from aou_dsl.core.diagnostics import RULES
 
     where, text = RULES["D602"].example.split(": ", 1)
     (tmp_path / where).parent.mkdir()
@@ -252,7 +252,7 @@ def test_without_the_extra_the_command_names_it(tmp_path, capsys, monkeypatch):
     install (exit 2) and writes nothing."""
     import sys
 
-    from aou_dsl.cli import main
+    from aou_dsl.cli.commands import main
 
     for name in ("movement_primitives", "movement_primitives.dmp", "movement_primitives.io",
                  "pytransform3d", "pytransform3d.rotations"):

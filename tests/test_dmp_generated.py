@@ -15,10 +15,10 @@ import pytest
 
 pytest.importorskip("movement_primitives")
 
-from aou_dsl.build import build_source  # noqa: E402
-from aou_dsl.descriptors import compare  # noqa: E402
-from aou_dsl.dmp import solve, to_dmp  # noqa: E402
-from aou_dsl.kinematics import load_arm  # noqa: E402
+from aou_dsl.build.builder import build_source
+from aou_dsl.dmp import solve, to_dmp
+from aou_dsl.lang.descriptors import compare
+from aou_dsl.robot.load import load_arm
 
 from .langgen import random_cases  # noqa: E402
 

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from aou_dsl.diagnostics import Severity
-from aou_dsl.linter import lint_file
+from aou_dsl.core.diagnostics import Severity
+from aou_dsl.lang.linter import lint_file
 
 from .conftest import BEHAVIOURS, INVALID, VALID
 

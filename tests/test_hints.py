@@ -9,11 +9,11 @@ import re
 import numpy as np
 import pytest
 
-from aou_dsl.build import build_source
+from aou_dsl.build.builder import build_source
 from aou_dsl.compiler.fits import floor_sig, largest_fitting, times
 from aou_dsl.compiler.oscillation import shiver_offset, shiver_ratios
-from aou_dsl.kinematics import load_arm
-from aou_dsl.linter import lint_source
+from aou_dsl.lang.linter import lint_source
+from aou_dsl.robot.load import load_arm
 
 
 def _lint(text: str):
@@ -130,7 +130,7 @@ def test_shiver_peaks_follow_the_motion_itself():
     tau = np.linspace(0.0, duration, 400_001)
     _, xd, xdd, _ = shiver_offset(tau, amp, f, duration)
     jerk = np.abs(np.diff(xdd)) / (tau[1] - tau[0])
-    from aou_dsl.compiler.peaks import JERK_SCALE
+    from aou_dsl.compiler.peak_limits import JERK_SCALE
 
     expected = (np.abs(xd).max() / arm.plan_vmax[j], np.abs(xdd).max() / arm.plan_amax[j],
                 jerk.max() / (arm.jmax[j] * JERK_SCALE))

@@ -15,12 +15,12 @@ import zipfile
 import numpy as np
 import pytest
 
-from aou_dsl.cli import EXIT_OK, EXIT_USAGE, main
-from aou_dsl.diagnostics import AouError, has_errors
-from aou_dsl.kinematics import load_arm
-from aou_dsl.linter import lint_file, lint_source
+from aou_dsl.cli.commands import EXIT_OK, EXIT_USAGE, main
+from aou_dsl.core.diagnostics import AouError, has_errors
+from aou_dsl.lang.linter import lint_file, lint_source
+from aou_dsl.lang.parse import parse
 from aou_dsl.measuring.recording import read_recording
-from aou_dsl.parse import parse
+from aou_dsl.robot.load import load_arm
 
 from .conftest import BEHAVIOURS, ROOT
 
@@ -87,7 +87,7 @@ def test_commands_read_a_file_with_a_byte_order_mark(tmp_path, capsys):
     path.write_bytes(b"\xef\xbb\xbfapproach a=0.1\npause 1s\n")
     for argv in (["lint", str(path)], ["explain", str(path)]):
         assert main(argv) == EXIT_OK, capsys.readouterr().err
-    from aou_dsl.build import build_file
+    from aou_dsl.build.builder import build_file
 
     marked = build_file(str(path), check=False)
     plain = tmp_path / "plain.aou"
@@ -113,7 +113,7 @@ def test_a_robot_file_with_a_byte_order_mark_loads_and_points_at_its_lines(tmp_p
     path.write_text(text, encoding="utf-8-sig")
     arm, named = load_arm(str(path)), load_arm("panda")
     assert np.array_equal(arm.vmax, named.vmax) and np.array_equal(arm.lower, named.lower)
-    from aou_dsl.arms.description import read_description
+    from aou_dsl.robot.description import read_description
 
     bad = tmp_path / "bad.toml"
     bad.write_text('robot = "panda"\nstart_direction = [-0.6, 0.0, 0.8]\n',
@@ -354,7 +354,7 @@ def test_a_vector_without_parentheses_says_how_to_write_one():
 
 def test_linting_slips_stays_light():
     """The hints need no heavy import: linting every slip above loads no numpy."""
-    code = ("import sys\nfrom aou_dsl.linter import lint_source\n"
+    code = ("import sys\nfrom aou_dsl.lang.linter import lint_source\n"
             "for t in ['pause 1,5s', 'tilt 20°', 'pause 1.25sec', 'shiver 1deg for=1s',\n"
             "          'pause 1.25 s', 'goal 0.5, 0, 0.3', 'approach v=0.2mps']:\n"
             "    lint_source(t)\n"

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from aou_dsl.cli import EXIT_USAGE
+from aou_dsl.cli.commands import EXIT_USAGE
 
 from .conftest import BEHAVIOURS, ROOT
 

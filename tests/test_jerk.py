@@ -11,13 +11,13 @@ import math
 import numpy as np
 import pytest
 
-from aou_dsl.build import build_source
+from aou_dsl.build.builder import build_source
 from aou_dsl.compiler.pipeline import evaluate, sample
 from aou_dsl.compiler.timelaw import SmoothLaw, TimeLaw
-from aou_dsl.controllers import controller_checks
-from aou_dsl.descriptors import REGISTRY
-from aou_dsl.kinematics import load_arm
-from aou_dsl.trajectory import Trajectory
+from aou_dsl.core.trajectory import Trajectory
+from aou_dsl.lang.descriptors import REGISTRY
+from aou_dsl.robot.load import load_arm
+from aou_dsl.safety.controllers import controller_checks
 
 from .conftest import BEHAVIOURS
 
@@ -164,10 +164,10 @@ def test_c304_says_when_the_speed_cap_is_what_binds():
     """With v / a shorter than the jerk ramp, the acceleration cannot build up before the
     speed cap ends it: the failure names the speed cap, not a joint, and the law's peak
     is below the declared acceleration."""
-    from aou_dsl.compiler.geometry import reach_frame
-    from aou_dsl.compiler.ik import solve_path
     from aou_dsl.compiler.timing import time_path
-    from aou_dsl.timeline import Pose
+    from aou_dsl.lang.timeline import Pose
+    from aou_dsl.robot.geometry import reach_frame
+    from aou_dsl.robot.ik import solve_path
 
     arm = load_arm("panda")
     frame = reach_frame((0.55, 0.0, 0.25), (-0.6, 0.0, 0.8))
@@ -239,7 +239,7 @@ def test_the_franka_controller_applies_its_published_limits():
 def test_a_controller_refuses_a_robot_it_does_not_drive():
     """The Franka controller does not drive a UR5, nor the UR one a Panda; an unknown
     controller is a diagnostic, not an exception of another kind."""
-    from aou_dsl.diagnostics import AouError
+    from aou_dsl.core.diagnostics import AouError
 
     ur5 = _build(FILES["ur5"])
     assert [(c.name, c.ok) for c in controller_checks(ur5.compiled, "franka")] == [

@@ -13,9 +13,9 @@ import math
 
 import pytest
 
-from aou_dsl.build import build_source
-from aou_dsl.descriptors import REGISTRY
-from aou_dsl.linter import lint_source
+from aou_dsl.build.builder import build_source
+from aou_dsl.lang.descriptors import REGISTRY
+from aou_dsl.lang.linter import lint_source
 
 CURIOUS = """behaviour curious : curious
 approach a=0.3

@@ -3,10 +3,10 @@ than the standoff, and realises the declared counts."""
 
 import pytest
 
-from aou_dsl.declared import declared, written
-from aou_dsl.descriptors import derive
-from aou_dsl.layout import episode_values, layout
-from aou_dsl.linter import load
+from aou_dsl.lang.declared import declared, written
+from aou_dsl.lang.descriptors import derive
+from aou_dsl.lang.layout import episode_values, layout
+from aou_dsl.lang.linter import load
 
 from .conftest import BEHAVIOURS
 

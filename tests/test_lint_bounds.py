@@ -16,9 +16,9 @@ import re
 
 import pytest
 
-from aou_dsl.build import build_source
-from aou_dsl.descriptors import compare
-from aou_dsl.linter import lint_source
+from aou_dsl.build.builder import build_source
+from aou_dsl.lang.descriptors import compare
+from aou_dsl.lang.linter import lint_source
 
 from . import langgen
 

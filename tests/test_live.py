@@ -1,4 +1,4 @@
-"""Live regulation (aou_dsl.live): hysteresis, the uncertainty mapping, and re-plans that
+"""Live regulation (aou_dsl.live.regulator): hysteresis, the uncertainty mapping, and re-plans that
 start at the arm's state with position, velocity and acceleration continuous.
 
 Continuity is checked with finite differences against explicit bounds: between samples
@@ -19,11 +19,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import aou_dsl
-from aou_dsl.cv import CANONICAL, classify
-from aou_dsl.diagnostics import AouError
-from aou_dsl.ir import State
-from aou_dsl.live import PATH, Hysteresis, Regulator, from_uncertainty
-from aou_dsl.live_splice import LEAD, transition
+from aou_dsl.core.diagnostics import AouError
+from aou_dsl.lang.cv import CANONICAL, classify
+from aou_dsl.lang.ir import State
+from aou_dsl.live.regulator import PATH, Hysteresis, Regulator, from_uncertainty
+from aou_dsl.live.splice import LEAD, transition
 
 from .conftest import ROOT
 

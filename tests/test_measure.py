@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from aou_dsl.descriptors import REGISTRY
-from aou_dsl.diagnostics import AouError
-from aou_dsl.measuring.descriptors import measure
+from aou_dsl.core.diagnostics import AouError
+from aou_dsl.core.trajectory import Trajectory as Recording
+from aou_dsl.lang.descriptors import REGISTRY
+from aou_dsl.measuring.measured import measure
 from aou_dsl.measuring.recording import read_csv, read_json, read_recording
-from aou_dsl.trajectory import Trajectory as Recording
 
 from .conftest import BEHAVIOURS
 from .synth import Synth
@@ -212,7 +212,7 @@ def test_csv_errors_name_row_and_column():
 def test_a_tilt_beside_a_shiver_is_a_tilt():
     """A rest-to-rest tilt right after a tremor, with no rest between, is told apart by
     its duration: the shiver's half periods are equal, the tilt lasts longer."""
-    from aou_dsl.build import build_source
+    from aou_dsl.build.builder import build_source
 
     res = build_source("tilt 5deg v=8deg/s x1\nshiver 2deg f=2Hz for 1.5s\n", "t.aou",
                        check=False)
@@ -299,7 +299,7 @@ def test_milliseconds_are_refused_unless_the_unit_is_given(tmp_path, synths):
 def test_files_written_by_aou_are_trusted_at_any_rate(tmp_path):
     """A trajectory compiled at 1 Hz has one sample a second: aou wrote it, so its clock
     is seconds."""
-    from aou_dsl.cli import main
+    from aou_dsl.cli.commands import main
 
     out = tmp_path / "slow.json"
     assert main(["compile", str(BEHAVIOURS / "inactive.aou"), "-o", str(out),
@@ -329,7 +329,7 @@ def test_a_json_without_goal_takes_the_goal_given(tmp_path, synths):
 def test_goal_final_is_the_hands_last_position(tmp_path, synths):
     import pinocchio as pin
 
-    from aou_dsl.kinematics import load_arm
+    from aou_dsl.robot.load import load_arm
 
     rec = synths["hesitant"].recording()
     path = tmp_path / "r.json"
@@ -345,7 +345,7 @@ def test_goal_final_is_the_hands_last_position(tmp_path, synths):
 
 
 def test_npz_written_by_aou_reads_back(tmp_path):
-    from aou_dsl.build import build_source
+    from aou_dsl.build.builder import build_source
     from aou_dsl.compiler.output import encode
 
     res = build_source((BEHAVIOURS / "fearful.aou").read_text(), "fearful.aou", check=False)
@@ -425,7 +425,7 @@ def test_joint_noise_is_reported(synths):
 
 
 def _built(text: str):
-    from aou_dsl.build import build_source
+    from aou_dsl.build.builder import build_source
 
     res = build_source(text, "t.aou", check=False)
     assert res.ok, [(d.code, d.message) for d in res.diagnostics]
@@ -445,7 +445,7 @@ def test_rolls_measure_as_declared(text):
     """Tilts and shivers are told apart by their speed profile and frequency: slow
     alternating tilts stay tilts, a tremor between two tilts does not take them in, a
     7 Hz shiver is seen, a 200 deg tilt reads 200, a slow tilt holds no pause."""
-    from aou_dsl.descriptors import compare
+    from aou_dsl.lang.descriptors import compare
 
     res = _built(text)
     assert compare(res.declared, res.measured.descriptors) == []
@@ -504,8 +504,8 @@ def test_plot_of_a_recording_shades_its_measured_episodes(synths):
 def test_an_acceleration_the_joints_cannot_produce_is_an_error(synths):
     """The measured peak is checked against J qdd + Jdot qd from the same joints: a peak
     they cannot produce is R406, never a reported value."""
-    from aou_dsl.measuring import descriptors as D
     from aou_dsl.measuring import episodes as E
+    from aou_dsl.measuring import measured as D
 
     ctx, bounds, _, _ = D._context(synths["hesitant"].recording())
     piece = next(p for p in E.pieces(ctx, bounds) if isinstance(p, E.Piece))

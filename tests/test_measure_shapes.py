@@ -19,11 +19,11 @@ import math
 import numpy as np
 import pytest
 
-from aou_dsl.build import build_source
-from aou_dsl.kinematics import load_arm
-from aou_dsl.measuring.descriptors import measure
-from aou_dsl.measuring.fk import batch_fk, classical_acceleration
-from aou_dsl.trajectory import Trajectory
+from aou_dsl.build.builder import build_source
+from aou_dsl.core.trajectory import Trajectory
+from aou_dsl.measuring.measured import measure
+from aou_dsl.robot.batch_fk import batch_fk, classical_acceleration
+from aou_dsl.robot.load import load_arm
 
 from .conftest import BEHAVIOURS
 from .synth import Synth

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 import aou_dsl
-from aou_dsl.build import build_file
-from aou_dsl.cli import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, main
-from aou_dsl.kinematics import load_arm
-from aou_dsl.linter import lint_file
+from aou_dsl.build.builder import build_file
+from aou_dsl.cli.commands import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, main
+from aou_dsl.lang.linter import lint_file
+from aou_dsl.robot.load import load_arm
 
 from .conftest import BEHAVIOURS
 
@@ -118,8 +118,10 @@ def test_a_frame_is_pybullets_own_picture_of_the_whole_scene():
     them by depth: each frame is, pixel for pixel, the image PyBullet draws of everything
     together, at the start, with the hand at its nearest to the target, and with the
     hand pushed through the table (which must hide it)."""
+    from aou_dsl.core.options import SceneOptions
+
     from aou_dsl.media.render import Camera, _Clip, _pedestal, _stage, render_configurations
-    from aou_dsl.safety.scene import Scene, SceneOptions
+    from aou_dsl.robot.scene import Scene
 
     tr = build_file(str(BEHAVIOURS / "hesitant.aou"), check=False).trajectory
     clip, cam, opts = _Clip.of(tr, 30.0), Camera(width=160, height=120), SceneOptions()
@@ -194,7 +196,7 @@ def test_variant_errors(tmp_path, vary, code):
 
 def test_compile_and_measure_never_import_matplotlib_or_video_libraries(tmp_path):
     src, out = BEHAVIOURS / "confident.aou", tmp_path / "c.json"
-    code = ("import sys\nfrom aou_dsl.cli import main\n"
+    code = ("import sys\nfrom aou_dsl.cli.commands import main\n"
             f"main(['compile', r'{src}', '-o', r'{out}'])\n"
             f"main(['measure', r'{out}'])\n"
             "print(sorted({'matplotlib', 'imageio', 'PIL'} & set(sys.modules)))")

@@ -11,10 +11,10 @@ import tomllib
 import numpy as np
 import pytest
 
-from aou_dsl.cli import EXIT_ERRORS, EXIT_OK, main
-from aou_dsl.kinematics import load_arm
-from aou_dsl.measuring.descriptors import measure
+from aou_dsl.cli.commands import EXIT_ERRORS, EXIT_OK, main
+from aou_dsl.measuring.measured import measure
 from aou_dsl.measuring.recording import read_recording
+from aou_dsl.robot.load import load_arm
 
 from .conftest import fails_with
 from .synth import Synth
@@ -202,7 +202,7 @@ def _same_limits(a, b):
 @pytest.mark.parametrize("robot", ["panda", "ur5"])
 def test_the_printed_robot_file_loads_the_same_limits_jerk_included(robot, tmp_path,
                                                                      capsys):
-    from aou_dsl.arms import robot_diagnostics
+    from aou_dsl.robot import robot_diagnostics
 
     path = _printed(capsys, robot, tmp_path, f"{robot}.toml")
     text = open(path).read()
@@ -223,7 +223,7 @@ def test_the_printed_robot_file_loads_the_same_limits_jerk_included(robot, tmp_p
 
 
 def _reader_keys() -> set[str]:
-    from aou_dsl.arms.description import KEYS
+    from aou_dsl.robot.description import KEYS
 
     return set(KEYS)
 
@@ -245,7 +245,7 @@ def test_a_description_prints_back_to_itself(tmp_path, capsys):
 
 
 def test_a_urdf_s_printed_file_keeps_its_unsourced_limits_flagged(tmp_path, capsys):
-    from aou_dsl.arms import robot_diagnostics
+    from aou_dsl.robot import robot_diagnostics
 
     from .test_robots import small_arm
 
@@ -259,7 +259,7 @@ def test_a_urdf_s_printed_file_keeps_its_unsourced_limits_flagged(tmp_path, caps
 
 
 def test_the_spec_names_aouc_robot_shows_are_pointed_to_the_file_s_names(tmp_path):
-    from aou_dsl.arms.description import read_description
+    from aou_dsl.robot.description import read_description
 
     bad = tmp_path / "b.toml"
     bad.write_text('robot = "panda"\nstart_direction = [-0.6, 0.0, 0.8]\n')
@@ -273,7 +273,7 @@ def test_the_spec_names_aouc_robot_shows_are_pointed_to_the_file_s_names(tmp_pat
 def aou_csv(tmp_path_factory):
     """A CSV written by `aouc compile` (comment lines say aou wrote it), and the same
     file with its joint columns turned into degrees, as a spreadsheet edit would."""
-    from aou_dsl.build import build_source
+    from aou_dsl.build.builder import build_source
     from aou_dsl.compiler.output import encode
 
     res = build_source("approach a=0.1\npause 1s x2\nretreat 0.05m a=0.1\n", "b.aou",

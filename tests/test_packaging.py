@@ -17,4 +17,4 @@ def test_wheel_contains_grammar_and_console_script(tmp_path):
     names = zipfile.ZipFile(wheel).namelist()
     assert "aou_dsl/grammar/aou.lark" in names
     entry = next(n for n in names if n.endswith("entry_points.txt"))
-    assert "aouc = aou_dsl.cli:main" in zipfile.ZipFile(wheel).read(entry).decode()
+    assert "aouc = aou_dsl.cli.commands:main" in zipfile.ZipFile(wheel).read(entry).decode()

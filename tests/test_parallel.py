@@ -3,9 +3,9 @@ input, exactly what building it alone gives, in the order of the inputs."""
 
 import pytest
 
-from aou_dsl.build import build_file
+from aou_dsl.build.builder import build_file
+from aou_dsl.build.parallel import BuildPool, build_many, encoded, write_result
 from aou_dsl.compiler.output import encode
-from aou_dsl.parallel import BuildPool, build_many, encoded, write_result
 
 from .conftest import BEHAVIOURS, INVALID
 

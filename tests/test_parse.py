@@ -2,8 +2,8 @@
 
 import pytest
 
-from aou_dsl.diagnostics import AouError
-from aou_dsl.parse import (
+from aou_dsl.core.diagnostics import AouError
+from aou_dsl.lang.parse import (
     KeyVal,
     Quantity,
     SequenceBlock,

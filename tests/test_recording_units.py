@@ -14,11 +14,11 @@ import json
 import numpy as np
 import pytest
 
-from aou_dsl.cli import EXIT_ERRORS, main
-from aou_dsl.kinematics import load_arm
-from aou_dsl.measuring.descriptors import measure
+from aou_dsl.cli.commands import EXIT_ERRORS, main
+from aou_dsl.measuring.measured import measure
 from aou_dsl.measuring.plausible import FASTEST
 from aou_dsl.measuring.recording import read_recording
+from aou_dsl.robot.load import load_arm
 
 from .conftest import BEHAVIOURS, fails_with
 from .recsim import PRESETS, record, to_csv_text, to_json_doc
@@ -30,7 +30,7 @@ COUNTS = ("pause_count", "retreat_count")
 def hesitant():
     """The slowest shipped behaviour (its joints stay near a tenth of their limits): the
     hardest to tell from a slow arm. Its compiled document and declared descriptors."""
-    from aou_dsl.build import build_source
+    from aou_dsl.build.builder import build_source
 
     res = build_source((BEHAVIOURS / "hesitant.aou").read_text(), "hesitant.aou",
                        check=False)

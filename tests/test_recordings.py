@@ -5,7 +5,7 @@ tests/recsim.py) and logged the way real loggers do: jittered and dropped timest
 per-joint encoder noise, rounded positions, extra and shuffled columns, wrapped
 continuous joints, a log that starts mid-motion. The log is written as a file, read back
 with ``read_recording`` and measured. The expected values are what the file declares
-(``aou_dsl.declared``), never what measure says of the compiled trajectory.
+(``aou_dsl.lang.declared``), never what measure says of the compiled trajectory.
 
 Tolerances for recordings (noise up to 1.5e-4 rad, 100 Hz to 1 kHz): counts exactly,
 pause durations within 50 ms, distances within 2 mm, angles within 0.5 deg, tilt
@@ -28,8 +28,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from aou_dsl.descriptors import REGISTRY, Descriptors
-from aou_dsl.measuring.descriptors import Measured, measure
+from aou_dsl.lang.descriptors import REGISTRY, Descriptors
+from aou_dsl.measuring.measured import Measured, measure
 from aou_dsl.measuring.recording import read_recording
 
 from .conftest import BEHAVIOURS
@@ -61,7 +61,7 @@ def build(text: str, name: str = "gen"):
     """The compiled document and declared descriptors of a behaviour that compiles and
     measures as declared on its own output; None otherwise (a compiler's problem, not
     this test's)."""
-    from aou_dsl.build import build_source
+    from aou_dsl.build.builder import build_source
 
     res = build_source(text, f"{name}.aou", check=False)
     if not res.ok or res.measured is None or res.declared is None:
@@ -202,7 +202,7 @@ def test_six_decimals_at_250_hz_read_accelerations_within_3_percent(shipped, nam
     doc, want, _, signal = shipped(name)
     rec = record(doc, PRESETS["csv_6_decimals_250hz"], signal=signal)
     names = rec["joint_names"]
-    from aou_dsl.trajectory import Trajectory
+    from aou_dsl.core.trajectory import Trajectory
 
     m = measure(Trajectory(rec["t"], rec["q"], tuple(names), rec["robot"], None,
                            tuple(rec["goal"]["position"])))

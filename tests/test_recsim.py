@@ -235,7 +235,7 @@ def test_dynamic_replay_of_a_short_motion(doc):
 
 @pytest.fixture(scope="module")
 def hesitant(tmp_path_factory) -> dict:
-    from aou_dsl.cli import main
+    from aou_dsl.cli.commands import main
 
     out = tmp_path_factory.mktemp("recsim") / "hesitant.json"
     assert main(["compile", str(BEHAVIOURS / "hesitant.aou"), "-o", str(out)]) == 0

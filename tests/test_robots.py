@@ -11,15 +11,14 @@ import sys
 import numpy as np
 import pytest
 
-from aou_dsl.arms.chain import arm_joints, ee_link
-from aou_dsl.arms.describe import describe_robot, robot_toml
-from aou_dsl.arms.description import read_description
-from aou_dsl.arms.load import load_robot, robot_diagnostics, scene_urdf
-from aou_dsl.arms.urdf import kinematic_xml, read_urdf, resolve_uri
-from aou_dsl.diagnostics import AouError
-from aou_dsl.kinematics import load_arm
-from aou_dsl.linter import lint_source
-from aou_dsl.robots import ROBOTS
+from aou_dsl.core.diagnostics import AouError
+from aou_dsl.core.robot_specs import ROBOTS
+from aou_dsl.lang.linter import lint_source
+from aou_dsl.robot.chain import arm_joints, ee_link
+from aou_dsl.robot.description import read_description
+from aou_dsl.robot.load import load_arm, load_robot, robot_diagnostics, scene_urdf
+from aou_dsl.robot.summary import describe_robot, robot_toml
+from aou_dsl.robot.urdf import kinematic_xml, read_urdf, resolve_uri
 
 from .conftest import BEHAVIOURS, ROOT
 
@@ -92,9 +91,9 @@ def test_builtin_arm_loads_without_meshes_and_its_table_fits_the_urdf(name):
     the URDF's chain, the posture lies within the limits, and the compiler's inverse
     kinematics reaches the default start pose (0.30 m from the default goal, looking at
     it) from the posture."""
-    from aou_dsl.compiler.geometry import reach_frame
-    from aou_dsl.compiler.ik import solve_path
-    from aou_dsl.timeline import Pose
+    from aou_dsl.lang.timeline import Pose
+    from aou_dsl.robot.geometry import reach_frame
+    from aou_dsl.robot.ik import solve_path
 
     arm = load_arm(name)
     spec = arm.spec
@@ -111,8 +110,8 @@ def test_builtin_arm_loads_without_meshes_and_its_table_fits_the_urdf(name):
 def test_derivations_agree_with_the_built_in_table(name):
     """The derivation rules, run on each built-in arm's URDF, find the table's shiver
     joint and (where the table names the URDF's own link) its forward axis."""
-    from aou_dsl.arms import derive
-    from aou_dsl.kinematics import frame_id
+    from aou_dsl.robot import derive
+    from aou_dsl.robot.kinematics import frame_id
 
     r = load_robot(name)
     spec = r.spec
@@ -286,7 +285,7 @@ def test_robot_setting_takes_a_quoted_path_from_the_file_s_folder(arm_file, tmp_
 # --- Compiling on a user's robot ---------------------------------------------------------
 
 def _build(tmp_path, behaviour: str, robot: str):
-    from aou_dsl.build import build_file
+    from aou_dsl.build.builder import build_file
 
     lines = (BEHAVIOURS / f"{behaviour}.aou").read_text().replace("robot panda\n", "")
     lines = lines.splitlines(keepends=True)
@@ -301,7 +300,7 @@ def test_a_copied_urdf_compiles_the_same_as_the_named_robot(tmp_path):
     """The Panda's package copied out of example-robot-data (its mesh paths still name
     the data package) and pinned like the built-in arm compiles the very same
     trajectory, and passes the checks with the copied meshes."""
-    from aou_dsl.build import build_file
+    from aou_dsl.build.builder import build_file
 
     pkg = _copy_package("panda_description", tmp_path)
     urdf = os.path.relpath(os.path.join(pkg, "urdf", "panda.urdf"), tmp_path)
@@ -342,8 +341,8 @@ def test_a_csv_recording_of_a_user_s_arm_measures_like_its_trajectory(kinova_cop
     user's arm measures the same descriptors as the trajectory itself, within each
     descriptor's tolerance (the CSV has no velocities, which place episode edges more
     exactly)."""
-    from aou_dsl.descriptors import REGISTRY
-    from aou_dsl.measuring.descriptors import measure
+    from aou_dsl.lang.descriptors import REGISTRY
+    from aou_dsl.measuring.measured import measure
     from aou_dsl.measuring.recording import read_recording
 
     dest, urdf = kinova_copy

@@ -4,8 +4,8 @@ and locations, never an exception."""
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from aou_dsl.diagnostics import RULES
-from aou_dsl.linter import lint_source
+from aou_dsl.core.diagnostics import RULES
+from aou_dsl.lang.linter import lint_source
 
 TOKENS = ["behaviour", "b", ":", "hesitant", "robot", "panda", "ur5", "goal", "from",
           "(", ")", ",", "0.5", "-1", "start", "standoff", "effort", "W=1", "T=-1",

@@ -8,8 +8,8 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from aou_dsl.build import build_file
-from aou_dsl.descriptors import compare as compare_descriptors
+from aou_dsl.build.builder import build_file
+from aou_dsl.lang.descriptors import compare as compare_descriptors
 
 from .conftest import BEHAVIOURS
 
@@ -93,7 +93,7 @@ def descriptor_behaviours(draw) -> str:
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(descriptor_behaviours())
 def test_generated_behaviours_measure_as_declared(tmp_path_factory, text):
-    from aou_dsl.linter import lint_source
+    from aou_dsl.lang.linter import lint_source
 
     lint = lint_source(text, "gen.aou")
     assume(lint.ok)
@@ -131,7 +131,7 @@ def sequence_behaviours(draw) -> str:
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(sequence_behaviours())
 def test_generated_sequences_measure_as_declared(tmp_path_factory, text):
-    from aou_dsl.linter import lint_source
+    from aou_dsl.lang.linter import lint_source
 
     assume(lint_source(text, "seq.aou").ok)
     path = tmp_path_factory.mktemp("seq") / "seq.aou"
@@ -189,7 +189,7 @@ TABLE_II = {
 def test_measuring_the_compiled_stimuli_gives_table_two(name):
     """The oracle is the paper's table itself, not the files: compile each shipped
     stimulus and measure it; the values are Table II's."""
-    from aou_dsl.descriptors import REGISTRY
+    from aou_dsl.lang.descriptors import REGISTRY
 
     res = build_file(str(BEHAVIOURS / f"{name}.aou"), check=False)
     measured = res.measured.descriptors
@@ -211,7 +211,7 @@ def test_generated_behaviours_pass_the_safety_checks(tmp_path_factory, text):
     """What the compiler makes of a valid file is safe to send: the PyBullet replay
     (limits, collisions, contact with the object and the table) passes, or the compiler
     says which limit it could not meet."""
-    from aou_dsl.linter import lint_source
+    from aou_dsl.lang.linter import lint_source
 
     assume(lint_source(text, "gen.aou").ok)
     path = tmp_path_factory.mktemp("safe") / "gen.aou"

@@ -22,12 +22,12 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from aou_dsl.kinematics import load_arm
+from aou_dsl.core.trajectory import Trajectory
+from aou_dsl.robot.load import load_arm
+from aou_dsl.robot.scene import Scene
 from aou_dsl.safety import replay as replay_module
 from aou_dsl.safety.replay import CLEARANCE_RATE, replay
-from aou_dsl.safety.scene import Scene
 from aou_dsl.safety.sweep import Sweep
-from aou_dsl.trajectory import Trajectory
 
 from .conftest import BEHAVIOURS
 
@@ -216,7 +216,7 @@ def test_the_vectorised_accelerations_are_pinocchios(robot):
 def test_a_turn_about_any_axis_is_rodrigues():
     from scipy.spatial.transform import Rotation
 
-    from aou_dsl.kinematics import rotate_columns as _rotate
+    from aou_dsl.robot.kinematics import rotate_columns as _rotate
 
     rng = np.random.default_rng(8)
     base = Rotation.random(50, random_state=1).as_matrix()  # (N, 3, 3)
@@ -234,7 +234,7 @@ def test_the_cartesian_peak_is_pinocchios_peak_over_every_instant():
     the peak is the one Pinocchio finds at every instant, bit for bit."""
     from aou_dsl.compiler.pipeline import compile_behaviour
     from aou_dsl.compiler.timing import PEAK_RATE, PathSegment, cartesian_peak
-    from aou_dsl.linter import lint_file
+    from aou_dsl.lang.linter import lint_file
 
     for name in ("hesitant", "confident"):
         lint = lint_file(str(BEHAVIOURS / f"{name}.aou"))
@@ -255,10 +255,10 @@ def test_the_joint_limit_bound_never_passes_a_segment_that_overshoots():
     segment the bound passes is within them at the check's instants."""
     from dataclasses import replace
 
-    from aou_dsl.compiler.peaks import limit_ratios, within_limits
+    from aou_dsl.compiler.peak_limits import limit_ratios, within_limits
     from aou_dsl.compiler.pipeline import compile_behaviour
     from aou_dsl.compiler.timing import PathSegment
-    from aou_dsl.linter import lint_file
+    from aou_dsl.lang.linter import lint_file
 
     passed = over = 0
     for path in sorted(BEHAVIOURS.glob("*.aou")):
@@ -306,9 +306,9 @@ def test_the_lean_toppra_gives_the_stock_law():
 
 
 def test_a_file_with_many_errors_keeps_a_hundred_and_counts_the_rest():
-    from aou_dsl.diagnostics import Severity
-    from aou_dsl.linter import MAX_DIAGNOSTICS, lint_source, severity_counts
-    from aou_dsl.report import format_suppressed
+    from aou_dsl.cli.report import format_suppressed
+    from aou_dsl.core.diagnostics import Severity
+    from aou_dsl.lang.linter import MAX_DIAGNOSTICS, lint_source, severity_counts
 
     # Every `pause` after the first is a duplicate primitive (an error of its own line).
     n = 3 * MAX_DIAGNOSTICS
@@ -326,8 +326,8 @@ def test_a_file_with_many_errors_keeps_a_hundred_and_counts_the_rest():
 
 def test_the_cap_keeps_errors_before_notes():
     """Notes early in a file do not push a later error out of the kept diagnostics."""
-    from aou_dsl.diagnostics import Severity, Span, diag
-    from aou_dsl.linter import MAX_DIAGNOSTICS, FileResult, _cap
+    from aou_dsl.core.diagnostics import Severity, Span, diag
+    from aou_dsl.lang.linter import MAX_DIAGNOSTICS, FileResult, _cap
 
     notes = [diag("M204", "a note", Span("f.aou", i + 1, 1, i + 1, 2))
              for i in range(MAX_DIAGNOSTICS + 5)]
@@ -340,7 +340,7 @@ def test_the_cap_keeps_errors_before_notes():
 
 
 def test_a_vector_spans_its_parentheses():
-    from aou_dsl.parse import parse
+    from aou_dsl.lang.parse import parse
 
     text = "goal (  0.5 ,0, 0.2 )  # there\n"
     (stmt,) = parse(text, "v.aou").items
@@ -381,15 +381,10 @@ def test_the_parser_tables_are_cached_and_a_cache_that_cannot_be_written_is_no_e
 def test_a_video_drawn_by_several_processes_is_the_one_drawn_by_one():
     """Frame for frame, side by side clips of different lengths included; held frames
     (drawn once) are the same image as drawing them again."""
-    from aou_dsl.build import build_file
-    from aou_dsl.media.render import (
-        Camera,
-        _Clip,
-        _Drawer,
-        _video_frames,
-        render_configurations,
-    )
-    from aou_dsl.safety.scene import SceneOptions
+    from aou_dsl.core.options import SceneOptions
+
+    from aou_dsl.build.builder import build_file
+    from aou_dsl.media.render import Camera, _Clip, _Drawer, _video_frames, render_configurations
 
     trs = [build_file(str(BEHAVIOURS / f"{n}.aou"), check=False).trajectory
            for n in ("confident", "inactive")]

@@ -1,4 +1,4 @@
-"""Synthesis (aou_dsl.synth): a state or a C-V point and an intensity -> a .aou file.
+"""Synthesis (aou_dsl.synth.synthesis): a state or a C-V point and an intensity -> a .aou file.
 
 The oracles are the model's tables, not the synthesizer's own numbers: the study's
 stimuli (behaviours/*.aou, read back through lint), the perceived directions and
@@ -15,13 +15,13 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import aou_dsl
-from aou_dsl.cv import CANONICAL, classify
-from aou_dsl.declared import written
-from aou_dsl.descriptors import REGISTRY
-from aou_dsl.diagnostics import AouError
-from aou_dsl.ir import State
-from aou_dsl.robots import ROBOTS
-from aou_dsl.synth import SPANS, STUDY_INTENSITY, blend_weights, compiled, synthesize
+from aou_dsl.core.diagnostics import AouError
+from aou_dsl.core.robot_specs import ROBOTS
+from aou_dsl.lang.cv import CANONICAL, classify
+from aou_dsl.lang.declared import written
+from aou_dsl.lang.descriptors import REGISTRY
+from aou_dsl.lang.ir import State
+from aou_dsl.synth.synthesis import SPANS, STUDY_INTENSITY, blend_weights, compiled, synthesize
 
 from .conftest import BEHAVIOURS
 

@@ -10,7 +10,7 @@ import zipfile
 import numpy as np
 import pytest
 
-from aou_dsl.diagnostics import AouError
+from aou_dsl.core.diagnostics import AouError
 from aou_dsl.measuring.recording import read_json, read_npz, read_recording
 
 T = [0.0, 0.1, 0.2, 0.3]

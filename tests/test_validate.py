@@ -5,9 +5,9 @@ import math
 
 import pytest
 
-from aou_dsl.ir import DEFAULTS, Effort, State
-from aou_dsl.linter import load
-from aou_dsl.robots import ROBOTS
+from aou_dsl.core.robot_specs import ROBOTS
+from aou_dsl.lang.ir import DEFAULTS, Effort, State
+from aou_dsl.lang.linter import load
 
 from .conftest import VALID
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import json
 
-from aou_dsl.diagnostics import Span, diag
-from aou_dsl.linter import lint_file
-from aou_dsl.report import EXCERPT, format_text
+from aou_dsl.cli.report import EXCERPT, format_text
+from aou_dsl.core.diagnostics import Span, diag
+from aou_dsl.lang.linter import lint_file
 
 
 def test_a_trajectory_given_to_lint_is_named_as_one(tmp_path):
@@ -45,7 +45,7 @@ def test_a_short_line_is_shown_whole():
 
 
 def test_a_quantity_of_the_wrong_kind_is_named_with_its_article():
-    from aou_dsl.linter import load
+    from aou_dsl.lang.linter import load
 
     _, diags = load("gaze horizontal 20m\npause 1s x2\napproach a=3deg\n", "t.aou")
     messages = " / ".join(d.message for d in diags)

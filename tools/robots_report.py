@@ -5,7 +5,7 @@ docs/robots.md (the part between the report markers; the rest of the page is pro
     python tools/robots_report.py --check    # exit 1 if the page differs from a new run
     python tools/robots_report.py --stdout   # print the report only
 
-Each behaviour goes through ``aou_dsl.build.build_file(path, robot=NAME)``: lint, compile,
+Each behaviour goes through ``aou_dsl.build.builder.build_file(path, robot=NAME)``: lint, compile,
 the safety replay, the measurement. Per arm and behaviour the report says whether it
 compiled, whether the checks passed, whether the measured descriptors equal the
 declared ones, and for what does not fit, the limit that binds and what the user can
@@ -66,8 +66,8 @@ def _advice(d, arm) -> tuple[str, str]:
 
 def _row(path: Path, robot: str) -> tuple[str, bool, list[str]]:
     """A table row for one behaviour on one arm, whether all is well, and notes."""
-    from aou_dsl.build import build_file
-    from aou_dsl.kinematics import load_arm
+    from aou_dsl.build.builder import build_file
+    from aou_dsl.robot.load import load_arm
 
     arm = load_arm(robot)
     res = build_file(str(path), robot=robot)
@@ -96,7 +96,7 @@ def _row(path: Path, robot: str) -> tuple[str, bool, list[str]]:
 
 
 def _arm_section(robot: str) -> tuple[list[str], int, list[str]]:
-    from aou_dsl.arms.load import load_robot
+    from aou_dsl.robot.load import load_robot
 
     r = load_robot(robot)
     spec = r.spec
@@ -121,7 +121,7 @@ def _arm_section(robot: str) -> tuple[list[str], int, list[str]]:
 
 def report() -> str:
     """The report: a summary table, then one section per arm."""
-    from aou_dsl.robots import ROBOTS
+    from aou_dsl.core.robot_specs import ROBOTS
 
     sections, summary = [], []
     all_pass = 0

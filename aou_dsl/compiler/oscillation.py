@@ -15,10 +15,10 @@ import math
 
 import numpy as np
 
-from ..kinematics import ArmModel
-from ..primitives import MIN_ANGLE, MIN_SHIVER_F
+from ..lang.primitives import MIN_ANGLE, MIN_SHIVER_F
+from ..robot.kinematics import ArmModel
 from .fits import TimingFailure, largest_fitting, times
-from .peaks import JERK_SCALE, LIMIT_SLACK
+from .peak_limits import JERK_SCALE, LIMIT_SLACK
 
 __all__ = ["JointSegment", "shiver_offset", "shiver_ratios", "shiver_segment"]
 

@@ -7,7 +7,7 @@ as YAML). Floats are written with Python's shortest round-trip representation (u
 significant digits). Nothing that varies between runs (times, paths, dates) is written,
 so the same input and versions give the same bytes. A file is written to a temporary
 name beside the target and renamed over it only when complete
-(:func:`aou_dsl.files.write_atomic`; a bag: a temporary folder, renamed): on any error no
+(:func:`aou_dsl.core.files.write_atomic`; a bag: a temporary folder, renamed): on any error no
 output appears and an existing file is untouched.
 """
 
@@ -20,9 +20,9 @@ import zipfile
 
 import numpy as np
 
-from .. import __version__
-from ..diagnostics import AouError, Span, diag
-from ..files import write_atomic
+from ..core.diagnostics import AouError, Span, diag
+from ..core.files import write_atomic
+from ..version import __version__
 from .ros import is_bag
 
 __all__ = ["FORMATS", "SAMPLE_KEYS", "document_header", "encode", "output_paths",

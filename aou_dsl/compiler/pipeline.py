@@ -15,15 +15,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..diagnostics import AouError, Diagnostic, diag, has_errors
-from ..ir import Behaviour
-from ..kinematics import ArmModel, load_arm
-from ..layout import layout
-from ..primitives import KINDS, MIN_SHIVER_F
-from ..timeline import Episode, Pose, Timeline
-from ..trajectory import Trajectory
-from .geometry import ReachFrame, reach_frame
-from .ik import IKStatus, solve_path
+from ..core.diagnostics import AouError, Diagnostic, diag, has_errors
+from ..core.trajectory import Trajectory
+from ..lang.ir import Behaviour
+from ..lang.layout import layout
+from ..lang.primitives import KINDS, MIN_SHIVER_F
+from ..lang.timeline import Episode, Pose, Timeline
+from ..robot.geometry import ReachFrame, reach_frame
+from ..robot.ik import IKStatus, solve_path
+from ..robot.kinematics import ArmModel
+from ..robot.load import load_arm
 from .start import CODES, start_diagnostic
 from .timing import (
     JointSegment,

@@ -25,8 +25,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .. import __version__
-from ..diagnostics import AouError, Span, diag
+from ..core.diagnostics import AouError, Span, diag
+from ..version import __version__
 
 __all__ = ["MSGTYPE", "TOPIC", "encode_yaml", "is_bag", "message", "read_bag", "write_bag"]
 

@@ -13,12 +13,12 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from ..diagnostics import Diagnostic, diag
-from ..ir import Behaviour
-from ..kinematics import ArmModel
-from ..timeline import Pose, Timeline
-from .geometry import ReachFrame
-from .ik import IKFailure, IKStatus, solve_path
+from ..core.diagnostics import Diagnostic, diag
+from ..lang.ir import Behaviour
+from ..lang.timeline import Pose, Timeline
+from ..robot.geometry import ReachFrame
+from ..robot.ik import IKFailure, IKStatus, solve_path
+from ..robot.kinematics import ArmModel
 
 __all__ = ["CODES", "start_diagnostic"]
 
@@ -57,8 +57,8 @@ def _reached(arm: ArmModel, frame: ReachFrame, cm: int) -> bool:
 def _valid(b: Behaviour, cm: int) -> Timeline | None:
     """The behaviour's timeline with its start ``cm`` centimetres from the goal, when the
     file would still be valid so (an approach may not pass the standoff)."""
-    from ..validate.reader import Ctx
-    from ..validate.whole import check_whole
+    from ..lang.values import Ctx
+    from ..lang.whole_file import check_whole
 
     moved = b.replace(settings=b.settings.replace(start=cm / 100))
     ctx = Ctx(b.span.path)

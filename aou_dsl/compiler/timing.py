@@ -5,7 +5,7 @@ line of sight for approach and retreat, radians of bearing for gaze, radians of 
 tilt) and starts and ends at rest, with zero acceleration.
 
 TOPP-RA parametrises approach, retreat and gaze time-optimally under the joint velocity
-limits (URDF, scaled) and joint acceleration limits (:mod:`aou_dsl.robots`). The
+limits (URDF, scaled) and joint acceleration limits (:mod:`aou_dsl.core.robot_specs`). The
 declared end-effector limits enter through a *virtual joint*: ``s`` itself is appended
 to the path as one more coordinate, with velocity limit ``v=`` and acceleration limit
 ``a=``. On a straight line the end-effector acceleration is ``s''``, so the time-optimal
@@ -29,10 +29,10 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..kinematics import ArmModel
+from ..robot.kinematics import ArmModel
 from .fits import TimingFailure, largest_fitting, times
 from .oscillation import JointSegment, shiver_ratios, shiver_segment
-from .peaks import (
+from .peak_limits import (
     JERK_SCALE,
     LIMIT_SLACK,
     PEAK_RATE,

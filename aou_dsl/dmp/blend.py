@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ..diagnostics import AouError, Span, diag
+from ..core.diagnostics import AouError, Span, diag
 from .export import MOVES, DmpSequence
 from .rollout import Rollout, roll
 from .solve import Solved
@@ -96,7 +96,7 @@ def change_goal(seq: DmpSequence, at: float, goal: tuple[float, float, float], *
 
 
 def _solve(seq: DmpSequence, ro: Rollout, where: Span, check: bool) -> Solved:
-    from ..measuring.descriptors import measure
+    from ..measuring.measured import measure
     from .solve import to_trajectory
 
     out = Solved(ro)

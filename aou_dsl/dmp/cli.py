@@ -14,10 +14,10 @@ __all__ = ["add_parser", "cmd_dmp", "rolled_document", "trajectory_of", "write_d
 
 
 def trajectory_of(doc: dict, path: str = "<document>") -> Any:
-    """The :class:`~aou_dsl.trajectory.Trajectory` of a trajectory document."""
+    """The :class:`~aou_dsl.core.trajectory.Trajectory` of a trajectory document."""
     import numpy as np
 
-    from ..trajectory import Trajectory
+    from ..core.trajectory import Trajectory
 
     arr = {k: np.asarray(doc[k], dtype=float) for k in ("t", "q", "qd", "qdd")}
     return Trajectory(arr["t"], arr["q"], tuple(doc["joint_names"]), doc["robot"],
@@ -41,7 +41,7 @@ def write_document(path: str, doc: dict, *, inputs: Any = ()) -> None:
 def rolled_document(seq: Any, solved: Any) -> dict:
     """The trajectory document (``aou-trajectory/1``) of a solved rollout; its
     ``descriptors.declared`` are what the scaling rules predict."""
-    from .. import __version__
+    from ..version import __version__
 
     tr, ro, m = solved.trajectory, solved.rollout, solved.measured
     return {
@@ -60,7 +60,7 @@ def rolled_document(seq: Any, solved: Any) -> dict:
 
 def add_parser(sub: Any) -> argparse.ArgumentParser:
     """The ``aouc dmp`` parser (``roll``)."""
-    from ..cli_args import number, point
+    from ..cli.args import number, point
 
     dmp = sub.add_parser("dmp", help="roll a behaviour's DMPs (--format dmp) out to a new "
                          "goal and tempo (needs the `dmp` extra; docs/dmp.md)")
@@ -86,11 +86,11 @@ def cmd_dmp(args: argparse.Namespace) -> int:
     """``aouc dmp roll``: 0 when the rollout passes, 1 when it is refused."""
     import os
 
-    from ..cli_args import EXIT_ERRORS, EXIT_OK
+    from ..cli.args import EXIT_ERRORS, EXIT_OK
+    from ..cli.report import format_text
     from ..compiler.output import encode
-    from ..files import write_atomic
-    from ..report import format_text
-    from ..synth_recipe import descriptor
+    from ..core.files import write_atomic
+    from ..synth.recipe import descriptor
     from .manifest import read_dmp
     from .solve import solve
 

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ..diagnostics import AouError, Span, diag
+from ..core.diagnostics import AouError, Span, diag
 
 __all__ = ["MOVES", "DmpPart", "DmpSequence", "to_dmp"]
 
@@ -119,7 +119,7 @@ def to_dmp(trajectory: Any, *, intensity: float = 0.5, behaviour: str | None = N
     """The DMP sequence of a compiled trajectory (see the module's docstring).
 
     Args:
-        trajectory: an :class:`aou_dsl.trajectory.Trajectory` with its episodes (a
+        trajectory: an :class:`aou_dsl.core.trajectory.Trajectory` with its episodes (a
             compiled one, or one read from a trajectory file ``aouc compile`` wrote).
         intensity: the intensity it expresses, in [0, 1] (the shipped and synthesized
             files at 0.5 are the study's stimuli).
@@ -129,8 +129,8 @@ def to_dmp(trajectory: Any, *, intensity: float = 0.5, behaviour: str | None = N
     Raises:
         AouError: D601 when the trajectory has no episodes or no goal (a recording).
     """
-    from ..kinematics import load_arm
-    from ..measuring.descriptors import measure
+    from ..measuring.measured import measure
+    from ..robot.load import load_arm
     from .fit import fit_pose_dmp, quaternions
 
     tr = trajectory

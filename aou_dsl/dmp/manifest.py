@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ..diagnostics import AouError, Span, diag
+from ..core.diagnostics import AouError, Span, diag
 from .export import MOVES, DmpPart, DmpSequence
 
 __all__ = ["FORMAT", "PARAMETERS", "manifest", "read_dmp", "write_dmp"]
@@ -67,7 +67,7 @@ def manifest(seq: DmpSequence) -> dict[str, Any]:
 
 
 def _parameters() -> dict[str, str]:
-    from ..synth_recipe import descriptor
+    from ..synth.recipe import descriptor
 
     return {descriptor(kind, key).name: text for (kind, key), text in PARAMETERS.items()}
 
@@ -132,7 +132,7 @@ def read_dmp(path: str) -> DmpSequence:
         AouError: I501 when the folder or its manifest cannot be read; D602 when they are
             not an ``aou-dmp/1`` sequence.
     """
-    from ..files import read_text
+    from ..core.files import read_text
 
     text = read_text(os.path.join(path, "manifest.json"), "the .dmp manifest")
     try:

@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from ..diagnostics import AouError, Span, diag
+from ..core.diagnostics import AouError, Span, diag
 from .export import DmpSequence
 
 __all__ = ["Rollout", "predict", "roll", "similarity"]
@@ -46,7 +46,7 @@ _WHERE = Span.whole_file("<dmp>")
 
 def _name(kind: str, key: str) -> str:
     """The descriptor read from ``kind`` episodes by ``key`` (the registry's name)."""
-    from ..synth_recipe import descriptor
+    from ..synth.recipe import descriptor
 
     return descriptor(kind, key).name
 
@@ -108,9 +108,9 @@ def similarity(start: np.ndarray, old: np.ndarray, new: np.ndarray
 
 def _factors(seq: DmpSequence, intensity: float | None) -> dict[str, float]:
     """Multipliers of the descriptors an intensity moves without a re-plan."""
-    from ..descriptors import REGISTRY
-    from ..ir import State
-    from ..synth import SPANS
+    from ..lang.descriptors import REGISTRY
+    from ..lang.ir import State
+    from ..synth.synthesis import SPANS
 
     if intensity is None or seq.state is None:
         return {}

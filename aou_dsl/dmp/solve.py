@@ -1,13 +1,13 @@
 """A rollout -> joint motion of the arm, checked and measured like a compiled trajectory.
 
 The hand's poses are solved by the compiler's inverse kinematics
-(:func:`aou_dsl.compiler.ik.solve_path`, gaze locked on the new goal since the poses
+(:func:`aou_dsl.robot.ik.solve_path`, gaze locked on the new goal since the poses
 are), warm-started from the sequence's start configuration. A hold repeats the joint
 configuration of its pose (a pause is all joints at rest); a shiver adds its offset to
 the shiver joint, as the compiler does. Velocities and accelerations are differentiated
 from the positions (the shiver's are analytic). Then the same safety replay as
 ``aouc compile`` (:func:`aou_dsl.safety.replay.replay`) and the same measurement
-(:func:`aou_dsl.measuring.descriptors.measure`); each descriptor is compared with the
+(:func:`aou_dsl.measuring.measured.measure`); each descriptor is compared with the
 scaling rule's prediction within the descriptor's tolerance.
 """
 
@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from ..diagnostics import AouError, Diagnostic, Span, diag, has_errors
+from ..core.diagnostics import AouError, Diagnostic, Span, diag, has_errors
 from .export import DmpSequence
 from .rollout import Rollout, roll
 
@@ -84,9 +84,9 @@ def to_trajectory(seq: DmpSequence, ro: Rollout, where: Span) -> Any:
     Raises:
         AouError: D603 when the inverse kinematics cannot follow the poses.
     """
-    from ..compiler.ik import solve_path
-    from ..kinematics import load_arm
-    from ..trajectory import Trajectory
+    from ..core.trajectory import Trajectory
+    from ..robot.ik import solve_path
+    from ..robot.load import load_arm
 
     arm = load_arm(seq.robot, seq.ee_frame)
     rot = _rot(ro.quat)
@@ -121,8 +121,8 @@ def solve(seq: DmpSequence, *, path: str = "<dmp>", check: bool = True,
     names the check, the joint and the limit), D605 (a descriptor is not what its
     scaling rule predicts).
     """
-    from ..descriptors import compare
-    from ..measuring.descriptors import measure
+    from ..lang.descriptors import compare
+    from ..measuring.measured import measure
 
     where = Span.whole_file(path)
     ro = roll(seq, **options)

@@ -14,7 +14,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
-from ..diagnostics import AouError, Span, diag
+from ..core.diagnostics import AouError, Span, diag
 
 __all__ = ["FORMAT", "Goal", "Header", "read_header"]
 

@@ -20,10 +20,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..descriptors import EpisodeValues
-from ..diagnostics import AouError, Span, diag
-from ..kinematics import ArmModel
-from .fk import classical_acceleration, linear_jacobian
+from ..core.diagnostics import AouError, Span, diag
+from ..lang.descriptors import EpisodeValues
+from ..robot.batch_fk import classical_acceleration, linear_jacobian
+from ..robot.kinematics import ArmModel
 from .holds import Boundary, Rest
 from .peaks import episode_peak, path_travel, phase_peak
 from .signal import curvature_gain, filter_at, odd, smooth

@@ -14,7 +14,7 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from ..diagnostics import Span
+from ..core.diagnostics import Span
 
 __all__ = ["Where", "json_position", "json_span"]
 

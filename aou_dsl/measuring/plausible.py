@@ -23,8 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from ..diagnostics import AouError, Span, diag
-from ..trajectory import Trajectory
+from ..core.diagnostics import AouError, Span, diag
+from ..core.trajectory import Trajectory
 from .locate import Where
 from .signal import joint_noise
 
@@ -52,7 +52,7 @@ def check_units(rec: Trajectory, angle_unit: str | None, time_unit: str | None,
     when none is given, for an angle unit that puts a joint outside its limits
     throughout, and for times that make the joints move far faster than they can.
     ``where``: where each sample is in its file (for the spans)."""
-    from ..kinematics import load_arm
+    from ..robot.load import load_arm
 
     where = where or Where(rec.path or "<recording>")
     for unit, table, what in ((angle_unit, ANGLE_UNITS, "angle"),

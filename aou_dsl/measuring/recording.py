@@ -1,5 +1,5 @@
 """Reading joint trajectories: aou's JSON, CSV and NPZ, or a recording of a real arm, as a
-:class:`~aou_dsl.trajectory.Trajectory`.
+:class:`~aou_dsl.core.trajectory.Trajectory`.
 
 What measuring needs is times, joint positions by joint name, the robot, its
 end-effector frame and the goal. The compiler's timeline and declared values are read
@@ -27,9 +27,9 @@ from typing import Any
 
 import numpy as np
 
-from ..diagnostics import AouError, Severity, Span, diag
-from ..files import decode, read_bytes
-from ..trajectory import Trajectory
+from ..core.diagnostics import AouError, Severity, Span, diag
+from ..core.files import decode, read_bytes
+from ..core.trajectory import Trajectory
 from .document import Header, read_header
 from .locate import Where, json_span
 from .plausible import ANGLE_UNITS, TIME_UNITS, check_units
@@ -327,8 +327,8 @@ def _format(path: str) -> tuple[str, bytes]:
 
 def final_goal(rec: Trajectory) -> tuple[float, float, float]:
     """The end-effector's position at the last sample: the goal of ``goal="final"``."""
-    from ..kinematics import load_arm
-    from .fk import batch_fk
+    from ..robot.batch_fk import batch_fk
+    from ..robot.load import load_arm
 
     arm = load_arm(rec.robot, rec.ee_frame)
     cols = rec.columns(arm.joint_names)

@@ -18,7 +18,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..descriptors import EpisodeValues
+from ..lang.descriptors import EpisodeValues
 from .episodes import Context, Piece
 
 __all__ = ["MIN_TILT", "SHAPED_CYCLE", "Lobe", "lobe", "roll_angle", "rotations"]

@@ -11,9 +11,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..cv import CANONICAL, CVPoint
-from ..diagnostics import Diagnostic, Span, diag
-from ..trajectory import Trajectory
+from ..core.diagnostics import Diagnostic, Span, diag
+from ..core.trajectory import Trajectory
+from ..lang.cv import CANONICAL, CVPoint
 
 __all__ = ["ProfileData", "cv_figure", "profile_data", "profile_figure", "save"]
 
@@ -66,11 +66,11 @@ def profile_data(rec: Trajectory) -> ProfileData:
     goal distance, and R405 (a warning) says so.
 
     Raises:
-        AouError: as :func:`aou_dsl.measuring.descriptors.measure` for a recording that
+        AouError: as :func:`aou_dsl.measuring.measured.measure` for a recording that
             cannot be measured.
     """
-    from ..kinematics import load_arm
-    from ..measuring.fk import batch_fk
+    from ..robot.batch_fk import batch_fk
+    from ..robot.load import load_arm
 
     arm = load_arm(rec.robot, rec.ee_frame)
     cols = rec.columns(arm.joint_names)
@@ -82,7 +82,7 @@ def profile_data(rec: Trajectory) -> ProfileData:
     episodes = rec.episodes
     extra: dict = {}
     if not episodes:
-        from ..measuring.descriptors import measure
+        from ..measuring.measured import measure
 
         m = measure(rec)
         episodes = tuple((e.kind, e.t_start + t[0], e.t_end + t[0]) for e in m.episodes)
@@ -201,7 +201,7 @@ def save(fig, path: str) -> None:
     Raises:
         AouError: I502 when the extension is unknown or the folder cannot be written.
     """
-    from ..files import atomic, check_output
+    from ..core.files import atomic, check_output
 
     fmt = check_output(path, ("png", "svg", "pdf"))
     with atomic(path) as tmp:

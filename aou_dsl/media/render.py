@@ -22,8 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from ..files import atomic
-from ..files import check_output as _check_output
+from ..core.files import atomic
+from ..core.files import check_output as _check_output
 
 __all__ = ["Camera", "frame_configurations", "frame_times", "render_configurations",
            "render_video", "start_workers", "Workers"]
@@ -52,7 +52,7 @@ def frame_times(duration: float, fps: float) -> np.ndarray:
 
 def frame_configurations(traj, fps: float) -> np.ndarray:
     """The arm's joint positions at every frame time, interpolated, shape (F, n)."""
-    from ..arms.load import load_robot
+    from ..robot.load import load_robot
 
     t = np.asarray(traj.t, float)
     q = np.asarray(traj.q, float)[:, traj.columns(load_robot(traj.robot).spec.arm_joints)]
@@ -79,7 +79,8 @@ class _Stage:
 
 def _stage(robot: str, goal: tuple, options, camera: Camera) -> _Stage:
     """The stage of a video, kept for the next one: loading the meshes takes a second."""
-    from ..safety.scene import Scene, SceneOptions
+    from ..core.options import SceneOptions
+    from ..robot.scene import Scene
 
     key = (robot, goal, options, repr(camera))
     if key not in _STAGES:
@@ -239,8 +240,7 @@ def start_workers(jobs: int | None = None) -> Workers | None:
 
 
 def _warm_worker() -> None:
-    from ..arms import load  # noqa: F401  (the robots' loader)
-    from ..safety.scene import import_pybullet
+    from ..robot.bullet import import_pybullet
 
     import_pybullet()
 
@@ -366,7 +366,7 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
         ``{"frames": N, "drawn": D, "fps": fps, "duration": seconds, "size": [w, h]}``:
         D of the N frames are drawn, the others repeat one (the arm holding still).
     """
-    from ..safety.scene import SceneOptions
+    from ..core.options import SceneOptions
 
     try:
         fmt = check_output(path)
@@ -410,7 +410,7 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
 
 
 def _cores() -> int:
-    from ..parallel import default_jobs
+    from ..build.parallel import default_jobs
 
     return default_jobs()
 

@@ -12,12 +12,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from ..declared import source_of
-from ..descriptors import REGISTRY
-from ..diagnostics import AouError, Span, diag
-from ..ir import Behaviour
-from ..linter import lint_source
-from ..primitives import KINDS
+from ..core.diagnostics import AouError, Span, diag
+from ..lang.declared import source_of
+from ..lang.descriptors import REGISTRY
+from ..lang.ir import Behaviour
+from ..lang.linter import lint_source
+from ..lang.primitives import KINDS
 
 __all__ = ["Variant", "make_variants", "parse_vary"]
 

@@ -2,13 +2,13 @@
 
 Position limits come from the URDF, velocity limits from the URDF (unscaled: the
 compiler plans at ``velocity_scale`` of them, the check allows the full limit), and
-acceleration limits from :mod:`aou_dsl.robots` (planned at ``accel_scale``, checked in
+acceleration limits from :mod:`aou_dsl.core.robot_specs` (planned at ``accel_scale``, checked in
 full). Each check reports its worst sample.
 
 :func:`check_rates` checks what a motion generator computes from the positions it is
 sent at its rate: velocity, acceleration and jerk by backward differences (the jerk
-limits come from :mod:`aou_dsl.robots`, or a controller's, see
-:mod:`aou_dsl.controllers`).
+limits come from :mod:`aou_dsl.core.robot_specs`, or a controller's, see
+:mod:`aou_dsl.safety.controllers`).
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..kinematics import ArmModel
+from ..robot.kinematics import ArmModel
 
 __all__ = ["Check", "check_limits", "check_rates"]
 

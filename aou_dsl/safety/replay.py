@@ -28,12 +28,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..kinematics import load_arm
-from ..trajectory import Trajectory
-from .fk import chain_fk, urdf_chain
+from ..core.options import SceneOptions
+from ..core.trajectory import Trajectory
+from ..robot.load import load_arm
+from ..robot.scene import Scene, urdf_path
 from .limits import Check, check_limits
-from .scene import Scene, SceneOptions, urdf_path
 from .sweep import CONTACT_MARGIN, QUERY_RANGE, Geometry, Sweep, geometry
+from .urdf_fk import chain_fk, urdf_chain
 
 __all__ = ["CheckReport", "replay"]
 
@@ -190,7 +191,7 @@ def _agreement(sweep: Sweep, arm, frame: str, t: np.ndarray, q: np.ndarray
     once, and by Pinocchio itself at :data:`AGREE_SPOTS` samples spread over the
     motion), and against PyBullet's at every sample the replay put PyBullet in (those
     spots included)."""
-    from ..measuring.fk import batch_fk
+    from ..robot.batch_fk import batch_fk
 
     spots = np.unique(np.linspace(0, len(t) - 1, AGREE_SPOTS).astype(int))
     for j in spots:

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .scene import Scene
+from ..robot.scene import Scene
 
 __all__ = ["CONTACT_MARGIN", "Geometry", "Sweep", "geometry"]
 

@@ -1,0 +1,283 @@
+"""The argument parser of ``aouc``: every command and option, and the checked number types.
+
+Every numeric option is checked here, before any work: a value that is not a finite
+number in its range is a usage error (exit 2) with a message that names the range.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from collections.abc import Callable
+
+from ..version import __version__
+
+__all__ = ["EXIT_ERRORS", "EXIT_OK", "EXIT_USAGE", "build_parser", "number", "usage_error"]
+
+EXIT_OK = 0
+EXIT_ERRORS = 1
+EXIT_USAGE = 2
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse exits 2 on usage errors, as the contract wants; keep its message short."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.print_usage(sys.stderr)
+        sys.stderr.write(f"aouc: error: {message}\n")
+        raise SystemExit(EXIT_USAGE)
+
+
+def usage_error(command: str, message: str) -> int:
+    """A usage error found after parsing (options that only make sense together): the
+    command's usage line and ``aouc: error: message`` on stderr, as argparse prints its
+    own; returns :data:`EXIT_USAGE`."""
+    build_parser()[1][command].print_usage(sys.stderr)
+    sys.stderr.write(f"aouc: error: {message}\n")
+    return EXIT_USAGE
+
+
+def number(lo: float, hi: float, *, lo_open: bool = False, what: str = "a number"
+           ) -> Callable[[str], float]:
+    """An argparse type: a finite float in [lo, hi] (or (lo, hi] with ``lo_open``)."""
+    def parse(text: str) -> float:
+        try:
+            x = float(text)
+        except ValueError:
+            x = math.nan
+        ok = math.isfinite(x) and (x > lo if lo_open else x >= lo) and x <= hi
+        if not ok:
+            bracket = "(" if lo_open else "["
+            raise argparse.ArgumentTypeError(
+                f"expected {what} in {bracket}{lo:g}, {hi:g}], found `{text}`")
+        return x
+    return parse
+
+
+def int_in(lo: int, hi: int) -> Callable[[str], int]:
+    """An argparse type: a whole number in [lo, hi]."""
+    def parse(text: str) -> int:
+        try:
+            x = int(text)
+        except ValueError:
+            x = lo - 1
+        if not lo <= x <= hi:
+            raise argparse.ArgumentTypeError(f"expected a whole number in [{lo}, {hi}], "
+                                             f"found `{text}`")
+        return x
+    return parse
+
+
+def point(text: str) -> tuple[float, float, float]:
+    """argparse type of X,Y,Z options (metres, finite, within 10 m)."""
+    parts = text.strip("()").split(",")
+    coord = number(-10.0, 10.0, what="a coordinate in metres")
+    if len(parts) != 3:
+        raise argparse.ArgumentTypeError(f"expected X,Y,Z in metres, found `{text}`")
+    x, y, z = (coord(p) for p in parts)
+    return (x, y, z)
+
+
+def frame_size(text: str) -> tuple[int, int]:
+    """argparse type of --size WxH (pixels, 16 to 4096 each)."""
+    try:
+        w, h = (int(x) for x in text.lower().split("x"))
+    except ValueError:
+        w = h = -1
+    if not (16 <= w <= 4096 and 16 <= h <= 4096):
+        raise argparse.ArgumentTypeError(f"expected WxH in pixels, each from 16 to 4096, "
+                                         f"e.g. 640x480, found `{text}`")
+    return (w, h)
+
+
+RATE = number(1.0, 10000.0, what="a sample rate in Hz")
+LENGTH = number(0.0, 2.0, what="a length in metres")
+HEIGHT = number(-2.0, 2.0, what="a height in metres")
+UNIT_RANGE = number(-1.0, 1.0, what="a coordinate of the C-V plane")
+
+
+ROBOT_HELP = ("robot: a built-in name (panda, ur5, xarm7, ...; `aouc robot --list`) or a "
+              "path to a .urdf or a .toml robot description; overrides the file's `robot`")
+
+
+def _robot(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--robot", metavar="NAME|PATH", help=ROBOT_HELP)
+    _package_dir(p)
+
+
+def _package_dir(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--package-dir", action="append", default=[], metavar="DIR",
+                   help="a folder holding ROS packages, searched first for the URDF's "
+                   "package:// meshes (repeatable)")
+
+
+def _controller(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--controller", choices=("franka", "ur"),
+                   help="also check that motion generator's rate and published limits "
+                   "(franka: 1 kHz FCI; ur: 500 Hz e-Series)")
+
+
+def _collision(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--no-collision-check", action="store_true",
+                   help="accept a robot without collision shapes (self-collision is then "
+                   "not checked, and the output says so)")
+
+
+def goal_point(text: str) -> tuple[float, float, float] | str:
+    """argparse type of --goal: X,Y,Z in metres, or `final`."""
+    return "final" if text.strip().lower() == "final" else point(text)
+
+
+def _recording(p: argparse.ArgumentParser) -> None:
+    _robot(p)
+    p.add_argument("--angle-unit", choices=("rad", "deg"),
+                   help="the joint columns of a recording are in this unit (default rad; "
+                   "values that look like degrees are an error unless said)")
+    p.add_argument("--time-unit", choices=("s", "ms"),
+                   help="the t column of a recording is in this unit (default s)")
+    p.add_argument("--ee-frame", help="end-effector frame (default: the robot's)")
+    p.add_argument("--goal", metavar="X,Y,Z|final", type=goal_point,
+                   help="goal position in metres, or `final`: the end-effector's last "
+                   "position (for a recording without a goal)")
+
+
+def _scene(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--target-size", type=LENGTH, default=0.05, metavar="M",
+                   help="edge of the target cube at the goal, in metres (default 0.05)")
+    p.add_argument("--table-height", type=HEIGHT, default=0.0, metavar="M",
+                   help="height of the table plane in the base frame (default 0)")
+    p.add_argument("--no-table", action="store_true", help="no table plane")
+
+
+def _render(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--fps", type=number(1.0, 240.0, what="frames per second"), default=30.0,
+                   help="frames per second (default 30)")
+    p.add_argument("--size", default=(640, 480), type=frame_size, metavar="WxH",
+                   help="frame size (default 640x480)")
+    p.add_argument("--camera-distance", type=number(0.05, 20.0, lo_open=True,
+                                                    what="a distance in metres"),
+                   default=1.2, metavar="M")
+    p.add_argument("--camera-yaw", type=number(-360.0, 360.0, what="an angle in degrees"),
+                   default=30.0, metavar="DEG")
+    p.add_argument("--camera-pitch", type=number(-89.0, 89.0, what="an angle in degrees"),
+                   default=-15.0, metavar="DEG")
+    p.add_argument("--camera-target", metavar="X,Y,Z", type=point,
+                   help="point looked at (default: halfway from the base to the goal)")
+
+
+def _commands(sub) -> dict[str, argparse.ArgumentParser]:
+    c = {}
+    c["lint"] = lint = sub.add_parser(
+        "lint", help="check .aou files against the language and the C-V model")
+    lint.add_argument("paths", nargs="+", metavar="PATH", help=".aou files or folders")
+    lint.add_argument("--format", choices=("text", "json", "github"), default="text")
+    lint.add_argument("--strict", action="store_true", help="warnings fail too (exit 1)")
+    c["explain"] = ex = sub.add_parser("explain", help="show the timeline a file compiles to")
+    ex.add_argument("path", metavar="FILE")
+    c["compile"] = comp = sub.add_parser(
+        "compile", help="compile .aou files into joint trajectories")
+    comp.add_argument("paths", nargs="+", metavar="PATH", help=".aou files or folders")
+    comp.add_argument("-o", "--output", metavar="FILE|DIR",
+                      help="output file, or folder (files found in a folder keep their "
+                      "path below it; default: the current folder)")
+    comp.add_argument("--format", choices=("json", "csv", "npz", "mcap", "yaml", "dmp"),
+                      help="output format (default: from -o's extension, else json); mcap: "
+                      "a ROS 2 bag (a folder) with one JointTrajectory, yaml: the same "
+                      "message as YAML (docs/ros2.md); dmp: a folder of DMPs (docs/dmp.md)")
+    comp.add_argument("--rate", type=RATE, metavar="HZ", help="sample rate in Hz (default 250)")
+    _robot(comp)
+    comp.add_argument("-j", "--jobs", type=int_in(0, 256), default=1, metavar="N",
+                      help="build N files at once in warm worker processes (0: one per "
+                      "core); output identical to --jobs 1, in input order")
+    comp.add_argument("--cluster", metavar="ADDRESS",
+                      help="build on a Dask cluster, e.g. tcp://host:8786 (needs the "
+                      "`cluster` extra; docs/speed.md)")
+    comp.add_argument("--no-check", action="store_true",
+                      help="skip the safety checks (recorded in the output)")
+    _collision(comp)
+    _controller(comp)
+    _scene(comp)
+    c["check"] = chk = sub.add_parser(
+        "check", help="replay a behaviour or trajectory in PyBullet and report every check")
+    chk.add_argument("path", metavar="FILE", help="a .aou file or a trajectory file")
+    chk.add_argument("--format", choices=("text", "json"), default="text")
+    chk.add_argument("--no-dynamic", action="store_true",
+                     help="kinematic checks only (skip the physics replay)")
+    _collision(chk)
+    _controller(chk)
+    _recording(chk)
+    _scene(chk)
+    c["plot"] = plot = sub.add_parser(
+        "plot", help="velocity profile of a behaviour or trajectory, or the C-V map (--cv)")
+    plot.add_argument("paths", nargs="+", metavar="FILE")
+    plot.add_argument("-o", "--output", required=True, metavar="X.png|X.svg")
+    plot.add_argument("--cv", action="store_true",
+                      help="plot the C-V plane with each behaviour's inferred point")
+    _recording(plot)
+    c["render"] = render = sub.add_parser("render", help="render a video of a behaviour")
+    render.add_argument("path", nargs="?", metavar="FILE")
+    render.add_argument("-o", "--output", required=True, metavar="X.mp4|X.gif")
+    render.add_argument("--side-by-side", nargs=2, metavar=("A", "B"),
+                        help="render two behaviours next to each other")
+    _render(render)
+    _recording(render)
+    _scene(render)
+    c["variants"] = var = sub.add_parser(
+        "variants", help="write a pair of files that differ in one descriptor (study Part B)")
+    var.add_argument("path", metavar="FILE")
+    var.add_argument("--vary", required=True, metavar="NAME=LOW,HIGH",
+                     help="descriptor and its two values, in the descriptor's unit")
+    var.add_argument("-o", "--output", metavar="DIR", help="folder (default: here)")
+    var.add_argument("--render", metavar="X.mp4|X.gif", help="also render the pair")
+    _render(var)
+    _scene(var)
+    c["measure"] = meas = sub.add_parser(
+        "measure", help="measure the eleven descriptors of a trajectory")
+    meas.add_argument("path", metavar="FILE", help="a trajectory .json/.npz, or a .csv")
+    _recording(meas)
+    meas.add_argument("--format", choices=("table", "json"), default="table")
+    c["robot"] = rob = sub.add_parser(
+        "robot", help="show what aou knows or derives of a robot (frames, limits, posture)")
+    rob.add_argument("robot", nargs="?", metavar="NAME|PATH",
+                     help="a built-in name, or a .urdf or .toml path")
+    rob.add_argument("--list", action="store_true", help="list the built-in robots")
+    rob.add_argument("--format", choices=("text", "json", "toml"), default="text",
+                     help="toml: a robot description pinning every value")
+    rob.add_argument("-o", "--output", metavar="FILE",
+                     help="write to FILE instead of standard output (e.g. -o arm.toml)")
+    _package_dir(rob)
+    c["synth"] = syn = sub.add_parser(
+        "synth", help="write a .aou file for a state, or a point of the C-V plane, at an "
+        "intensity")
+    which = syn.add_mutually_exclusive_group(required=True)
+    which.add_argument("--state", choices=("confident", "curious", "hesitant", "fearful",
+                                           "inactive"))
+    which.add_argument("--C", type=UNIT_RANGE, dest="C", metavar="C",
+                       help="commitment in [-1, 1] (with --V)")
+    syn.add_argument("--V", type=UNIT_RANGE, dest="V", metavar="V",
+                     help="vigilance in [-1, 1] (with --C)")
+    syn.add_argument("--intensity", type=number(0.0, 1.0, what="an intensity"), default=0.5,
+                     metavar="I", help="in [0, 1]; 0.5 gives the study's stimulus")
+    _robot(syn)
+    syn.add_argument("--no-verify", action="store_true",
+                     help="skip the compile that fits the values to the arm")
+    syn.add_argument("-o", "--output", metavar="FILE.aou",
+                     help="output file (default: standard output)")
+    from ..dmp.cli import add_parser as dmp_parser
+
+    c["dmp"] = dmp_parser(sub)
+    c["rules"] = rules = sub.add_parser("rules", help="list the diagnostic codes, or explain some")
+    rules.add_argument("codes", nargs="*", metavar="CODE")
+    rules.add_argument("--format", choices=("text", "json"), default="text")
+    return c
+
+
+def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:
+    """The parser and its sub-parsers by command name."""
+    p = Parser(prog="aouc", description="aou: expressive robot-arm motion from .aou files.")
+    p.add_argument("--version", action="version", version=f"aouc {__version__}")
+    p.add_argument("--debug", action="store_true",
+                   help="show the traceback of an internal error")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
+    return p, _commands(sub)

@@ -1,0 +1,361 @@
+"""``aouc``: the command line. Thin: each command calls the library and formats records.
+
+Exit codes: 0 no error, 1 the input has errors (or warnings under ``--strict``), 2 usage
+or I/O problems, and internal errors (a one-line message; ``--debug`` shows the
+traceback). A 2 is never hidden by a flag.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from collections.abc import Callable, Sequence
+
+from ..core.diagnostics import RULES, AouError, Diagnostic, Severity, Span
+from .args import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, build_parser
+from .report import format_github, format_json, format_suppressed, format_text
+from .tools import cmd_robot, cmd_synth
+
+__all__ = ["EXIT_ERRORS", "EXIT_OK", "EXIT_USAGE", "main"]
+
+
+def _print_diags(diags: list[Diagnostic], fmt: str = "text",
+                 sources: dict[str, str] | None = None, stream=None) -> None:
+    stream = stream or sys.stderr
+    for d in diags:
+        text = format_github(d) if fmt == "github" else format_text(
+            d, (sources or {}).get(d.span.path))
+        print(text, file=stream)
+
+
+def _exit_for(diags: list[Diagnostic]) -> int:
+    """2 when the input could not be read or written (I codes), else 1."""
+    return EXIT_USAGE if any(d.code.startswith("I") for d in diags) else EXIT_ERRORS
+
+
+def _fail(err: AouError) -> int:
+    _print_diags(err.diagnostics)
+    return _exit_for(err.diagnostics)
+
+
+def _scene_kw(args: argparse.Namespace) -> dict:
+    return {"target_size": args.target_size,
+            "table_height": None if args.no_table else args.table_height}
+
+
+def _read_kw(args: argparse.Namespace) -> dict:
+    return {"robot": args.robot, "goal": args.goal, "ee_frame": args.ee_frame,
+            "angle_unit": args.angle_unit, "time_unit": args.time_unit}
+
+
+def _count(n: int, noun: str) -> str:
+    """``1 error``, ``2 errors``."""
+    return f"{n} {noun}{'s' * (n != 1)}"
+
+
+# --- lint, rules, explain ---------------------------------------------------------------
+
+
+def _cmd_lint(args: argparse.Namespace) -> int:
+    from ..lang.linter import lint_paths, severity_counts
+
+    results, problems = lint_paths(args.paths)
+    counts = severity_counts(results)
+    io_errors = bool(problems) or any(d.code.startswith("I")
+                                      for r in results for d in r.diagnostics)
+    if args.format == "json":
+        print(format_json({"files": [r.to_json() for r in results],
+                           "problems": [d.to_json() for d in problems],
+                           "summary": {str(k): v for k, v in counts.items()}}))
+    else:
+        _print_diags(problems, args.format)
+        for r in results:
+            _print_diags(r.diagnostics, args.format, {r.path: r.source or ""}, sys.stdout)
+            note = format_suppressed(r.path, r.suppressed)
+            if note:
+                print(note)
+        if args.format == "text":
+            print(f"{_count(len(results), 'file')} checked: "
+                  f"{_count(counts[Severity.ERROR], 'error')}, "
+                  f"{_count(counts[Severity.WARNING], 'warning')}, "
+                  f"{_count(counts[Severity.NOTE], 'note')}", file=sys.stderr)
+    if io_errors:
+        return EXIT_USAGE
+    if counts[Severity.ERROR] or (args.strict and counts[Severity.WARNING]):
+        return EXIT_ERRORS
+    return EXIT_OK
+
+
+def _cmd_rules(args: argparse.Namespace) -> int:
+    wanted = [c.upper() for c in args.codes]
+    unknown = [c for c in wanted if c not in RULES]
+    if unknown:
+        print(f"aouc: unknown rule code(s): {', '.join(unknown)}; `aouc rules` lists them",
+              file=sys.stderr)
+        return EXIT_USAGE
+    rules = [RULES[c] for c in wanted] if wanted else list(RULES.values())
+    if args.format == "json":
+        print(format_json([{"code": r.code, "name": r.name, "severity": str(r.severity),
+                            "what": r.what, "why": r.why, "example": r.example}
+                           for r in rules]))
+        return EXIT_OK
+    for r in rules:
+        if wanted:
+            print(f"{r.code} {r.name} [{r.severity}]\n  what: {r.what}\n  why: {r.why}\n"
+                  f"  example:\n" + "\n".join(f"    {ln}" for ln in r.example.splitlines()))
+        else:
+            print(f"{r.code}  {r.name:<28} {r.severity:<8} {r.what}")
+    return EXIT_OK
+
+
+def _cmd_explain(args: argparse.Namespace) -> int:
+    from ..lang.linter import lint_file
+    from .report import format_timeline
+
+    r = lint_file(args.path)
+    if not r.ok or r.behaviour is None or r.cv is None or r.timeline is None:
+        _print_diags(r.diagnostics, sources={r.path: r.source or ""})
+        return _exit_for(r.diagnostics)
+    print(format_timeline(r.behaviour, r.cv, r.timeline))
+    return EXIT_OK
+
+
+# --- compile ----------------------------------------------------------------------------
+
+
+def _cmd_compile(args: argparse.Namespace) -> int:
+    from ..build.parallel import build_many, default_jobs, write_result
+    from ..compiler.output import FORMATS, output_paths
+    from ..core.diagnostics import has_errors
+    from ..core.files import check_format
+    from ..core.options import SceneOptions
+    from ..lang.linter import collect_inputs
+
+    inputs, problems = collect_inputs(args.paths)
+    if problems:
+        _print_diags(problems)
+        return EXIT_USAGE
+    try:
+        dests, fmt = output_paths(inputs, args.output, args.format)
+        check_format(args.output, args.format, FORMATS)  # --format csv -o x.json
+    except AouError as err:
+        return _fail(err)
+    sources = [src for src, _ in inputs]
+    options = {"robot": args.robot, "rate": args.rate, "check": not args.no_check,
+               "scene": SceneOptions(**_scene_kw(args)),
+               "collision_check": not args.no_collision_check, "controller": args.controller}
+    results = build_many(sources, options, args.jobs or default_jobs(), cluster=args.cluster,
+                         encode=fmt)  # the workers encode; this process writes bytes
+    worst = EXIT_OK
+    for k, ((src, _), dest, res) in enumerate(zip(inputs, dests, results, strict=True), 1):
+        _print_diags(res.diagnostics, sources={src: res.lint.source or ""})
+        if not res.ok or res.document is None:
+            worst = max(worst, _exit_for(res.diagnostics))
+            print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)
+            continue
+        try:
+            write_result(dest, res, fmt, inputs=sources)
+        except AouError as err:
+            worst = max(worst, _fail(err))
+            continue
+        tr = res.trajectory
+        note = " (checks skipped)" if args.no_check else ""
+        print(f"[{k}/{len(inputs)}] {src} -> {dest}: {tr.duration:.2f} s of motion, "
+              f"{len(tr.t)} samples, compiled in {res.seconds:.2f} s{note}", file=sys.stderr)
+        if has_errors(res.diagnostics):
+            worst = max(worst, EXIT_ERRORS)
+    return worst
+
+
+# --- check, measure ---------------------------------------------------------------------
+
+
+def _cmd_check(args: argparse.Namespace) -> int:
+    from ..api import check, read_trajectory
+    from .report import format_check
+
+    tr = read_trajectory(args.path, **_read_kw(args))
+    from ..robot import robot_diagnostics
+
+    named = Span.whole_file("<command line>" if args.robot else args.path)  # the robot
+    refused = robot_diagnostics(tr.robot, collision_check=not args.no_collision_check,
+                                span=named)
+    _print_diags(refused)
+    if any(d.severity == Severity.ERROR for d in refused):
+        return EXIT_ERRORS
+    report = check(tr, dynamic=not args.no_dynamic, controller=args.controller,
+                   **_scene_kw(args))
+    if args.format == "json":
+        print(format_json({"path": args.path, **report.to_json()}))
+    else:
+        print(format_check(args.path, tr.robot, tr.t, report))
+    return EXIT_OK if report.ok else EXIT_ERRORS
+
+
+def _cmd_measure(args: argparse.Namespace) -> int:
+    from ..api import measure, read_trajectory
+    from ..lang.cv import missing_descriptors
+    from .report import format_measured
+
+    tr = read_trajectory(args.path, **_read_kw(args))
+    m = measure(tr)
+    missing = missing_descriptors(tr.goal)  # what the C-V point could not use
+    if args.format == "json":
+        doc = m.to_json()
+        doc["cv"] = {**doc["cv"], "missing_descriptors": list(missing)}
+        print(format_json({"path": args.path, "robot": tr.robot, **doc}))
+    else:
+        print(format_measured(args.path, tr.robot, m, missing))
+        _print_diags(m.diagnostics)
+    return EXIT_OK
+
+
+# --- plot, render, variants --------------------------------------------------------------
+
+
+def _cmd_plot(args: argparse.Namespace) -> int:
+    from ..api import read_trajectory
+    from ..lang.linter import lint_paths
+    from ..media.plot import cv_figure, profile_data, profile_figure, save
+
+    if args.cv:
+        results, problems = lint_paths(args.paths)
+        bad = problems + [d for r in results if not r.ok for d in r.diagnostics]
+        if bad:
+            return _fail(AouError(bad))
+        fig = cv_figure([(r.behaviour.name, r.cv) for r in results
+                         if r.behaviour is not None and r.cv is not None])
+    elif len(args.paths) != 1:
+        print("aouc: plot takes one file (or --cv with several)", file=sys.stderr)
+        return EXIT_USAGE
+    else:
+        tr = read_trajectory(args.paths[0], **_read_kw(args))
+        data = profile_data(tr)
+        _print_diags(list(data.diagnostics))  # R405: no goal, no goal-distance panel
+        fig = profile_figure(data)
+    save(fig, args.output)
+    print(f"wrote {args.output}", file=sys.stderr)
+    return EXIT_OK
+
+
+def _render(paths: list[str], output: str, args: argparse.Namespace, read_kw: dict) -> int:
+    import time
+
+    from ..api import read_trajectory
+    from ..core.options import SceneOptions
+    from ..media.render import Camera, check_output, render_video, start_workers
+
+    check_output(output)
+    w, h = args.size
+    camera = Camera(distance=args.camera_distance, yaw=args.camera_yaw,
+                    pitch=args.camera_pitch, target=args.camera_target, width=w, height=h)
+    workers = start_workers()  # they start while the motions are compiled or read
+    try:
+        motions = [read_trajectory(p, **read_kw) for p in paths]
+    except BaseException:
+        if workers is not None:
+            workers.close()
+        raise
+    start = time.perf_counter()
+    info = render_video(motions, output, fps=args.fps, camera=camera,
+                        scene_options=SceneOptions(**_scene_kw(args)), workers=workers)
+    print(f"wrote {output}: {info['frames']} frames at {info['fps']:g} fps "
+          f"({info['duration']:.2f} s), {info['size'][0]}x{info['size'][1]}, "
+          f"{_count(info['drawn'], 'image')} drawn (a frame where the arm holds still "
+          f"repeats one) in {time.perf_counter() - start:.1f} s", file=sys.stderr)
+    return EXIT_OK
+
+
+def _cmd_render(args: argparse.Namespace) -> int:
+    paths = args.side_by_side or ([args.path] if args.path else [])
+    if not paths:
+        print("aouc: render takes FILE, or --side-by-side A B", file=sys.stderr)
+        return EXIT_USAGE
+    return _render(paths, args.output, args, _read_kw(args))
+
+
+def _cmd_variants(args: argparse.Namespace) -> int:
+    from ..compiler.output import write_atomic
+    from ..lang.linter import lint_file
+    from ..media.variants import make_variants, parse_vary
+
+    name, low, high = parse_vary(args.vary)
+    base = lint_file(args.path)
+    if not base.ok or base.behaviour is None or base.source is None:
+        _print_diags(base.diagnostics, sources={args.path: base.source or ""})
+        return _exit_for(base.diagnostics)
+    stem = os.path.splitext(os.path.basename(args.path))[0]
+    folder = args.output or "."
+    variants = make_variants(base.behaviour, base.source, name, low, high,
+                             os.path.join(folder, f"{stem}-{name}"))
+    for v in variants:
+        write_atomic(v.path, v.text.encode(), inputs=[args.path])
+        print(f"wrote {v.path} ({name}={v.value:g})", file=sys.stderr)
+    if args.render:
+        return _render([v.path for v in variants], args.render, args, {})
+    return EXIT_OK
+
+
+def _cmd_dmp(args: argparse.Namespace) -> int:
+    from ..dmp.cli import cmd_dmp
+
+    return cmd_dmp(args)
+
+
+_COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
+    "lint": _cmd_lint, "rules": _cmd_rules, "explain": _cmd_explain,
+    "compile": _cmd_compile, "check": _cmd_check, "measure": _cmd_measure,
+    "plot": _cmd_plot, "render": _cmd_render, "variants": _cmd_variants,
+    "robot": cmd_robot, "synth": cmd_synth, "dmp": _cmd_dmp,
+}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser, commands = build_parser()
+    args, extra = parser.parse_known_args(argv)
+    if extra:  # said with the usage of the command they were given to
+        (commands.get(args.command) or parser).error(
+            f"unrecognized arguments: {' '.join(extra)}")
+    if args.command is None:
+        parser.print_help(sys.stderr)
+        return EXIT_USAGE
+    try:
+        if getattr(args, "package_dir", None):
+            from ..robot import set_package_dirs
+
+            set_package_dirs(args.package_dir)
+        return _COMMANDS[args.command](args)
+    except AouError as err:
+        return _fail(err)
+    except ImportError as exc:
+        if args.command in ("plot", "render", "variants") and exc.name:
+            print(f"aouc: this command needs the media extra ({exc.name} is missing): "
+                  "pip install '.[media]' in aou's folder (the one with pyproject.toml)",
+                  file=sys.stderr)
+            return EXIT_USAGE
+        if exc.name and exc.name.split(".")[0] in ("movement_primitives", "pytransform3d"):
+            print(f"aouc: this command needs the dmp extra ({exc.name} is missing): "
+                  "pip install '.[dmp]' in aou's folder (the one with pyproject.toml)",
+                  file=sys.stderr)
+            return EXIT_USAGE
+        return _internal(exc, args.debug)
+    except KeyboardInterrupt:
+        print("aouc: interrupted", file=sys.stderr)
+        return EXIT_USAGE
+    except BrokenPipeError:
+        return EXIT_OK
+    except Exception as exc:  # noqa: BLE001 - the last line of defence
+        return _internal(exc, args.debug)
+
+
+def _internal(exc: BaseException, debug: bool) -> int:
+    if debug:
+        raise exc
+    print(f"aouc: internal error: {type(exc).__name__}: {exc} (rerun with --debug for the "
+          "traceback, and please report it)", file=sys.stderr)
+    return EXIT_USAGE
+
+
+if __name__ == "__main__":  # pragma: no cover
+    raise SystemExit(main())

@@ -1,0 +1,165 @@
+"""Formatting diagnostics for people and machines: text (with caret), JSON, GitHub."""
+
+from __future__ import annotations
+
+import json
+import math
+
+from ..core.diagnostics import Diagnostic
+
+__all__ = [
+    "format_check",
+    "format_github",
+    "format_json",
+    "format_measured",
+    "format_suppressed",
+    "format_text",
+    "format_timeline",
+]
+
+
+#: The most characters of a source line an excerpt shows.
+EXCERPT = 120
+_LAST: tuple[str | None, list[str]] = (None, [])  # the last source formatted, its lines
+
+
+def _lines(source: str) -> list[str]:
+    """The lines of ``source``, split once however many diagnostics point into it."""
+    global _LAST
+    last = _LAST
+    if last[0] is not source:
+        last = _LAST = (source, source.splitlines())
+    return last[1]
+
+
+def _source_excerpt(d: Diagnostic, source: str | None) -> list[str]:
+    if not source or d.span.line < 1:
+        return []
+    lines = _lines(source)
+    if d.span.line > len(lines):
+        return []
+    text = lines[d.span.line - 1].expandtabs(1)
+    width = (d.span.end_col - d.span.col) if d.span.end_line == d.span.line else len(text)
+    width = max(1, min(width, len(text) - d.span.col + 2, EXCERPT))
+    col = d.span.col
+    if len(text) > EXCERPT:  # a long line (a JSON file given as .aou): the part around col
+        start = max(0, min(col - 1 - EXCERPT // 4, len(text) - EXCERPT))
+        text = ("..." if start else "") + text[start:start + EXCERPT] + (
+            "..." if start + EXCERPT < len(text) else "")
+        col -= start - (3 if start else 0)
+    gutter = f"{d.span.line:>4} | "
+    return [gutter + text, " " * (len(gutter) - 2) + "| " + " " * (col - 1) + "^" * width]
+
+
+def format_text(d: Diagnostic, source: str | None = None) -> str:
+    """``path:line:col: CODE [severity] message``, the source line with a caret, the hint."""
+    out = [f"{d.span}: {d.code} [{d.severity}] {d.message}"]
+    out += _source_excerpt(d, source)
+    if d.hint:
+        out.append(f"     = hint: {d.hint}")
+    return "\n".join(out)
+
+
+def format_suppressed(path: str, suppressed: dict) -> str | None:
+    """The line saying how many diagnostics of a file were not shown (None: all were)."""
+    n = sum(suppressed.values())
+    if not n:
+        return None
+    from ..lang.linter import MAX_DIAGNOSTICS
+
+    parts = ", ".join(f"{v} {k}{'s' * (v != 1)}" for k, v in suppressed.items() if v)
+    return (f"{path}: {n} more diagnostic{'s' * (n != 1)} not shown ({parts}); at most "
+            f"{MAX_DIAGNOSTICS} are kept per file, the most severe first")
+
+
+def format_github(d: Diagnostic) -> str:
+    """A GitHub Actions workflow command, shown as an annotation on the pull request."""
+    level = {"error": "error", "warning": "warning", "note": "notice"}[str(d.severity)]
+    msg = d.message + (f" ({d.hint})" if d.hint else "")
+    msg = msg.replace("%", "%25").replace("\r", "%0D").replace("\n", "%0A")
+    return (f"::{level} file={d.span.path},line={d.span.line},col={d.span.col},"
+            f"endLine={d.span.end_line},endColumn={d.span.end_col},"
+            f"title={d.code} {d.rule.name}::{msg}")
+
+
+def format_json(payload: object) -> str:
+    return json.dumps(payload, indent=2, sort_keys=False)
+
+
+def format_timeline(behaviour, cv, timeline) -> str:
+    """``aouc explain``: the behaviour, its C-V point, and one line per episode."""
+    b = behaviour
+    declared = f"declared {b.state}" if b.state else "no state declared"
+    lines = [f"behaviour {b.name} ({declared}; {b.form} form) on {b.settings.robot}",
+             f"C-V point: C={cv.C:+.2f} V={cv.V:+.2f} -> {cv.state}; laid out as "
+             f"{timeline.state}",
+             f"{'#':>3}  {'episode':<9}{'start':>8}{'dur':>8}  what moves"]
+    t = 0.0
+    for i, e in enumerate(timeline.episodes, 1):
+        if e.kind in ("approach", "retreat"):
+            what = f"distance {e.start.d:.3f} -> {e.end.d:.3f} m (a={e.a:g} m/s^2)"
+        elif e.kind == "gaze":
+            a0, a1 = (e.start.h, e.end.h) if e.plane == "horizontal" else (e.start.v, e.end.v)
+            what = (f"{e.plane} bearing {math.degrees(a0):+.1f} -> {math.degrees(a1):+.1f} "
+                    f"deg at {e.start.d:.3f} m")
+        elif e.kind == "tilt":
+            what = (f"roll {math.degrees(e.start.roll):+.1f} -> "
+                    f"{math.degrees(e.end.roll):+.1f} deg")
+        elif e.kind == "shiver":
+            what = f"shiver {math.degrees(e.amplitude):g} deg peak to peak at {e.f:g} Hz"
+        else:
+            what = f"hold at {e.start.d:.3f} m"
+        lines.append(f"{i:>3}  {e.kind:<9}{t:>7.2f}s{e.duration:>7.2f}s  {what}  "
+                     f"(line {e.span.line})")
+        t += e.duration
+    lines.append(f"planned duration {t:.2f} s (moving episodes at the declared limits; "
+                 "`aouc compile` may slow them to the joint limits)")
+    return "\n".join(lines)
+
+
+def format_check(path: str, robot: str, t, report) -> str:
+    """``aouc check``: each check, pass or fail, its worst sample; clearances; agreement."""
+    lines = [f"{path}: {robot}, {t[-1] - t[0]:.2f} s, {len(t)} samples"]
+    for c in report.checks:
+        mark = "pass" if c.ok else "FAIL"
+        where = "" if c.time is None else f" worst at t={c.time:.3f}s"
+        who = f" {c.joint}" if c.joint else ""
+        val = "" if c.value is None else f" value {c.value:.4g}"
+        lim = "" if c.limit is None else f" limit {c.limit:.4g}"
+        lines.append(f"  {mark}  {c.name:<21}{where}{who}{val}{lim}  ({c.detail})")
+    lines.append("  clearances: " + ", ".join(
+        f"{k} {'n/a' if v is None else f'{v * 1000:.1f} mm'}"
+        for k, v in report.clearances.items()))
+    ag = report.agreement
+    lines.append(f"  PyBullet vs Pinocchio end-effector: {ag['position_mm']:.2e} mm, "
+                 f"{ag['rotation_deg']:.2e} deg")
+    if report.dynamic:
+        d = report.dynamic
+        lines.append(f"  dynamic replay at {d['physics_rate_hz']:.0f} Hz: tracking max "
+                     f"{d['tracking_max_rad']:.2e} rad, RMS {d['tracking_rms_rad']:.2e} rad; "
+                     f"peak torque {d['torque_max_ratio'] * 100:.0f} % of the effort limit")
+    return "\n".join(lines)
+
+
+def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = ()) -> str:
+    """``aouc measure``: the eleven descriptors as a table, and the C-V point; ``missing``:
+    the descriptors the point could not use (:func:`aou_dsl.lang.cv.missing_descriptors`)."""
+    m = measured
+    n = len(m.episodes)
+    lines = [f"{path}: {robot}, {m.duration:.2f} s, {n} episode{'' if n == 1 else 's'}"]
+    from ..lang.descriptors import REGISTRY
+
+    for k, v in m.descriptors.items():
+        val = "null" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
+        lines.append(f"  {k:<22} {val:>10} {REGISTRY[k].unit}".rstrip())
+    los = m.line_of_sight
+    if los is not None and len(los.angle):
+        # The model assumes the hand looks at the goal throughout: how far it did not.
+        lines.append(f"  line of sight off the goal: median {los.median:.3g} deg, "
+                     f"max {los.max:.3g} deg")
+    point = f"  C-V: C={m.cv.C:+.2f} V={m.cv.V:+.2f} -> {m.cv.state}"
+    if missing:
+        point += (f" (incomplete: read without the gaze descriptors {', '.join(missing)}, "
+                  "unknown without a goal)")
+    lines.append(point)
+    return "\n".join(lines)

@@ -1,0 +1,84 @@
+"""``gaze horizontal|vertical ANGLE [v=ANGSPEED] [xN]``: an arc about the goal."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+from ...core.units import Dim
+from ..ir import DEFAULTS, Node
+from ..timeline import Pose
+from .kind import MIN_ANGLE, Key, Kind, fmt, move, repeat
+
+__all__ = ["GAZE_ANGULAR_ACCEL", "Gaze", "GazeKind"]
+
+#: Angular acceleration of gaze arcs [rad/s^2] (the language sets only their speed).
+GAZE_ANGULAR_ACCEL = math.radians(45.0)
+_PLANES = ("horizontal", "vertical")
+
+
+@dataclass(frozen=True, kw_only=True, slots=True)
+class Gaze(Node):
+    """An arc about the goal in the horizontal or vertical plane, gaze locked on it.
+
+    ``angle`` [rad] is the angle of the goal vector from the initial line of sight in
+    that plane at the end of the episode (signed in a sequence; the amplitude in the
+    descriptor form). ``v`` [rad/s] is the angular speed cap.
+    """
+
+    kind: Literal["gaze"] = "gaze"
+    plane: Literal["horizontal", "vertical"]
+    angle: float
+    v: float
+    count: int = 1
+
+
+def _angle_in(pose: Pose, plane: str) -> float:
+    return pose.h if plane == "horizontal" else pose.v
+
+
+class GazeKind(Kind):
+    name = "gaze"
+    node = Gaze
+    usage = "gaze horizontal|vertical ANGLE [v=ANGSPEED] [xN]"
+    keys = {"v": Key(Dim.ANGULAR_SPEED, "deg/s", "angular speed")}
+    evidence = {"exploration": ("angle", "sum")}
+
+    def read(self, r):
+        plane = r.word(_PLANES, "`gaze` needs a plane: `horizontal` or `vertical`")
+        q = r.quantity("an angle")
+        angle = r.amplitude(q, r.si(q, Dim.ANGLE, "gaze angle"), "a gaze angle")
+        if not r.in_sequence:  # in a sequence, 0deg looks straight again
+            r.visible(q, angle, MIN_ANGLE, "a gaze of", "deg")
+        v = r.key("v")
+        if r.done() and plane is not None and angle is not None:
+            return Gaze(span=r.st.span, plane=plane, angle=angle, v=v or DEFAULTS["gaze_v"],
+                        count=r.count)
+        return None
+
+    def episode(self, node, pose: Pose, angle: float):
+        """An arc from ``pose`` to the plane angle ``angle`` [rad] in the node's plane."""
+        if node.plane == "horizontal":
+            end = Pose(pose.d, angle, pose.v, pose.roll)
+        else:
+            end = Pose(pose.d, pose.h, angle, pose.roll)
+        return move("gaze", node.span, pose, end, GAZE_ANGULAR_ACCEL, node.v,
+                    plane=node.plane)
+
+    def values(self, node):
+        deg = abs(math.degrees(node.angle))
+        return {node.plane: deg, "angle": deg}
+
+    def episode_values(self, ep):
+        out = {}
+        for plane in _PLANES:
+            if _angle_in(ep.start, plane) != _angle_in(ep.end, plane):
+                out[plane] = abs(math.degrees(_angle_in(ep.end, plane)))
+        out["angle"] = max(out.values(), default=0.0)
+        return out
+
+
+    def format(self, node):
+        return (f"gaze {node.plane} {fmt(math.degrees(node.angle))}deg "
+                f"v={fmt(math.degrees(node.v))}deg/s{repeat(node.count)}")

@@ -1,0 +1,65 @@
+"""``retreat LENGTH [a=ACC] [v=SPEED] [xN]``: translation away from the goal."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+from ...core.units import Dim
+from ..ir import DEFAULTS, Node
+from ..timeline import Pose
+from .approach import translation
+from .kind import MIN_RETREAT, Key, Kind, fmt, repeat
+
+__all__ = ["Retreat", "RetreatKind"]
+
+
+@dataclass(frozen=True, kw_only=True, slots=True)
+class Retreat(Node):
+    """Translation away from the goal by ``length`` [m] with peak acceleration ``a``
+    [m/s^2] and speed cap ``v`` [m/s]; negative in a sequence moves toward it."""
+
+    kind: Literal["retreat"] = "retreat"
+    length: float
+    a: float
+    v: float
+    count: int = 1
+
+
+class RetreatKind(Kind):
+    name = "retreat"
+    node = Retreat
+    translation = True
+    usage = "retreat LENGTH [a=ACC] [v=SPEED] [xN]"
+    keys = {"a": Key(Dim.ACCEL, "m/s^2", "acceleration"),
+            "v": Key(Dim.SPEED, "m/s", "speed")}
+    evidence = {"extent": ("distance", "sum"), "vigour": ("peak_acceleration", "max")}
+
+    def read(self, r):
+        q = r.quantity("a distance")
+        d = r.si(q, Dim.LENGTH, "retreat distance")
+        if q is not None and not r.in_sequence:
+            d = r.positive(q, d, "retreat distance")
+        elif q is not None and d == 0:
+            r.error("V105", "a retreat distance must not be zero", q.span)
+        r.visible(q, d, MIN_RETREAT, "a retreat of", "m")
+        a, v = r.key("a"), r.key("v")
+        if r.done() and d is not None:
+            return Retreat(span=r.st.span, length=d, a=a or DEFAULTS["retreat_a"],
+                           v=v or DEFAULTS["speed_cap"], count=r.count)
+        return None
+
+    def episode(self, node, pose: Pose):
+        """Away from the goal by ``length`` (toward it when negative: an approach)."""
+        return translation(node, node.span, pose, pose.d + node.length)
+
+    def values(self, node):
+        return {"distance": abs(node.length), "peak_acceleration": node.a}
+
+    def episode_values(self, ep):
+        return {"distance": ep.path_length, "peak_acceleration": ep.a}
+
+
+    def format(self, node):
+        return (f"retreat {fmt(node.length)}m a={fmt(node.a)} v={fmt(node.v)}"
+                f"{repeat(node.count)}")

@@ -1,0 +1,174 @@
+"""Stage 2, validate: syntax tree -> :class:`~aou_dsl.lang.ir.Behaviour`, with diagnostics.
+
+Every validity rule of the language lives here, so ``validate()`` and ``aouc lint``
+agree. The validator reports every problem it can find in one pass (not just the
+first), each with the span of the offending token: statements (:mod:`.reader` and each
+kind's ``read``), settings (:mod:`.settings`), then the behaviour as a whole
+(:mod:`.whole`: resource bounds, reach, and whether its layout shows what it declares).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ..core.diagnostics import Diagnostic, Span
+from .ir import Behaviour, Node, State
+from .parse import Colon, SequenceBlock, Statement, SyntaxTree, Word
+from .primitives import KINDS
+from .settings import SETTINGS, read_settings
+from .timeline import Timeline
+from .values import Ctx, Reader, did_you_mean
+from .whole_file import MAX_EPISODES, MAX_MOTION_TIME, check_whole
+
+__all__ = ["KEYWORDS", "MAX_EPISODES", "MAX_MOTION_TIME", "Validated", "validate",
+           "validate_tree"]
+
+KEYWORDS = ("behaviour", *SETTINGS, *KINDS, "sequence")
+
+
+@dataclass(frozen=True)
+class Validated:
+    """A validated file: the behaviour and its timeline (None on errors), diagnostics."""
+
+    behaviour: Behaviour | None
+    timeline: Timeline | None
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+
+
+def _primitive(ctx: Ctx, st: Statement, in_sequence: bool) -> Node | None:
+    """A primitive statement as IR, or None (with diagnostics) when it does not fit."""
+    kind = KINDS[st.keyword]
+    return kind.read(Reader(ctx, st, kind, in_sequence))
+
+
+def _header(ctx: Ctx, st: Statement) -> tuple[str | None, State | None]:
+    pos = list(st.args)
+    if not pos or not isinstance(pos[0], Word):
+        ctx.error("V113", "`behaviour` takes a name, e.g. `behaviour peek : curious`",
+                  st.keyword_span)
+        return None, None
+    name, rest = pos[0].text, pos[1:]
+    if not rest:
+        return name, None
+    if not isinstance(rest[0], Colon) or len(rest) != 2 or not isinstance(rest[1], Word):
+        ctx.error("V113", "the header is `behaviour NAME : STATE`", rest[0].span)
+        return name, None
+    sw = rest[1]
+    if sw.text not in State.__members__.values():
+        ctx.error("V114", f"unknown state `{sw.text}`: expected one of "
+                  f"{', '.join(s.value for s in State)}", sw.span,
+                  hint=did_you_mean(sw.text, [s.value for s in State]), found=sw.text)
+        return name, None
+    return name, State(sw.text)
+
+
+@dataclass
+class _File:
+    """What the statements of a file say, sorted."""
+
+    name: str | None = None
+    state: State | None = None
+    header: Span | None = None
+    settings: list[Statement] = field(default_factory=list)
+    descriptor: list[Node] = field(default_factory=list)
+    sequence: list[Node] = field(default_factory=list)
+    block: SequenceBlock | None = None
+    first_primitive: Span | None = None
+    seen: dict[str, Span] = field(default_factory=dict)
+
+
+def _block(ctx: Ctx, f: _File, item: SequenceBlock) -> None:
+    if f.block is not None:
+        ctx.error("V111", f"a file has one `sequence` block; the first is at {f.block.span}",
+                  item.span)
+        return
+    f.block = item
+    for st in item.statements:
+        if st.keyword not in KINDS:
+            ctx.error("V101" if st.keyword not in KEYWORDS else "V113",
+                      f"`{st.keyword}` is not a primitive; a sequence holds only "
+                      f"{', '.join(KINDS)}", st.keyword_span,
+                      hint=did_you_mean(st.keyword, KINDS))
+            continue
+        p = _primitive(ctx, st, in_sequence=True)
+        if p is not None:
+            f.sequence.append(p)
+
+
+def _descriptor_statement(ctx: Ctx, f: _File, st: Statement) -> None:
+    f.first_primitive = f.first_primitive or st.span
+    p = _primitive(ctx, st, in_sequence=False)
+    key = f"gaze {getattr(p, 'plane', '')}" if p is not None and p.kind == "gaze" \
+        else st.keyword
+    if key in f.seen:
+        ctx.error("V107", f"`{key}` appears twice in the descriptor form (first at "
+                  f"{f.seen[key]})", st.keyword_span,
+                  hint="use `xN` for more episodes, or a `sequence { }` block for episodes "
+                  "that differ")
+        return
+    f.seen[key] = st.span
+    if p is not None:
+        f.descriptor.append(p)
+
+
+def _statement(ctx: Ctx, f: _File, st: Statement, first: bool) -> None:
+    if st.keyword == "behaviour":
+        if f.header is not None:
+            ctx.error("V111", f"the header is given twice (first at {f.header})",
+                      st.keyword_span)
+        elif not first:
+            ctx.error("V115", "the `behaviour` header must be the first statement",
+                      st.keyword_span)
+        else:
+            f.header = st.span
+            f.name, f.state = _header(ctx, st)
+    elif st.keyword in SETTINGS:
+        f.settings.append(st)
+    elif st.keyword in KINDS:
+        _descriptor_statement(ctx, f, st)
+    else:
+        ctx.error("V101", f"unknown statement `{st.keyword}`", st.keyword_span,
+                  hint=did_you_mean(st.keyword, KEYWORDS) or
+                  f"statements are {', '.join(KEYWORDS)}", found=st.keyword)
+
+
+def validate_tree(tree: SyntaxTree) -> Validated:
+    """Check a syntax tree, build the IR and lay it out."""
+    ctx = Ctx(tree.path)
+    f = _File()
+    for i, item in enumerate(tree.items):
+        if isinstance(item, SequenceBlock):
+            _block(ctx, f, item)
+        else:
+            _statement(ctx, f, item, first=i == 0)
+    if f.block is not None and f.first_primitive is not None:
+        ctx.error("V108", "a file has either a `sequence { }` block or descriptor-form "
+                  "primitives, not both", f.first_primitive,
+                  hint=f"the sequence block is at {f.block.span}")
+    settings = read_settings(ctx, f.settings)
+    if ctx.has_errors():
+        return Validated(None, None, ctx.diags)
+    stem = tree.path.replace("\\", "/").rsplit("/", 1)[-1].removesuffix(".aou")
+    behaviour = Behaviour(
+        name=f.name or stem or "behaviour",
+        state=f.state,
+        form="sequence" if f.block is not None else "descriptor",
+        settings=settings,
+        primitives=tuple(f.sequence if f.block is not None else f.descriptor),
+        span=Span(tree.path, 1, 1, 1, 1),
+        header_span=f.header,
+    )
+    timeline = check_whole(ctx, behaviour)
+    if ctx.has_errors():
+        return Validated(None, None, ctx.diags)
+    return Validated(behaviour, timeline, ctx.diags)
+
+
+def validate(tree: SyntaxTree) -> tuple[Behaviour | None, list[Diagnostic]]:
+    """Check a syntax tree and build the IR.
+
+    Returns:
+        ``(behaviour, diagnostics)``; ``behaviour`` is None when any error was found.
+    """
+    v = validate_tree(tree)
+    return v.behaviour, v.diagnostics

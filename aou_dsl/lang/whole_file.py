@@ -1,0 +1,213 @@
+"""Checks of a whole behaviour: resource bounds, how far it goes, and whether its layout
+can show what it declares."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from .declared import source_of, written
+from .descriptors import REGISTRY, compare, derive
+from .ir import Behaviour
+from .layout import episode_values, layout
+from .primitives import KINDS, MIN_RETREAT
+from .timeline import Timeline
+from .values import Ctx
+
+__all__ = ["MAX_EPISODES", "MAX_MOTION_TIME", "MAX_REACH_DISTANCE", "check_whole"]
+
+#: Resource bounds: a file asking for more is an error, not a hang.
+MAX_MOTION_TIME = 600.0  # s
+MAX_EPISODES = 1000
+#: Furthest the end-effector may be sent from the goal [m].
+MAX_REACH_DISTANCE = 1.0
+
+
+def _episodes(ctx: Ctx, b: Behaviour) -> bool:
+    n = sum(p.count for p in b.primitives)
+    if n > MAX_EPISODES:
+        big = max(b.primitives, key=lambda p: p.count)
+        ctx.error("V110", f"the behaviour has {n} episodes; at most {MAX_EPISODES} are allowed",
+                  big.span, found=n, limit=MAX_EPISODES)
+        return False
+    return True
+
+
+def _time(ctx: Ctx, b: Behaviour, tl: Timeline) -> bool:
+    t = tl.planned_duration
+    if t > MAX_MOTION_TIME:
+        big = max(tl.episodes, key=lambda e: e.duration)
+        ctx.error("V110", f"the behaviour asks for about {t:.0f} s of motion; at most "
+                  f"{MAX_MOTION_TIME:.0f} s are allowed", big.span, found=t,
+                  limit=MAX_MOTION_TIME)
+        return False
+    return True
+
+
+def _standoff(ctx: Ctx, b: Behaviour) -> bool:
+    """A sequence's moves toward the goal stop at the standoff (V120)."""
+    s = b.settings
+    dist = s.start
+    for node in b.primitives:
+        p: Any = node
+        if p.kind not in ("approach", "retreat"):
+            continue
+        for _ in range(p.count):
+            if p.kind == "approach" and p.length is None:
+                dist = s.standoff
+                continue
+            new = dist - p.length if p.kind == "approach" else dist + p.length
+            if new < s.standoff - 1e-9:
+                left = max(dist - s.standoff, 0.0)
+                ctx.error("V120", f"this {p.kind} would end {s.standoff - new:.3g} m inside "
+                          f"the standoff ({s.standoff:g} m from the goal); {left:.3g} m are "
+                          "left", p.span, left=left)
+                return False
+            dist = new
+    return True
+
+
+def _reach(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
+    """V119: no pose of the timeline, its start included, lies further than
+    :data:`MAX_REACH_DISTANCE` from the goal."""
+    far = max(((max(e.start.d, e.end.d), e) for e in tl.episodes), key=lambda x: x[0],
+              default=None)
+    if far is not None and far[0] > MAX_REACH_DISTANCE + 1e-9:
+        where = b.settings.spans.get("start") if far[1] is tl.episodes[0] and \
+            far[1].start.d >= far[1].end.d else None
+        ctx.error("V119", f"the end-effector would be {far[0]:.3g} m from the goal; at most "
+                  f"{MAX_REACH_DISTANCE:g} m", where or far[1].span, distance=far[0])
+
+
+def _swept(ctx: Ctx, tl: Timeline) -> None:
+    """V123: a gaze moves the end-effector around the goal; an arc shorter than the
+    smallest visible motion cannot be seen, whatever its angle."""
+    for e in tl.episodes:
+        if e.kind != "gaze":
+            continue
+        turn = math.hypot(e.end.h - e.start.h, e.end.v - e.start.v)
+        arc = 2.0 * e.start.d * math.sin(turn / 2.0)
+        if 0.0 < arc < MIN_RETREAT:
+            ctx.error("V123", f"this gaze of {math.degrees(turn):.3g} deg at "
+                      f"{e.start.d:.3g} m from the goal moves the end-effector "
+                      f"{arc * 1e3:.2g} mm; at least {MIN_RETREAT * 1e3:g} mm can be seen",
+                      e.span, hint="a larger angle, or gaze from further away",
+                      swept=arc, least=MIN_RETREAT)
+            return
+
+
+def _short_moves(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
+    """V123: a move along the line of sight shorter than the smallest visible motion. A
+    written length is checked where it is read; here, the moves the layout makes: an
+    approach without a length (the rest of the way to the standoff) and, in the
+    descriptor form, the pieces the approach is split into between the stops."""
+    short = [e for e in tl.episodes if KINDS[e.kind].translation
+             and 0.0 < e.path_length < MIN_RETREAT - 1e-12]
+    if not short:
+        return
+    e = min(short, key=lambda x: x.path_length)
+    mm = f"{e.path_length * 1e3:.2g} mm"
+    least_mm = f"{MIN_RETREAT * 1e3:g} mm"
+    least = f"at least {least_mm}"
+    if b.form == "sequence":
+        ctx.error("V123", f"this approach runs the rest of the way to the standoff: "
+                  f"{mm}, too little to be seen or measured; {least}", e.span,
+                  hint=f"the moves before it end {mm} from the standoff: end them at "
+                  f"least {least_mm} from it, or leave this approach out",
+                  moved=e.path_length, least=MIN_RETREAT)
+        return
+    pieces = sum(1 for x in tl.episodes if x.kind == "approach")
+    ctx.error("V123", f"the layout splits the approach into {pieces} pieces (one to each "
+              f"stop, the last to the standoff) and the shortest moves {mm}, too little to "
+              f"be seen or measured; {least}", e.span,
+              hint=_further_start(b, pieces), moved=e.path_length, least=MIN_RETREAT)
+
+
+def _further_start(b: Behaviour, pieces: int) -> str:
+    """A hint for approach pieces too short: a start far enough for every piece (checked
+    on the layout), or fewer stops."""
+    s = b.settings
+    fewer = "fewer pauses, gazes, tilts or retreats to stop at"
+    first = max(s.start + 0.01, s.standoff + MIN_RETREAT * pieces)  # equal shares at best
+    for cm in range(math.ceil(first * 100 - 1e-9), round(MAX_REACH_DISTANCE * 100) + 1):
+        tl = layout(b.replace(settings=s.replace(start=cm / 100)))
+        if all(e.path_length >= MIN_RETREAT for e in tl.episodes
+               if e.kind == "approach"):
+            return f"start further from the goal, e.g. `start {cm}cm`, or {fewer}"
+    return f"{fewer}, or a start further from the goal (`start`)"
+
+
+def _touching(ctx: Ctx, tl: Timeline) -> None:
+    """V125: two pauses in a row are one hold."""
+    for a, b in zip(tl.episodes, tl.episodes[1:], strict=False):
+        if a.kind == b.kind == "pause":
+            ctx.report("V125", f"this pause follows another with no motion between them: "
+                       f"they are seen and measured as one hold of "
+                       f"{a.duration + b.duration:.3g} s", b.span,
+                       hint="put a motion between them, or write one longer pause")
+
+
+_NEEDS = {"retreat": "a retreat counts only between two pauses, one before and one after it",
+          "gaze": "a gaze counts only when a pause ends it"}
+
+
+def _none_shown(kind: str, n_pauses: int) -> str:
+    """Why no episode of ``kind`` counts in the layout, in words."""
+    article = "an" if kind[0] in "aeiou" else "a"
+    why = _NEEDS.get(kind, f"no {kind} of its layout counts")
+    if kind in _NEEDS and n_pauses < (2 if kind == "retreat" else 1):
+        why += f", and this file has {('no pause', 'only one pause')[n_pauses]}"
+    return f"no layout of this file can show {article} {kind}: {why}"
+
+
+def _shown(name: str, value: float | int | None) -> str:
+    """A descriptor's value with its unit, as the file would write it."""
+    unit = REGISTRY[name].unit
+    return f"{value:.3g} {unit}" if isinstance(value, float) and unit else f"{value}"
+
+
+def _realisable(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
+    """V121: the laid-out descriptor form must show the values the file writes. When no
+    episode of a statement counts, one diagnostic says why: its values are absent for
+    that one reason."""
+    pause = b.first("pause")
+    n_pauses = pause.count if pause is not None else 0
+    said: set[int] = set()
+    for m in compare(written(b), derive(episode_values(tl.episodes))):
+        node = source_of(b, m.name)
+        if m.measured is None and id(node) in said:
+            continue  # its statement is already said to show no episode that counts
+        said.add(id(node))
+        kind = REGISTRY[m.name].kind
+        none = m.measured is None or (REGISTRY[m.name].is_count and m.measured == 0)
+        shows = _none_shown(kind, n_pauses) if none else \
+            f"no layout of this file can show more than {_shown(m.name, m.measured)}" \
+            if REGISTRY[m.name].is_count else \
+            f"its layout shows {_shown(m.name, m.measured)}"
+        ctx.error("V121", f"{m.name} is declared {_shown(m.name, m.declared)} but {shows}",
+                  node.span if node else b.span,
+                  hint="pauses need motion between them (an approach, a retreat, a gaze...); "
+                  "a retreat needs a pause before and after it, a gaze one after it",
+                  descriptor=m.name, declared=m.declared, realised=m.measured)
+
+
+def check_whole(ctx: Ctx, b: Behaviour) -> Timeline | None:
+    """Check the behaviour as a whole; its timeline, or None when it cannot be laid out."""
+    if not _episodes(ctx, b):
+        return None
+    if b.form == "sequence" and not _standoff(ctx, b):
+        return None
+    tl = layout(b)
+    if not _time(ctx, b, tl):
+        return None
+    if not tl.episodes:
+        ctx.error("V124", "the behaviour has nothing to move or hold: no primitive makes an "
+                  "episode", b.span, hint="add a primitive, e.g. `approach` or `pause 1s`")
+        return tl
+    _reach(ctx, b, tl)
+    _swept(ctx, tl)
+    _short_moves(ctx, b, tl)
+    _touching(ctx, tl)
+    if b.form == "descriptor":
+        _realisable(ctx, b, tl)
+    return tl

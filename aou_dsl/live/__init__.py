@@ -1,0 +1,1 @@
+"""The perception-loop regulator: re-plans a running behaviour as uncertainty changes."""

@@ -1,0 +1,307 @@
+"""The eleven expressive descriptors, measured from a joint trajectory: compiled by aou,
+or recorded on a real arm.
+
+The steps (docs/measure.md explains the choices):
+
+1. :mod:`.signal`: continuous joints unwrapped; the noise of each joint estimated from
+   its own samples (still joints have none, rounded ones their resolution); one uniform
+   clock (linear interpolation, never a spline through noise); a velocity filter just
+   long enough for that noise.
+2. :mod:`.fk`: forward kinematics of every sample: the hand's position, rotation and
+   unwrapped roll about its forward axis.
+3. :mod:`.holds`: pauses (every joint still, within its noise) with their edges refined
+   to where the motion stops, and the instants between two episodes.
+4. :mod:`.episodes` and :mod:`.roll`: the motion between them, classified by what
+   moved: approach, retreat, gaze, tilt, shiver.
+5. The descriptors, from those episodes by :func:`aou_dsl.lang.descriptors.derive`: the
+   same function that derives what a file declares.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core.diagnostics import AouError, Diagnostic, Span, diag
+from ..core.trajectory import Trajectory
+from ..lang.cv import CVPoint, composition, infer
+from ..lang.descriptors import REGISTRY, Descriptors, EpisodeValues, derive, qualify, spread
+from ..robot.batch_fk import batch_fk
+from ..robot.load import load_arm
+from .episodes import (
+    COMPUTED_NOISE,
+    STILL_TRANSLATION,
+    Context,
+    Piece,
+    Samples,
+    pieces,
+    translation,
+)
+from .holds import MIN_PAUSE, REST_SPEED, Boundary, Rest, boundaries, rest_at_end, rest_signals
+from .roll import MIN_TILT, SHAPED_CYCLE, Lobe, lobe, roll_angle, rotations
+from .signal import Grid, joint_noise, short_window, smooth, to_grid, unwrap
+
+__all__ = ["MIN_PAUSE", "MIN_TILT", "STILL_TRANSLATION", "LineOfSight", "Measured",
+           "measure"]
+
+
+@dataclass(frozen=True)
+class LineOfSight:
+    """How far the hand's forward axis points away from the goal over time: the model
+    assumes it never does (the gaze is locked on the goal).
+
+    Attributes:
+        t: times from the first sample [s], (N,).
+        angle: angle between the forward axis and the direction to the goal [deg], (N,).
+    """
+
+    t: np.ndarray
+    angle: np.ndarray
+
+    @property
+    def median(self) -> float:
+        return float(np.median(self.angle))
+
+    @property
+    def max(self) -> float:
+        return float(self.angle.max())
+
+    def to_json(self) -> dict:
+        return {"median_deg": round(self.median, 6), "max_deg": round(self.max, 6)}
+
+
+@dataclass
+class Measured:
+    """The result of measuring one trajectory.
+
+    ``noise`` is the largest joint noise [rad] (``joint_noise`` per arm joint,
+    ``resolution`` the grid rounded positions lie on, 0 for none); ``gaze_error`` the
+    largest line-of-sight angle [deg] (NaN without a goal);
+    episode times are from the first sample, which is at ``t_origin`` on the
+    recording's own clock.
+    """
+
+    descriptors: Descriptors
+    episodes: list[EpisodeValues]
+    cv: CVPoint
+    diagnostics: list[Diagnostic]
+    noise: float
+    gaze_error: float
+    duration: float
+    joint_noise: tuple[float, ...] = ()
+    line_of_sight: LineOfSight | None = None
+    t_origin: float = 0.0
+    resolution: tuple[float, ...] = field(default=())
+
+    def to_json(self) -> dict:
+        eps = [{"kind": e.kind, "start": round(e.t_start + self.t_origin, 4),
+                "end": round(e.t_end + self.t_origin, 4), "counts": e.counts,
+                "values": {k: round(v, 6) for k, v in e.values.items()}}
+               for e in qualify(self.episodes)]
+        los = self.line_of_sight
+        return {
+            "descriptors": self.descriptors.to_json(),
+            "episodes": eps,
+            "cv": self.cv.to_json(),
+            "noise": self.noise,
+            "joint_noise": list(self.joint_noise),
+            "line_of_sight": los.to_json() if los is not None else None,
+            "gaze_error_deg": (round(self.gaze_error, 6) if math.isfinite(self.gaze_error)
+                               else None),
+            "duration": round(self.duration, 6),
+            "diagnostics": [d.to_json() for d in self.diagnostics],
+        }
+
+
+def _bad(path: str, message: str, **fields) -> AouError:
+    return AouError(diag("R401", message, Span.whole_file(path), **fields))
+
+
+def _checked(rec: Trajectory, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    t = np.asarray(rec.t, float)
+    q = np.asarray(rec.q, float)[:, cols]
+    if t.ndim != 1 or len(t) < 3 or q.shape[0] != len(t):
+        raise _bad(rec.path, f"a trajectory needs at least 3 samples, found {len(t)}")
+    bad = ~(np.isfinite(t) & np.isfinite(q).all(axis=1))
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise _bad(rec.path, f"sample {i} is not a finite number", sample=i)
+    step = np.diff(t)
+    if (step <= 0).any():
+        i = int(np.argmax(step <= 0)) + 1
+        raise _bad(rec.path, f"time must increase strictly: sample {i} has t={t[i]:g}s "
+                   f"after t={t[i - 1]:g}s", sample=i)
+    return t, q
+
+
+def _context(rec: Trajectory) -> tuple[Context, list[Boundary], np.ndarray, np.ndarray]:
+    """The per-sample signals of a trajectory and its boundaries; also the joints'
+    noise and resolution."""
+    arm = load_arm(rec.robot, rec.ee_frame)
+    cols = rec.columns(arm.joint_names)
+    t, q = _checked(rec, cols)
+    q, _ = unwrap(q)
+    jn = joint_noise(t, q)
+    noise = jn.effective
+    h0 = float(np.median(np.diff(t)))
+    window = short_window(float(noise.max()), h0)
+    grid = to_grid(t, q, window * h0)
+    carried = _carried(rec, cols, grid)
+    rest = rest_signals(grid.t, grid.h, grid.q, noise, jn.quantum, grid.density, window,
+                        grid.t_last, carried)
+    pos, rot = batch_fk(arm, grid.q)
+    pos_s = smooth(pos, window, 0, grid.h) if window > 3 else pos
+    goal = None if rec.goal is None else np.asarray(rec.goal, float)
+    raw = Samples(t - t[0], q, batch_fk(arm, q)[0]) if grid.resampled else None
+    ctx = Context(arm, rec.path, rest, grid.q, noise, pos, pos_s, rot, roll_angle(rot),
+                  goal, rot[0][:, 1].copy(), rot[0][:, 0].copy(), _edge_rest(rec, rest),
+                  raw, _computed(noise, grid, carried))
+    return ctx, boundaries(rest), jn.sigma, jn.quantum
+
+
+def _carried(rec: Trajectory, cols: np.ndarray, grid: Grid
+             ) -> tuple[np.ndarray, np.ndarray] | None:
+    """The joint velocities and accelerations the file carries, on the grid's samples
+    (None when it carries none, or when the grid is not the file's own clock)."""
+    if rec.qd is None or rec.qdd is None or grid.resampled:
+        return None
+    qd, qdd = np.asarray(rec.qd, float), np.asarray(rec.qdd, float)
+    if qd.shape != np.shape(rec.q) or qdd.shape != qd.shape:
+        return None
+    n = len(grid.t)
+    qd, qdd = qd[:n, cols], qdd[:n, cols]
+    if not (np.isfinite(qd).all() and np.isfinite(qdd).all()):
+        return None
+    return qd, qdd
+
+
+def _computed(noise: np.ndarray, grid: Grid,
+              carried: tuple[np.ndarray, np.ndarray] | None) -> bool:
+    """Whether the trajectory was computed (aou's own, a planner's), not recorded on an
+    arm: its joints carry no noise, or the velocities and accelerations it carries are
+    the derivatives of its positions (each step is their trapezoid with its end
+    correction, within :data:`COMPUTED_NOISE` for most samples). A logger's velocities
+    are an estimate: they miss its positions by about their noise."""
+    if float(noise.max()) <= COMPUTED_NOISE:
+        return True
+    if carried is None or len(grid.t) < 3:
+        return False
+    qd, qdd = carried
+    h = np.diff(grid.t)[:, None]
+    step = np.diff(grid.q, axis=0)
+    miss = step - h * (qd[1:] + qd[:-1]) / 2 + h * h * (qdd[1:] - qdd[:-1]) / 12
+    moving = step != 0
+    return bool(moving.any() and np.median(np.abs(miss[moving])) <= COMPUTED_NOISE)
+
+
+def _edge_rest(rec: Trajectory, rest: Rest) -> tuple[bool, bool]:
+    """Whether the arm is at rest at the first and last sample: from the velocities the
+    file carries, else from the rest test."""
+    qd = rec.qd
+    if qd is None or np.shape(qd) != np.shape(rec.q) or not np.isfinite(qd).all():
+        return rest_at_end(rest, last=False), rest_at_end(rest, last=True)
+    speed = np.abs(np.asarray(qd, float))
+    return bool(speed[0].max() <= REST_SPEED), bool(speed[-1].max() <= REST_SPEED)
+
+
+def _episodes(ctx: Context, parts: list[Piece | Boundary],
+              coarse: list[tuple[float, float, float]] | None = None) -> list[EpisodeValues]:
+    """Pauses, translations and rolls in time order; oscillations sampled too coarsely
+    to tell a shiver from tilts are added to ``coarse`` (see :func:`.roll.rotations`)."""
+    out: list[EpisodeValues] = []
+    lobes: list[Lobe] = []
+    g0 = None
+    if ctx.goal is not None:
+        first = parts[0] if parts else None
+        p0 = first.p0 if isinstance(first, Piece) else ctx.pos_s[0]
+        if isinstance(first, Boundary):
+            idx = np.arange(first.i0, first.i1 + 1)
+            p0 = ctx.pos[idx].mean(axis=0)
+        g0 = ctx.goal - p0
+
+    def flush() -> None:
+        out.extend(rotations(ctx, lobes, coarse))
+        lobes.clear()
+
+    for part in parts:
+        if isinstance(part, Boundary):
+            flush()
+            t0 = part.t0
+            if out and out[-1].kind == "pause":  # nothing moved since the last pause
+                t0 = out.pop().t_start
+            out.append(EpisodeValues("pause", t0, part.t1, {"duration": part.t1 - t0}))
+            continue
+        moved = translation(ctx, part, g0)
+        if moved is not None:
+            flush()
+            out.append(moved)
+            continue
+        lb = lobe(ctx, part)
+        if lb is not None:
+            lobes.append(lb)
+    flush()
+    return out
+
+
+def _line_of_sight(ctx: Context) -> LineOfSight | None:
+    if ctx.goal is None:
+        return None
+    g = ctx.goal - ctx.pos_s
+    norm = np.linalg.norm(g, axis=1)
+    ok = norm > 1e-6
+    cosang = np.einsum("ij,ij->i", ctx.rot[:, :, 2][ok], g[ok]) / norm[ok]
+    return LineOfSight(ctx.rest.t[ok], np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0))))
+
+
+def _undersampled(where: Span, t0: float, t1: float, per_cycle: float, h: float
+                  ) -> Diagnostic:
+    """R407: an oscillation sampled too coarsely to tell a shiver from tilts."""
+    f = 1.0 / (per_cycle * h)
+    return diag("R407", f"the hand rolls back and forth at about {f:.2g} Hz from t={t0:.3f}s to "
+                f"t={t1:.3f}s, sampled {per_cycle:.2g} times per cycle: too few to tell a "
+                "shiver from tilts by its speed profile, so it is reported as neither",
+                where, hint=f"sample it at {math.ceil(SHAPED_CYCLE * f)} Hz or more "
+                f"({SHAPED_CYCLE} samples per cycle)", start=t0, end=t1,
+                frequency=f, samples_per_cycle=per_cycle)
+
+
+def _unequal(name: str, vals: list[float]) -> bool:
+    return max(vals) - min(vals) > REGISTRY[name].tolerance(float(np.median(vals)))
+
+
+def measure(rec: Trajectory) -> Measured:
+    """Measure the eleven descriptors of a trajectory.
+
+    Without a goal (``rec.goal`` None) the gaze descriptors and the line of sight are
+    unknown (None), approach and retreat are told by the hand's forward axis, and R405
+    says so.
+
+    Raises:
+        AouError: R401/R402 when the trajectory cannot be measured; R406 when a
+            measured value contradicts the joint motion it came from.
+    """
+    ctx, bounds, sigma, quantum = _context(rec)
+    coarse: list[tuple[float, float, float]] = []
+    episodes = _episodes(ctx, pieces(ctx, bounds), coarse)
+    descriptors = derive(episodes)
+    where = Span.whole_file(rec.path)
+    diags = [_undersampled(where, t0 + float(rec.t[0]), t1 + float(rec.t[0]), per_cycle,
+                           ctx.rest.h) for t0, t1, per_cycle in coarse]
+    if ctx.goal is None:
+        diags.append(diag("R405", "the trajectory has no goal: gaze descriptors and the line "
+                          "of sight are not measured; approach and retreat are read along "
+                          "the hand's forward axis", where,
+                          hint="give it with --goal X,Y,Z, or --goal final"))
+    diags += [diag("R403", f"{name} differs between episodes: "
+                   f"{', '.join(f'{v:.4g}' for v in vals)}; reporting the "
+                   f"{REGISTRY[name].aggregate} {descriptors[name]:.4g}", where,
+                   descriptor=name, values=vals)
+              for name, vals in spread(episodes).items() if _unequal(name, vals)]
+    point, _ = infer(composition(episodes))
+    los = _line_of_sight(ctx)
+    return Measured(descriptors, episodes, point, diags, float(ctx.noise.max()),
+                    los.max if los is not None and len(los.angle) else math.nan,
+                    float(ctx.rest.t_last), tuple(float(x) for x in ctx.noise), los,
+                    float(rec.t[0]), tuple(float(x) for x in quantum))

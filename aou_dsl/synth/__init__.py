@@ -1,0 +1,1 @@
+"""Behaviours chosen from a state or a C-V point and an intensity, fitted to an arm."""

@@ -1,0 +1,3 @@
+"""The version of aou, in one place (the package and every file it writes)."""
+
+__version__ = "0.2.0"
