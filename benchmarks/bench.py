@@ -9,7 +9,8 @@ floors), ``lint`` (long files, many files), ``jobs`` (``--jobs N``), ``render`` 
 video), ``measure`` (60 s at 1 kHz), ``compile`` (below), ``replan`` (a live re-plan,
 ``bench_replan.py``), ``house`` (the warm session: re-lint and recompile; ``--jobs 2``
 against ``--jobs 1``, cold, ``house.py``), ``studio`` (``aouc studio``, ``bench_studio.py``),
-``editor`` (the language server and ``aouc fmt``, ``bench_editor.py``); see ``speed.py``
+``editor`` (the language server and ``aouc fmt``, ``bench_editor.py``), ``dmp``
+(behaviours as DMPs, ``bench_dmp.py``); see ``speed.py``
 for ``build`` to ``render``. Ratios
 are measured in one run, so they hold on any machine; absolute times are this
 machine's (its cores and load are in the JSON). The JSON lists every figure with its
@@ -38,6 +39,7 @@ import sys
 import time
 from pathlib import Path
 
+import bench_dmp
 import bench_studio
 import numpy as np
 import speed
@@ -183,7 +185,8 @@ def bench_measure() -> None:
 SECTIONS = {"build": speed.bench_build, "cold": speed.bench_cold, "lint": speed.bench_lint,
             "jobs": speed.bench_jobs, "render": speed.bench_render, "measure": bench_measure,
             "compile": bench_compile, "replan": speed.bench_replan, "house": bench_house,
-            "studio": bench_studio.bench_studio, "editor": bench_editor}
+            "studio": bench_studio.bench_studio, "editor": bench_editor,
+            "dmp": bench_dmp.bench_dmp}
 
 
 def main(argv: list[str]) -> int:

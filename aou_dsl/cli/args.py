@@ -211,10 +211,10 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     comp.add_argument("-o", "--output", metavar="FILE|DIR",
                       help="output file, or folder (files found in a folder keep their "
                       "path below it; default: the current folder)")
-    comp.add_argument("--format", choices=("json", "csv", "npz", "mcap", "yaml"),
+    comp.add_argument("--format", choices=("json", "csv", "npz", "mcap", "yaml", "dmp"),
                       help="output format (default: from -o's extension, else json); mcap: "
                       "a ROS 2 bag (a folder) with one JointTrajectory, yaml: the same "
-                      "message as YAML (docs/ros2.md)")
+                      "message as YAML (docs/ros2.md); dmp: a folder of DMPs (docs/dmp.md)")
     comp.add_argument("--rate", type=RATE, metavar="HZ", help="sample rate in Hz (default 250)")
     _robot(comp)
     comp.add_argument("-j", "--jobs", type=int_in(0, 256), default=1, metavar="N",
@@ -314,10 +314,33 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
                      help="show a second behaviour, ghosted, on the same clock")
     _robot(stu)
     _editor(sub, c)
+    c["dmp"] = _dmp(sub)
     c["rules"] = rules = sub.add_parser("rules", help="list the diagnostic codes, or explain some")
     rules.add_argument("codes", nargs="*", metavar="CODE")
     rules.add_argument("--format", choices=("text", "json"), default="text")
     return c
+
+
+def _dmp(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """The ``aouc dmp`` parser (``roll``)."""
+    dmp = sub.add_parser("dmp", help="roll a behaviour's DMPs (--format dmp) out to a new "
+                         "goal and tempo (needs the `dmp` extra; docs/dmp.md)")
+    dmp.add_argument("action", choices=("roll",))
+    dmp.add_argument("path", metavar="FILE.dmp", help="a folder `aouc compile --format dmp` "
+                     "wrote")
+    dmp.add_argument("--goal", type=point, metavar="X,Y,Z",
+                     help="the new goal in metres (default: the one it was compiled for)")
+    dmp.add_argument("--time-scale", type=number(0.25, 4.0, what="a time scale"), default=1.0,
+                     metavar="K", help="durations times K, accelerations over K^2 (default 1)")
+    dmp.add_argument("--intensity", type=number(0.0, 1.0, what="an intensity"),
+                     metavar="I", help="in [0, 1] (default: the behaviour's own)")
+    dmp.add_argument("--pin", action="append", default=[], choices=("approach", "retreat"),
+                     help="keep the peak acceleration of these motions whatever the goal "
+                     "(repeatable)")
+    dmp.add_argument("-o", "--output", metavar="FILE",
+                     help="write the solved trajectory (.json, .csv, .npz)")
+    dmp.add_argument("--no-check", action="store_true", help="skip the safety replay")
+    return dmp
 
 
 def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:

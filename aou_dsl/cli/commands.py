@@ -116,12 +116,13 @@ def _cmd_explain(args: argparse.Namespace) -> int:
 
 
 def _cmd_compile(args: argparse.Namespace) -> int:
-    from ..build.parallel import build_many, default_jobs, write_result
+    from ..build.parallel import build_many, default_jobs
     from ..compiler.output import FOLDER_FORMATS, FORMATS, output_paths
     from ..core.diagnostics import has_errors
     from ..core.files import check_format, guard_output
     from ..core.options import BuildOptions, SceneOptions
     from ..lang.linter import collect_inputs
+    from .dmp_cmd import write_compiled
 
     inputs, problems = collect_inputs(args.paths)
     if problems:
@@ -155,7 +156,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
             print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)
             continue
         try:
-            write_result(dest, res, fmt, inputs=reads)
+            write_compiled(dest, res, fmt, inputs=reads)
         except AouError as err:
             worst = max(worst, _fail(err))
             continue
@@ -349,12 +350,18 @@ def _cmd_studio(args: argparse.Namespace) -> int:
                  compare=args.compare, package_dirs=_package_dirs(args))
 
 
+def _cmd_dmp(args: argparse.Namespace) -> int:
+    from .dmp_cmd import cmd_dmp
+
+    return cmd_dmp(args)
+
+
 _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "lint": _cmd_lint, "rules": cmd_rules, "explain": _cmd_explain,
     "compile": _cmd_compile, "check": _cmd_check, "measure": _cmd_measure,
     "plot": _cmd_plot, "render": _cmd_render, "variants": _cmd_variants,
     "robot": cmd_robot, "synth": cmd_synth, "studio": _cmd_studio,
-    "fmt": cmd_fmt, "server": cmd_server,
+    "fmt": cmd_fmt, "server": cmd_server, "dmp": _cmd_dmp,
 }
 
 
@@ -380,6 +387,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.command == "studio" and exc.name:
             print(f"aouc: this command needs the studio extra ({exc.name} is missing): "
                   "pip install '.[studio]' in aou's folder (the one with pyproject.toml)",
+                  file=sys.stderr)
+            return EXIT_USAGE
+        if exc.name and exc.name.split(".")[0] in ("movement_primitives", "pytransform3d"):
+            print(f"aouc: this command needs the dmp extra ({exc.name} is missing): "
+                  "pip install '.[dmp]' in aou's folder (the one with pyproject.toml)",
                   file=sys.stderr)
             return EXIT_USAGE
         return _internal(exc, args.debug)

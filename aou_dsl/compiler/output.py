@@ -30,9 +30,9 @@ __all__ = ["FORMATS", "SAMPLE_KEYS", "document_header", "encode", "output_paths"
            "trajectory_document", "with_samples", "write_atomic",
            "write_output"]
 
-FORMATS = ("json", "csv", "npz", "mcap", "yaml")
-#: Formats whose output is a folder (a ROS 2 bag), not a file.
-FOLDER_FORMATS = ("mcap",)
+FORMATS = ("json", "csv", "npz", "mcap", "yaml", "dmp")
+#: Formats whose output is a folder (a ROS 2 bag; DMPs, aou_dsl.dmp), not a file.
+FOLDER_FORMATS = ("mcap", "dmp")
 
 
 #: The keys of a trajectory document that hold its samples, one list entry per sample.
@@ -153,6 +153,8 @@ def write_output(path: str, doc: dict, fmt: str, *, inputs: list[str] | tuple = 
     Raises:
         AouError: I502 when it cannot be written.
     """
+    if fmt == "dmp":  # the command line writes DMPs (aou_dsl/cli/dmp_cmd.py)
+        raise ValueError("DMPs are written by aou_dsl.cli.dmp_cmd.write_compiled")
     if fmt in FOLDER_FORMATS:
         from .ros import write_bag
 
@@ -180,7 +182,7 @@ def output_paths(inputs: list[tuple[str, str | None]], output: str | None, fmt: 
     """
     many = len(inputs) > 1 or any(root is not None for _, root in inputs)
     is_dir = output is not None and (output.endswith(os.sep) or (
-        os.path.isdir(output) and not is_bag(output)))
+        os.path.isdir(output) and not is_bag(output) and not output.endswith(".dmp")))
     if fmt is None:
         ext = os.path.splitext(output or "")[1].lstrip(".")
         fmt = ext if output and not many and not is_dir and ext else "json"
@@ -191,7 +193,7 @@ def output_paths(inputs: list[tuple[str, str | None]], output: str | None, fmt: 
         raise AouError(diag(I502, f"several inputs need -o to be a folder, found "
                             f"`{output}`", Span.whole_file(output)))
     folder = output if (many or is_dir) else None
-    suffix = "" if fmt in FOLDER_FORMATS else f".{fmt}"
+    suffix = "" if fmt == "mcap" else f".{fmt}"
     dests = []
     for src, root in inputs:
         rel = os.path.relpath(src, root) if root is not None else os.path.basename(src)

@@ -7,6 +7,7 @@ A code is a stage letter plus three digits:
 - ``M`` the Commitment-Vigilance model (lint's judgement of a valid file),
 - ``C`` compilation (layout, geometry, IK, timing, simulation check),
 - ``R`` reading trajectories (``aouc measure``),
+- ``D`` behaviours as Dynamic Movement Primitives (``--format dmp``, ``aouc dmp``),
 - ``I`` input/output and usage.
 
 Codes are never reused; a retired code stays in :data:`RULES` as an alias. Every
@@ -15,50 +16,9 @@ example triggers its own code (the architecture tests run them).
 
 from __future__ import annotations
 
-import enum
-from dataclasses import dataclass
+from .rule_model import Category, Rule, Severity
 
 __all__ = ["RULES", "Category", "Rule", "Severity", "category"]
-
-
-class Severity(enum.StrEnum):
-    """How serious a diagnostic is. Only errors (and warnings under ``--strict``) fail."""
-
-    ERROR = "error"
-    WARNING = "warning"
-    NOTE = "note"
-
-
-class Category(enum.Enum):
-    """Where a problem comes from; it decides the exit status: a usage or input/output
-    problem exits 2, a problem of the input's content exits 1."""
-
-    SYNTAX = "S"
-    VALIDATION = "V"
-    MODEL = "M"
-    COMPILE = "C"
-    READING = "R"
-    USAGE = "I"
-
-    @property
-    def is_usage(self) -> bool:
-        return self is Category.USAGE
-
-
-@dataclass(frozen=True, slots=True)
-class Rule:
-    """One diagnostic code: its stable name and the text ``aouc rules`` prints."""
-
-    code: str
-    name: str
-    severity: Severity
-    what: str
-    why: str
-    example: str
-
-    @property
-    def category(self) -> Category:
-        return Category(self.code[0])
 
 
 _E, _W, _N = Severity.ERROR, Severity.WARNING, Severity.NOTE
@@ -304,6 +264,38 @@ _RULE_LIST = [
          "The fitted behaviour keeps its state and the order of its values (docs/robots.md "
          "gives the rule); --write-fitted writes the file so the change is reviewed.",
          "robot ur5\nshiver 6deg f=2.5Hz\npause 1s"),
+    # --- D: behaviours as Dynamic Movement Primitives ------------------------------------
+    Rule("D601", "dmp-needs-episodes", _E,
+         "Only a compiled trajectory (with the compiler's episodes and goal) can become a "
+         "sequence of DMPs; a recording carries neither.",
+         "Each DMP is one rest-to-rest episode; without the episodes there are no parts.",
+         "aou_dsl.dmp.to_dmp(aou_dsl.read_trajectory('arm.csv', robot='panda'))"),
+    Rule("D602", "bad-dmp-file", _E,
+         "A `.dmp` folder's manifest is not an `aou-dmp/1` sequence, or a part it names is "
+         "missing.",
+         "The sequence cannot be rolled out.",
+         'x.dmp/manifest.json: {"format": "aou-trajectory/1"}'),
+    Rule("D603", "rollout-unreachable", _E,
+         "The arm cannot follow the rolled-out motion: a pose is out of reach, needs a "
+         "joint past its limit, or passes a singularity.",
+         "The goal moved too far for this arm; move it less or compile for the new goal.",
+         "aouc dmp roll hesitant.dmp --goal 2,0,0.3   # far out of the Panda's reach"),
+    Rule("D604", "rollout-beyond-limit", _E,
+         "The rolled-out motion fails a safety check; the message names the check, the "
+         "joint, the value and the limit (joint velocity, acceleration, collision...).",
+         "A faster tempo or a larger motion needs more of the arm than it has; such a "
+         "motion is not safe to send.",
+         "aouc dmp roll fearful.dmp --time-scale 0.25   # its 2 m/s^2 retreat at 32 m/s^2"),
+    Rule("D605", "rollout-off-rule", _W,
+         "A descriptor measured on the rolled-out motion is not what its scaling rule "
+         "predicts, within the descriptor's tolerance.",
+         "The adapted motion would not mean what the behaviour means.",
+         "a rollout whose pauses no longer read as pauses"),
+    Rule("D606", "blend-beyond-limit", _E,
+         "A goal changed in the middle of a motion would need more than the declared peak "
+         "acceleration (plus 10 %) or more than the arm's limits.",
+         "The blend is refused rather than sent: the arm keeps its goal.",
+         "a goal moved 30 cm during a fast retreat"),
     # --- R: reading trajectories -------------------------------------------------------
     Rule("C314", "fitted-value", _W,
          "With --fit, a value the arm cannot give was changed to one it can: the "

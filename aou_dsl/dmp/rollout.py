@@ -1,0 +1,364 @@
+"""Rolling a DMP sequence out to a new goal, tempo and intensity, keeping its meaning.
+
+The scaling rules (docs/dmp.md):
+
+- **Goal.** The arm starts where the sequence starts; the goal moves. The whole motion
+  is mapped by the similarity about the start position that takes the old goal to the
+  new one: a rotation ``R`` (the smallest turning the old line from start to goal into
+  the new) and a scale ``s`` (the ratio of the two lengths). Each motion's start and goal
+  poses are mapped so, its position weights become ``s R W`` and its orientation weights
+  ``R W``: the DMP then rolls out exactly the mapped motion. Distances scale by ``s``;
+  the gaze stays locked on the new goal; gaze, tilt and shiver angles are unchanged.
+- **Tempo.** A time scale ``K`` multiplies every DMP's ``execution_time_`` and every
+  hold: pause durations scale by ``K``, tilt velocities by ``1 / K``, and accelerations
+  by ``s / K^2``. A pinned acceleration keeps its value: that motion's own time scale is
+  ``sqrt(s)`` instead. A shiver keeps its frequency (the arm's limits allow it) and
+  lasts ``K`` times as many whole cycles (at least 3).
+- **Intensity.** The descriptors the study found to change how strongly the state reads
+  (the synthesis' spans, docs/synthesis.md) move with the intensity without a re-plan:
+  a pause's hold, a motion's time scale (its acceleration), a shiver's amplitude. Counts
+  and distances are the parts themselves: changing them needs a re-plan.
+
+The DMPs are rolled out every millisecond; what the DMP misses of its goal at its
+execution time (under 0.3 mm) is faded in over the motion by a quintic, so every motion
+ends exactly at rest at its goal. Each motion's DMP runs from a little before its slot
+to a little after (its lead-in and run-out, :data:`aou_dsl.dmp.fit.PAD`); the hand's pose
+is the start pose moved by every motion's displacement, so these margins overlap their
+neighbours smoothly. The result is sampled at the sequence's rate.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..core.codes import I504
+from ..core.diagnostics import AouError, Span, diag
+from .export import DmpSequence
+
+__all__ = ["Rollout", "predict", "roll", "similarity"]
+
+_WHERE = Span.whole_file("<dmp>")
+
+
+def _name(kind: str, key: str) -> str:
+    """The descriptor read from ``kind`` episodes by ``key`` (the registry's name)."""
+    from ..synth.recipe import descriptor
+
+    return descriptor(kind, key).name
+
+
+#: The moving kinds whose peak acceleration is a descriptor, and its name.
+_ACCEL = {kind: _name(kind, "peak_acceleration") for kind in ("approach", "retreat")}
+#: Step of the DMPs' rollouts [s] (the library integrates orientation every millisecond
+#: within it); the rollout is then sampled at the sequence's rate through a cubic spline.
+ROLL_DT = 0.002
+
+
+@dataclass
+class Rollout:
+    """A sequence rolled out: the hand's poses on one clock, and what it should measure.
+
+    Attributes:
+        t: sample times [s], shape (N,); pos (N, 3) [m], quat (N, 4) ``(w, x, y, z)``.
+        part: the index of the part each sample belongs to, shape (N,).
+        shiver: the shiver joint's offset [rad] and its two derivatives, shape (3, N).
+        parts: ``(kind, t_start, t_end)`` of every part.
+        goal: the goal [m]; scale, rotation: the similarity (``s``, ``R`` (3, 3)).
+        time_scale, intensity, pinned: as asked.
+        predicted: the descriptors the scaling rules predict.
+        offset: when the sequence's first part starts on this clock [s] (the lead-in
+            of a first motion is rest before it).
+    """
+
+    t: np.ndarray
+    pos: np.ndarray
+    quat: np.ndarray
+    part: np.ndarray
+    shiver: np.ndarray
+    parts: list[tuple[str, float, float]]
+    goal: tuple[float, float, float]
+    scale: float
+    rotation: np.ndarray
+    time_scale: float
+    intensity: float
+    pinned: tuple[str, ...] = ()
+    predicted: dict[str, Any] = field(default_factory=dict)
+    offset: float = 0.0
+
+
+def similarity(start: np.ndarray, old: np.ndarray, new: np.ndarray
+               ) -> tuple[float, np.ndarray]:
+    """Scale and rotation (3, 3) of the similarity about ``start`` taking ``old`` to ``new``."""
+    u, w = np.asarray(old) - start, np.asarray(new) - start
+    s = float(np.linalg.norm(w) / np.linalg.norm(u))
+    a, b = u / np.linalg.norm(u), w / np.linalg.norm(w)
+    axis = np.cross(a, b)
+    sin, cos = float(np.linalg.norm(axis)), float(a @ b)
+    if sin < 1e-12:
+        return s, np.eye(3)
+    k = axis / sin
+    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    angle = math.atan2(sin, cos)
+    return s, np.eye(3) + math.sin(angle) * kx + (1 - math.cos(angle)) * kx @ kx
+
+
+def _factors(seq: DmpSequence, intensity: float | None) -> dict[str, float]:
+    """Multipliers of the descriptors an intensity moves without a re-plan."""
+    from ..lang.descriptors import REGISTRY
+    from ..lang.ir import State
+    from ..synth.synthesis import SPANS
+
+    if intensity is None or seq.state is None:
+        return {}
+    state = State(seq.state)
+    out = {}
+    for d in REGISTRY.values():
+        span = SPANS.get(state, {}).get((d.kind, d.key))
+        if span is None or d.is_count or d.kind == "retreat" and d.key == "distance":
+            continue
+        if d.kind == "gaze" or d.kind == "tilt":
+            continue  # an angle is the parts' geometry: a re-plan
+        out[d.name] = span ** (d.stronger[state] * 2.0 * (intensity - seq.intensity))
+    return out
+
+
+def predict(seq: DmpSequence, s: float, k: float, factors: dict[str, float],
+            pinned: tuple[str, ...]) -> dict[str, Any]:
+    """The descriptors the scaling rules predict from the sequence's measured ones."""
+    out = dict(seq.descriptors)
+
+    def times(name: str, f: float) -> None:
+        if out.get(name) is not None:
+            out[name] = out[name] * f
+
+    for name in _ACCEL.values():
+        f = factors.get(name, 1.0)
+        times(name, f if name in pinned else s * f / k ** 2)
+    hold, shake = _name("pause", "duration"), _name("shiver", "amplitude")
+    times(hold, k * factors.get(hold, 1.0))
+    times(_name("retreat", "distance"), s)
+    times(_name("tilt", "velocity"), 1.0 / k)
+    times(shake, factors.get(shake, 1.0))
+    return out
+
+
+def _map_pose(pose: np.ndarray, p0: np.ndarray, s: float, r: np.ndarray) -> np.ndarray:
+    import pytransform3d.rotations as pr
+
+    q = pr.concatenate_quaternions(pr.quaternion_from_matrix(r), pose[3:])
+    return np.concatenate([p0 + s * r @ (pose[:3] - p0), q])
+
+
+def _quintic(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The quintics from rest to (1, 0, 0) and to (0, 1, 0) in value, slope, curvature."""
+    return (10 * x ** 3 - 15 * x ** 4 + 6 * x ** 5, -4 * x ** 3 + 7 * x ** 4 - 3 * x ** 5)
+
+
+def _roll_move(dmp: Any, start: np.ndarray, goal: np.ndarray, s: float, r: np.ndarray,
+               duration: float) -> tuple[np.ndarray, np.ndarray]:
+    """One motion rolled out every millisecond to ``duration``: times and poses (n, 7)."""
+    import pytransform3d.rotations as pr
+
+    d = copy.deepcopy(dmp)
+    wp, wr = d.forcing_term_pos.weights_.copy(), d.forcing_term_rot.weights_.copy()
+    d.execution_time_ = duration
+    d.forcing_term_pos.weights_ = s * r @ wp
+    d.forcing_term_rot.weights_ = r @ wr
+    d.dt_ = ROLL_DT
+    d.configure(start_y=start, goal_y=goal)
+    t, y = d.open_loop(run_t=duration)
+    t = np.asarray(t) - t[0]
+    y = np.asarray(y, dtype=float)
+    x = np.clip(t / duration, 0.0, 1.0)
+    h0, h1 = _quintic(x)
+    dt = float(t[-1] - t[-2])
+    miss, v_end = goal[:3] - y[-1, :3], (y[-1, :3] - y[-2, :3]) / dt
+    y[:, :3] += np.outer(h0, miss) - np.outer(h1 * duration, v_end)
+    turn = pr.compact_axis_angle_from_quaternion(
+        pr.concatenate_quaternions(goal[3:], pr.q_conj(y[-1, 3:])))
+    half = 0.5 * np.outer(h0, turn)  # the rotation vectors' halves, (n, 3)
+    angle = np.linalg.norm(half, axis=1)
+    sinc = np.where(angle > 1e-12, np.sin(angle) / np.maximum(angle, 1e-300), 1.0)
+    fade = np.column_stack([np.cos(angle), half * sinc[:, None]])
+    y[:, 3:] = _qmul(fade, y[:, 3:])
+    return t, y
+
+
+def _shiver(tau: np.ndarray, amplitude: float, f: float, duration: float) -> np.ndarray:
+    from ..compiler.oscillation import shiver_offset
+
+    x, xd, xdd, _ = shiver_offset(tau, amplitude, f, duration)
+    return np.vstack([x, xd, xdd])
+
+
+def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
+         time_scale: float = 1.0, intensity: float | None = None,
+         pinned: tuple[str, ...] = (), rate: float | None = None,
+         stretch: dict[int, float] | None = None, cache: dict | None = None,
+         since: int = 0) -> Rollout:
+    """Roll ``seq`` out (see the module's docstring).
+
+    Args:
+        goal: the new goal [m] (default: the sequence's).
+        time_scale: ``K`` in [0.25, 4].
+        intensity: in [0, 1] (default: the sequence's own).
+        pinned: the peak accelerations to keep, by descriptor name (of the approach,
+            the retreat).
+        rate: sample rate [Hz] (default: the sequence's).
+        stretch: extra time scale of some motions, by part index (a blend slows the
+            motion that carries it, :mod:`.blend`).
+        cache: motions already rolled out, reused (a dict the caller keeps).
+        since: the intensity applies from this part on; earlier parts keep the
+            sequence's own (a running behaviour changes intensity, :mod:`.intensity`).
+
+    Raises:
+        AouError: I504 for a value out of range.
+    """
+    _check(time_scale, intensity, pinned)
+    p0 = seq.parts[0].start[:3]
+    new_goal = tuple(float(x) for x in (goal if goal is not None else seq.goal))
+    s, r = similarity(p0, np.asarray(seq.goal), np.asarray(new_goal))
+    factors = _factors(seq, intensity)
+    plans = _plans(seq, p0, s, r, time_scale, factors, pinned, stretch or {},
+                   {} if cache is None else cache, since)
+    first, last = plans[0], plans[-1]
+    # The first motion's lead-in and the last one's run-out are rest of their own.
+    offset = first.t0 - first.begin if first.spline is not None else 0.0
+    for plan in plans:
+        plan.t0 += offset
+        plan.begin += offset
+    total = max(last.t0 + last.duration, last.begin + last.runs)
+    rate = rate or seq.rate
+    t = np.append(np.arange(0.0, total, 1.0 / rate), total)
+    if len(t) > 1 and t[-1] - t[-2] < 1e-9:
+        t = t[:-1]
+    pos, quat = _compose(t, plans, _map_pose(seq.parts[0].start, p0, s, r))
+    which = np.zeros(len(t), dtype=int)
+    shiver = np.zeros((3, len(t)))
+    spans = []
+    for k, plan in enumerate(plans):
+        t1 = plan.t0 + plan.duration
+        which[t >= plan.t0] = k
+        spans.append((plan.kind, plan.t0, t1))
+        if plan.kind == "shiver":
+            sel = (t >= plan.t0) & (t <= t1)
+            shiver[:, sel] = _shiver(t[sel] - plan.t0, plan.amplitude, plan.freq,
+                                     plan.duration)
+    predicted = predict(seq, s, time_scale, factors, pinned)
+    return Rollout(t, pos, quat, which, shiver, spans, new_goal,  # type: ignore[arg-type]
+                   s, r, time_scale, seq.intensity if intensity is None else intensity,
+                   tuple(pinned), predicted, offset)
+
+
+@dataclass
+class _Plan:
+    """One part on the rollout's clock: its slot ``[t0, t0 + duration]``; a motion's DMP
+    rolled out from ``begin`` for ``runs`` seconds (``spline`` of its pose, from its
+    ``start``); a shiver's amplitude [rad] and frequency [Hz]."""
+
+    kind: str
+    t0: float
+    duration: float
+    begin: float = 0.0
+    runs: float = 0.0
+    spline: Any = None
+    start: Any = None
+    amplitude: float = 0.0
+    freq: float = 0.0
+
+
+def _plans(seq: DmpSequence, p0: np.ndarray, s: float, r: np.ndarray, time_scale: float,
+           new_factors: dict[str, float], pinned: tuple[str, ...],
+           stretch: dict[int, float], cache: dict, since: int = 0) -> list[_Plan]:
+    """Every part on one clock, each motion rolled out."""
+    from scipy.interpolate import CubicSpline
+
+    ks = [_time_scale(p, s, time_scale, new_factors if i >= since else {}, pinned)
+          * stretch.get(i, 1.0) for i, p in enumerate(seq.parts)]
+    plans, t0 = [], 0.0
+    for i, p in enumerate(seq.parts):
+        factors = new_factors if i >= since else {}
+        start = _map_pose(p.start, p0, s, r)
+        if p.dmp is not None:
+            k = ks[i]
+            end = _map_pose(p.end, p0, s, r)
+            key = (i, s, r.tobytes(), k)
+            if key not in cache:
+                tt, yy = _roll_move(p.dmp, start, end, s, r, k * p.dmp.execution_time_)
+                cache[key] = (float(tt[-1]), CubicSpline(tt, yy, axis=0))
+            runs, spline = cache[key]
+            plans.append(_Plan(p.kind, t0, k * p.duration, t0 - k * p.lead, runs, spline,
+                               start))
+        elif p.kind == "shiver":
+            cycles = max(3, int(round(p.values["cycles"] * time_scale)))
+            freq = p.values["frequency"]
+            amp = math.radians(p.values["amplitude"]) * factors.get(
+                _name("shiver", "amplitude"), 1.0)
+            plans.append(_Plan("shiver", t0, cycles / freq, amplitude=amp, freq=freq))
+        else:
+            dur = p.duration * time_scale * factors.get(_name("pause", "duration"), 1.0)
+            # A motion's fitted tails reach into a hold by about half its margin, and
+            # stretch with its time scale: the hold gives back what the stretch adds.
+            dur += sum(0.5 * seq.parts[j].lead * (ks[j] - 1.0) for j in (i - 1, i + 1)
+                       if 0 <= j < len(seq.parts) and seq.parts[j].dmp is not None)
+            plans.append(_Plan(p.kind, t0, max(dur, 0.0)))
+        t0 += plans[-1].duration
+    return plans
+
+
+def _time_scale(p: Any, s: float, time_scale: float, factors: dict[str, float],
+                pinned: tuple[str, ...]) -> float:
+    """The time scale of part ``p``'s DMP (1 for a part without one)."""
+    if p.dmp is None:
+        return 1.0
+    name = _ACCEL.get(p.kind)
+    f = factors.get(name, 1.0) if name else 1.0
+    return math.sqrt(s / f) if name in pinned else time_scale / math.sqrt(f)
+
+
+def _qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Products of quaternions ``(w, x, y, z)`` row by row, shapes (N, 4)."""
+    aw, ax, ay, az = a.T
+    bw, bx, by, bz = b.T
+    return np.stack([aw * bw - ax * bx - ay * by - az * bz,
+                     aw * bx + ax * bw + ay * bz - az * by,
+                     aw * by - ax * bz + ay * bw + az * bx,
+                     aw * bz + ax * by - ay * bx + az * bw], axis=1)
+
+
+def _compose(t: np.ndarray, plans: list[_Plan], start: np.ndarray
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """The hand's pose at ``t``: the start pose moved by every motion's displacement so
+    far (positions added, rotations applied in the base frame in turn), so that a
+    motion's lead-in and run-out may overlap its neighbours'."""
+    pos = np.tile(start[:3], (len(t), 1))
+    quat = np.tile(start[3:], (len(t), 1))
+    for plan in plans:
+        if plan.spline is None:
+            continue
+        y = plan.spline(np.clip(t - plan.begin, 0.0, plan.runs))
+        pos += y[:, :3] - plan.start[:3]
+        q = y[:, 3:] / np.linalg.norm(y[:, 3:], axis=1, keepdims=True)
+        inv = plan.start[3:] * np.array([1.0, -1.0, -1.0, -1.0])
+        quat = _qmul(_qmul(q, np.tile(inv, (len(t), 1))), quat)
+    return pos, quat
+
+
+def _check(time_scale: float, intensity: float | None, pinned: tuple[str, ...]) -> None:
+    if not (isinstance(time_scale, int | float) and 0.25 <= time_scale <= 4.0):
+        raise AouError(diag(I504, f"the time scale must be a number in [0.25, 4], found "
+                            f"{time_scale!r}", _WHERE))
+    if intensity is not None and not (isinstance(intensity, int | float)
+                                      and 0.0 <= intensity <= 1.0):
+        raise AouError(diag(I504, f"the intensity must be a number in [0, 1], found "
+                            f"{intensity!r}", _WHERE))
+    bad = [p for p in pinned if p not in _ACCEL.values()]
+    if bad:
+        raise AouError(diag(I504, f"only accelerations can be pinned "
+                            f"({', '.join(_ACCEL.values())}), found {', '.join(bad)}",
+                            _WHERE))
