@@ -152,7 +152,7 @@ def _guard_bag(path: str, reads: Sequence[str], where: Span, folder: bool) -> No
             raise AouError(diag(I502, f"refusing to write the bag `{path}`: it holds "
                                 f"`{read}`, which this command reads", where,
                                 hint="choose another output with -o", input=read))
-    if os.listdir(real) and not _is_aou_bag(real):
+    if os.listdir(real) and not (_is_aou_bag(real) or _is_aou_dmp(real)):
         raise AouError(diag(I502, f"refusing to write the bag `{path}`: the folder holds "
                             "files other than a bag aou wrote", where,
                             hint="a bag goes into a new or empty folder, or over a bag aou "
@@ -191,6 +191,18 @@ def _is_aou_bag(folder: str) -> bool:
     try:
         with open(os.path.join(folder, "metadata.yaml"), "rb") as fh:
             return BAG_TOPIC.encode() in fh.read(1 << 16)
+    except OSError:
+        return False
+
+
+def _is_aou_dmp(folder: str) -> bool:
+    """Whether ``folder`` holds DMPs aou wrote and nothing else: ``manifest.json`` (an
+    ``aou-dmp/1`` sequence) and its ``parts`` folder."""
+    if not set(os.listdir(folder)) <= {"manifest.json", "parts"}:
+        return False
+    try:
+        with open(os.path.join(folder, "manifest.json"), "rb") as fh:
+            return b'"aou-dmp/1"' in fh.read(1 << 16)
     except OSError:
         return False
 
