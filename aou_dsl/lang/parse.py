@@ -115,7 +115,7 @@ def grammar_text() -> str:
     try:
         res = resources.files("aou_dsl.grammar").joinpath("aou.lark")
     except ModuleNotFoundError:
-        res = Path(__file__).resolve().parent.parent / "grammar" / "aou.lark"
+        res = Path(__file__).resolve().parents[2] / "grammar" / "aou.lark"
     return res.read_text(encoding="utf-8")
 
 
