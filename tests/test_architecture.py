@@ -136,7 +136,9 @@ def test_each_reading_and_usage_rule_example_triggers_its_own_code(code, tmp_pat
         (tmp_path / "x.json").write_text(example)
         argv = ["measure", str(tmp_path / "x.json")]
     elif example.startswith("t,"):
-        (tmp_path / "x.csv").write_text(example + "\n0,0\n0.1,0\n0.2,0\n")
+        rows = example.strip().splitlines()[1:]
+        more = "" if len(rows) >= 3 else "\n0,0\n0.1,0\n0.2,0"  # samples enough to measure
+        (tmp_path / "x.csv").write_text(example + more + "\n")
         argv = ["measure", str(tmp_path / "x.csv"), "--robot", "panda", "--goal", "0.5,0,0.3"]
     else:
         pytest.skip(f"{code}'s example is measured in test_measure.py")

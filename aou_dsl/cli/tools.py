@@ -34,13 +34,13 @@ def _with_alias(err: AouError, robot: str) -> AouError:
                      and not d.hint else d for d in err.diagnostics])
 
 
-def _missing_meshes(robot: str) -> list[Diagnostic]:
+def _missing_meshes(robot: str, dirs: tuple[str, ...]) -> list[Diagnostic]:
     """V109 when meshes the checks load cannot be found: said here, not first at the
     compile (and how to compile without them)."""
     from ..robot.load import load_robot
     from ..robot.urdf import scene_xml
 
-    r = load_robot(robot)
+    r = load_robot(robot, dirs)
     _, missing = scene_xml(r.urdf, r.package_dirs, r.gaze, visuals=False)
     if not missing:
         return []
@@ -74,10 +74,7 @@ def cmd_robot(args: argparse.Namespace) -> int:
         doc, text = describe_robot(args.robot, package_dirs(args.package_dir))
     except AouError as err:
         raise _with_alias(err, args.robot) from None
-    missing = _missing_meshes(args.robot)
-    if missing:  # shapes named, but not there to load: not "yes"
-        text = text.replace("  collision geometry: yes\n", "  collision geometry: named, "
-                            "but its mesh files are missing (V109 below)\n")
+    missing = _missing_meshes(args.robot, package_dirs(args.package_dir))
     if args.format == "json":
         out = format_json({"generator": f"aouc {__version__}", **doc} if args.output
                           else doc)

@@ -322,7 +322,7 @@ _RULE_LIST = [
          "not radians and seconds; or a unit given contradicts the robot's joint limits.",
          "Descriptors measured from wrong units are nonsense; say the unit "
          "(--angle-unit deg, --time-unit ms) if the file really uses it.",
-         "t,panda_joint1\n0,45\n1,90"),
+         "t,panda_joint1\n0,45\n1,90\n2,100\n3,110"),
     Rule("R405", "missing-goal", _W,
          "A recording carries no goal and none was given; gaze descriptors need one.",
          "Give --goal X,Y,Z, or --goal final to take the end-effector's final position "

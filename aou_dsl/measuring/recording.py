@@ -326,6 +326,13 @@ def final_goal(rec: Trajectory) -> tuple[float, float, float]:
     return (float(pos[0, 0]), float(pos[0, 1]), float(pos[0, 2]))
 
 
+def _other_arm(rec: Trajectory, robot: str, package_dirs: tuple[str, ...]) -> bool:
+    """Whether ``robot`` moves joints the recording lacks (it is another arm)."""
+    from ..robot.load import load_robot
+
+    return not set(load_robot(robot, package_dirs).spec.arm_joints) <= set(rec.joint_names)
+
+
 def read_recording(path: str, *, robot: str | None = None,
                    goal: tuple[float, float, float] | str | None = None,
                    ee_frame: str | None = None, angle_unit: str | None = None,
@@ -368,8 +375,8 @@ def read_recording(path: str, *, robot: str | None = None,
         where = Where(path, text=text if fmt == "json" else None)
     changes: dict[str, Any] = {k: v for k, v in (("robot", robot), ("ee_frame", ee_frame),
                                                  ("package_dirs", tuple(package_dirs))) if v}
-    if robot and robot != rec.robot and not ee_frame:
-        changes["ee_frame"] = None  # the file's frame is its own robot's: use the new one's
+    if robot and robot != rec.robot and not ee_frame and _other_arm(rec, robot, package_dirs):
+        changes["ee_frame"] = None  # the file's frame is its own arm's: say the joints first
     if goal is not None and not isinstance(goal, str):
         changes["goal"] = tuple(float(x) for x in goal)
     rec = rec.with_(**changes) if changes else rec

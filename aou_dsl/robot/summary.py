@@ -115,10 +115,13 @@ def _text(doc: dict[str, Any]) -> str:
             f"{j['velocity']:.4g} rad/s ({j['velocity_source']}), "
             f"{j['acceleration']:g} rad/s^2, {jerk}, effort {effort}")
     missing = doc["missing_meshes"]
-    lines.append(f"  collision geometry: {'yes' if doc['collision_geometry'] else 'NO'}" + (
-        f", but {len(missing)} mesh file(s) not found, first `{missing[0]}`: compiling "
-        "needs them (give their package's folder with --package-dir), or compile with "
-        "--no-check" if missing and doc["collision_geometry"] else ""))
+    if missing and doc["collision_geometry"]:
+        lines.append(f"  collision geometry: named, but its meshes are missing: "
+                     f"{len(missing)} mesh file(s) not found, first `{missing[0]}`: compiling "
+                     "needs them (give their package's folder with --package-dir), or "
+                     "compile with --no-check")
+    else:
+        lines.append(f"  collision geometry: {'yes' if doc['collision_geometry'] else 'NO'}")
     if doc["reach_found"] is False:
         lines.append("  default reach: NOT FOUND (pin goal, from and posture)")
     for w in doc["warnings"]:
