@@ -66,7 +66,7 @@ def build(text: str, name: str = "gen"):
     res = build_source(text, f"{name}.aou", check=False)
     if not res.ok or res.measured is None or res.declared is None:
         return None
-    if any(d.code == "C310" for d in res.diagnostics):
+    if any(d.code in ("C304", "C310") for d in res.diagnostics):  # not as declared
         return None
     return res.document, res.declared, res.trajectory.episodes
 
