@@ -249,3 +249,14 @@ def test_the_exit_status_comes_from_the_rule_category():
     for code, rule in RULES.items():
         want = 2 if rule.category is Category.USAGE else 1
         assert _exit_for([diag(code, "m", where)]) == want, code
+
+
+def test_every_subpackage_ships_in_the_wheel():
+    """pyproject.toml lists every subpackage of aou_dsl (a missing one installs without
+    it, and only an installed aou finds out)."""
+    import tomllib
+
+    listed = set(tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"][
+        "packages"])
+    here = {".".join(p.parent.relative_to(ROOT).parts) for p in PACKAGE.rglob("__init__.py")}
+    assert here - listed == set()
