@@ -25,7 +25,7 @@ BASE = {
     "plot": ["x.json", "-o", "x.png"], "render": ["x.aou", "-o", "x.gif"],
     "variants": ["x.aou", "--vary", "pause_duration=1,2"], "measure": ["x.json"],
     "rules": [], "robot": ["panda"], "synth": ["--state", "curious"],
-    "studio": ["x.aou"],
+    "studio": ["x.aou"], "dmp": ["roll", "x.dmp"],
 }
 
 
