@@ -28,7 +28,7 @@ import numpy as np
 
 from ..core.codes import I502, R401
 from ..core.diagnostics import AouError, Span, diag
-from ..core.files import BAG_TOPIC
+from ..core.output_folders import BAG_TOPIC
 from ..version import __version__
 
 __all__ = ["MSGTYPE", "TOPIC", "encode_yaml", "is_bag", "message", "read_bag", "write_bag"]

@@ -30,6 +30,7 @@ from typing import Any
 
 from .codes import I501, I502, I506
 from .diagnostics import AouError, Span, diag
+from .output_folders import is_aou_bag, is_aou_dmp
 
 __all__ = ["atomic", "check_format", "check_output", "decode", "guard_output", "is_own_output",
            "make_folders", "read_bytes", "read_text", "sweep_stale", "temp_prefix",
@@ -152,7 +153,7 @@ def _guard_bag(path: str, reads: Sequence[str], where: Span, folder: bool) -> No
             raise AouError(diag(I502, f"refusing to write the bag `{path}`: it holds "
                                 f"`{read}`, which this command reads", where,
                                 hint="choose another output with -o", input=read))
-    if os.listdir(real) and not (_is_aou_bag(real) or _is_aou_dmp(real)):
+    if os.listdir(real) and not (is_aou_bag(real) or is_aou_dmp(real)):
         raise AouError(diag(I502, f"refusing to write the bag `{path}`: the folder holds "
                             "files other than a bag aou wrote", where,
                             hint="a bag goes into a new or empty folder, or over a bag aou "
@@ -176,35 +177,6 @@ def is_own_output(path: str) -> bool:
     except OSError:
         return False
     return OWN_MARK.match(head) is not None
-
-
-#: The topic of the bags aou writes (a ROS 2 ``joint_trajectory_controller``'s).
-BAG_TOPIC = "/joint_trajectory_controller/joint_trajectory"
-
-
-def _is_aou_bag(folder: str) -> bool:
-    """Whether ``folder`` holds a bag aou wrote and nothing else: ``metadata.yaml`` and
-    ``NAME.mcap`` (NAME: the folder's name) on aou's topic."""
-    name = os.path.basename(folder)
-    if sorted(os.listdir(folder)) != sorted(["metadata.yaml", f"{name}.mcap"]):
-        return False
-    try:
-        with open(os.path.join(folder, "metadata.yaml"), "rb") as fh:
-            return BAG_TOPIC.encode() in fh.read(1 << 16)
-    except OSError:
-        return False
-
-
-def _is_aou_dmp(folder: str) -> bool:
-    """Whether ``folder`` holds DMPs aou wrote and nothing else: ``manifest.json`` (an
-    ``aou-dmp/1`` sequence) and its ``parts`` folder."""
-    if not set(os.listdir(folder)) <= {"manifest.json", "parts"}:
-        return False
-    try:
-        with open(os.path.join(folder, "manifest.json"), "rb") as fh:
-            return b'"aou-dmp/1"' in fh.read(1 << 16)
-    except OSError:
-        return False
 
 
 def temp_prefix() -> str:
