@@ -161,12 +161,17 @@ def build_lint(lint: FileResult, options: BuildOptions | None = None,
 
     opts = (options or BuildOptions()).replace(**changes) if changes else (
         options or BuildOptions())
+    from .reach_fit import with_reach_fit
+
+    def one(linted: FileResult) -> BuildResult:  # a reach refusal's hint: every change
+        return with_reach_fit(_build_lint(linted, opts), opts.robot, opts.package_dirs)
+
     if opts.fit:
         from .fit_loop import fit_loop
 
-        res = fit_loop(lint, lambda linted: _build_lint(linted, opts))
+        res = fit_loop(lint, one)
     else:
-        res = _build_lint(lint, opts)
+        res = one(lint)
     res.diagnostics = said_once(res.diagnostics)
     return res
 

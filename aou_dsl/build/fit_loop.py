@@ -24,18 +24,33 @@ from ..lang.linter import FileResult, lint_source
 __all__ = ["MAX_ROUNDS", "fit_loop"]
 
 #: Builds at most, the first included.
-MAX_ROUNDS = 4
+MAX_ROUNDS = 5
+
+
+def _binds(c: Change) -> str:
+    """What binds, in words: a joint's limit, the arm's reach or a singularity."""
+    if c.limit in ("reach", "singularity"):
+        return f"the arm's {c.limit}" + (f" ({c.joint})" if c.joint else "")
+    return f"{c.joint}'s {c.limit or 'acceleration'} limit" if c.joint else "the arm"
 
 
 def _warning(c: Change) -> Diagnostic:
     what = c.descriptor or {"f": "shiver frequency", "for": "shiver duration",
-                            "a": "acceleration", "v": "tilt velocity"}[c.key]
+                            "a": "acceleration", "v": "tilt velocity",
+                            "length": "approach distance", "angle": "angle"}[c.key]
     was = f"{c.declared}{c.unit}" if c.declared else "the default"
-    binds = f"{c.joint}'s {c.limit or 'acceleration'} limit" if c.joint else "the arm"
+    binds = _binds(c)
     return diag(C314, f"{what}: declared {was} -> fitted {c.fitted}{c.unit} "
                 f"(`{c.text}`): {binds} binds", c.span, key=c.key, declared=c.declared,
                 fitted=c.fitted, unit=c.unit, joint=c.joint, limit=c.limit,
                 descriptor=c.descriptor)
+
+
+def _not_fitted(todo: list[Diagnostic], where: Any) -> list[Diagnostic]:
+    """C314 for each reach refusal no change answers, with why
+    (:mod:`~aou_dsl.build.reach_fit`)."""
+    return [diag(C314, f"not fitted: {d.fields['reach_fit']}", d.span)
+            for d in todo if d.fields.get("reach_fit")]
 
 
 def fit_loop(lint: FileResult, build: Callable[[FileResult], Any]) -> Any:
@@ -52,6 +67,7 @@ def fit_loop(lint: FileResult, build: Callable[[FileResult], Any]) -> Any:
         todo = [d for d in said_once(res.diagnostics) if d.code in FITTED]
         changes = plan(todo, first)
         if not changes:
+            res.diagnostics += _not_fitted(todo, b.span)
             break
         new_text = apply(text, changes)
         new_lint = lint_source(new_text, lint.path)

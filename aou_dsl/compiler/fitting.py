@@ -31,15 +31,16 @@ import math
 import re
 from dataclasses import dataclass
 
-from ..core.codes import C304, C308, C309
+from ..core.codes import C301, C302, C303, C304, C308, C309
 from ..core.diagnostics import Diagnostic, Span
 
 __all__ = ["KNEE", "Change", "apply", "apply_edit", "compress", "hint_edit", "plan"]
 
 #: Fraction of the arm's peak below which a declared value is never changed.
 KNEE = 0.9
-#: The codes whose values :func:`plan` fits.
-FITTED = (C304, C308, C309)
+#: The codes whose values :func:`plan` fits (a reach refusal by the changes the builder
+#: found, its field ``reach``: :mod:`aou_dsl.build.reach_fit`).
+FITTED = (C301, C302, C303, C304, C308, C309)
 
 
 @dataclass(frozen=True)
@@ -48,7 +49,8 @@ class Change:
 
     Attributes:
         span: the statement.
-        key: ``a``, ``f``, ``v`` or ``for``.
+        key: ``a``, ``f``, ``v`` or ``for``; ``angle`` or ``length`` for the positional
+            value of a gaze, tilt, retreat or approach.
         declared: the value as written (``2``, absent as ``""``); fitted: as now written.
         unit: the unit written after the fitted value.
         joint, limit: what binds (the joint, and which of its limits).
@@ -66,6 +68,8 @@ class Change:
 
     @property
     def text(self) -> str:
+        if self.key in _POSITIONAL:
+            return f"{self.fitted}{self.unit}"
         return f"{self.key}={self.fitted}{self.unit}" if self.key != "for" else \
             f"for {self.fitted}{self.unit}"
 
@@ -138,6 +142,10 @@ def plan(diagnostics: list[Diagnostic], declared: dict[tuple, float]) -> list[Ch
             fitted = _down(compress(float(v), cap) if v else cap, 4)
             out.append(Change(d.span, "v", "" if v is None else f"{v:g}", fitted, "deg/s",
                               joint, limit, "tilt_velocity"))
+        elif d.code in (C301, C302, C303):
+            out += [Change(Span(d.span.path, r["line"], r["col"], r["line"], r["end_col"]),
+                           r["key"], r["declared"], r["fitted"], r["unit"], r["joint"],
+                           r["limit"], r["descriptor"]) for r in d.fields.get("reach", ())]
     return out
 
 
@@ -145,7 +153,10 @@ def _at(d: Diagnostic, key: str) -> tuple[int, int, str]:
     return d.span.line, d.span.col, key
 
 
-_KEY = {"a": r"a=\S+", "f": r"f=\S+", "v": r"v=\S+", "for": r"for\s+\S+"}
+#: Keys of a statement's positional value (its first quantity of that dimension).
+_POSITIONAL = {"angle": r"[-+]?[\d.]+(?:[eE][-+]?\d+)?(?:deg|rad)(?=\s|;|#|$)",
+               "length": r"[-+]?[\d.]+(?:[eE][-+]?\d+)?(?:mm|cm|m)(?=\s|;|#|$)"}
+_KEY = {"a": r"a=\S+", "f": r"f=\S+", "v": r"v=\S+", "for": r"for\s+\S+", **_POSITIONAL}
 
 
 def apply(text: str, changes: list[Change]) -> str:

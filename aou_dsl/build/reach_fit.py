@@ -1,0 +1,239 @@
+"""Fitting a reach: where the arm cannot follow a pose of the motion (C301: outside its
+workspace; C302: a joint at its limit; C303: a singularity), the statement whose gaze
+angle, retreat or approach distance or tilt angle takes the hand there is brought back
+within reach, by the least that keeps the order of values.
+
+The rule, for the statement a refusal points at (the one whose episode IK failed):
+
+- Only its positional value changes (`gaze horizontal 60deg` -> `gaze horizontal
+  46.1deg`): the angle or distance that takes the hand where the arm cannot follow.
+- Its **bound** ``R``, the largest magnitude at which IK follows every pose up to the
+  statement's last episode (everything else as written), is found by bisection on a
+  fixed grid (0 to :data:`SPAN` of the quantity, halved :data:`STEPS` times), so two
+  files that differ only in that value find the same bound.
+- The declared magnitude is compressed under ``R`` by the same increasing map as an
+  acceleration (:func:`~aou_dsl.compiler.fitting.compress`), so two files that differ
+  only in that value are fitted to values in the same order (a Part B variant pair keeps
+  its contrast); the sign (a direction in a sequence) stays.
+- When a later statement then fails, it is fitted the same way, and so on: the changes
+  are every change the whole motion needs, said at once (the hint of the refusal
+  without ``--fit``, the changes made with it).
+
+Reaching is checked by the compiler's own IK from the start pose, episode by episode,
+as the compiler follows the path; a fit whose file no longer expresses the declared
+state is not offered.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import replace
+from typing import Any
+
+from ..core.codes import C301, C302, C303
+from ..core.diagnostics import Diagnostic, Severity
+from ..lang.linter import FileResult, lint_source
+
+__all__ = ["REACH", "STEPS", "with_reach_fit"]
+
+#: The refusals a reach fit answers.
+REACH = (C301, C302, C303)
+#: Bisection steps of a bound (on a grid of SPAN / 2**STEPS).
+STEPS = 14
+#: The range searched for a bound, in SI units, by the unit's dimension.
+SPAN = {"angle": math.pi, "length": 2.0}
+#: Statements more than this are not fitted in one refusal.
+MOST = 4
+
+_UNITS = {"m": ("length", 1.0), "cm": ("length", 0.01), "mm": ("length", 0.001),
+          "deg": ("angle", math.pi / 180.0), "rad": ("angle", 1.0)}
+_QUANTITY = re.compile(r"(?<=\s)([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)(mm|cm|m|deg|rad)"
+                       r"(?=\s|;|#|$)")
+_LIMIT = {C301: "reach", C302: "position", C303: "singularity"}
+
+
+def _descriptor(words: list[str]) -> str | None:
+    """The descriptor a statement's positional value sets (None: none)."""
+    if words[0] == "gaze" and len(words) > 1 and words[1] in ("horizontal", "vertical"):
+        return f"{words[1]}_gaze"
+    return {"retreat": "retreat_distance", "tilt": "tilt_angle"}.get(words[0])
+
+
+class _Statement:
+    """One statement's positional value, and the file's text with another value there."""
+
+    def __init__(self, text: str, line: int, col: int, end_col: int) -> None:
+        self.text, self.line, self.col = text, line, col
+        row = text.split("\n")[line - 1]
+        self.stop = end_col - 1 if end_col > col else len(row)
+        self.stmt = row[col - 1:self.stop]
+        self.match = _QUANTITY.search(" " + self.stmt)
+        words = self.stmt.split()
+        self.ok = bool(words) and words[0] in ("gaze", "retreat", "tilt", "approach") \
+            and self.match is not None
+        if self.ok:
+            assert self.match is not None
+            self.written, self.unit = self.match[1], self.match[2]
+            self.dim, self.scale = _UNITS[self.unit]
+            self.value = float(self.written) * self.scale  # SI, signed
+            self.descriptor = _descriptor(words)
+
+    def with_value(self, si: float) -> tuple[str, str]:
+        """The statement and the file's text with the magnitude ``si`` (SI) written in
+        the statement's unit, rounded down to 4 significant digits."""
+        assert self.match is not None
+        shown = _down(si / self.scale)
+        if self.value < 0:
+            shown = "-" + shown
+        a, b = self.match.span(1)
+        stmt = self.stmt[:a - 1] + shown + self.stmt[b - 1:]
+        lines = self.text.split("\n")
+        row = lines[self.line - 1]
+        lines[self.line - 1] = row[:self.col - 1] + stmt + row[self.stop:]
+        return stmt, "\n".join(lines)
+
+
+def _down(x: float) -> str:
+    """``x`` > 0 with 4 significant digits, rounded down."""
+    e = math.floor(math.log10(x)) - 3
+    return f"{math.floor(x / 10 ** e + 1e-9) * 10 ** e:.{max(0, -e)}f}".rstrip("0").rstrip(".")
+
+
+def _reach(lint: FileResult, robot: str, package_dirs: tuple[str, ...]) -> Any:
+    """``reaches(timeline) -> (episode index, IKFailure) | None``: where IK first fails
+    to follow the motion (index -1: the start pose), for the behaviour's arm and goal."""
+    import numpy as np
+
+    from ..compiler.pipeline import MIN_WAYPOINTS, STEP_ANGLE, STEP_LENGTH
+    from ..lang.primitives import KINDS, Timing
+    from ..robot.geometry import reach_frame
+    from ..robot.ik import solve_path
+    from ..robot.load import load_arm
+
+    b = lint.behaviour
+    assert b is not None
+    arm = load_arm(robot, None, package_dirs)
+    frame = reach_frame(b.settings.goal or arm.spec.goal,
+                        b.settings.start_direction or arm.spec.start_direction)
+
+    def targets(ep) -> list:
+        step = STEP_LENGTH if KINDS[ep.kind].translation else STEP_ANGLE
+        n = max(MIN_WAYPOINTS, math.ceil(ep.path_length / step) + 1)
+        return [frame.target(ep.start.lerp(ep.end, f)) for f in np.linspace(0.0, 1.0, n)]
+
+    def reaches(tl) -> tuple[int, Any] | None:
+        if not tl.episodes:
+            return None
+        ik = solve_path(arm, [frame.target(tl.episodes[0].start)])
+        if ik.failure is not None:
+            return -1, ik.failure
+        q = ik.q[0]
+        for i, ep in enumerate(tl.episodes):
+            if KINDS[ep.kind].timing in (Timing.HOLD, Timing.OSCILLATION):
+                continue
+            ik = solve_path(arm, targets(ep), q)
+            if ik.failure is not None:
+                return i, ik.failure
+            q = ik.q[-1]
+        return None
+
+    return reaches
+
+
+def _bound(st: _Statement, path: str, last: int, follows: Any) -> float:
+    """The largest magnitude (SI) on the fixed grid at which IK follows the motion past
+    episode ``last`` (0.0: none found). Grid points at or above the declared value are
+    taken as failing (it failed), so they cost nothing."""
+    lo, hi = 0.0, SPAN[st.dim]
+    for _ in range(STEPS):
+        mid = (lo + hi) / 2.0
+        if mid < abs(st.value) and follows(st.with_value(mid)[1], path, last):
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+def _fits(lint: FileResult, d: Diagnostic, robot: str, package_dirs: tuple[str, ...]
+          ) -> list[dict[str, Any]] | str:
+    """Every change the motion needs to be followed, as records (see the module), or
+    why none is offered."""
+    from ..compiler.fitting import compress
+
+    reaches = _reach(lint, robot, package_dirs)
+
+    def follows(text: str, path: str, last: int) -> bool:
+        again = lint_source(text, path)
+        if not again.ok or again.timeline is None:
+            return False
+        failed = reaches(again.timeline)
+        return failed is None or failed[0] > last
+
+    text, path = lint.source or "", lint.path
+    changes: list[dict[str, Any]] = []
+    span, code, failure = d.span, d.code, d.fields.get("joint")
+    for _ in range(MOST):
+        st = _Statement(text, span.line, span.col, span.end_col)
+        if not st.ok:
+            return "the refused statement has no angle or distance to fit"
+        tl = lint_source(text, path).timeline
+        assert tl is not None
+        last = max(i for i, e in enumerate(tl.episodes) if (e.span.line, e.span.col)
+                   == (span.line, span.col))
+        bound = _bound(st, path, last, follows)
+        if bound <= 0.0:
+            return f"no {st.dim} of `{st.stmt}` is followed by the arm"
+        fitted = compress(abs(st.value), bound)
+        stmt, new_text = st.with_value(fitted)
+        if not follows(new_text, path, last):
+            return f"`{stmt}` is not followed either"
+        changes.append({"line": span.line, "col": span.col, "end_col": span.end_col,
+                        "key": st.dim, "declared": st.written, "fitted":
+                        _Statement(new_text, span.line, span.col, span.col + len(stmt))
+                        .written, "unit": st.unit, "bound": bound / st.scale,
+                        "joint": failure, "limit": _LIMIT.get(code, "reach"),
+                        "descriptor": st.descriptor, "statement": stmt})
+        text = new_text
+        again = lint_source(text, path)
+        assert again.timeline is not None
+        failed = reaches(again.timeline)
+        if failed is None:
+            state = lint.behaviour.state if lint.behaviour is not None else None
+            if state is not None and (again.cv is None or again.cv.state != state):
+                found = again.cv.state.value if again.cv is not None else "nothing"
+                return f"the fitted file would express `{found}`, not `{state.value}`"
+            return changes
+        index, fail = failed
+        if index < 0:
+            return "the start pose is then out of reach"
+        span, failure = again.timeline.episodes[index].span, fail.joint
+        code = {"UNREACHABLE": C301, "JOINT_LIMIT": C302}.get(fail.status.name, C303)
+    return f"more than {MOST} statements would change"
+
+
+def with_reach_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...]) -> Any:
+    """``res`` (a build result) with each reach refusal at a statement given the changes
+    that bring the whole motion within reach: as the hint (``write `gaze horizontal
+    46.1deg` at line 5``) and as the field ``reach`` (read by ``--fit``)."""
+    lint = res.lint
+    b = lint.behaviour
+    if b is None or lint.source is None:
+        return res
+    out = []
+    for d in res.diagnostics:
+        if d.code not in REACH or d.severity is not Severity.ERROR or not d.fields.get(
+                "time") or d.span.path != lint.path or d.span.line < 1:
+            out.append(d)
+            continue
+        found = _fits(lint, d, robot or b.settings.robot, package_dirs)
+        if isinstance(found, str):
+            why = f"no smaller angle or distance is offered: {found}"
+            out.append(replace(d, hint=f"{d.hint}; {why}" if d.hint else why,
+                               fields={**d.fields, "reach_fit": found}))
+            continue
+        said = "; ".join(f"`{c['statement']}` at line {c['line']}" for c in found)
+        hint = f"write {said}" + (f"; or {d.hint}" if d.hint else "")
+        out.append(replace(d, hint=hint, fields={**d.fields, "reach": found}))
+    res.diagnostics = out
+    return res
