@@ -155,6 +155,27 @@ def _bound(st: _Statement, path: str, last: int, follows: Any) -> float:
     return lo
 
 
+def _candidate(text: str, path: str, episodes: Any, last: int, follows: Any
+               ) -> tuple[_Statement, float] | str:
+    """The statement to change and its bound: the refused one (the last of
+    ``episodes``) when some value of it is followed, else the nearest earlier one whose
+    angle or distance takes the hand to where the refused one starts."""
+    seen: list[tuple[int, int]] = []
+    for ep in reversed(episodes):
+        at = (ep.span.line, ep.span.col)
+        if at in seen:
+            continue
+        seen.append(at)
+        st = _Statement(text, ep.span.line, ep.span.col, ep.span.end_col)
+        if st.ok:
+            bound = _bound(st, path, last, follows)
+            if bound > 0.0:
+                return st, bound
+    first = _Statement(text, *seen[0], episodes[-1].span.end_col)
+    return f"no angle or distance of `{first.stmt}` or of a statement before it is " \
+        "followed by the arm"
+
+
 def _fits(lint: FileResult, d: Diagnostic, robot: str, package_dirs: tuple[str, ...]
           ) -> list[dict[str, Any]] | str:
     """Every change the motion needs to be followed, as records (see the module), or
@@ -172,25 +193,26 @@ def _fits(lint: FileResult, d: Diagnostic, robot: str, package_dirs: tuple[str, 
 
     text, path = lint.source or "", lint.path
     changes: list[dict[str, Any]] = []
+    first: dict[tuple[int, int], tuple[str, float, int]] = {}
     span, code, failure = d.span, d.code, d.fields.get("joint")
     for _ in range(MOST):
-        st = _Statement(text, span.line, span.col, span.end_col)
-        if not st.ok:
-            return "the refused statement has no angle or distance to fit"
         tl = lint_source(text, path).timeline
         assert tl is not None
         last = max(i for i, e in enumerate(tl.episodes) if (e.span.line, e.span.col)
                    == (span.line, span.col))
-        bound = _bound(st, path, last, follows)
-        if bound <= 0.0:
-            return f"no {st.dim} of `{st.stmt}` is followed by the arm"
-        fitted = compress(abs(st.value), bound)
-        stmt, new_text = st.with_value(fitted)
+        found = _candidate(text, path, tl.episodes[:last + 1], last, follows)
+        if isinstance(found, str):
+            return found
+        st, bound = found
+        # a statement changed before is fitted again from its declared value
+        was = first.setdefault((st.line, st.col), (st.written, abs(st.value), st.stop + 1))
+        stmt, new_text = st.with_value(compress(was[1], bound))
         if not follows(new_text, path, last):
             return f"`{stmt}` is not followed either"
-        changes.append({"line": span.line, "col": span.col, "end_col": span.end_col,
-                        "key": st.dim, "declared": st.written, "fitted":
-                        _Statement(new_text, span.line, span.col, span.col + len(stmt))
+        changes = [c for c in changes if (c["line"], c["col"]) != (st.line, st.col)]
+        changes.append({"line": st.line, "col": st.col, "end_col": int(was[2]),
+                        "key": st.dim, "declared": was[0], "fitted":
+                        _Statement(new_text, st.line, st.col, st.col + len(stmt))
                         .written, "unit": st.unit, "bound": bound / st.scale,
                         "joint": failure, "limit": _LIMIT.get(code, "reach"),
                         "descriptor": st.descriptor, "statement": stmt})
