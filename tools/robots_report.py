@@ -58,8 +58,10 @@ def _advice(d, arm) -> tuple[str, str]:
                 else "a smaller or slower tilt")
     if d.code in ("C301", "C302", "C303"):
         joint = f.get("joint")
+        within = "; ".join(f"`{r['statement']}` at line {r['line']}" for r in f.get("reach", ()))
         return (f"{joint} position limit" if joint else "the workspace",
-                "move the goal (`goal`) or the start direction (`from`), or shorten the motion")
+                (f"{within} (within reach), or " if within else "")
+                + "move the goal (`goal`) or the start direction (`from`), or shorten the motion")
     if d.code == "C306":
         return (f"{f.get('check')} check", "move the goal or the start direction")
     if d.code == "C311":

@@ -154,7 +154,8 @@ def _recording(p: argparse.ArgumentParser) -> None:
 def _fit(p: argparse.ArgumentParser) -> None:
     p.add_argument("--fit", action="store_true",
                    help="change what the arm cannot give (accelerations, shiver frequency, "
-                   "tilt speed) to what it can, keeping the state; each change a C314 warning")
+                   "tilt speed, a gaze angle or distance out of reach) to what it can, "
+                   "keeping the state; each change a C314 warning")
     p.add_argument("--write-fitted", metavar="PATH.aou",
                    help="with --fit: write the fitted behaviour there (one input)")
 
