@@ -14,6 +14,7 @@ import pytest
 
 from aou_dsl.build.builder import build_source
 from aou_dsl.compiler.fitting import apply_edit
+from aou_dsl.core.diagnostics import Span
 
 from . import langgen
 
@@ -39,8 +40,13 @@ def apply_hint(text: str, d) -> str:
     edits the refused statement."""
     said = re.findall(r"`([^`]+)` at line (\d+)", d.hint or "")
     if not said:
-        edit = d.hint.split("`")[1]
-        return apply_edit(text, d.span, edit)
+        text = apply_edit(text, d.span, d.hint.split("`")[1])
+        for edit, kind, n in re.findall(r"`([^`]+)` in the (\w+) at line (\d+)", d.hint):
+            row = text.split("\n")[int(n) - 1]
+            col = row.index(kind + " ") + 1
+            end = min([len(row)] + [row.index(c, col) for c in ";#" if c in row[col:]])
+            text = apply_edit(text, Span(d.span.path, int(n), col, int(n), end + 1), edit)
+        return text
     lines = text.split("\n")
     for stmt, n in said:
         words = stmt.split()
@@ -161,6 +167,19 @@ def test_the_hint_gives_every_reach_change_at_once():
     assert {c.span.line for c in _fitted(fit)} == {5, 6}
 
 
+def test_a_too_fast_refusal_s_hint_names_every_statement_too_fast():
+    """Two shivers of a sequence too fast for the Z1's wrist: the compiler stops at the
+    first, and its hint adds the second's edit; applied, the file compiles."""
+    text = ("robot z1\nsequence {\n  approach 0.1m\n  pause 1s\n  shiver 5deg f=2.5Hz\n"
+            "  pause 1s\n  shiver 4deg f=2.2Hz for 2s\n}\n")
+    (d,) = _errors(build_source(text, "s.aou", check=False))
+    assert d.code == "C308" and d.span.line == 5
+    assert re.search(r"; and `f=[0-9.]+Hz[^`]*` in the shiver at line 7", d.hint), d.hint
+    fixed = apply_hint(text, d)
+    again = build_source(fixed, "s.aou")
+    assert again.ok, (fixed, [(x.code, x.message) for x in again.diagnostics])
+
+
 def _family(code: str) -> tuple[str, ...]:
     return REACH if code in REACH else (code,)
 
@@ -185,7 +204,7 @@ def test_applying_any_refusals_hint_over_a_generated_set_compiles_in_one_round()
             fixed = apply_hint(text, d)
             assert fixed != text, d.hint
             again = build_source(fixed, "gen.aou", robot=robot, check=False)
-            named = {int(n) for n in re.findall(r"` at line (\d+)", d.hint)} or {d.span.line}
+            named = {int(n) for n in re.findall(r"at line (\d+)", d.hint)} | {d.span.line}
             left = [x for x in _errors(again) if x.code in _family(d.code)
                     and x.span.line in named]
             assert not left, (text, d.hint, [(x.code, x.message) for x in left])
