@@ -214,3 +214,33 @@ def test_applying_any_refusals_hint_over_a_generated_set_compiles_in_one_round()
         if text != case.text:
             assert not _errors(res), (text, [(x.code, x.message) for x in _errors(res)])
     assert seen.get("C308") and seen.get("C309") and any(seen.get(c) for c in REACH), seen
+
+
+def test_every_arm_gives_every_shipped_behaviour_as_declared_or_as_fitted():
+    """The robots page's report (kept equal to a fresh run by the slow test of
+    test_robots.py): on every built-in arm each shipped behaviour compiles, passes the
+    checks and measures as declared, or does so with --fit (measured as its fitted file
+    declares, in its declared state), and each fitted change is stated."""
+    from aou_dsl.core.robot_specs import ROBOTS
+
+    from .conftest import BEHAVIOURS, ROOT
+
+    page = (ROOT / "docs" / "robots.md").read_text()
+    report = page[page.index("<!-- report:start"):page.index("<!-- report:end")]
+    n = len(list(BEHAVIOURS.glob("*.aou")))
+    assert f"{len(ROBOTS)} of {len(ROBOTS)} do with --fit" in report
+    for robot in ROBOTS:
+        section = report[report.index(f"\n### {robot}\n"):]
+        section = section[:section.index("\n### ", 5)] if "\n### " in section[5:] \
+            else section
+        rows = [r for r in section.split("\n") if r.startswith("| ")
+                and not r.startswith("| behaviour")]
+        assert len(rows) == n, robot
+        for row in rows:
+            cells = [c.strip() for c in row.strip("|").split("|")]
+            declared_ok = cells[1:4] == ["yes", "yes", "yes"]
+            assert declared_ok or cells[-1] == "yes", (robot, row)
+            if not declared_ok:
+                note = f"- {cells[0]} with --fit: "
+                assert note in section and " -> fitted " in section.split(note)[1] \
+                    .split("\n")[0], (robot, cells[0])
