@@ -171,9 +171,9 @@ def _candidate(text: str, path: str, episodes: Any, last: int, follows: Any
             bound = _bound(st, path, last, follows)
             if bound > 0.0:
                 return st, bound
-    first = _Statement(text, *seen[0], episodes[-1].span.end_col)
-    return f"no angle or distance of `{first.stmt}` or of a statement before it is " \
-        "followed by the arm"
+    refused = _Statement(text, *seen[0], episodes[-1].span.end_col) if seen else None
+    return f"no angle or distance of `{refused.stmt if refused else '?'}` or of a " \
+        "statement before it is followed by the arm"
 
 
 def _fits(lint: FileResult, d: Diagnostic, robot: str, package_dirs: tuple[str, ...]
@@ -197,9 +197,10 @@ def _fits(lint: FileResult, d: Diagnostic, robot: str, package_dirs: tuple[str, 
     span, code, failure = d.span, d.code, d.fields.get("joint")
     for _ in range(MOST):
         tl = lint_source(text, path).timeline
-        assert tl is not None
-        last = max(i for i, e in enumerate(tl.episodes) if (e.span.line, e.span.col)
-                   == (span.line, span.col))
+        last = -1 if tl is None else max((i for i, e in enumerate(tl.episodes) if (
+            e.span.line, e.span.col) == (span.line, span.col)), default=-1)
+        if tl is None or last < 0:
+            return "the refused statement makes no episode of the motion"
         found = _candidate(text, path, tl.episodes[:last + 1], last, follows)
         if isinstance(found, str):
             return found
@@ -218,8 +219,7 @@ def _fits(lint: FileResult, d: Diagnostic, robot: str, package_dirs: tuple[str, 
                         "descriptor": st.descriptor, "statement": stmt})
         text = new_text
         again = lint_source(text, path)
-        assert again.timeline is not None
-        failed = reaches(again.timeline)
+        failed = reaches(again.timeline) if again.timeline is not None else (-1, None)
         if failed is None:
             state = lint.behaviour.state if lint.behaviour is not None else None
             if state is not None and (again.cv is None or again.cv.state != state):
@@ -227,7 +227,7 @@ def _fits(lint: FileResult, d: Diagnostic, robot: str, package_dirs: tuple[str, 
                 return f"the fitted file would express `{found}`, not `{state.value}`"
             return changes
         index, fail = failed
-        if index < 0:
+        if index < 0 or again.timeline is None or fail is None:
             return "the start pose is then out of reach"
         span, failure = again.timeline.episodes[index].span, fail.joint
         code = {"UNREACHABLE": C301, "JOINT_LIMIT": C302}.get(fail.status.name, C303)
