@@ -26,13 +26,14 @@ state is not offered.
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from dataclasses import replace
 from typing import Any
 
 from ..core.codes import C301, C302, C303
-from ..core.diagnostics import Diagnostic, Severity
+from ..core.diagnostics import Diagnostic, Severity, Span, diag
 from ..lang.linter import FileResult, lint_source
 
 __all__ = ["REACH", "STEPS", "with_reach_fit"]
@@ -234,6 +235,17 @@ def _fits(lint: FileResult, d: Diagnostic, robot: str, package_dirs: tuple[str, 
     return f"more than {MOST} statements would change"
 
 
+@functools.lru_cache(maxsize=32)
+def _remembered(source: str, path: str, robot: str, package_dirs: tuple[str, ...],
+                code: str, span: Span, joint: str | None) -> list[dict[str, Any]] | str:
+    """:func:`_fits`, kept for the last texts: an editor builds the same text again
+    (a refusal's search costs about a second)."""
+    lint = lint_source(source, path)
+    if lint.behaviour is None or lint.timeline is None:
+        return "the file does not lint"
+    return _fits(lint, diag(code, "", span, joint=joint), robot, package_dirs)
+
+
 def with_reach_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...]) -> Any:
     """``res`` (a build result) with each reach refusal at a statement given the changes
     that bring the whole motion within reach: as the hint (``write `gaze horizontal
@@ -248,7 +260,9 @@ def with_reach_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...]) -
                 "time") or d.span.path != lint.path or d.span.line < 1:
             out.append(d)
             continue
-        found = _fits(lint, d, robot or b.settings.robot, package_dirs)
+        found = _remembered(lint.source, lint.path, robot or b.settings.robot, package_dirs,
+                            d.code, d.span, d.fields.get("joint"))
+        found = found if isinstance(found, str) else [dict(c) for c in found]
         if isinstance(found, str):
             why = f"no smaller angle or distance is offered: {found}"
             out.append(replace(d, hint=f"{d.hint}; {why}" if d.hint else why,
