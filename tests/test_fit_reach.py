@@ -244,3 +244,25 @@ def test_every_arm_gives_every_shipped_behaviour_as_declared_or_as_fitted():
                 note = f"- {cells[0]} with --fit: "
                 assert note in section and " -> fitted " in section.split(note)[1] \
                     .split("\n")[0], (robot, cells[0])
+
+
+def test_a_shiver_no_frequency_fits_is_fitted_by_its_amplitude_in_order():
+    """60 deg would need a shiver slower than the language allows: the amplitude is
+    fitted instead, at its frequency; applying the hint compiles, the fitted file
+    measures the amplitude it declares, and two amplitudes keep their order."""
+    got = []
+    for amp in (50, 60):
+        text = f"shiver {amp}deg f=2.5Hz\n"
+        (d,) = _errors(build_source(text, "s.aou", check=False))
+        assert d.code == "C308" and not d.fields["max_frequency"]
+        assert d.hint.startswith("write `shiver "), d.hint
+        assert build_source(apply_hint(text, d), "s.aou").ok
+        res = build_source(text, "s.aou", fit=True)
+        assert res.ok, [(x.code, x.message) for x in res.diagnostics]
+        (c,) = _fitted(res)
+        assert c.fields["descriptor"] == "shiver_amplitude" and c.fields["joint"]
+        fitted = float(c.fields["fitted"])
+        assert not [x for x in res.diagnostics if x.code == "C310"]
+        assert res.measured.descriptors["shiver_amplitude"] == pytest.approx(fitted, abs=0.5)
+        got.append(fitted)
+    assert got[0] < got[1]

@@ -165,7 +165,11 @@ def test_c308_offers_a_smaller_amplitude_when_no_frequency_fits():
     """60 deg at 2.5 Hz would need a shiver slower than the language allows: the
     amplitude that fits at 2.5 Hz is given instead, and it compiles."""
     d = _one(build_source("shiver 60deg f=2.5Hz\n", "t.aou", check=False), "C308")
-    assert d.hint is None and "Hz fits" not in d.message
+    assert "Hz fits" not in d.message
+    # the hint is the amplitude that fits at 2.5 Hz (the rule of --fit, under that bound)
+    hinted = re.fullmatch(r"write `shiver ([0-9.]+)deg f=2.5Hz` at line 1", d.hint)
+    assert hinted, d.hint
+    assert build_source(f"shiver {hinted.group(1)}deg f=2.5Hz\n", "t.aou").ok
     m = re.search(r"at most ([0-9.]+) deg at 2.5 Hz", d.message)
     assert m, d.message
     res = build_source(f"shiver {m.group(1)}deg f=2.5Hz\n", "t.aou")

@@ -161,11 +161,13 @@ def build_lint(lint: FileResult, options: BuildOptions | None = None,
 
     opts = (options or BuildOptions()).replace(**changes) if changes else (
         options or BuildOptions())
+    from .amplitude_fit import with_amplitude_fit
     from .every_change import with_every_change
     from .reach_fit import with_reach_fit
 
     def one(linted: FileResult) -> BuildResult:  # a refusal's hint: every change
         res = with_reach_fit(_build_lint(linted, opts), opts.robot, opts.package_dirs)
+        res = with_amplitude_fit(res, opts.robot, opts.package_dirs)
         return with_every_change(res, opts.package_dirs)
 
     if opts.fit:

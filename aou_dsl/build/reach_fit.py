@@ -36,7 +36,7 @@ from ..core.codes import C301, C302, C303
 from ..core.diagnostics import Diagnostic, Severity, Span, diag
 from ..lang.linter import FileResult, lint_source
 
-__all__ = ["REACH", "STEPS", "with_reach_fit"]
+__all__ = ["REACH", "STEPS", "Statement", "with_reach_fit"]
 
 #: The refusals a reach fit answers.
 REACH = (C301, C302, C303)
@@ -58,20 +58,22 @@ def _descriptor(words: list[str]) -> str | None:
     """The descriptor a statement's positional value sets (None: none)."""
     if words[0] == "gaze" and len(words) > 1 and words[1] in ("horizontal", "vertical"):
         return f"{words[1]}_gaze"
-    return {"retreat": "retreat_distance", "tilt": "tilt_angle"}.get(words[0])
+    return {"retreat": "retreat_distance", "tilt": "tilt_angle",
+            "shiver": "shiver_amplitude"}.get(words[0])
 
 
-class _Statement:
+class Statement:
     """One statement's positional value, and the file's text with another value there."""
 
-    def __init__(self, text: str, line: int, col: int, end_col: int) -> None:
+    def __init__(self, text: str, line: int, col: int, end_col: int,
+                 kinds: tuple[str, ...] = ("gaze", "retreat", "tilt", "approach")) -> None:
         self.text, self.line, self.col = text, line, col
         row = text.split("\n")[line - 1]
         self.stop = end_col - 1 if end_col > col else len(row)
         self.stmt = row[col - 1:self.stop]
         self.match = _QUANTITY.search(" " + self.stmt)
         words = self.stmt.split()
-        self.ok = bool(words) and words[0] in ("gaze", "retreat", "tilt", "approach") \
+        self.ok = bool(words) and words[0] in kinds \
             and self.match is not None
         if self.ok:
             assert self.match is not None
@@ -142,7 +144,7 @@ def _reach(lint: FileResult, robot: str, package_dirs: tuple[str, ...]) -> Any:
     return reaches
 
 
-def _bound(st: _Statement, path: str, last: int, follows: Any) -> float:
+def _bound(st: Statement, path: str, last: int, follows: Any) -> float:
     """The largest magnitude (SI) on the fixed grid at which IK follows the motion past
     episode ``last`` (0.0: none found). Grid points at or above the declared value are
     taken as failing (it failed), so they cost nothing."""
@@ -157,7 +159,7 @@ def _bound(st: _Statement, path: str, last: int, follows: Any) -> float:
 
 
 def _candidate(text: str, path: str, episodes: Any, last: int, follows: Any
-               ) -> tuple[_Statement, float] | str:
+               ) -> tuple[Statement, float] | str:
     """The statement to change and its bound: the refused one (the last of
     ``episodes``) when some value of it is followed, else the nearest earlier one whose
     angle or distance takes the hand to where the refused one starts."""
@@ -167,12 +169,12 @@ def _candidate(text: str, path: str, episodes: Any, last: int, follows: Any
         if at in seen:
             continue
         seen.append(at)
-        st = _Statement(text, ep.span.line, ep.span.col, ep.span.end_col)
+        st = Statement(text, ep.span.line, ep.span.col, ep.span.end_col)
         if st.ok:
             bound = _bound(st, path, last, follows)
             if bound > 0.0:
                 return st, bound
-    refused = _Statement(text, *seen[0], episodes[-1].span.end_col) if seen else None
+    refused = Statement(text, *seen[0], episodes[-1].span.end_col) if seen else None
     return f"no angle or distance of `{refused.stmt if refused else '?'}` or of a " \
         "statement before it is followed by the arm"
 
@@ -214,7 +216,7 @@ def _fits(lint: FileResult, d: Diagnostic, robot: str, package_dirs: tuple[str, 
         changes = [c for c in changes if (c["line"], c["col"]) != (st.line, st.col)]
         changes.append({"line": st.line, "col": st.col, "end_col": int(was[2]),
                         "key": st.dim, "declared": was[0], "fitted":
-                        _Statement(new_text, st.line, st.col, st.col + len(stmt))
+                        Statement(new_text, st.line, st.col, st.col + len(stmt))
                         .written, "unit": st.unit, "bound": bound / st.scale,
                         "joint": failure, "limit": _LIMIT.get(code, "reach"),
                         "descriptor": st.descriptor, "statement": stmt})

@@ -142,10 +142,10 @@ def plan(diagnostics: list[Diagnostic], declared: dict[tuple, float]) -> list[Ch
             fitted = _down(compress(float(v), cap) if v else cap, 4)
             out.append(Change(d.span, "v", "" if v is None else f"{v:g}", fitted, "deg/s",
                               joint, limit, "tilt_velocity"))
-        elif d.code in (C301, C302, C303):
-            out += [Change(Span(d.span.path, r["line"], r["col"], r["line"], r["end_col"]),
-                           r["key"], r["declared"], r["fitted"], r["unit"], r["joint"],
-                           r["limit"], r["descriptor"]) for r in d.fields.get("reach", ())]
+        # the changes the builder found (a reach, a shiver's amplitude: field ``reach``)
+        out += [Change(Span(d.span.path, r["line"], r["col"], r["line"], r["end_col"]),
+                       r["key"], r["declared"], r["fitted"], r["unit"], r["joint"],
+                       r["limit"], r["descriptor"]) for r in d.fields.get("reach", ())]
     return out
 
 
