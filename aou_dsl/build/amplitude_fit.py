@@ -54,7 +54,7 @@ def with_amplitude_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...
     record = {"line": st.line, "col": st.col, "end_col": st.stop + 1, "key": "angle",
               "declared": st.written, "fitted": fitted.written, "unit": st.unit,
               "bound": bound / st.scale, "joint": d.fields.get("joint"),
-              "limit": d.fields.get("limit"), "descriptor": "shiver_amplitude",
+              "limit": d.fields.get("limit"), "descriptor": st.descriptor,
               "statement": stmt}
     hint = f"write `{stmt}` at line {st.line}"
     res.diagnostics = [replace(x, hint=f"{hint}; or {x.hint}" if x.hint else hint,
