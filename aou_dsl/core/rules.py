@@ -297,13 +297,6 @@ _RULE_LIST = [
          "The blend is refused rather than sent: the arm keeps its goal.",
          "a goal moved 30 cm during a fast retreat"),
     # --- R: reading trajectories -------------------------------------------------------
-    Rule("C314", "fitted-value", _W,
-         "With --fit, a value the arm cannot give was changed to one it can: the "
-         "statement, the value declared and fitted, the joint and the limit that bind.",
-         "The fitted behaviour keeps its state and the order of its values (docs/robots.md "
-         "gives the rule); --write-fitted writes the file so the change is reviewed.",
-         "robot ur5\nshiver 6deg f=2.5Hz\npause 1s"),
-    # --- R: reading trajectories -------------------------------------------------------
     Rule("R401", "bad-trajectory", _E,
          "A trajectory file is not valid: missing keys or columns, non-increasing time, NaN.",
          "Descriptors cannot be measured from it.",
@@ -392,6 +385,10 @@ _RULE_LIST = [
 ]
 
 RULES: dict[str, Rule] = {r.code: r for r in _RULE_LIST}
+if len(RULES) != len(_RULE_LIST):  # a code listed twice: the second would hide the first
+    raise RuntimeError("a rule code is registered twice: "
+                       + ", ".join(sorted({r.code for r in _RULE_LIST
+                                           if [q.code for q in _RULE_LIST].count(r.code) > 1})))
 
 
 def category(code: str) -> Category:
