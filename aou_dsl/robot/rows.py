@@ -11,6 +11,7 @@ on two (the row twice), as a batch of one can round differently from a larger ba
 from __future__ import annotations
 
 import functools
+import itertools
 from collections.abc import Callable
 
 import numpy as np
@@ -57,8 +58,8 @@ class RowMemo:
         if len(q) > self.size:  # more than it keeps: computed, not kept
             return tuple(fn(q))
         keys = row_keys(q)
-        get = self.index.get
-        at = np.fromiter((get(k, -1) for k in keys), dtype=np.intp, count=len(keys))
+        at = np.fromiter(map(self.index.get, keys, itertools.repeat(-1)), dtype=np.intp,
+                         count=len(keys))
         missing = np.flatnonzero(at < 0)
         if len(missing):
             if self.used + len(missing) > self.size:
