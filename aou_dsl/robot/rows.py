@@ -13,6 +13,7 @@ from __future__ import annotations
 import functools
 import itertools
 from collections.abc import Callable
+from typing import cast
 
 import numpy as np
 
@@ -29,7 +30,8 @@ def row_keys(q: np.ndarray) -> list[bytes]:
     q = np.ascontiguousarray(np.atleast_2d(q), dtype=float)
     if q.shape[1] == 0:
         return [b""] * len(q)
-    return q.view(np.dtype((np.void, q.shape[1] * q.itemsize))).ravel().tolist()
+    rows = q.view(np.dtype((np.void, q.shape[1] * q.itemsize))).ravel()
+    return cast("list[bytes]", rows.tolist())  # a void row's item is its bytes
 
 
 class RowMemo:

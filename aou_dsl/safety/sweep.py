@@ -85,7 +85,7 @@ class Sweep:
         self.visited: dict[int, tuple] = {}  # sample -> PyBullet's end-effector pose
         self.queries = 0
         self.memo = memo if memo is not None else Memo()
-        self._keys: dict[int, bytes] = {}  # sample -> its joint values as bytes
+        self._keys: list[bytes] | None = None  # per sample, its joint values as bytes
         set_joints(scene, geo.free, np.zeros(len(geo.free)))
         if geo.plan is None:
             geo.plan = plan(scene, geo)
@@ -115,10 +115,11 @@ class Sweep:
 
     def key(self, j: int) -> bytes:
         """Sample ``j``'s joint values as bytes (what the memo knows a pose by)."""
-        key = self._keys.get(j)
-        if key is None:
-            key = self._keys[j] = self.q[j].tobytes()
-        return key
+        if self._keys is None:
+            from ..robot.rows import row_keys
+
+            self._keys = row_keys(self.q)
+        return self._keys[j]
 
     def _put(self, j: int) -> None:
         """Put PyBullet's arm at sample ``j``."""
