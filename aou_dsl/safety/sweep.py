@@ -54,7 +54,7 @@ class Memo:
 
     distances: dict[tuple[int, bytes], float] = field(default_factory=dict)
     poses: dict[tuple[int, bytes], tuple] = field(default_factory=dict)
-    size: int = 200_000
+    size: int = 100_000
 
     def trim(self) -> None:
         """Forget everything once over :attr:`size` (called between sweeps)."""
