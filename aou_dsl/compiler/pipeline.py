@@ -92,8 +92,16 @@ class CompileResult:
 
 def _waypoints(ep: Episode, frame: ReachFrame, opts: CompileOptions
                ) -> tuple[np.ndarray, list[tuple[np.ndarray, np.ndarray]]]:
-    """Path coordinate samples (K,) and end-effector targets of a moving episode."""
+    """Path coordinate samples (K,) and end-effector targets of a moving episode; kept
+    for recompilations by what they depend on (neither is changed by their users)."""
     step = opts.step_length if KINDS[ep.kind].translation else opts.step_angle
+    key = (frame.goal.tobytes(), frame.R0.tobytes(), ep.start, ep.end, ep.path_length, step)
+    return _kept_waypoints(Keyed(key, (ep, frame, step)))
+
+
+@functools.lru_cache(maxsize=256)
+def _kept_waypoints(probe: Keyed) -> tuple[np.ndarray, list[tuple[np.ndarray, np.ndarray]]]:
+    ep, frame, step = probe.value
     n = max(MIN_WAYPOINTS, math.ceil(ep.path_length / step) + 1)
     s = np.linspace(0.0, ep.path_length, n)
     a, b = ep.start, ep.end
@@ -101,6 +109,7 @@ def _waypoints(ep: Episode, frame: ReachFrame, opts: CompileOptions
     for si in s:
         f = si / ep.path_length
         targets.append(frame.target(a.lerp(b, f)))
+    s.setflags(write=False)  # shared by the compilations that keep it
     return s, targets
 
 

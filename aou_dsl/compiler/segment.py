@@ -54,7 +54,7 @@ class PathSegment:
 
     def positions(self, tau: np.ndarray) -> np.ndarray:
         """Joint positions at local times, (len(tau), n): :meth:`sample`'s first."""
-        return self.spline(self.law(tau)[0])
+        return self.spline(self.law.position(tau))
 
     def jerk(self, tau: np.ndarray) -> np.ndarray:
         """Joint jerks at local times, shape (len(tau), n):

@@ -90,6 +90,22 @@ class TimeLaw:
         piece = self.s[:-1] * dt + self.sd[:-1] * dt**2 / 2 + self.u * dt**3 / 6
         return np.concatenate([[0.0], np.cumsum(piece)])
 
+    def position(self, tau: np.ndarray) -> np.ndarray:
+        """``s`` alone at local times ``tau``: :meth:`__call__`'s first."""
+        return self(tau)[0]
+
+    def area(self, tau: np.ndarray) -> np.ndarray:
+        """``integral of s over [0, tau]`` alone: :meth:`state`'s last, computed the same
+        way to the bit (a controller's view of the motion reads positions only)."""
+        tau = np.asarray(tau, dtype=float)
+        end = self.duration
+        tc = np.clip(tau, 0.0, end)
+        i = np.clip(np.searchsorted(self.t, tc, side="right") - 1, 0, len(self.u) - 1)
+        dt = tc - self.t[i]
+        area = self._area[i] + self.s[i] * dt + self.sd[i] * dt**2 / 2 + self.u[i] * dt**3 / 6
+        return np.where(tau < 0.0, 0.0, area + np.where(tau > end, self.length * (tau - end),
+                                                        0.0))
+
     def state(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``s, s', s''`` and ``integral of s over [0, tau]`` at any times: at rest at 0
         before the law, at rest at ``length`` after it. Each shape (len(tau),)."""
@@ -146,6 +162,16 @@ class SmoothLaw:
                                                 [x[n:].reshape(tau.shape) for x in both])
         s = np.where(tau >= self.duration, self.base.length, (a1 - a0) / w)
         return s, (s1 - s0) / w, (sd1 - sd0) / w, (u1 - u0) / w
+
+    def position(self, tau: np.ndarray) -> np.ndarray:
+        """``s`` alone at local times ``tau``: :meth:`derivatives`'s first, computed the
+        same way to the bit from the base law's areas alone."""
+        tau = np.clip(np.asarray(tau, dtype=float), 0.0, self.duration)
+        w = self.window
+        n = len(tau) if tau.ndim else 1
+        both = self.base.area(np.concatenate([tau.reshape(-1), tau.reshape(-1) - w]))
+        a1, a0 = both[:n].reshape(tau.shape), both[n:].reshape(tau.shape)
+        return np.where(tau >= self.duration, self.base.length, (a1 - a0) / w)
 
     def jerk(self, tau: np.ndarray) -> np.ndarray:
         """``s'''`` at local times ``tau``."""

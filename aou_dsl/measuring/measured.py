@@ -152,7 +152,9 @@ def _context(rec: Trajectory) -> tuple[Context, list[Boundary], np.ndarray, np.n
     carried = _carried(rec, cols, grid)
     rest = rest_signals(grid.t, grid.h, grid.q, noise, jn.quantum, grid.density, window,
                         grid.t_last, carried)
-    pos, rot = batch_fk(arm, grid.q)
+    from ..robot.batch_fk import kept_fk  # the checks of a build met these rows
+
+    pos, rot = kept_fk(arm, grid.q)
     pos_s = smooth(pos, window, 0, grid.h) if window > 3 else pos
     goal = None if rec.goal is None else np.asarray(rec.goal, float)
     raw = Samples(t - t[0], q, batch_fk(arm, q)[0]) if grid.resampled else None

@@ -16,7 +16,7 @@ import numpy as np
 
 from .kinematics import ArmModel, rotate_columns
 
-__all__ = ["batch_fk", "classical_acceleration", "linear_jacobian"]
+__all__ = ["batch_fk", "classical_acceleration", "kept_fk", "linear_jacobian"]
 
 _AXES = {"X": 0, "Y": 1, "Z": 2}
 
@@ -89,6 +89,17 @@ def batch_fk(arm: ArmModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     r_f = np.ascontiguousarray(frame.placement.rotation, float)
     pos = p_j + np.tensordot(p_f, c_j, axes=1)
     return pos.T, times(r_f, c_j).transpose(2, 1, 0)
+
+
+def kept_fk(arm: ArmModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`batch_fk`, with the rows seen before (by this arm) looked up: the checks
+    and the measurement of a build share them, and a recompilation repeats most of
+    them (:mod:`.rows`)."""
+    from .rows import kept
+
+    pos, rot = kept(arm, "batch_fk", np.atleast_2d(np.asarray(q, float)),
+                    lambda rows: batch_fk(arm, rows))
+    return pos, rot
 
 
 def linear_jacobian(arm: ArmModel, q: np.ndarray) -> np.ndarray:

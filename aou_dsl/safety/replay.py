@@ -35,8 +35,8 @@ from ..core.trajectory import Trajectory
 from ..robot.load import load_arm
 from ..robot.scene import Scene, urdf_path
 from .limits import Check, check_limits
-from .sweep import CONTACT_MARGIN, QUERY_RANGE, Geometry, Sweep, geometry
-from .urdf_fk import chain_fk, urdf_chain
+from .sweep import CONTACT_MARGIN, QUERY_RANGE, Geometry, Memo, Sweep, geometry
+from .urdf_fk import kept_chain_fk, urdf_chain
 
 __all__ = ["CheckReport", "replay"]
 
@@ -117,8 +117,10 @@ def replay(tr: Trajectory, *, options: SceneOptions | None = None,
         scene.pb.resetBasePositionAndOrientation(scene.target, goal or _AWAY, (0, 0, 0, 1),
                                                  physicsClientId=scene.client)
     frame = tr.ee_frame or arm.spec.ee_frame
+    memo = _memo(tr.robot, options, goal)
+    memo.trim()
     sweep = Sweep(scene, geo, q, scene.link_index.get(frame, scene.joint_index.get(frame)),
-                  target=goal is not None)
+                  target=goal is not None, memo=memo)
     kin_checks, clear = _contacts(sweep, t)
     agree_check, agree = _agreement(sweep, arm, frame, t, q)
     report = CheckReport(tr.robot, checks + kin_checks + [agree_check], clear, agree)
@@ -155,6 +157,13 @@ def _scene(robot: str, options: SceneOptions) -> tuple[Scene, Geometry]:
     settings it relies on."""
     scene = Scene(robot, _AWAY, options, visuals=False)
     return scene, geometry(scene, load_arm(robot, None, options.package_dirs).spec.allowed_contacts)
+
+
+@functools.lru_cache(maxsize=8)
+def _memo(robot: str, options: SceneOptions, goal: tuple[float, ...] | None) -> Memo:
+    """What the sweeps in one scene with the cube at one goal measured, for the next
+    replay there (a recompilation repeats most joint values: see :class:`.sweep.Memo`)."""
+    return Memo()
 
 
 def _contacts(sweep: Sweep, t: np.ndarray) -> tuple[list[Check], dict]:
@@ -205,7 +214,7 @@ def _agreement(sweep: Sweep, arm, frame: str, t: np.ndarray, q: np.ndarray
     once, and by Pinocchio itself at :data:`AGREE_SPOTS` samples spread over the
     motion), and against PyBullet's at every sample the replay put PyBullet in (those
     spots included)."""
-    from ..robot.batch_fk import batch_fk
+    from ..robot.batch_fk import kept_fk
 
     spots = np.unique(np.linspace(0, len(t) - 1, AGREE_SPOTS).astype(int))
     for j in spots:
@@ -213,8 +222,8 @@ def _agreement(sweep: Sweep, arm, frame: str, t: np.ndarray, q: np.ndarray
     chain = urdf_chain(urdf_path(sweep.scene.robot, visuals=False,
                                  package_dirs=sweep.scene.options.package_dirs)[0], frame,
                        arm.joint_names)
-    pos, rot = chain_fk(chain, q)
-    pin_pos, pin_rot = batch_fk(arm, q)
+    pos, rot = kept_chain_fk(chain, q)
+    pin_pos, pin_rot = kept_fk(arm, q)
     dp = np.linalg.norm(pos - pin_pos, axis=1)
     dr = _angles_deg(rot, pin_rot)
     own_pos, own_rot = arm.fk(q[spots])  # Pinocchio's own forward kinematics

@@ -32,8 +32,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..robot.scene import Scene
+from .levers import Geometry, geometry, plan, set_joints
 
-__all__ = ["CONTACT_MARGIN", "Geometry", "Sweep", "geometry"]
+__all__ = ["CONTACT_MARGIN", "Geometry", "Memo", "Sweep", "geometry"]
 
 #: A sample whose distance bound is within this of contact is measured [m] (room for
 #: the collision engine's own numerical tolerance).
@@ -42,186 +43,24 @@ CONTACT_MARGIN = 1e-3
 CLEARANCE_TOL = 1e-7
 #: Distances are queried up to this [m]; beyond, only "at least this far" is known.
 QUERY_RANGE = 1.0
-#: Random configurations that bound each link's radius about its frame (seeded).
-_RADIUS_POSES = 24
 
 
 @dataclass
-class Geometry:
-    """What the bounds need of a robot in a scene, computed once per scene.
+class Memo:
+    """What a sweep measured, by the joint values it measured at, for the next sweep in
+    the same scene (the same robot, options and goal): PyBullet's answers depend on the
+    pose alone, so a recompilation whose samples repeat asks PyBullet only about the new
+    ones. Bounded: it starts again empty past :attr:`size` entries."""
 
-    Attributes:
-        pairs: link pairs that must not touch (PyBullet link indices, -1 the base).
-        base: the root link and links welded to it (they stand on the table).
-        shaped: links with a collision shape.
-        free: movable joints that are not arm joints (held at zero during a replay).
-        lever: per link, ``{joint: L}``: no point of the link is further than ``L`` from
-            the axis of ``joint`` (an ancestor joint, or the link's own), in any pose.
-        arm_pos: PyBullet joint index -> column of the arm's ``q``.
-        ancestors: per link, the link and its ancestors up to (not including) the base.
-        world_axis: arm joints below no other arm joint -> their axis in the world
-            (constant): a turn about a vertical axis moves nothing up or down.
-    """
+    distances: dict[tuple[int, bytes], float] = field(default_factory=dict)
+    poses: dict[tuple[int, bytes], tuple] = field(default_factory=dict)
+    size: int = 100_000
 
-    pairs: list[tuple[int, int]]
-    base: set[int]
-    shaped: list[int]
-    free: list[int]
-    lever: dict[int, dict[int, float]]
-    arm_pos: dict[int, int]
-    ancestors: dict[int, list[int]] = field(default_factory=dict)
-    world_axis: dict[int, np.ndarray] = field(default_factory=dict)
-    plan: tuple | None = None  # made by the first sweep: see _plan
-
-    def weights(self, a: int, b: int | None, normal: np.ndarray | None = None
-                ) -> np.ndarray:
-        """Per arm joint, how far a unit turn can move link ``a`` relative to link ``b``
-        (None: the world; then ``normal``: only motion along it counts) [m/rad]. Only
-        the joints below the links' common ancestor count."""
-        chains = [(x, self.ancestors.get(x, [])) for x in (a, b) if x is not None]
-        shared = set(chains[0][1]) & set(chains[1][1]) if len(chains) == 2 else set()
-        w = np.zeros(len(self.arm_pos))
-        for x, chain in chains:
-            for m in chain:  # from the link up: the shared part is the top of the chain
-                if m in shared:
-                    break
-                if m in self.arm_pos:
-                    axis = self.world_axis.get(m)
-                    # turning about u moves a point along u x (point - axis): its
-                    # component along the normal is at most |normal x u| of it
-                    f = 1.0 if normal is None or axis is None else float(
-                        np.linalg.norm(np.cross(normal, axis)))
-                    w[self.arm_pos[m]] += f * self.lever[x][m]
-        return w
-
-
-def geometry(scene: Scene, allowed: tuple[tuple[str, str], ...]) -> Geometry:
-    """The pairs, base links and lever arms of ``scene``'s robot (see :class:`Geometry`).
-    Leaves the arm in some pose: a replay sets every joint it relies on."""
-    pb, c, body = scene.pb, scene.client, scene.body
-    n = pb.getNumJoints(body, physicsClientId=c)
-    info = [pb.getJointInfo(body, j, physicsClientId=c) for j in range(n)]
-    parent = {j: info[j][16] for j in range(n)}
-    shaped = [j for j in range(-1, n) if pb.getCollisionShapeData(body, j, physicsClientId=c)]
-    ancestors = {}
-    for j in range(n):
-        chain, x = [], j
-        while x != -1:
-            chain.append(x)
-            x = parent[x]
-        ancestors[j] = chain
-    base = {-1}
-    for j in range(n):
-        if info[j][2] == pb.JOINT_FIXED and info[j][16] in base:
-            base.add(j)
-    arm_pos = {j: k for k, j in enumerate(scene.arm)}
-    free = [j for j in range(n) if info[j][2] != pb.JOINT_FIXED and j not in arm_pos]
-    geo = Geometry(_pairs(scene, parent, shaped, allowed), base, shaped, free, {}, arm_pos,
-                   ancestors)
-    radius, offset = _radii(scene, info, shaped, free)
-    slides = {j for j in scene.arm if info[j][2] == pb.JOINT_PRISMATIC}
-    geo.world_axis = {m: _world_axis(scene, m) for m in scene.arm
-                      if m not in slides and not any(x in arm_pos for x in ancestors[m][1:])}
-    for x in range(n):
-        lever, reach = {}, radius.get(x, 0.0)
-        for m in ancestors[x]:  # x first, then up: the reach grows by each link's offset
-            lever[m] = 1.0 if m in slides else reach  # a slide moves every point as far
-            reach += offset[m]
-        geo.lever[x] = lever
-    return geo
-
-
-def _pairs(scene: Scene, parent: dict[int, int], shaped: list[int],
-           allowed: tuple[tuple[str, str], ...]) -> list[tuple[int, int]]:
-    """Link pairs that must not touch: not adjacent (through shapeless links) and not
-    allowed by the robot table."""
-    shaped_set = set(shaped)
-
-    def shaped_parent(j: int) -> int:
-        p = parent.get(j, -1)
-        while p != -1 and p not in shaped_set:
-            p = parent.get(p, -1)
-        return p
-
-    allowed_ids = {frozenset((scene.link_index[a], scene.link_index[b])) for a, b in allowed}
-    out = []
-    for i, a in enumerate(shaped):
-        for b in shaped[i + 1:]:
-            if shaped_parent(b) == a or shaped_parent(a) == b:
-                continue
-            if frozenset((a, b)) not in allowed_ids:
-                out.append((a, b))
-    return out
-
-
-def _radii(scene: Scene, info: list, shaped: list[int], free: list[int]
-           ) -> tuple[dict[int, float], dict[int, float]]:
-    """Per link, a radius about its frame's origin that holds its collision shapes (the
-    farthest corner of PyBullet's bounding box, at its smallest over seeded random
-    poses); per link, the distance from its parent's frame origin to its own (constant:
-    a joint turns about its child's origin; free joints are at zero)."""
-    pb, c, body = scene.pb, scene.client, scene.body
-    rng = np.random.default_rng(0)
-    lo = np.array([info[j][8] for j in scene.arm])
-    hi = np.array([info[j][9] for j in scene.arm])
-    lo, hi = np.where(hi > lo, lo, -math.pi), np.where(hi > lo, hi, math.pi)
-    radius: dict[int, float] = {}
-    offset: dict[int, float] = {}
-    links = [j for j in shaped if j >= 0]
-    for k in range(_RADIUS_POSES):
-        q = (lo + hi) / 2 if k == 0 else rng.uniform(lo, hi)
-        set_joints(scene, scene.arm, q)
-        set_joints(scene, free, np.zeros(len(free)))
-        origin = {j: np.array(pb.getLinkState(body, j, computeForwardKinematics=True,
-                                              physicsClientId=c)[4])
-                  for j in range(len(info))}
-        for j in links:
-            box = np.array(pb.getAABB(body, j, physicsClientId=c))
-            corners = np.array([[box[a][0], box[b][1], box[d][2]]
-                                for a in (0, 1) for b in (0, 1) for d in (0, 1)])
-            r = float(np.linalg.norm(corners - origin[j], axis=1).max())
-            radius[j] = min(radius.get(j, math.inf), r)
-        if k == 0:  # arm joints in the middle of their ranges; a slide's offset varies
-            for j in range(len(info)):
-                p = info[j][16]
-                offset[j] = float(np.linalg.norm(origin[j] - origin[p])) if p >= 0 else 0.0
-                if info[j][2] == pb.JOINT_PRISMATIC and j in scene.arm:
-                    offset[j] += float(hi[scene.arm.index(j)] - lo[scene.arm.index(j)]) / 2
-    return radius, offset
-
-
-def _plan(scene: Scene, geo: Geometry) -> tuple[list[tuple[str, int, int]], np.ndarray]:
-    """The distances a replay follows (kind, link, link or body) and their weights."""
-    kinds = [("self", a, b) for a, b in geo.pairs]
-    w = [geo.weights(a, b) for a, b in geo.pairs]
-    if scene.target is not None:
-        kinds += [("target", a, scene.target) for a in geo.shaped]
-        w += [geo.weights(a, None) for a in geo.shaped]
-    if scene.table is not None:
-        movers = [a for a in geo.shaped if a not in geo.base]
-        kinds += [("table", a, scene.table) for a in movers]
-        w += [geo.weights(a, None, np.array([0.0, 0.0, 1.0])) for a in movers]
-    return kinds, np.array(w).reshape(len(w), len(geo.arm_pos))
-
-
-def _world_axis(scene: Scene, m: int) -> np.ndarray:
-    """The world axis of joint ``m``, from how its link turns when the joint does."""
-    pb, c, body = scene.pb, scene.client, scene.body
-    rots = []
-    for x in (0.0, 0.5):
-        pb.resetJointState(body, m, x, physicsClientId=c)
-        quat = pb.getLinkState(body, m, computeForwardKinematics=True, physicsClientId=c)[5]
-        rots.append(np.reshape(pb.getMatrixFromQuaternion(quat), (3, 3)))
-    turn = rots[1] @ rots[0].T
-    axis = np.array([turn[2, 1] - turn[1, 2], turn[0, 2] - turn[2, 0], turn[1, 0] - turn[0, 1]])
-    return axis / np.linalg.norm(axis)
-
-
-def set_joints(scene: Scene, joints: list[int], q) -> None:
-    """Put ``joints`` at ``q``, kinematically."""
-    if joints:
-        scene.pb.resetJointStatesMultiDof(scene.body, joints, [[float(v)] for v in q],
-                                          physicsClientId=scene.client)
+    def trim(self) -> None:
+        """Forget everything once over :attr:`size` (called between sweeps)."""
+        if len(self.distances) + len(self.poses) > self.size:
+            self.distances.clear()
+            self.poses.clear()
 
 
 @dataclass
@@ -239,17 +78,20 @@ class Sweep:
     """The distances of one trajectory in one scene, measured on demand."""
 
     def __init__(self, scene: Scene, geo: Geometry, q: np.ndarray, ee_link: int | None,
-                 *, target: bool = True):
+                 *, target: bool = True, memo: Memo | None = None):
         self.scene, self.geo, self.q = scene, geo, q
         self.ee_link = ee_link
         self.at = -1
         self.visited: dict[int, tuple] = {}  # sample -> PyBullet's end-effector pose
         self.queries = 0
+        self.memo = memo if memo is not None else Memo()
+        self._keys: list[bytes] | None = None  # per sample, its joint values as bytes
         set_joints(scene, geo.free, np.zeros(len(geo.free)))
         if geo.plan is None:
-            geo.plan = _plan(scene, geo)
+            geo.plan = plan(scene, geo)
         kinds, w = geo.plan
         keep = [k for k, (kind, _, _) in enumerate(kinds) if target or kind != "target"]
+        self.planned = keep  # item -> its place in the plan (what the memo knows it by)
         items = [_Item(*kinds[k]) for k in keep]
         w = w[keep]
         self.items = items
@@ -271,20 +113,37 @@ class Sweep:
 
     # --- measuring ---
 
-    def visit(self, j: int) -> None:
-        """Put PyBullet's arm at sample ``j``, and note PyBullet's end-effector pose
-        there (the replay compares it with its own kinematics)."""
+    def key(self, j: int) -> bytes:
+        """Sample ``j``'s joint values as bytes (what the memo knows a pose by)."""
+        if self._keys is None:
+            from ..robot.rows import row_keys
+
+            self._keys = row_keys(self.q)
+        return self._keys[j]
+
+    def _put(self, j: int) -> None:
+        """Put PyBullet's arm at sample ``j``."""
         if j != self.at:
             scene = self.scene
             scene.pb.resetJointStatesMultiDof(scene.body, scene.arm,
                                               [[v] for v in self.q[j].tolist()],
                                               physicsClientId=scene.client)
             self.at = j
-        if self.ee_link is not None and j not in self.visited:
+
+    def visit(self, j: int) -> None:
+        """Note PyBullet's end-effector pose at sample ``j`` (the replay compares it
+        with its own kinematics): from the memo, else with PyBullet's arm put there."""
+        if self.ee_link is None or j in self.visited:
+            return
+        key = (self.ee_link, self.key(j))
+        pose = self.memo.poses.get(key)
+        if pose is None:
+            self._put(j)
             st = self.scene.pb.getLinkState(self.scene.body, self.ee_link,
                                             computeForwardKinematics=True,
                                             physicsClientId=self.scene.client)
-            self.visited[j] = (st[4], st[5])
+            pose = self.memo.poses[key] = (st[4], st[5])
+        self.visited[j] = pose
 
     def measure(self, p: int, j: int) -> float:
         """The distance of item ``p`` at sample ``j`` (at most :data:`QUERY_RANGE`)."""
@@ -293,6 +152,17 @@ class Sweep:
         if k < len(it.js) and it.js[k] == j:
             return it.ds[k]
         self.visit(j)
+        key = (self.planned[p], self.key(j))
+        d = self.memo.distances.get(key)
+        if d is None:
+            d = self.memo.distances[key] = self._query(it, j)
+        it.js.insert(k, j)
+        it.ds.insert(k, d)
+        return d
+
+    def _query(self, it: _Item, j: int) -> float:
+        """PyBullet's distance of ``it`` at sample ``j``."""
+        self._put(j)
         pb, c, body = self.scene.pb, self.scene.client, self.scene.body
         if it.kind == "self":
             pts = pb.getClosestPoints(body, body, QUERY_RANGE, it.a, it.b, physicsClientId=c)
@@ -300,11 +170,8 @@ class Sweep:
             pts = pb.getClosestPoints(body, it.b, QUERY_RANGE, linkIndexA=it.a,
                                       physicsClientId=c)
         d = min((pt[8] for pt in pts), default=QUERY_RANGE)
-        d = min(d, QUERY_RANGE)
-        it.js.insert(k, j)
-        it.ds.insert(k, d)
         self.queries += 1
-        return d
+        return min(d, QUERY_RANGE)
 
     def seed(self, samples: list[int]) -> None:
         for j in samples:

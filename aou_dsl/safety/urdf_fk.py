@@ -17,7 +17,7 @@ import numpy as np
 from ..core.codes import R402
 from ..core.diagnostics import AouError, Span, diag
 
-__all__ = ["Chain", "chain_fk", "urdf_chain"]
+__all__ = ["Chain", "chain_fk", "kept_chain_fk", "urdf_chain"]
 
 
 @dataclass(frozen=True)
@@ -159,3 +159,13 @@ def chain_fk(chain: Chain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     if rot.ndim == 2:
         return np.tile(pos, (n, 1)), np.tile(rot, (n, 1, 1))
     return pos.T.copy(), np.ascontiguousarray(rot.transpose(2, 0, 1))
+
+
+def kept_chain_fk(chain: Chain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`chain_fk`, with the rows seen before (by this chain) looked up: a
+    recompilation repeats most of them."""
+    from ..robot.rows import kept
+
+    pos, rot = kept(chain, "chain_fk", np.atleast_2d(np.asarray(q, dtype=float)),
+                    lambda rows: chain_fk(chain, rows))
+    return pos, rot
