@@ -1,14 +1,16 @@
 """A batch on this machine's cores that is never slower than one process: this process
-builds too, and workers join as they warm up.
+builds too, and workers join as soon as they can take a file.
 
-Starting a worker costs an interpreter, the imports and a warm-up build (about a second
-on a quiet machine): more than a small batch gains from it. So this process does not
-wait for its workers. It lints every file, then builds them itself, shortest first,
-while ``jobs - 1`` workers start; each worker that has warmed up takes the longest file
-not yet taken, one at a time. A batch that ends before any worker is warm was built as
-``--jobs 1`` builds it, with one more core busy starting workers; a long batch is
-shared by every core. Results come back in the order of the inputs, each the same as
-``build_file`` of its path.
+On Linux (:func:`~aou_dsl.build.pool.can_fork`) this process lints every file, loads what
+the builds need (the libraries and the robots the files name; ``--jobs 1`` loads the same
+at its first build) and forks ``jobs - 1`` workers, which start warm in milliseconds.
+Elsewhere the workers are fresh interpreters that import, load and build a small
+behaviour first (about a second on a quiet machine, more than a small batch gains), so
+this process does not wait for them. Either way it builds the files itself, shortest
+first, and each worker that is ready takes the longest file not yet taken, one at a
+time; a batch that ends before any worker is ready was built as ``--jobs 1`` builds it.
+Results come back in the order of the inputs, each the same as ``build_file`` of its
+path.
 """
 
 from __future__ import annotations
@@ -36,6 +38,14 @@ def _buildable(lint: FileResult) -> bool:
     return not (lint.behaviour is None or lint.timeline is None or lint.cv is None)
 
 
+def _robots(lints: list[FileResult], options: BuildOptions) -> tuple[str, ...]:
+    """The robots the builds will load: the options' one, else those the files name."""
+    if options.robot:
+        return (options.robot,)
+    named = (lint.behaviour.settings.robot for lint in lints if lint.behaviour is not None)
+    return tuple(dict.fromkeys(r for r in named if r)) or ("panda",)
+
+
 def shared_map(paths: list[str], options: BuildOptions, jobs: int,
                encode: str | None = None) -> Iterator[BuildResult]:
     """Build ``paths`` on this process and ``jobs - 1`` workers; results in input order.
@@ -57,7 +67,7 @@ def shared_map(paths: list[str], options: BuildOptions, jobs: int,
     session = Session(options)
     running: dict[Future, int] = {}
     done = 0
-    pool = BuildPool(jobs - 1, robots=(options.robot or "panda",), options=options, wait=False)
+    pool = BuildPool(jobs - 1, robots=_robots(lints, options), options=options, wait=False)
     try:
         while todo or running:
             for f in [f for f in running if f.done()]:
