@@ -70,15 +70,18 @@ def can_fork() -> bool:
 def preload(robots: Iterable[str], options: BuildOptions | None = None) -> None:
     """Load here what a build loads before its first file, without building: the
     build's modules and libraries (TOPP-RA as the compiler imports it, without
-    matplotlib; PyBullet, quietly) and, for each robot, its model, its arm and the URDF
-    file its checks' scene loads. None of it starts a thread or a physics client, so a
-    worker forked after it starts warm. A robot that cannot be loaded is left for the
-    build, which says why."""
+    matplotlib; PyBullet, quietly) and, for each robot, its model, its arm and the scene
+    its checks replay in (the URDF file written, the PyBullet world loaded, as the
+    replay keeps them). None of it starts a thread, so a worker forked after it starts
+    warm: its copy of the scene is its own world (PyBullet's DIRECT mode lives in the
+    process's memory). A robot that cannot be loaded is left for the build, which says
+    why."""
     import importlib
 
     from ..compiler.topp import _import_toppra
     from ..robot.bullet import import_pybullet
-    from ..robot.load import load_arm, load_robot, scene_urdf
+    from ..robot.load import load_arm, load_robot
+    from ..safety.replay import _scene
 
     for name in _STAGES:
         importlib.import_module(name)
@@ -90,7 +93,7 @@ def preload(robots: Iterable[str], options: BuildOptions | None = None) -> None:
             load_robot(robot, opts.package_dirs)
             load_arm(robot, None, opts.package_dirs)
             if opts.check:
-                scene_urdf(robot, visuals=False, package_dirs=opts.package_dirs)
+                _scene(robot, opts.scene)
         except Exception:  # noqa: BLE001,S112 - the build of a file naming it says why
             continue
 
