@@ -212,8 +212,9 @@ class BuildPool:
     The workers start at once, warm: forked after this process has loaded the build's
     libraries and ``robots`` (``start="fork"``, the default where :func:`can_fork`), or
     each a fresh interpreter that loads them and builds a small behaviour before it
-    takes a file (``start="spawn"``, the default elsewhere; ask for it when this process
-    holds what a copy must not share, such as a display or a connection).
+    takes a file (``start="spawn"``, the default elsewhere, and what a pool asked to
+    fork does where it cannot; ask for it when this process holds what a copy must not
+    share, such as a display or a connection).
     :meth:`map` can be called again and again (a sweep that compiles in rounds pays the
     start once). Scripts that make a spawned pool need the
     ``if __name__ == "__main__":`` guard: each worker is a fresh interpreter.
@@ -230,6 +231,8 @@ class BuildPool:
         import threading
         from concurrent.futures import ProcessPoolExecutor
 
+        if start not in (None, "fork", "spawn"):
+            raise ValueError(f"start must be 'fork' or 'spawn', not {start!r}")
         self.jobs = jobs or default_jobs()
         forked = (start or ("fork" if can_fork() else "spawn")) == "fork" and can_fork()
         self.start = "fork" if forked else "spawn"
