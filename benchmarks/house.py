@@ -10,6 +10,7 @@
 
 from __future__ import annotations
 
+import os
 import random
 import shutil
 import statistics
@@ -90,10 +91,19 @@ def _batch_ratio(paths: list[str], rounds: int) -> float:
     return statistics.median(ratios)
 
 
+def _load() -> str:
+    """The machine's load average over the last minute: a ratio of two cores' work is
+    only as good as the second core was free."""
+    try:
+        return f"load average {os.getloadavg()[0]:.2f}"
+    except OSError:  # not reported here
+        return "load average unknown"
+
+
 def _batch_figures(rounds: int = 3) -> None:
     shipped = [str(p) for p in BEHAVIOURS]
     say(f"`aouc compile --jobs 2` against `--jobs 1`, each a fresh command, {rounds} rounds "
-        "interleaved (medians)")
+        f"interleaved (medians); {_load()} at the start")
     figure("jobs2_cold_shipped", f"--jobs 1 time / --jobs 2 time, the {len(shipped)} "
            "shipped behaviours", _batch_ratio(shipped, rounds), "x", at_least=1.5,
            fmt="{:.2f}")
@@ -107,7 +117,7 @@ def _batch_figures(rounds: int = 3) -> None:
                 shutil.copy(src, dst)
                 paths.append(str(dst))
             r = _batch_ratio(paths, rounds)
-            say(f"  {n} files: --jobs 1 / --jobs 2 = {r:.2f}x")
+            say(f"  {n} files: --jobs 1 / --jobs 2 = {r:.2f}x ({_load()})")
             worst.append(r)
     figure("jobs2_never_slower", "the least of those ratios on 2, 5, 10 and 20 files",
            min(worst), "x", at_least=1.0, fmt="{:.2f}")

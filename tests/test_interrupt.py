@@ -44,9 +44,10 @@ def _inputs(folder: Path, copies: int) -> list[Path]:
     return sorted(folder.glob("*.aou"))
 
 
-def _group(pgid: int) -> dict[int, str]:
-    """The processes of the group ``pgid`` that have not ended: pid -> command line.
-    (An ended process whose parent is gone may stay a zombie: it runs nothing.)"""
+def _group(pgid: int, parent: int | None = None) -> dict[int, str]:
+    """The processes of the group ``pgid`` that have not ended (those whose parent is
+    ``parent``, when given): pid -> command line. (An ended process whose parent is gone
+    may stay a zombie: it runs nothing.)"""
     found = {}
     for entry in os.listdir("/proc"):
         if not entry.isdigit():
@@ -57,13 +58,25 @@ def _group(pgid: int) -> dict[int, str]:
         except OSError:  # ended meanwhile
             continue
         fields = stat[stat.rfind(")") + 2:].split()  # state, ppid, pgrp, ...
-        if int(fields[2]) == pgid and fields[0] not in "ZX":
+        if int(fields[2]) == pgid and fields[0] not in "ZX" and parent in (None, int(fields[1])):
             found[int(entry)] = cmd
     return found
 
 
 def _workers(pgid: int) -> list[int]:
-    return [pid for pid, cmd in _group(pgid).items() if "spawn_main" in cmd]
+    """aouc's workers: its children (forked, or spawned fresh interpreters), but the
+    helper that tracks a spawned pool's shared resources."""
+    return [pid for pid, cmd in _group(pgid, parent=pgid).items()
+            if "resource_tracker" not in cmd]
+
+
+def _maps_name(pid: int, word: str) -> bool:
+    """Whether the process ``pid`` has a file whose path holds ``word`` mapped (a
+    library it has begun to import)."""
+    try:
+        return word in Path("/proc", str(pid), "maps").read_text()
+    except OSError:
+        return False
 
 
 def _wait_for(what, proc: subprocess.Popen) -> None:
@@ -75,6 +88,9 @@ def _wait_for(what, proc: subprocess.Popen) -> None:
 
 
 @pytest.mark.parametrize(("to", "phase"), [
+    # before any worker: aouc lints and loads what the builds need (forked workers
+    # start after that, warm)
+    ("the group", "loading"),
     ("the group", "warming up"), ("aouc alone", "warming up"),
     # the workers ignore Ctrl-C, so while they build, aouc alone or all of the group
     # being interrupted are the same to them: aouc stops them
@@ -91,12 +107,17 @@ def test_one_ctrl_c_ends_a_parallel_compile(tmp_path, to, phase):
             stderr=stderr)
     try:
         # --jobs 2: aouc builds too, beside one worker
-        _wait_for(lambda: len(_workers(proc.pid)) == 1, proc)
-        if phase == "warming up":  # importing the compiler, loading the robot (seconds)
-            time.sleep(0.5)
+        if phase == "loading":  # once aouc has begun to load SciPy, a second or so
+            _wait_for(lambda: _maps_name(proc.pid, "scipy"), proc)
+            assert not _workers(proc.pid) and proc.poll() is None, "too late, or ended"
         else:
+            _wait_for(lambda: len(_workers(proc.pid)) == 1, proc)
+        if phase == "warming up":  # a spawned worker imports the compiler and loads the
+            time.sleep(0.5)        # robot (seconds); a forked one starts building at once
+        elif phase == "building":
             _wait_for(lambda: (out / f"{inputs[0].stem}.json").exists(), proc)
-        assert len(_workers(proc.pid)) == 1 and proc.poll() is None, "ended before Ctrl-C"
+        if phase != "loading":
+            assert len(_workers(proc.pid)) == 1 and proc.poll() is None, "ended before Ctrl-C"
         if to == "the group":
             os.killpg(proc.pid, signal.SIGINT)
         else:

@@ -1,6 +1,11 @@
 """Many builds at once: a pool of worker processes and a Dask cluster give, for every
 input, exactly what building it alone gives, in the order of the inputs."""
 
+import os
+import re
+import subprocess
+import sys
+
 import pytest
 
 from aou_dsl.build.builder import build_file
@@ -8,7 +13,7 @@ from aou_dsl.build.parallel import BuildPool, build_many, encoded, write_result
 from aou_dsl.compiler.output import encode
 from aou_dsl.core.options import BuildOptions
 
-from .conftest import BEHAVIOURS, INVALID
+from .conftest import BEHAVIOURS, INVALID, ROOT
 
 #: Valid behaviours, a file that does not exist and an invalid one, interleaved, so that
 #: results finish out of order (the long hesitant first) and failures sit in between.
@@ -41,11 +46,14 @@ def test_a_pool_of_workers_gives_what_each_build_alone_gives(alone):
 
 
 @pytest.mark.slow
-def test_a_pool_stays_warm_across_maps(alone, tmp_path):
+@pytest.mark.parametrize("start", ["fork", "spawn"])
+def test_a_pool_stays_warm_across_maps(alone, tmp_path, start):
     """The second map is longer than one window of files handed out (longest motion
     first), and has the workers encode the documents: the bytes written are those of
-    encoding the document built alone."""
-    with BuildPool(2) as pool:
+    encoding the document built alone. Forked workers (copies of this process, which
+    has built before) and fresh ones give the same."""
+    with BuildPool(2, start=start) as pool:
+        assert pool.start == start or not sys.platform.startswith("linux")
         first = list(pool.map(INPUTS, OPTIONS))
         again = list(build_many(INPUTS * 4, OPTIONS, pool=pool, encode="json"))
     _same(first, alone)
@@ -73,3 +81,31 @@ def test_a_dask_cluster_gives_what_each_build_alone_gives(alone):
         with distributed.Client(cluster) as client:
             _same(list(build_many(INPUTS, OPTIONS, cluster=client)), alone)
         _same(list(build_many(INPUTS, OPTIONS, cluster=cluster.scheduler_address)), alone)
+
+
+def _compile(paths: list[str], jobs: int, out) -> tuple[int, list[str]]:
+    """``aouc compile`` of ``paths`` in a fresh process: its exit status and what it
+    printed, the compile times left out (they differ from run to run)."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    proc = subprocess.run([sys.executable, "-m", "aou_dsl", "compile", *paths, "--jobs",
+                           str(jobs), "-o", f"{out}/"], cwd=ROOT, env=env,
+                          capture_output=True, text=True)
+    said = re.sub(r"compiled in [0-9.]+ s", "compiled", proc.stderr).replace(str(out), "OUT")
+    return proc.returncode, said.splitlines()
+
+
+@pytest.mark.slow
+def test_a_parallel_compile_writes_and_says_what_one_process_does(tmp_path):
+    """``--jobs 2`` (this process and a worker it forks, or spawns) against ``--jobs 1``:
+    the same files, byte for byte, the same diagnostics in the same order, the same exit
+    status; a file that fails among them included."""
+    paths = [str(p) for p in sorted(BEHAVIOURS.glob("*.aou"))]
+    paths.insert(2, str(INVALID / "invalid_bad_character.aou"))
+    one, two = tmp_path / "one", tmp_path / "two"
+    said_one, said_two = _compile(paths, 1, one), _compile(paths, 2, two)
+    assert said_two == said_one
+    assert said_one[0] != 0 and any("[5/6]" in line for line in said_one[1])
+    assert sorted(p.name for p in two.iterdir()) == sorted(p.name for p in one.iterdir())
+    assert len(list(one.iterdir())) == 5
+    for written in one.iterdir():
+        assert (two / written.name).read_bytes() == written.read_bytes()

@@ -1,9 +1,18 @@
 """The worker pool: processes kept warm between maps, and what a build sends back.
 
-A :class:`BuildPool` starts its workers at once; each ignores SIGINT, imports the build's
-stages and builds a small behaviour (:func:`~aou_dsl.build.session.warm`) before it takes
-a file. A build's result goes back with its document's samples left behind (the arrays
-travel as raw bytes) and, when asked, its document already encoded.
+A :class:`BuildPool` starts its workers at once, in one of two ways:
+
+- forked (Linux, where this process runs no other thread): this process first loads what
+  a build needs (:func:`preload`: the libraries, each robot's model), then forks, so a
+  worker starts in milliseconds with all of it loaded and no second core is spent
+  importing the same libraries again;
+- spawned (elsewhere, or when asked): each worker is a fresh interpreter that imports
+  the build's stages and builds a small behaviour (:func:`~aou_dsl.build.session.warm`)
+  before it takes a file.
+
+Either way a worker ignores SIGINT (this process stops it). A build's result goes back
+with its document's samples left behind (the arrays travel as raw bytes) and, when asked,
+its document already encoded.
 """
 
 from __future__ import annotations
@@ -20,7 +29,7 @@ if TYPE_CHECKING:
     from ..lang.linter import FileResult
     from .builder import BuildResult
 
-__all__ = ["BuildPool", "default_jobs", "encoded"]
+__all__ = ["BuildPool", "can_fork", "default_jobs", "encoded", "preload"]
 
 #: Files linted and handed out at once, per worker, the longest motions first: a
 #: short file last keeps no core idle at the end while another builds a long one.
@@ -29,7 +38,13 @@ _WINDOW = 8
 _START_TIMEOUT = 120.0
 #: How long stopping a pool waits for a worker to end after it was told to [s].
 _STOP_TIMEOUT = 2.0
-
+#: The modules a build imports as it goes (the compiler, the checks, the measurement and
+#: the libraries under them), imported by :func:`preload`. One missing here is imported
+#: by each worker when its first build needs it: slower, never different.
+_STAGES = ("aou_dsl.build.builder", "aou_dsl.compiler.pipeline", "aou_dsl.compiler.output",
+           "aou_dsl.compiler.branches", "aou_dsl.safety.replay", "aou_dsl.safety.controllers",
+           "aou_dsl.measuring.measured", "aou_dsl.lang.declared", "scipy.interpolate",
+           "scipy.signal")
 
 
 def default_jobs() -> int:
@@ -38,6 +53,49 @@ def default_jobs() -> int:
         return max(1, len(os.sched_getaffinity(0)))
     except AttributeError:  # not on Linux
         return max(1, os.cpu_count() or 1)
+
+
+def can_fork() -> bool:
+    """Whether workers may be forked from this process: on Linux, and only while this
+    process runs no other thread (a fork copies one thread; a lock another thread held
+    would stay held in the worker for ever)."""
+    import multiprocessing
+    import sys
+    import threading
+
+    return (sys.platform.startswith("linux") and threading.active_count() == 1
+            and "fork" in multiprocessing.get_all_start_methods())
+
+
+def preload(robots: Iterable[str], options: BuildOptions | None = None) -> None:
+    """Load here what a build loads before its first file, without building: the
+    build's modules and libraries (TOPP-RA as the compiler imports it, without
+    matplotlib; PyBullet, quietly) and, for each robot, its model, its arm and the scene
+    its checks replay in (the URDF file written, the PyBullet world loaded, as the
+    replay keeps them). None of it starts a thread, so a worker forked after it starts
+    warm: its copy of the scene is its own world (PyBullet's DIRECT mode lives in the
+    process's memory). A robot that cannot be loaded is left for the build, which says
+    why."""
+    import importlib
+
+    from ..compiler.topp import _import_toppra
+    from ..robot.bullet import import_pybullet
+    from ..robot.load import load_arm, load_robot
+    from ..safety.replay import _scene
+
+    for name in _STAGES:
+        importlib.import_module(name)
+    _import_toppra()
+    import_pybullet()
+    opts = options or BuildOptions()
+    for robot in dict.fromkeys(robots):
+        try:
+            load_robot(robot, opts.package_dirs)
+            load_arm(robot, None, opts.package_dirs)
+            if opts.check:
+                _scene(robot, opts.scene)
+        except Exception:  # noqa: BLE001,S112 - the build of a file naming it says why
+            continue
 
 
 def _build_linted(lint: FileResult, options: BuildOptions, encode: str | None
@@ -120,6 +178,29 @@ def _sigint_held() -> Iterator[None]:
         signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
+@contextlib.contextmanager
+def _forking(forked: bool) -> Iterator[None]:
+    """Around the fork of the workers: what this process has still to print is printed
+    first (a worker's copy of it would be printed again when the worker ends), and in
+    the workers the objects loaded so far are left out of the garbage collector's rounds
+    (a worker that walked them would copy every page it touched, which its parent
+    shares with it until then)."""
+    import gc
+    import sys
+
+    if not forked:
+        yield
+        return
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(AttributeError, OSError, ValueError):
+            stream.flush()
+    gc.freeze()
+    try:
+        yield
+    finally:
+        gc.unfreeze()
+
+
 def _cost(lint: FileResult) -> float:
     """How long a linted file's build will take, roughly: its planned motion [s]."""
     return lint.timeline.planned_duration if lint.timeline is not None else 0.0
@@ -128,9 +209,14 @@ def _cost(lint: FileResult) -> float:
 class BuildPool:
     """Worker processes kept warm between maps (``with BuildPool(4) as pool: ...``).
 
-    The workers start at once and each imports the build's stages and loads the default
-    robot before it takes a file; :meth:`map` can be called again and again (a sweep
-    that compiles in rounds pays the start once). Scripts that make a pool need the
+    The workers start at once, warm: forked after this process has loaded the build's
+    libraries and ``robots`` (``start="fork"``, the default where :func:`can_fork`), or
+    each a fresh interpreter that loads them and builds a small behaviour before it
+    takes a file (``start="spawn"``, the default elsewhere, and what a pool asked to
+    fork does where it cannot; ask for it when this process holds what a copy must not
+    share, such as a display or a connection).
+    :meth:`map` can be called again and again (a sweep that compiles in rounds pays the
+    start once). Scripts that make a spawned pool need the
     ``if __name__ == "__main__":`` guard: each worker is a fresh interpreter.
 
     The workers ignore SIGINT: a ``KeyboardInterrupt`` is this process's, and leaving
@@ -139,15 +225,21 @@ class BuildPool:
     """
 
     def __init__(self, jobs: int | None = None, *, robots: tuple[str, ...] = ("panda",),
-                 options: BuildOptions | None = None, wait: bool = True):
+                 options: BuildOptions | None = None, wait: bool = True,
+                 start: str | None = None):
         import multiprocessing
         import threading
         from concurrent.futures import ProcessPoolExecutor
 
+        if start not in (None, "fork", "spawn"):
+            raise ValueError(f"start must be 'fork' or 'spawn', not {start!r}")
         self.jobs = jobs or default_jobs()
-        # "spawn": a fresh interpreter per worker (no copy of this process's threads or
-        # physics clients).
-        ctx = multiprocessing.get_context("spawn")
+        forked = (start or ("fork" if can_fork() else "spawn")) == "fork" and can_fork()
+        self.start = "fork" if forked else "spawn"
+        if forked:  # what the workers need, loaded once, here, before they are copies
+            preload(robots, options)
+            robots = ()  # nothing left to warm up in a worker
+        ctx = multiprocessing.get_context(self.start)
         ready = ctx.Barrier(self.jobs + 1) if wait else None
         self._warmed = ctx.Value("i", 0)
         self._pool = ProcessPoolExecutor(max_workers=self.jobs, mp_context=ctx,
@@ -161,7 +253,7 @@ class BuildPool:
         if calls is not None and hasattr(calls, "_ignore_epipe"):
             calls._ignore_epipe = True
         try:
-            with _sigint_held():  # one task each makes the pool start every worker
+            with _sigint_held(), _forking(forked):  # the first task starts every worker
                 for _ in range(self.jobs):
                     self._pool.submit(os.getpid)
             # until every worker has built its warm-up behaviour; a slow or failed start
