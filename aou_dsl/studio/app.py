@@ -164,6 +164,12 @@ class Studio:
             self.save_button = gui.add_button("Save", hint=f"write the values into {self.path}")
             self.save_button.on_click(lambda _: self.save())
         self.diags = gui.add_html("")
+        if self.ghost is not None and self.compare_path:
+            self.ghost_box = gui.add_checkbox(
+                f"Show {os.path.basename(self.compare_path)}", True,
+                hint="the compared behaviour, ghosted, on the same clock")
+            ghost = self.ghost
+            self.ghost_box.on_update(lambda _: ghost.set_visible(self.ghost_box.value))
         self.fitted = gui.add_html("")  # with --fit: what was fitted to the arm
         with gui.add_folder("Timeline"):
             self.timeline = gui.add_html("")
@@ -175,9 +181,14 @@ class Studio:
     def _frame(self, t: float) -> None:
         from .plots import timeline
 
-        self.arm.pose(t)
-        if self.ghost is not None:
-            self.ghost.pose(t)
+        try:
+            self.arm.pose(t)
+            if self.ghost is not None:
+                self.ghost.pose(t)
+        except RuntimeError:  # the player's last tick as the studio closes: no scene
+            if self._closed:
+                return
+            raise
         now = time.monotonic()
         tr = self.drawn
         if tr is not None and (now - self._marked > 0.2 or not self.player.playing):
