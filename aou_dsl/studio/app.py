@@ -80,9 +80,10 @@ class Studio:
         from . import view3d as scene
         from .controls import Player, Sliders
 
-        self.server = viser.ViserServer(host=self.host, port=self.asked_port,
-                                        label=f"aou studio: {os.path.basename(self.path)}",
-                                        verbose=False)
+        with _quiet():  # viser prints its own banner: `aouc studio:` says the address
+            self.server = viser.ViserServer(
+                host=self.host, port=self.asked_port, verbose=False,
+                label=f"aou studio: {os.path.basename(self.path)}")
         self.server.scene.set_up_direction("+z")
         # Plain lights, no shadows nor environment map: a laptop without a GPU (or a
         # browser rendering WebGL in software) keeps a smooth frame rate.
@@ -154,7 +155,8 @@ class Studio:
         if self.watcher is not None:
             self.watcher.close()
         self.player.close()
-        self.server.stop()
+        with _quiet():
+            self.server.stop()
 
     # --- the page -------------------------------------------------------------------
 
@@ -359,6 +361,14 @@ class Studio:
         else:
             self._say(m, "The file on disk does not build; the motion shown is the last "
                       "good one.")
+
+
+def _quiet():
+    """Standard output silenced (viser's messages; aou's own go to stderr)."""
+    import contextlib
+    import io
+
+    return contextlib.redirect_stdout(io.StringIO())
 
 
 def _same(a: Trajectory, b: Trajectory) -> bool:
