@@ -76,6 +76,8 @@ def studio_of(tmp_path, browser):
         return studio, page, path
 
     yield start
+    for page in browser.pages:  # a page left open renders on: the next tests starve
+        page.close()
     for s in made:
         s.close()
 
@@ -232,12 +234,21 @@ def test_editing_the_file_on_disk_reloads_the_motion(studio_of):
     assert studio.shown.text == text  # the last good motion stays on screen
 
 
-def open_page(browser, studio):
-    page = browser.new_page()
-    page.goto(studio.url)
-    page.locator("canvas").first.wait_for(timeout=60_000)
-    page.locator("#aou-descriptors").wait_for(timeout=60_000)
-    return page
+@pytest.fixture
+def open_page(browser):
+    """``open_page(studio)``: the studio's page, loaded; closed after the test (a page
+    left open goes on rendering in software and starves the next tests)."""
+
+    def start(studio):
+        page = browser.new_page()
+        page.goto(studio.url)
+        page.locator("canvas").first.wait_for(timeout=60_000)
+        page.locator("#aou-descriptors").wait_for(timeout=60_000)
+        return page
+
+    yield start
+    for page in browser.pages:
+        page.close()
 
 
 def paused_at(page, studio, t: float) -> np.ndarray:
@@ -256,7 +267,7 @@ def scene_only(page, shot: np.ndarray) -> np.ndarray:
     return shot[:, :int(panel["x"] - origin["x"]) - 20]
 
 
-def test_compare_draws_the_second_arm_ghosted_on_the_same_clock(tmp_path, browser):
+def test_compare_draws_the_second_arm_ghosted_on_the_same_clock(tmp_path, open_page):
     from aou_dsl.studio.app import Studio
 
     for name in ("hesitant", "fearful"):
@@ -264,7 +275,7 @@ def test_compare_draws_the_second_arm_ghosted_on_the_same_clock(tmp_path, browse
     studio = Studio(str(tmp_path / "hesitant.aou"), port=0,
                     compare=str(tmp_path / "fearful.aou")).start()
     try:
-        page = open_page(browser, studio)
+        page = open_page(studio)
         a, b = studio.shown.trajectory, studio.other.trajectory
         # one clock for both: the page's time slider spans the longer motion
         thumb = page.locator(f'[id="{page.locator("label", has_text="Time [s]").first.get_attribute("for")}"] [role="slider"]')  # noqa: E501
@@ -290,7 +301,7 @@ def test_compare_draws_the_second_arm_ghosted_on_the_same_clock(tmp_path, browse
     assert sorted(os.listdir(tmp_path)) == ["fearful.aou", "hesitant.aou"]
 
 
-def test_a_recording_plays_in_the_page_with_its_measured_episodes(tmp_path, browser):
+def test_a_recording_plays_in_the_page_with_its_measured_episodes(tmp_path, open_page):
     from aou_dsl.studio.app import Studio
 
     src = tmp_path / "hesitant.aou"
@@ -302,7 +313,7 @@ def test_a_recording_plays_in_the_page_with_its_measured_episodes(tmp_path, brow
     rec.write_text("\n".join(rows) + "\n")
     studio = Studio(str(rec), robot="panda", port=0).start()
     try:
-        page = open_page(browser, studio)
+        page = open_page(studio)
         assert page.get_by_role("button", name="Save").count() == 0  # nothing to save
         assert page.get_by_text("Shape it").count() == 1 and studio.sliders.handles == {}
         m = measure(studio.shown.trajectory)
@@ -324,3 +335,64 @@ def test_a_recording_plays_in_the_page_with_its_measured_episodes(tmp_path, brow
     finally:
         studio.close()
     assert sorted(os.listdir(tmp_path)) == ["hesitant.aou", "rec.csv"]
+
+
+PEEK = """\
+behaviour peek : curious
+sequence {
+  approach 0.08m a=0.09
+  pause 1.25s
+  gaze horizontal 20deg
+  pause 1.25s
+  gaze horizontal -20deg   # the other side
+  pause 1.25s
+  approach a=0.09
+}
+"""
+
+
+def test_a_sequence_gets_its_sliders_in_the_page_and_saves_them(tmp_path, open_page):
+    from aou_dsl.studio.app import Studio
+
+    path = tmp_path / "peek.aou"
+    path.write_text(PEEK)
+    studio = Studio(str(path), port=0).start()
+    try:
+        page = open_page(studio)
+        for name in ("approach_acceleration", "pause_duration", "horizontal_gaze"):
+            assert number_box(page, name).count() == 1
+        assert page.locator("label", has_text="pause_count").count() == 0
+        first = studio.generation
+        type_value(page, "horizontal_gaze", "26")
+        wait_for(lambda: studio.generation > first and "-26deg" in studio.shown.text)
+        m = measure(studio.shown.trajectory)
+        assert REGISTRY["horizontal_gaze"].matches(26.0, m.descriptors["horizontal_gaze"])
+        wait_for(lambda: (v := measured_in_page(page, "horizontal_gaze")) is not None
+                 and v == pytest.approx(m.descriptors["horizontal_gaze"]))
+        page.get_by_role("button", name="Save").click()
+        wait_for(lambda: path.read_text() != PEEK)
+    finally:
+        studio.close()
+    assert path.read_text() == PEEK.replace("20deg", "26deg")
+    build = aou_compile(str(path))
+    assert build.ok and np.array_equal(build.trajectory.q, studio.shown.trajectory.q)
+
+
+def test_fit_lists_the_fitted_values_in_the_page_and_fits_each_move(tmp_path, open_page):
+    from aou_dsl.studio.app import Studio
+
+    path = tmp_path / "fearful.aou"
+    shutil.copy(os.path.join(ROOT, "behaviours", "fearful.aou"), path)
+    studio = Studio(str(path), robot="ur5", port=0, fit=True).start()
+    try:
+        page = open_page(studio)
+        item = page.locator('#aou-fitted li[data-key="a"]')
+        item.wait_for(timeout=60_000)
+        assert "retreat_acceleration 2 " in item.inner_text()
+        assert page.locator('#aou-fitted li[data-key="f"]').count() == 1
+        type_value(page, "retreat_acceleration", "3")
+        wait_for(lambda: "retreat_acceleration 3 " in item.inner_text())
+        assert float(item.get_attribute("data-fitted")) < 2.0
+        assert "retreat 0.06m a=3\n" in studio.shown.text and studio.shown.ok
+    finally:
+        studio.close()
