@@ -2,7 +2,7 @@
 shape it live (the ``studio`` extra: viser, yourdfpy, watchfiles).
 
 - :mod:`.engine`: the one door to the pipeline (build, measure, keep the last good);
-- :mod:`.app`: the wiring; :mod:`.scene`: the 3D scene; :mod:`.controls`: the player
+- :mod:`.app`: the wiring; :mod:`.view3d`: the 3D scene; :mod:`.controls`: the player
   and the sliders; :mod:`.plots`: the numbers; :mod:`.edits`: Save's rewrite of the
   text; :mod:`.watch`: reloading when the file changes on disk.
 

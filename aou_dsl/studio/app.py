@@ -1,7 +1,7 @@
 """``aouc studio``: a behaviour in 3D in the browser, its numbers beside it, shaped live.
 
 :class:`Studio` wires the pieces: the :class:`~.engine.Engine` builds, the scene draws
-(:mod:`.scene`), the player and the sliders drive (:mod:`.controls`), the numbers are
+(:mod:`.view3d`), the player and the sliders drive (:mod:`.controls`), the numbers are
 shown (:mod:`.plots`), Save writes (:mod:`.edits`), the file is watched (:mod:`.watch`).
 
 The file is the truth: the sliders edit its text (:func:`.edits.apply`), the engine
