@@ -76,6 +76,8 @@ def studio_of(tmp_path, browser):
         return studio, page, path
 
     yield start
+    for page in browser.pages:  # a page left open renders on: the next tests starve
+        page.close()
     for s in made:
         s.close()
 
@@ -230,3 +232,167 @@ def test_editing_the_file_on_disk_reloads_the_motion(studio_of):
     path.write_text(bad)
     page.locator('#aou-diagnostics li[data-code="V121"]').wait_for(timeout=60_000)
     assert studio.shown.text == text  # the last good motion stays on screen
+
+
+@pytest.fixture
+def open_page(browser):
+    """``open_page(studio)``: the studio's page, loaded; closed after the test (a page
+    left open goes on rendering in software and starves the next tests)."""
+
+    def start(studio):
+        page = browser.new_page()
+        page.goto(studio.url)
+        page.locator("canvas").first.wait_for(timeout=60_000)
+        page.locator("#aou-descriptors").wait_for(timeout=60_000)
+        return page
+
+    yield start
+    for page in browser.pages:
+        page.close()
+
+
+def paused_at(page, studio, t: float) -> np.ndarray:
+    """The 3D scene left of the control panel, settled, with the player paused at ``t``
+    [s from the start] (the panel's own widgets change with the clock)."""
+    if studio.player.playing:
+        page.get_by_role("button", name="Pause").click()
+        wait_for(lambda: not studio.player.playing)
+    studio.player.seek(t)
+    return scene_only(page, settled(page))
+
+
+def scene_only(page, shot: np.ndarray) -> np.ndarray:
+    panel = page.get_by_role("button", name="Play").bounding_box()
+    origin = scene_canvas(page).bounding_box()
+    return shot[:, :int(panel["x"] - origin["x"]) - 20]
+
+
+def test_compare_draws_the_second_arm_ghosted_on_the_same_clock(tmp_path, open_page):
+    from aou_dsl.studio.app import Studio
+
+    for name in ("hesitant", "fearful"):
+        shutil.copy(os.path.join(ROOT, "behaviours", f"{name}.aou"), tmp_path / f"{name}.aou")
+    studio = Studio(str(tmp_path / "hesitant.aou"), port=0,
+                    compare=str(tmp_path / "fearful.aou")).start()
+    try:
+        page = open_page(studio)
+        a, b = studio.shown.trajectory, studio.other.trajectory
+        # one clock for both: the page's time slider spans the longer motion
+        thumb = page.locator(f'[id="{page.locator("label", has_text="Time [s]").first.get_attribute("for")}"] [role="slider"]')  # noqa: E501
+        wait_for(lambda: thumb.get_attribute("aria-valuemax") ==
+                 f"{round(max(a.duration, b.duration), 2):g}")
+        kind, start, end = b.episodes[-1]  # the ghost's last episode: far from the other
+        t = (start + end) / 2 - b.t[0]
+        both = paused_at(page, studio, t)
+        page.get_by_text("Show fearful.aou").click()  # the page's checkbox hides the ghost
+        wait_for(lambda: not studio.ghost_box.value)
+        alone = scene_only(page, settled(page))
+        ghost = np.abs(both - alone).sum(axis=2) > 30
+        assert ghost.sum() > 200, "the compared arm is not drawn"
+        page.get_by_text("Show fearful.aou").click()
+        wait_for(lambda: studio.ghost_box.value)
+        again = scene_only(page, settled(page))
+        assert (np.abs(again - both).sum(axis=2) > 30).sum() < 0.1 * ghost.sum()
+        # the ghost moves with the clock
+        later = paused_at(page, studio, 0.0)
+        assert (np.abs(later - both).sum(axis=2) > 30).sum() > 200
+    finally:
+        studio.close()
+    assert sorted(os.listdir(tmp_path)) == ["fearful.aou", "hesitant.aou"]
+
+
+def test_a_recording_plays_in_the_page_with_its_measured_episodes(tmp_path, open_page):
+    from aou_dsl.studio.app import Studio
+
+    src = tmp_path / "hesitant.aou"
+    shutil.copy(os.path.join(ROOT, "behaviours", "hesitant.aou"), src)
+    tr = aou_compile(str(src), check=False).trajectory
+    rec = tmp_path / "rec.csv"  # a bare recording: joint columns, no goal, no episodes
+    rows = ["t," + ",".join(tr.joint_names)] + [
+        ",".join(f"{x:.6f}" for x in (t, *q)) for t, q in zip(tr.t, tr.q, strict=True)]
+    rec.write_text("\n".join(rows) + "\n")
+    studio = Studio(str(rec), robot="panda", port=0).start()
+    try:
+        page = open_page(studio)
+        assert page.get_by_role("button", name="Save").count() == 0  # nothing to save
+        assert page.get_by_text("Shape it").count() == 1 and studio.sliders.handles == {}
+        m = measure(studio.shown.trajectory)
+        for name in ("pause_count", "retreat_count", "pause_duration"):
+            wait_for(lambda n=name: measured_in_page(page, n) is not None)
+            assert measured_in_page(page, name) == pytest.approx(m.descriptors[name])
+        assert (m.descriptors["pause_count"], m.descriptors["retreat_count"]) == (5, 3)
+        titles = page.locator("svg title").all_text_contents()
+        kinds = [t.split()[0] for t in titles]
+        for kind in ("approach", "pause", "retreat"):  # each episode measured, in the page
+            assert kinds.count(kind) >= sum(1 for e in m.episodes if e.kind == kind)
+        shown = studio.shown.trajectory
+        kind, _a, b = shown.episodes[0]
+        start = paused_at(page, studio, 0.0)
+        later = paused_at(page, studio, b - shown.t[0])
+        drawn = np.abs(start - start[0, 0]).sum(axis=2) > 30
+        assert drawn.mean() > 0.01
+        assert (np.abs(later - start).sum(axis=2) > 30).sum() > 200  # the recorded arm moved
+    finally:
+        studio.close()
+    assert sorted(os.listdir(tmp_path)) == ["hesitant.aou", "rec.csv"]
+
+
+PEEK = """\
+behaviour peek : curious
+sequence {
+  approach 0.08m a=0.09
+  pause 1.25s
+  gaze horizontal 20deg
+  pause 1.25s
+  gaze horizontal -20deg   # the other side
+  pause 1.25s
+  approach a=0.09
+}
+"""
+
+
+def test_a_sequence_gets_its_sliders_in_the_page_and_saves_them(tmp_path, open_page):
+    from aou_dsl.studio.app import Studio
+
+    path = tmp_path / "peek.aou"
+    path.write_text(PEEK)
+    studio = Studio(str(path), port=0).start()
+    try:
+        page = open_page(studio)
+        for name in ("approach_acceleration", "pause_duration", "horizontal_gaze"):
+            assert number_box(page, name).count() == 1
+        assert page.locator("label", has_text="pause_count").count() == 0
+        first = studio.generation
+        type_value(page, "horizontal_gaze", "26")
+        wait_for(lambda: studio.generation > first and "-26deg" in studio.shown.text)
+        m = measure(studio.shown.trajectory)
+        assert REGISTRY["horizontal_gaze"].matches(26.0, m.descriptors["horizontal_gaze"])
+        wait_for(lambda: (v := measured_in_page(page, "horizontal_gaze")) is not None
+                 and v == pytest.approx(m.descriptors["horizontal_gaze"]))
+        page.get_by_role("button", name="Save").click()
+        wait_for(lambda: path.read_text() != PEEK)
+    finally:
+        studio.close()
+    assert path.read_text() == PEEK.replace("20deg", "26deg")
+    build = aou_compile(str(path))
+    assert build.ok and np.array_equal(build.trajectory.q, studio.shown.trajectory.q)
+
+
+def test_fit_lists_the_fitted_values_in_the_page_and_fits_each_move(tmp_path, open_page):
+    from aou_dsl.studio.app import Studio
+
+    path = tmp_path / "fearful.aou"
+    shutil.copy(os.path.join(ROOT, "behaviours", "fearful.aou"), path)
+    studio = Studio(str(path), robot="ur5", port=0, fit=True).start()
+    try:
+        page = open_page(studio)
+        item = page.locator('#aou-fitted li[data-key="a"]')
+        item.wait_for(timeout=60_000)
+        assert "retreat_acceleration 2 " in item.inner_text()
+        assert page.locator('#aou-fitted li[data-key="f"]').count() == 1
+        type_value(page, "retreat_acceleration", "3")
+        wait_for(lambda: "retreat_acceleration 3 " in item.inner_text())
+        assert float(item.get_attribute("data-fitted")) < 2.0
+        assert "retreat 0.06m a=3\n" in studio.shown.text and studio.shown.ok
+    finally:
+        studio.close()

@@ -78,3 +78,16 @@ def test_a_busy_port_takes_the_next_free_one_and_another_host_is_warned_of(tmp_p
     assert served > port
     assert proc.returncode == 0, rest
     assert path.read_bytes() == before and os.listdir(tmp_path) == ["h.aou"]
+
+
+def test_fit_is_for_a_behaviour_and_compare_for_a_aou_file(capsys, tmp_path):
+    pytest.importorskip("viser")
+    rec = tmp_path / "rec.csv"
+    rec.write_text("t,panda_joint1\n0,0\n")
+    assert main(["studio", str(rec), "--robot", "panda", "--fit"]) == 2
+    assert "--fit shapes a .aou file" in capsys.readouterr().err
+    path = tmp_path / "h.aou"
+    shutil.copy(os.path.join(ROOT, "behaviours", "hesitant.aou"), path)
+    assert main(["studio", str(path), "--compare", str(rec)]) == 2
+    assert "--compare takes a .aou file" in capsys.readouterr().err
+    assert sorted(os.listdir(tmp_path)) == ["h.aou", "rec.csv"]

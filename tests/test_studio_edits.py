@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from aou_dsl.core.diagnostics import AouError
 from aou_dsl.lang.declared import written
 from aou_dsl.lang.linter import lint_source
-from aou_dsl.studio.edits import apply, settable, synth_origin
+from aou_dsl.studio.edits import Origin, apply, settable, synth_origin
 
 HESITANT = """\
 # a comment that stays
@@ -71,9 +71,10 @@ def test_unchanged_values_leave_the_text_as_it_was():
 
 def test_what_cannot_be_changed_is_refused_with_a_code():
     seq = "behaviour s : hesitant\nsequence {\n  approach 0.1m\n  pause 1s\n}\n"
-    assert settable(lint_source(seq, "s.aou").behaviour) == {}
-    with pytest.raises(AouError) as err:
-        apply(seq, {"pause_duration": 2.0})
+    lint = lint_source(seq, "s.aou")
+    assert "pause_count" not in settable(lint.behaviour, lint.timeline)
+    with pytest.raises(AouError) as err:  # a sequence's counts are its statements' order
+        apply(seq, {"pause_count": 2})
     assert err.value.diagnostics[0].code == "I504"
     with pytest.raises(AouError) as err:
         apply(HESITANT, {"shiver_amplitude": 3.0})  # the file has no shiver
@@ -116,7 +117,7 @@ def test_a_file_synth_wrote_for_a_state_says_its_intensity():
     from aou_dsl.synth.synthesis import synthesize
 
     text = synthesize("hesitant", intensity=0.7, verify=False)
-    assert synth_origin(text) == ("hesitant", 0.7)
+    assert synth_origin(text) == Origin("hesitant", 0.7)
     assert synth_origin(HESITANT) is None
-    blend = synthesize(C=-0.5, V=0.2, verify=False)  # a C-V point: no state to redo
-    assert synth_origin(blend) is None
+    blend = synthesize(C=-0.5, V=0.2, intensity=0.8, verify=False)  # a C-V point
+    assert synth_origin(blend) == Origin("hesitant", 0.8, (-0.5, 0.2))

@@ -313,6 +313,9 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
                      help="address to bind (default 127.0.0.1: this machine only)")
     stu.add_argument("--compare", metavar="OTHER.aou",
                      help="show a second behaviour, ghosted, on the same clock")
+    stu.add_argument("--fit", action="store_true",
+                     help="build as `aouc compile --fit` does (the fitted values shown in the "
+                     "page; Save writes the sliders' values)")
     _robot(stu)
     _editor(sub, c)
     c["dmp"] = _dmp(sub)

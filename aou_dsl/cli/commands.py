@@ -344,10 +344,9 @@ def _cmd_variants(args: argparse.Namespace) -> int:
 
 
 def _cmd_studio(args: argparse.Namespace) -> int:
-    from ..studio import serve
+    from .studio_cmd import cmd_studio
 
-    return serve(args.path, robot=args.robot, host=args.host, port=args.port,
-                 compare=args.compare, package_dirs=_package_dirs(args))
+    return cmd_studio(args)
 
 
 def _cmd_dmp(args: argparse.Namespace) -> int:

@@ -2,7 +2,7 @@
 shape it live (the ``studio`` extra: viser, yourdfpy, watchfiles).
 
 - :mod:`.engine`: the one door to the pipeline (build, measure, keep the last good);
-- :mod:`.app`: the wiring; :mod:`.scene`: the 3D scene; :mod:`.controls`: the player
+- :mod:`.app`: the wiring; :mod:`.view3d`: the 3D scene; :mod:`.controls`: the player
   and the sliders; :mod:`.plots`: the numbers; :mod:`.edits`: Save's rewrite of the
   text; :mod:`.watch`: reloading when the file changes on disk.
 
@@ -19,8 +19,9 @@ __all__ = ["serve"]
 
 def serve(path: str, *, robot: str | None = None, host: str = "127.0.0.1", port: int = 8080,
           compare: str | None = None, stop: threading.Event | None = None,
-          package_dirs: tuple[str, ...] = ()) -> int:
+          package_dirs: tuple[str, ...] = (), fit: bool = False) -> int:
     """Run the studio of ``path`` until interrupted (or ``stop`` is set); the exit status.
+    ``fit``: build as ``aouc compile --fit`` does.
 
     Raises:
         AouError: the file (or ``compare``) does not build, or the robot cannot be drawn.
@@ -36,7 +37,7 @@ def serve(path: str, *, robot: str | None = None, host: str = "127.0.0.1", port:
         print(f"aouc: warning: the studio binds {host}: anyone who can reach this machine "
               "can see the page and save into the file", file=sys.stderr)
     studio = Studio(path, robot=robot, host=host, port=port, compare=compare,
-                    package_dirs=package_dirs).start()
+                    package_dirs=package_dirs, fit=fit).start()
     if studio.port != port:
         print(f"aouc: port {port} is taken: serving on {studio.port} (--port chooses)",
               file=sys.stderr)

@@ -1,7 +1,7 @@
 """``aouc studio``: a behaviour in 3D in the browser, its numbers beside it, shaped live.
 
 :class:`Studio` wires the pieces: the :class:`~.engine.Engine` builds, the scene draws
-(:mod:`.scene`), the player and the sliders drive (:mod:`.controls`), the numbers are
+(:mod:`.view3d`), the player and the sliders drive (:mod:`.controls`), the numbers are
 shown (:mod:`.plots`), Save writes (:mod:`.edits`), the file is watched (:mod:`.watch`).
 
 The file is the truth: the sliders edit its text (:func:`.edits.apply`), the engine
@@ -22,6 +22,7 @@ from .engine import Engine, Motion
 
 if TYPE_CHECKING:
     from ..core.trajectory import Trajectory
+    from .edits import Origin
 
 __all__ = ["LOCAL", "Studio"]
 
@@ -39,14 +40,17 @@ class Studio:
         compare: a second ``.aou`` file shown ghosted on the same clock.
         watch: reload when the file changes on disk.
         engine: the build session to use (a new :class:`Engine` by default).
+        fit: build as ``aouc compile --fit`` does: what the arm cannot give is fitted
+            (shown in the page); Save still writes the values of the sliders.
     """
 
     def __init__(self, path: str, *, robot: str | None = None, host: str = LOCAL,
                  port: int = 8080, compare: str | None = None, watch: bool = True,
-                 engine: Engine | None = None, package_dirs: tuple[str, ...] = ()) -> None:
+                 engine: Engine | None = None, package_dirs: tuple[str, ...] = (),
+                 fit: bool = False) -> None:
         self.path = path
         self.recording = not path.endswith(".aou")
-        self.engine = engine or Engine(robot, package_dirs)
+        self.engine = engine or Engine(robot, package_dirs, fit=fit)
         self.compare_path = compare
         self.host, self.asked_port = host, port
         self._watch = watch
@@ -76,9 +80,10 @@ class Studio:
         from . import view3d as scene
         from .controls import Player, Sliders
 
-        self.server = viser.ViserServer(host=self.host, port=self.asked_port,
-                                        label=f"aou studio: {os.path.basename(self.path)}",
-                                        verbose=False)
+        with _quiet():  # viser prints its own banner: `aouc studio:` says the address
+            self.server = viser.ViserServer(
+                host=self.host, port=self.asked_port, verbose=False,
+                label=f"aou studio: {os.path.basename(self.path)}")
         self.server.scene.set_up_direction("+z")
         # Plain lights, no shadows nor environment map: a laptop without a GPU (or a
         # browser rendering WebGL in software) keeps a smooth frame rate.
@@ -125,7 +130,7 @@ class Studio:
         from ..core.files import read_text
 
         assert self.compare_path is not None
-        engine = Engine(self.engine.robot, self.engine.package_dirs)
+        engine = Engine(self.engine.robot, self.engine.package_dirs, fit=self.engine.fit)
         other = engine.build(read_text(self.compare_path), self.compare_path)
         if not other.ok or other.trajectory is None:
             raise AouError([d for d in other.diagnostics if d.severity == Severity.ERROR])
@@ -150,7 +155,8 @@ class Studio:
         if self.watcher is not None:
             self.watcher.close()
         self.player.close()
-        self.server.stop()
+        with _quiet():
+            self.server.stop()
 
     # --- the page -------------------------------------------------------------------
 
@@ -160,6 +166,13 @@ class Studio:
             self.save_button = gui.add_button("Save", hint=f"write the values into {self.path}")
             self.save_button.on_click(lambda _: self.save())
         self.diags = gui.add_html("")
+        if self.ghost is not None and self.compare_path:
+            self.ghost_box = gui.add_checkbox(
+                f"Show {os.path.basename(self.compare_path)}", True,
+                hint="the compared behaviour, ghosted, on the same clock")
+            ghost = self.ghost
+            self.ghost_box.on_update(lambda _: ghost.set_visible(self.ghost_box.value))
+        self.fitted = gui.add_html("")  # with --fit: what was fitted to the arm
         with gui.add_folder("Timeline"):
             self.timeline = gui.add_html("")
             self.profile = gui.add_html("")
@@ -170,9 +183,14 @@ class Studio:
     def _frame(self, t: float) -> None:
         from .plots import timeline
 
-        self.arm.pose(t)
-        if self.ghost is not None:
-            self.ghost.pose(t)
+        try:
+            self.arm.pose(t)
+            if self.ghost is not None:
+                self.ghost.pose(t)
+        except RuntimeError:  # the player's last tick as the studio closes: no scene
+            if self._closed:
+                return
+            raise
         now = time.monotonic()
         tr = self.drawn
         if tr is not None and (now - self._marked > 0.2 or not self.player.playing):
@@ -205,9 +223,12 @@ class Studio:
         if m.cv is not None:
             name = m.behaviour.name if m.behaviour is not None else os.path.basename(m.path)
             self.cvmap.content = plots.cv_map(m.cv, name)
-        if m.behaviour is not None:
+        self.fitted.content = plots.fitted_html(m.diagnostics) if self.engine.fit else ""
+        lint = self.engine.session.lint(m.text, m.path) if m.text else None
+        if lint is not None and lint.behaviour is not None:
             origin = synth_origin(m.text)
-            self.sliders.show(settable(m.behaviour), origin[1] if origin else None)
+            self.sliders.show(settable(lint.behaviour, lint.timeline),
+                              origin.intensity if origin else None)
         self.generation += 1
         self._say(m)
 
@@ -267,8 +288,8 @@ class Studio:
         intensity = values.pop(INTENSITY, None)
         origin = synth_origin(self.base_text)
         try:
-            if origin is not None and intensity is not None and intensity != origin[1]:
-                text = self._synthesized(origin[0], intensity)
+            if origin is not None and intensity is not None and intensity != origin.intensity:
+                text = self._synthesized(origin, intensity)
             else:
                 text = apply(self.base_text, values, self.path)
         except AouError as err:
@@ -282,7 +303,8 @@ class Studio:
                 self.previewed += 1
             m = self.engine.build(text, self.path)
             if m.ok and m.trajectory is not None:
-                if intensity is not None and origin is not None and intensity != origin[1]:
+                if intensity is not None and origin is not None and \
+                        intensity != origin.intensity:
                     self.base_text = text  # the sliders now shape the new file
                 self._show(m, drawn=tr is not None and _same(tr, m.trajectory))
             else:
@@ -291,15 +313,21 @@ class Studio:
                 self._say(m)
         return m
 
-    def _synthesized(self, state: str, intensity: float) -> str:
-        """The file ``aouc synth`` writes for ``state`` at ``intensity``, for the same
-        robot and goal (its values fitted to the arm; the build checks them)."""
+    def _synthesized(self, origin: Origin, intensity: float) -> str:
+        """The file ``aouc synth`` writes for ``origin`` (a state, or a blend's C-V
+        point) at ``intensity``, for the same robot and goal (its values fitted to the
+        arm; the build checks them)."""
         from ..synth.synthesis import synthesize
 
         b = self.shown.behaviour if self.shown is not None else None
         robot = self.engine.robot or (b.settings.robot if b is not None else None)
         goal = b.settings.goal if b is not None and "goal" in b.settings.spans else None
-        return synthesize(state, intensity=intensity, robot=robot, goal=goal, verify=False)
+        if origin.point is not None:
+            c, v = origin.point
+            return synthesize(C=c, V=v, intensity=intensity, robot=robot, goal=goal,
+                              verify=False)
+        return synthesize(origin.state, intensity=intensity, robot=robot, goal=goal,
+                          verify=False)
 
     def save(self) -> str:
         """Write the text of the motion shown into the file (atomic); the path."""
@@ -333,6 +361,14 @@ class Studio:
         else:
             self._say(m, "The file on disk does not build; the motion shown is the last "
                       "good one.")
+
+
+def _quiet():
+    """Standard output silenced (viser's messages; aou's own go to stderr)."""
+    import contextlib
+    import io
+
+    return contextlib.redirect_stdout(io.StringIO())
 
 
 def _same(a: Trajectory, b: Trajectory) -> bool:

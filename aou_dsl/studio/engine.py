@@ -43,6 +43,8 @@ class Motion:
         declared: the descriptors the file declares; behaviour: its IR (None for a
             recording or a text that does not lint); cv: the file's C-V point.
         seconds: how long the build took.
+        fitted: with ``fit``, the text the motion was built from when a value was
+            fitted to the arm (None: nothing was).
     """
 
     path: str
@@ -55,6 +57,7 @@ class Motion:
     cv: CVPoint | None = None
     seconds: float = 0.0
     recorded: bool = field(default=False)
+    fitted: str | None = None
 
     @property
     def ok(self) -> bool:
@@ -63,14 +66,18 @@ class Motion:
 
 class Engine:
     """Builds for one robot (``robot`` overrides the files' ``robot`` line; None keeps
-    it), remembering the last good :class:`Motion`."""
+    it), remembering the last good :class:`Motion`. With ``fit``, it builds as
+    ``aouc compile --fit`` does: a value the arm cannot give is fitted (C314 warnings),
+    the motion is the fitted text's, and :attr:`Motion.text` stays the text asked for."""
 
-    def __init__(self, robot: str | None = None, package_dirs: tuple[str, ...] = ()) -> None:
+    def __init__(self, robot: str | None = None, package_dirs: tuple[str, ...] = (),
+                 fit: bool = False) -> None:
         from ..build.session import Session
         from ..core.options import BuildOptions
 
         self.robot = robot
-        self.session = Session(BuildOptions(robot=robot, package_dirs=package_dirs))
+        self.fit = fit
+        self.session = Session(BuildOptions(robot=robot, package_dirs=package_dirs, fit=fit))
         self.package_dirs = self.session.options.package_dirs
         self.last_good: Motion | None = None
         self.last: Motion | None = None
@@ -87,7 +94,8 @@ class Engine:
             path, text, tuple(res.diagnostics),
             trajectory=res.compiled.trajectory if res.ok and res.compiled else None,
             measured=res.measured if res.ok else None, declared=res.declared,
-            behaviour=lint.behaviour, cv=lint.cv, seconds=time.perf_counter() - start)
+            behaviour=lint.behaviour, cv=lint.cv, seconds=time.perf_counter() - start,
+            fitted=res.fitted_source)
         return self._keep(motion)
 
     def preview(self, text: str, path: str) -> Trajectory | None:
@@ -95,6 +103,7 @@ class Engine:
         (None when it does not compile): the studio plays it while :meth:`build` checks
         and measures the same text. The compiler is deterministic, so :meth:`build`
         makes this very motion; only a check it fails can take it off screen."""
+        from ..compiler.fitting import FITTED
         from ..compiler.pipeline import CompileOptions, compile_behaviour
 
         with self._lock:
@@ -109,6 +118,8 @@ class Engine:
                                         timeline=lint.timeline)
             except AouError:  # an arm that cannot be loaded: build() says why
                 return None
+        if self.fit and any(d.code in FITTED for d in res.diagnostics):
+            return None  # the motion shown is the fitted one: build() makes it
         return res.trajectory if res.ok else None
 
     def read(self, path: str) -> Motion:

@@ -5,7 +5,8 @@
   current time marked;
 - the C-V map: the five states, the border of the hesitant region, the file's point;
 - each descriptor the file declares beside its measured value;
-- the diagnostics with their hints.
+- the diagnostics with their hints;
+- with ``--fit``, the values fitted to the arm (declared -> fitted, what binds).
 
 Pure: data in, text out (deterministic, so the page changes only when the motion does).
 """
@@ -17,14 +18,19 @@ from collections.abc import Iterable
 
 import numpy as np
 
+from ..core.codes import C314
 from ..core.diagnostics import Diagnostic
 from ..lang.cv import CANONICAL, CVPoint
 from ..lang.descriptors import REGISTRY, Descriptors
 from .view3d import EPISODE_COLOURS
 
-__all__ = ["cv_map", "descriptor_table", "diagnostics_html", "timeline", "velocity_profile"]
+__all__ = ["cv_map", "descriptor_table", "diagnostics_html", "fitted_html", "timeline",
+           "velocity_profile"]
 
 _W, _H = 300, 120
+#: What a fitted value is, when it is no descriptor (``--fit``'s own words).
+_FIT_KEYS = {"f": "shiver frequency", "for": "shiver duration", "a": "acceleration",
+             "v": "tilt velocity"}
 
 
 def _rgb(kind: str) -> str:
@@ -132,3 +138,26 @@ def diagnostics_html(diags: Iterable[Diagnostic], note: str = "") -> str:
     body = f'<ul style="font-size:11px;padding-left:14px">{"".join(items)}</ul>' if items \
         else ""
     return f'<div id="aou-diagnostics">{head}{body}</div>'
+
+
+def fitted_html(diags: Iterable[Diagnostic]) -> str:
+    """The values ``--fit`` changed (its C314 warnings): each as declared -> fitted with
+    the joint that binds; the file keeps the declared ones."""
+    items = []
+    for d in diags:
+        if d.code != C314 or "fitted" not in d.fields:
+            continue
+        f = d.fields
+        what = f.get("descriptor") or _FIT_KEYS.get(str(f.get("key")), f.get("key"))
+        was = f"{f['declared']}{f['unit']}" if f.get("declared") else "the default"
+        binds = f" ({html.escape(str(f['joint']))} binds)" if f.get("joint") else ""
+        items.append(f'<li data-key="{html.escape(str(f["key"]))}" data-line="{d.span.line}" '
+                     f'data-fitted="{html.escape(str(f["fitted"]))}">line {d.span.line}: '
+                     f"{html.escape(str(what))} {html.escape(was)} &rarr; "
+                     f"{html.escape(str(f['fitted']))}{html.escape(str(f['unit']))}"
+                     f"{binds}</li>")
+    if not items:
+        return '<div id="aou-fitted"><p>Fitted to the arm: nothing (every value fits).</p></div>'
+    return ('<div id="aou-fitted"><p>Fitted to the arm (the motion shown; Save keeps the '
+            'values of the sliders):</p><ul style="font-size:11px;padding-left:14px">'
+            + "".join(items) + "</ul></div>")

@@ -80,7 +80,8 @@ class Arm:
         from viser.extras import ViserUrdf
 
         self.server, self.root, self.ghost = server, root, ghost
-        server.scene.add_frame(root, show_axes=False)
+        self.frame = server.scene.add_frame(root, show_axes=False)
+        self._path: Any = None
         colour = (0.55, 0.75, 1.0, 0.35) if ghost else None
         self.urdf = ViserUrdf(server, Path(urdf_path), root_node_name=root,
                               mesh_color_override=colour)
@@ -98,13 +99,20 @@ class Arm:
         seg = np.stack([pts[:-1], pts[1:]], axis=1)
         colours = np.array([EPISODE_COLOURS.get(_kind_at(tk.episodes, m), _OTHER)
                             for m in mids[:-1]], dtype=np.uint8)
-        self.server.scene.add_line_segments(
+        self._path = self.server.scene.add_line_segments(
             f"{self.root}_path", seg, np.repeat(colours[:, None, :], 2, axis=1),
-            thickness=2.0 if self.ghost else 4.0, thickness_units="screen")
+            thickness=2.0 if self.ghost else 4.0, thickness_units="screen",
+            visible=self.frame.visible)
         if tk.goal is not None and not self.ghost:
             self.server.scene.add_box("/goal", color=(230, 180, 40),
                                       dimensions=(0.05, 0.05, 0.05),
                                       position=tuple(tk.goal))
+
+    def set_visible(self, visible: bool) -> None:
+        """Show or hide the arm and its path (the compared arm's checkbox)."""
+        self.frame.visible = visible
+        if self._path is not None:
+            self._path.visible = visible
 
     def pose(self, t: float) -> None:
         """The arm at time ``t`` from the start, with its line of sight."""
