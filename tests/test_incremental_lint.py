@@ -205,3 +205,27 @@ def test_the_session_lints_edits_as_a_fresh_lint():
         for _ in range(6):
             assert outcome(session.lint(text, path)) == outcome(lint_source(text, path))
             text = edit(rng, text, texts)
+
+
+def test_a_layout_kept_from_the_last_lint_tells_minus_zero_from_zero():
+    """The episodes after a gaze back to `-0deg` start from a plane angle of -0.0, after
+    one to `0deg` from 0.0: equal numbers, but not the same timeline, and the relint
+    gives each its own."""
+    linter = Relinter()
+    text = "sequence {\n  gaze horizontal 10deg\n  pause 1s\n  gaze horizontal {}deg\n" \
+        "  pause 1s\n  approach 2cm\n}\n"
+    for angle in ("0", "-0", "0", "-0.0", "+0"):
+        t = text.replace("{}", angle)
+        assert outcome(linter.lint(t, "z.aou")) == outcome(lint_source(t, "z.aou")), angle
+
+
+def test_a_statement_laid_out_from_another_pose_is_laid_out_again():
+    """A sequence statement whose start changes (an edit before it) is laid out anew;
+    those after an edit that leaves every pose as it was keep their episodes."""
+    linter = Relinter()
+    text = long_sequence(60)
+    for old, new in (("approach 0.01m", "approach 0.02m"), ("pause 0.6s", "pause 0.7s"),
+                     ("start 0.6m", "start 0.7m"),
+                     ("gaze horizontal 10deg", "gaze horizontal 12deg")):
+        text = text.replace(old, new, 1)
+        assert outcome(linter.lint(text, "s.aou")) == outcome(lint_source(text, "s.aou"))

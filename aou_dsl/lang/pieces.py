@@ -26,6 +26,7 @@ from typing import Any
 
 from ..core.diagnostics import Diagnostic, Span
 from .ir import Node
+from .layout import Laid
 from .parse import SequenceBlock, Statement, SyntaxTree, parse_statement
 from .values import Ctx
 
@@ -147,11 +148,13 @@ class Pieces:
         self._new_anywhere: dict[tuple[str, int], Piece] = {}
         self._by_statement: dict[int, Piece] = {}
         self.parsed = 0  # pieces parsed (not found kept), for tests and benchmarks
+        self.laid = Laid()  # the episodes of the last layout, by statement
 
     def tree(self, text: str) -> SyntaxTree | None:
         """The syntax tree of ``text`` (no byte-order mark), or None when only a parse
         of the whole file can tell."""
         self._new_at, self._new_anywhere, self._by_statement = {}, {}, {}
+        self.laid.turn()
         shape = _Shape(self.path, self._statement)
         ok = self._cut(text, shape) and shape.done()
         self._at, self._anywhere = self._new_at, self._new_anywhere

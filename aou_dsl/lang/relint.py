@@ -5,8 +5,10 @@ language server, the warm :class:`~aou_dsl.build.session.Session`).
 the same text (the same diagnostics, behaviour, timeline and C-V point), but keeps each
 file's statements (:mod:`.pieces`): an edit parses and reads only the statements it
 changed. The behaviour as a whole (settings, layout, the whole-file checks, the model's
-judgement) is made again from them every time, as a full lint makes it. A text the
-pieces cannot be sure of (a syntax error, most often) is linted whole.
+judgement) is made again from them every time, as a full lint makes it, the layout of a
+sequence taking again the episodes of each statement whose node and starting pose are
+as before (:class:`~aou_dsl.lang.layout.Laid`). A text the pieces cannot be sure of (a
+syntax error, most often) is linted whole.
 """
 
 from __future__ import annotations
@@ -49,5 +51,6 @@ class Relinter:
         if tree is None:
             v = load_validated(text, path)
         else:
-            v = validate_tree(tree, lambda ctx, st, seq: pieces.read(primitive, ctx, st, seq))
+            v = validate_tree(tree, lambda ctx, st, seq: pieces.read(primitive, ctx, st, seq),
+                              pieces.laid)
         return judge(text, path, v, weights)

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from ..core.codes import V101, V107, V108, V111, V113, V114, V115
 from ..core.diagnostics import Diagnostic, Span
 from .ir import Behaviour, Node, State
+from .layout import Laid
 from .parse import Colon, SequenceBlock, Statement, SyntaxTree, Word
 from .primitives import KINDS
 from .settings import SETTINGS, read_settings
@@ -140,11 +141,12 @@ def _statement(ctx: Ctx, f: _File, st: Statement, first: bool) -> None:
 
 
 def validate_tree(tree: SyntaxTree,
-                  read: Callable[[Ctx, Statement, bool], Node | None] | None = None
-                  ) -> Validated:
+                  read: Callable[[Ctx, Statement, bool], Node | None] | None = None,
+                  laid: Laid | None = None) -> Validated:
     """Check a syntax tree, build the IR and lay it out. ``read(ctx, statement,
-    in_sequence)`` reads a primitive statement as :func:`primitive` does (the
-    incremental linter passes one that remembers each statement's reading)."""
+    in_sequence)`` reads a primitive statement as :func:`primitive` does, and ``laid``
+    keeps the layout's episodes: the incremental linter passes both, to take again what
+    the file's last lint made of the statements an edit left as they were."""
     ctx = Ctx(tree.path)
     f = _File(read=read or primitive)
     for i, item in enumerate(tree.items):
@@ -169,7 +171,7 @@ def validate_tree(tree: SyntaxTree,
         span=Span(tree.path, 1, 1, 1, 1),
         header_span=f.header,
     )
-    timeline = check_whole(ctx, behaviour)
+    timeline = check_whole(ctx, behaviour, laid)
     if ctx.has_errors():
         return Validated(None, None, ctx.diags)
     return Validated(behaviour, timeline, ctx.diags)
