@@ -229,3 +229,41 @@ def test_a_statement_laid_out_from_another_pose_is_laid_out_again():
                      ("gaze horizontal 10deg", "gaze horizontal 12deg")):
         text = text.replace(old, new, 1)
         assert outcome(linter.lint(text, "s.aou")) == outcome(lint_source(text, "s.aou"))
+
+
+def test_typing_in_one_line_at_a_time_is_the_full_lint():
+    """Typing as in an editor: characters typed or deleted in one line at a time (the
+    path where only that line's statement is new), numbers half typed, the line made
+    junk, blank or a comment and back."""
+    rng = random.Random(21)
+    texts = seeds()
+    for text in [long_sequence(80), *texts[:12]]:
+        linter = Relinter()
+        history = [text]
+        original = text.split("\n")
+        for _ in range(60):
+            got = outcome(linter.lint(text, "typed.aou"))
+            assert got == outcome(lint_source(text, "typed.aou")), history[-3:]
+            lines = text.split("\n")
+            k = rng.randrange(len(lines))
+            line = lines[k]
+            at = rng.randint(0, len(line))
+            pick = rng.randrange(5)
+            if pick == 0:
+                typed = TYPED if rng.random() < 0.2 else list("0123456789.-=sxaegm ")
+                line = line[:at] + rng.choice([*typed, "1.", "e", "deg", " x2"]) + line[at:]
+            elif pick == 1:
+                line = line[:at] + line[at + rng.randint(1, 3):]
+            elif pick == 2 and _numbers(line):
+                m = rng.choice(_numbers(line))
+                line = line[:m.start()] + rng.choice(["", "1", "0.", "2.5", "-3"]) + \
+                    line[m.end():]
+            elif pick == 3:
+                line = rng.choice(["", "  # gone", "  ??", line, "  pause 1s", "  approach"])
+            elif len(lines) == len(original):  # a line typed back as it was
+                k = rng.choice([i for i, (a, b) in enumerate(zip(lines, original, strict=True))
+                                if a != b] or [k])
+                line = original[k]
+            lines[k] = line
+            text = "\n".join(lines)
+            history.append(text)

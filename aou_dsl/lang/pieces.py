@@ -40,7 +40,16 @@ _BLANK = " \t\f\r"
 #: A piece that starts with the keyword ``sequence`` (a longer word is not it).
 _SEQUENCE = re.compile(r"[ \t\f\r]*sequence(?![A-Za-z0-9_-])")
 
+#: A line the cutting finds nothing in: one piece, the whole line.
+_PLAIN = re.compile(r'[^;{}"#\n]*')
+
 Read = tuple[Node | None, tuple[Diagnostic, ...]]
+
+
+def _alone(line: str) -> bool:
+    """``line`` holds one statement and nothing else (it may not parse)."""
+    return _PLAIN.fullmatch(line) is not None and bool(line.strip(_BLANK)) and \
+        _SEQUENCE.match(line) is None
 
 
 @functools.cache
@@ -98,6 +107,9 @@ class _Shape:
         self.block: list[Statement] = []
         self.state = _TOP
         self.opened = (0, 0)
+        #: Where each line's (last) statement went: (index in items, index in the block
+        #: or -1 at the top level).
+        self.where: dict[int, tuple[int, int]] = {}
 
     def sep(self) -> None:
         if self.state in (_AFTER, _BLOCK_AFTER):  # the next statement may start
@@ -115,7 +127,9 @@ class _Shape:
         st = self.statement(piece, line, col)
         if st is None:
             return False
-        (self.items if self.state == _TOP else self.block).append(st)
+        at_top = self.state == _TOP
+        self.where[line] = (len(self.items), -1 if at_top else len(self.block))
+        (self.items if at_top else self.block).append(st)
         self.state += 1  # to _AFTER or _BLOCK_AFTER: a separator must follow
         return True
 
@@ -149,16 +163,61 @@ class Pieces:
         self._by_statement: dict[int, Piece] = {}
         self.parsed = 0  # pieces parsed (not found kept), for tests and benchmarks
         self.laid = Laid()  # the episodes of the last layout, by statement
+        self._last: SyntaxTree | None = None  # the last tree, of the text of _lines
+        self._lines: list[str] = []
+        self._where: dict[int, tuple[int, int]] = {}
 
     def tree(self, text: str) -> SyntaxTree | None:
         """The syntax tree of ``text`` (no byte-order mark), or None when only a parse
         of the whole file can tell."""
-        self._new_at, self._new_anywhere, self._by_statement = {}, {}, {}
         self.laid.turn()
+        tree = self._one_line(text)
+        if tree is not None:
+            return tree
+        self._new_at, self._new_anywhere, self._by_statement = {}, {}, {}
         shape = _Shape(self.path, self._statement)
         ok = self._cut(text, shape) and shape.done()
         self._at, self._anywhere = self._new_at, self._new_anywhere
-        return SyntaxTree(self.path, tuple(shape.items)) if ok else None
+        self._last = SyntaxTree(self.path, tuple(shape.items)) if ok else None
+        self._lines, self._where = text.split("\n"), shape.where
+        return self._last
+
+    def _one_line(self, text: str) -> SyntaxTree | None:
+        """The last tree with one statement replaced, when ``text`` differs from the
+        last text in one line, which both before and after is one statement with nothing
+        the cutting looks for (no separator, brace, quote or comment): the file's shape is
+        then as it was, and only that statement is new."""
+        lines = text.split("\n")
+        if self._last is None or len(lines) != len(self._lines):
+            return None
+        changed = [k for k, (a, b) in enumerate(zip(lines, self._lines, strict=True))
+                   if a != b]
+        if len(changed) != 1:
+            return None
+        k = changed[0]
+        was, now = self._lines[k], lines[k]
+        where = self._where.get(k + 1)
+        if where is None or not (_alone(was) and _alone(now)):
+            return None
+        self._new_at, self._new_anywhere = self._at, self._anywhere  # one generation on
+        st = self._statement(now, k + 1, 1)
+        if st is None:
+            return None
+        gone = self._at.pop((was, k + 1, 1), None)
+        if gone is not None:
+            self._by_statement.pop(id(gone.statement), None)
+            if self._anywhere.get((was, 1)) is gone:
+                del self._anywhere[was, 1]
+        items = list(self._last.items)
+        i, j = where
+        block = items[i]
+        if isinstance(block, SequenceBlock):
+            items[i] = SequenceBlock((*block.statements[:j], st, *block.statements[j + 1:]),
+                                     block.span)
+        else:
+            items[i] = st
+        self._last, self._lines = SyntaxTree(self.path, tuple(items)), lines
+        return self._last
 
     def _cut(self, text: str, shape: _Shape) -> bool:
         """Feed ``shape`` the pieces and cuts of ``text``; False at the first doubt,
