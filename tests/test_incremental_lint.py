@@ -267,3 +267,21 @@ def test_typing_in_one_line_at_a_time_is_the_full_lint():
             lines[k] = line
             text = "\n".join(lines)
             history.append(text)
+
+
+def test_the_relinter_s_tree_is_the_parse_and_none_on_a_syntax_error():
+    """What the language server's outline reads: the parser's tree of the text, from
+    the kept statements, the same text twice included; None where the parse fails."""
+    rng = random.Random(33)
+    texts = seeds()
+    linter = Relinter()
+    for text in texts[:25]:
+        for _ in range(8):
+            for variant in (text, text, "\ufeff" + text):
+                try:
+                    full = repr(parse(variant.removeprefix("\ufeff"), "o.aou"))
+                except Exception:  # noqa: BLE001 - an AouError: a syntax error
+                    full = None
+                tree = linter.tree(variant, "o.aou")
+                assert (repr(tree) if tree is not None else None) == full, variant
+            text = edit(rng, text, texts)

@@ -192,6 +192,8 @@ class Pieces:
             return None
         changed = [k for k, (a, b) in enumerate(zip(lines, self._lines, strict=True))
                    if a != b]
+        if not changed:
+            return self._last  # the same text: the same tree
         if len(changed) != 1:
             return None
         k = changed[0]

@@ -15,8 +15,10 @@ from __future__ import annotations
 
 from collections import OrderedDict
 
+from ..core.diagnostics import AouError
 from .cv import DEFAULT_WEIGHTS, CVWeights
 from .linter import FileResult, judge, load_validated
+from .parse import SyntaxTree, parse
 from .pieces import Pieces
 from .validate import primitive, validate_tree
 
@@ -41,6 +43,19 @@ class Relinter:
                 self._pieces.popitem(last=False)
         self._pieces.move_to_end(path)
         return kept
+
+    def tree(self, text: str, path: str = "<string>") -> SyntaxTree | None:
+        """The syntax tree of ``text`` (a leading byte-order mark dropped) as
+        :func:`~aou_dsl.lang.parse.parse` gives it, from what is kept; None on a syntax
+        error."""
+        text = text.removeprefix("\ufeff")
+        tree = self.pieces(path).tree(text)
+        if tree is not None:
+            return tree
+        try:
+            return parse(text, path)
+        except AouError:
+            return None
 
     def lint(self, text: str, path: str = "<string>", *,
              weights: CVWeights = DEFAULT_WEIGHTS) -> FileResult:
