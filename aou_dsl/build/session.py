@@ -7,7 +7,8 @@ parser (built once per process), every arm it has loaded (the robot loader cache
 name and package folders; :meth:`Session.warm` loads one ahead), and the last results of
 each stage, keyed by that stage's inputs:
 
-- ``lint``: by the text and its path;
+- ``lint``: by the text and its path; a changed text of a file is linted from the
+  statements kept of its last lints, so an edit parses only what it changed;
 - ``build`` (compile, check, measure): by the linted behaviour and timeline (their values
   and source positions, which the build's diagnostics point at), the file's path and the
   :class:`~aou_dsl.core.options.BuildOptions`. A change that leaves them as they were (a
@@ -87,7 +88,10 @@ class Session:
 
     def __init__(self, options: BuildOptions | None = None, *, keep: int = 16):
         self.options = options or BuildOptions()
+        from ..lang.relint import Relinter
+
         self._lints = _Kept(keep)
+        self._relinter = Relinter(keep)
         self._builds = _Kept(keep)
         self.runs = {"lint": 0, "build": 0}
 
@@ -97,12 +101,14 @@ class Session:
         warm((robot or self.options.robot or "panda",), self.options)
 
     def lint(self, text: str, path: str = "<string>") -> FileResult:
-        """The lint of ``text`` (named ``path`` in diagnostics), kept for the same text."""
-        from ..lang.linter import lint_source
+        """The lint of ``text`` (named ``path`` in diagnostics), kept for the same text.
+        A changed text is linted from the statements it kept of the file's last lints
+        (:class:`~aou_dsl.lang.relint.Relinter`): only what the edit changed is parsed
+        and read again, and the result is the full lint's."""
 
         def run() -> FileResult:
             self.runs["lint"] += 1
-            return lint_source(text, path)
+            return self._relinter.lint(text, path)
 
         return self._lints.get_or((path, text), run)
 

@@ -31,6 +31,7 @@ if TYPE_CHECKING:
     from ..build.session import Session
     from ..lang.linter import FileResult
     from ..lang.parse import SyntaxTree
+    from ..lang.relint import Relinter
     from ..lang.timeline import Episode
 
 __all__ = ["Built", "Shown", "build", "compile_only", "format_text", "lint", "rule", "shown",
@@ -74,13 +75,19 @@ def lint(text: str, path: str) -> FileResult:
     return _session("typing").lint(text, path)
 
 
-def syntax(text: str, path: str) -> SyntaxTree | None:
-    from ..lang.parse import parse
+@functools.cache
+def _trees() -> Relinter:
+    """What the outline's parses keep of each file (on the typing thread): a request
+    after an edit parses only the statement the edit changed."""
+    from ..lang.relint import Relinter
 
-    try:
-        return parse(text.removeprefix("\ufeff"), path)
-    except AouError:
-        return None
+    return Relinter()
+
+
+def syntax(text: str, path: str) -> SyntaxTree | None:
+    """The syntax tree of the text (a leading byte-order mark dropped), or None while it
+    does not parse."""
+    return _trees().tree(text, path)
 
 
 def format_text(text: str, path: str) -> str | None:

@@ -56,6 +56,9 @@ DEFAULTS = {
 
 def _check(obj: Any, name: str, value: Any, hint: Any) -> Any:
     """``value`` as field ``name`` of ``obj`` declared ``hint`` stores it, or an error."""
+    if type(hint) is type and hint is not float and hint is not int \
+            and isinstance(value, hint):
+        return value  # a plain class, already of it (the IR's nodes in a tuple): as below
     origin, args = typing.get_origin(hint), typing.get_args(hint)
     if origin in (types.UnionType, typing.Union):
         if value is None and type(None) in args:

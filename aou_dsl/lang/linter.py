@@ -21,8 +21,8 @@ from .parse import parse
 from .timeline import Timeline
 from .validate import Validated, validate_tree
 
-__all__ = ["MAX_DIAGNOSTICS", "FileResult", "collect_files", "collect_inputs", "lint_file",
-           "lint_paths", "lint_source", "load", "read_source", "severity_counts"]
+__all__ = ["MAX_DIAGNOSTICS", "FileResult", "collect_files", "collect_inputs", "judge",
+           "lint_file", "lint_paths", "lint_source", "load", "read_source", "severity_counts"]
 
 
 #: At most this many diagnostics are kept per file (the most severe, earliest first);
@@ -151,7 +151,13 @@ def lint_source(text: str, path: str = "<string>", *,
                 weights: CVWeights = DEFAULT_WEIGHTS) -> FileResult:
     """Lint ``.aou`` source text (a leading byte-order mark is not part of it)."""
     text = text.removeprefix("\ufeff")
-    v = load_validated(text, path)
+    return judge(text, path, load_validated(text, path), weights)
+
+
+def judge(text: str, path: str, v: Validated, weights: CVWeights = DEFAULT_WEIGHTS
+          ) -> FileResult:
+    """The lint of ``text`` (no byte-order mark) from its validation ``v``: the model's
+    judgement added, the diagnostics capped and in file order."""
     result = FileResult(path, list(v.diagnostics), source=text)
     b = v.behaviour
     if b is not None and not has_errors(result.diagnostics):

@@ -24,18 +24,8 @@ from ..core.codes import S001, S002, S003
 from ..core.diagnostics import AouError, Fix, Span, degree_fix, diag
 from ..core.units import lookalike_digit, parse_quantity
 
-__all__ = [
-    "Colon",
-    "KeyVal",
-    "Quantity",
-    "SequenceBlock",
-    "Statement",
-    "SyntaxTree",
-    "Vector",
-    "Word",
-    "build_parser",
-    "parse",
-]
+__all__ = ["Colon", "KeyVal", "Quantity", "SequenceBlock", "Statement", "SyntaxTree",
+           "Vector", "Word", "build_parser", "parse", "parse_statement"]
 
 
 # --- The syntax tree --------------------------------------------------------------------
@@ -141,8 +131,9 @@ def cache_dir() -> str | None:
 
 
 @functools.cache
-def _parser() -> Lark:
-    """The parser :func:`parse` uses: LALR, building the syntax tree while it parses.
+def _parser(start: str = "start") -> Lark:
+    """The parser :func:`parse` uses (or, from ``start="statement"``,
+    :func:`parse_statement`): LALR, building the syntax tree while it parses.
 
     Lark's analysis of the grammar (its tables, and the terminal-collision check it runs
     when ``interegular`` is installed) takes most of a cold start; it is cached in
@@ -154,12 +145,13 @@ def _parser() -> Lark:
     import hashlib
 
     text = grammar_text()
-    options = {"parser": "lalr", "transformer": _ToSyntax()}
+    options = {"parser": "lalr", "transformer": _ToSyntax(), "start": start}
     where = cache_dir()
     if where is None:
         return Lark(text, **options)
     key = hashlib.sha256(f"{text}|{lark.__version__}|{sys.version_info[:2]}".encode())
-    path = os.path.join(where, f"grammar-{key.hexdigest()[:20]}.lark-cache")
+    name = key.hexdigest()[:20] + ("" if start == "start" else f"-{start}")
+    path = os.path.join(where, f"grammar-{name}.lark-cache")
     if os.path.isfile(path):
         return Lark(text, cache=path, **options)
     tmp = f"{path}.{os.getpid()}.{threading.get_ident()}.tmp"
@@ -414,3 +406,15 @@ def parse(text: str, path: str = "<string>") -> SyntaxTree:
     finally:
         _CURRENT.text = None
     return SyntaxTree(path, items)  # type: ignore[arg-type]
+
+
+def parse_statement(text: str, path: str) -> Statement | None:
+    """``text`` as one statement alone (a piece of a file, padded with spaces to its
+    column), or None when it is not one: the caller then parses the whole file."""
+    _CURRENT.path, _CURRENT.text = path, text
+    try:
+        return _parser("statement").parse(text)  # type: ignore[return-value]
+    except lark.exceptions.UnexpectedInput:
+        return None
+    finally:
+        _CURRENT.text = None

@@ -9,11 +9,13 @@ kind's ``read``), settings (:mod:`.settings`), then the behaviour as a whole
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from ..core.codes import V101, V107, V108, V111, V113, V114, V115
 from ..core.diagnostics import Diagnostic, Span
 from .ir import Behaviour, Node, State
+from .layout import Laid
 from .parse import Colon, SequenceBlock, Statement, SyntaxTree, Word
 from .primitives import KINDS
 from .settings import SETTINGS, read_settings
@@ -21,7 +23,7 @@ from .timeline import Timeline
 from .values import Ctx, Reader, did_you_mean, fix_word
 from .whole_file import MAX_EPISODES, MAX_MOTION_TIME, check_whole
 
-__all__ = ["KEYWORDS", "MAX_EPISODES", "MAX_MOTION_TIME", "Validated", "validate",
+__all__ = ["KEYWORDS", "MAX_EPISODES", "MAX_MOTION_TIME", "Validated", "primitive", "validate",
            "validate_tree"]
 
 KEYWORDS = ("behaviour", *SETTINGS, *KINDS, "sequence")
@@ -36,7 +38,7 @@ class Validated:
     diagnostics: list[Diagnostic] = field(default_factory=list)
 
 
-def _primitive(ctx: Ctx, st: Statement, in_sequence: bool) -> Node | None:
+def primitive(ctx: Ctx, st: Statement, in_sequence: bool) -> Node | None:
     """A primitive statement as IR, or None (with diagnostics) when it does not fit."""
     kind = KINDS[st.keyword]
     return kind.read(Reader(ctx, st, kind, in_sequence))
@@ -77,6 +79,8 @@ class _File:
     block: SequenceBlock | None = None
     first_primitive: Span | None = None
     seen: dict[str, Span] = field(default_factory=dict)
+    #: How a primitive statement is read (:func:`primitive`, or a kept reading of it).
+    read: Callable[[Ctx, Statement, bool], Node | None] = primitive
 
 
 def _block(ctx: Ctx, f: _File, item: SequenceBlock) -> None:
@@ -93,14 +97,14 @@ def _block(ctx: Ctx, f: _File, item: SequenceBlock) -> None:
                       hint=did_you_mean(st.keyword, KINDS),
                       fix=fix_word(st.keyword_span, st.keyword, KINDS))
             continue
-        p = _primitive(ctx, st, in_sequence=True)
+        p = f.read(ctx, st, True)
         if p is not None:
             f.sequence.append(p)
 
 
 def _descriptor_statement(ctx: Ctx, f: _File, st: Statement) -> None:
     f.first_primitive = f.first_primitive or st.span
-    p = _primitive(ctx, st, in_sequence=False)
+    p = f.read(ctx, st, False)
     key = f"gaze {getattr(p, 'plane', '')}" if p is not None and p.kind == "gaze" \
         else st.keyword
     if key in f.seen:
@@ -136,10 +140,15 @@ def _statement(ctx: Ctx, f: _File, st: Statement, first: bool) -> None:
                   fix=fix_word(st.keyword_span, st.keyword, KEYWORDS))
 
 
-def validate_tree(tree: SyntaxTree) -> Validated:
-    """Check a syntax tree, build the IR and lay it out."""
+def validate_tree(tree: SyntaxTree,
+                  read: Callable[[Ctx, Statement, bool], Node | None] | None = None,
+                  laid: Laid | None = None) -> Validated:
+    """Check a syntax tree, build the IR and lay it out. ``read(ctx, statement,
+    in_sequence)`` reads a primitive statement as :func:`primitive` does, and ``laid``
+    keeps the layout's episodes: the incremental linter passes both, to take again what
+    the file's last lint made of the statements an edit left as they were."""
     ctx = Ctx(tree.path)
-    f = _File()
+    f = _File(read=read or primitive)
     for i, item in enumerate(tree.items):
         if isinstance(item, SequenceBlock):
             _block(ctx, f, item)
@@ -162,7 +171,7 @@ def validate_tree(tree: SyntaxTree) -> Validated:
         span=Span(tree.path, 1, 1, 1, 1),
         header_span=f.header,
     )
-    timeline = check_whole(ctx, behaviour)
+    timeline = check_whole(ctx, behaviour, laid)
     if ctx.has_errors():
         return Validated(None, None, ctx.diags)
     return Validated(behaviour, timeline, ctx.diags)

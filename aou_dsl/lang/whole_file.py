@@ -10,7 +10,7 @@ from ..core.codes import V110, V119, V120, V121, V123, V124, V125
 from .declared import source_of, written
 from .descriptors import REGISTRY, compare, derive
 from .ir import Behaviour
-from .layout import episode_values, layout
+from .layout import Laid, episode_values, layout
 from .primitives import KINDS, MIN_RETREAT
 from .timeline import Timeline
 from .values import Ctx
@@ -192,13 +192,14 @@ def _realisable(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
                   descriptor=m.name, declared=m.declared, realised=m.measured)
 
 
-def check_whole(ctx: Ctx, b: Behaviour) -> Timeline | None:
-    """Check the behaviour as a whole; its timeline, or None when it cannot be laid out."""
+def check_whole(ctx: Ctx, b: Behaviour, laid: Laid | None = None) -> Timeline | None:
+    """Check the behaviour as a whole; its timeline, or None when it cannot be laid out
+    (with ``laid``, the episodes of the file's last layout are taken again)."""
     if not _episodes(ctx, b):
         return None
     if b.form == "sequence" and not _standoff(ctx, b):
         return None
-    tl = layout(b)
+    tl = layout(b, laid)
     if not _time(ctx, b, tl):
         return None
     if not tl.episodes:
