@@ -267,7 +267,8 @@ def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
             shiver[:, sel] = _shiver(t[sel] - plan.t0, plan.amplitude, plan.freq,
                                      plan.duration)
     predicted = predict(seq, s, time_scale, factors, pinned)
-    changes = ((since, float(intensity)),) if intensity is not None else ()
+    changes: tuple[tuple[int, float], ...] = ((since, float(intensity)),) \
+        if intensity is not None else ()
     changes += tuple(schedule)
     level = changes[-1][1] if changes else seq.intensity
     return Rollout(t, pos, quat, which, shiver, spans, new_goal,  # type: ignore[arg-type]
