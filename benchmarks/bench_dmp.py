@@ -3,15 +3,17 @@
 - rollout: the hesitant behaviour's DMPs rolled out (the library's integration, every
   2 ms, then sampled at 250 Hz), and rolled out and solved for the Panda (inverse
   kinematics at every sample), each per second of motion: the median of 3;
-- intensity: hesitant raised from 0.5 to 1 in its first pause, two ways. Through the DMPs
-  (the running part finishes, later parts take the new intensity: the motions whose time
-  scale changes are rolled out again, the rest kept from the running rollout, and the
-  whole solved by inverse kinematics), and by today's live re-plan
-  (:class:`aou_dsl.live.regulator.Regulator`: a synthesized, compiled, checked plan, warm, joined
-  by a jerk-limited transition). Time
-  of each, and smoothness over the second after the change: the largest joint jerk
-  (third differences at the sample rate) and the largest step of a joint acceleration
-  between two samples.
+- intensity: hesitant raised from 0.5 to 1 in its first pause. Through the DMPs, three
+  ways: whole (the motions whose time scale changes integrated again, the whole
+  behaviour solved by inverse kinematics: how it was first done), live (those motions'
+  rollouts stretched in time instead, and only the samples after the change solved),
+  and the live regulator's own call (``Regulator.change_intensity``: the live way plus
+  the safety check of what changed). Beside them today's live re-plan
+  (:meth:`aou_dsl.live.regulator.Regulator.replan`: a synthesized, compiled, checked
+  plan, warm, joined by a jerk-limited transition). Wall and CPU time of each (the CPU
+  time is steadier on a shared machine), and smoothness over the second after the
+  change: the largest joint jerk (third differences at the sample rate) and the largest
+  step of a joint acceleration between two samples.
 """
 
 from __future__ import annotations
@@ -62,29 +64,58 @@ def bench_dmp() -> None:
 
     pause = next((a, b) for k, a, b in ro.parts if k == "pause")
     at = 0.5 * sum(pause)
-    roll(seq, cache=cache)  # the running behaviour's rolled motions, kept
-    t = time.perf_counter()
-    changed = change_intensity(seq, at, 1.0, cache=cache)
-    tr = to_trajectory(seq, changed, where)
-    dmp_s = time.perf_counter() - t
+    running = roll(seq, cache=cache)  # the running behaviour's rolled motions, kept
+    first = to_trajectory(seq, running, where)
+    ways = {}
+    for name, retime in (("whole", False), ("live", True)):
+        kept = dict(cache)
+        t, c = time.perf_counter(), time.process_time()
+        changed = change_intensity(seq, at, 1.0, cache=kept, running=running, retime=retime)
+        tr = to_trajectory(seq, changed, where,
+                           reuse=(running, first) if retime else None)
+        ways[name] = (time.perf_counter() - t, time.process_time() - c, tr)
     dmp_jerk, dmp_step = _smoothness(tr.t, tr.qdd, at)
+
+    live = Regulator("panda", through_dmp=True)
+    lplan = live.plan(State.HESITANT, 0.5)
+    started = live.replan(lplan.q[0], None, None, State.HESITANT, 0.5, restart=True)
+    begun = started.trajectory  # the transition into the rollout, then the rollout
+    k = int(np.searchsorted(begun.t, at + started.transition - 1e-9))
+    c = time.process_time()
+    through = live.change_intensity(begun.q[k], begun.qd[k], begun.qdd[k], 1.0,
+                                    elapsed=float(begun.t[k]))
+    ways["regulator"] = (through.seconds, time.process_time() - c, through.trajectory)
 
     reg = Regulator("panda")
     plan = reg.plan(State.HESITANT, 0.5)
     reg.plan(State.HESITANT, 1.0)  # warm, as a prepared regulator is
     reg.replan(plan.q[0], None, None, State.HESITANT, 0.5, restart=True)
     i = int(np.searchsorted(plan.t, at))
+    c = time.process_time()
     rep = reg.replan(plan.q[i], plan.qd[i], plan.qdd[i], State.HESITANT, 1.0)
+    replan_cpu = time.process_time() - c
     rt = rep.trajectory
     re_jerk, re_step = _smoothness(rt.t, rt.qdd, 0.0)
-    say("  intensity 0.5 -> 1 in the first pause:      through the DMPs   re-plan (warm)")
-    say(f"    time [ms]                                {dmp_s * 1000:>12.1f}   "
-        f"{rep.seconds * 1000:>12.1f}")
-    say(f"    largest joint jerk in 1 s [rad/s^3]      {dmp_jerk:>12.2f}   {re_jerk:>12.2f}")
-    say(f"    largest acceleration step [rad/s^2]      {dmp_step:>12.4f}   {re_step:>12.4f}")
-    figure("dmp_intensity_ms", "intensity change through the DMPs (roll and IK)",
-           dmp_s * 1000, "ms")
-    figure("dmp_intensity_vs_replan", "its time over a warm re-plan's", dmp_s / rep.seconds,
-           "x")
+    say("  intensity 0.5 -> 1 in the first pause:   DMPs whole   DMPs live   regulator"
+        "   re-plan (warm)")
+    say("    wall time [ms]                        " + "".join(
+        f"{ways[w][0] * 1000:>11.1f} " for w in ("whole", "live", "regulator"))
+        + f"{rep.seconds * 1000:>13.1f}")
+    say("    CPU time [ms]                         " + "".join(
+        f"{ways[w][1] * 1000:>11.1f} " for w in ("whole", "live", "regulator"))
+        + f"{replan_cpu * 1000:>13.1f}")
+    say(f"    largest joint jerk in 1 s [rad/s^3]   {dmp_jerk:>35.2f}  {re_jerk:>13.2f}")
+    say(f"    largest acceleration step [rad/s^2]   {dmp_step:>35.4f}  {re_step:>13.4f}")
+    say("    (the live way's joint motion equals the whole way's: "
+        f"{np.abs(ways['live'][2].q - ways['whole'][2].q).max() * 1000:.3f} mrad apart)")
+    dmp_s = ways["live"][0]
+    figure("dmp_intensity_whole_ms", "intensity change through the DMPs, whole (roll, IK)",
+           ways["whole"][0] * 1000, "ms")
+    figure("dmp_intensity_ms", "intensity change through the DMPs, live (retimed, the "
+           "remainder's IK)", dmp_s * 1000, "ms")
+    figure("dmp_intensity_regulator_ms", "the regulator's change through the DMPs (checked)",
+           ways["regulator"][0] * 1000, "ms")
+    figure("dmp_intensity_vs_replan", "the live way's time over a warm re-plan's",
+           dmp_s / rep.seconds, "x")
     figure("dmp_intensity_jerk", "its largest joint jerk over the re-plan's",
            dmp_jerk / max(re_jerk, 1e-12), "x", at_most=1.0, fmt="{:.2f}")

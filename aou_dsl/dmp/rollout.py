@@ -73,6 +73,8 @@ class Rollout:
         predicted: the descriptors the scaling rules predict.
         offset: when the sequence's first part starts on this clock [s] (the lead-in
             of a first motion is rest before it).
+        schedule: the intensity changes of a running behaviour, ``(from part,
+            intensity)`` in order (:mod:`.intensity`).
     """
 
     t: np.ndarray
@@ -89,6 +91,7 @@ class Rollout:
     pinned: tuple[str, ...] = ()
     predicted: dict[str, Any] = field(default_factory=dict)
     offset: float = 0.0
+    schedule: tuple[tuple[int, float], ...] = ()
 
 
 def similarity(start: np.ndarray, old: np.ndarray, new: np.ndarray
@@ -200,7 +203,8 @@ def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
          time_scale: float = 1.0, intensity: float | None = None,
          pinned: tuple[str, ...] = (), rate: float | None = None,
          stretch: dict[int, float] | None = None, cache: dict | None = None,
-         since: int = 0) -> Rollout:
+         since: int = 0, schedule: tuple[tuple[int, float], ...] = (),
+         retime: bool = False) -> Rollout:
     """Roll ``seq`` out (see the module's docstring).
 
     Args:
@@ -215,17 +219,30 @@ def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
         cache: motions already rolled out, reused (a dict the caller keeps).
         since: the intensity applies from this part on; earlier parts keep the
             sequence's own (a running behaviour changes intensity, :mod:`.intensity`).
+        schedule: later changes, ``(from part, intensity)`` in order, each applying
+            from its part on (a behaviour whose intensity changed more than once).
+        retime: a motion whose time scale is not 1 is its DMP's rollout at its own
+            execution time stretched in time, not integrated again. A DMP's
+            transformation system is invariant under scaling time with its execution
+            time, so the two differ only by the integrator's error (under 0.04 mm on
+            the shipped behaviours): the live path uses it (:mod:`.intensity`).
 
     Raises:
         AouError: I504 for a value out of range.
     """
     _check(time_scale, intensity, pinned)
+    for _, later in schedule:
+        _check(time_scale, later, pinned)
     p0 = seq.parts[0].start[:3]
     new_goal = tuple(float(x) for x in (goal if goal is not None else seq.goal))
     s, r = similarity(p0, np.asarray(seq.goal), np.asarray(new_goal))
     factors = _factors(seq, intensity)
-    plans = _plans(seq, p0, s, r, time_scale, factors, pinned, stretch or {},
-                   {} if cache is None else cache, since)
+    per_part = [factors if i >= since else {} for i in range(len(seq.parts))]
+    for first_part, later in schedule:
+        factors = _factors(seq, later)
+        per_part[first_part:] = [factors] * (len(seq.parts) - first_part)
+    plans = _plans(seq, p0, s, r, time_scale, per_part, pinned, stretch or {},
+                   {} if cache is None else cache, retime)
     first, last = plans[0], plans[-1]
     # The first motion's lead-in and the last one's run-out are rest of their own.
     offset = first.t0 - first.begin if first.spline is not None else 0.0
@@ -250,9 +267,12 @@ def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
             shiver[:, sel] = _shiver(t[sel] - plan.t0, plan.amplitude, plan.freq,
                                      plan.duration)
     predicted = predict(seq, s, time_scale, factors, pinned)
+    changes: tuple[tuple[int, float], ...] = ((since, float(intensity)),) \
+        if intensity is not None else ()
+    changes += tuple(schedule)
+    level = changes[-1][1] if changes else seq.intensity
     return Rollout(t, pos, quat, which, shiver, spans, new_goal,  # type: ignore[arg-type]
-                   s, r, time_scale, seq.intensity if intensity is None else intensity,
-                   tuple(pinned), predicted, offset)
+                   s, r, time_scale, level, tuple(pinned), predicted, offset, changes)
 
 
 @dataclass
@@ -272,26 +292,46 @@ class _Plan:
     freq: float = 0.0
 
 
-def _plans(seq: DmpSequence, p0: np.ndarray, s: float, r: np.ndarray, time_scale: float,
-           new_factors: dict[str, float], pinned: tuple[str, ...],
-           stretch: dict[int, float], cache: dict, since: int = 0) -> list[_Plan]:
-    """Every part on one clock, each motion rolled out."""
+class _Stretched:
+    """A motion's rollout stretched ``k`` times in time (``retime``, :func:`roll`)."""
+
+    def __init__(self, spline: Any, k: float):
+        self.spline, self.k = spline, k
+
+    def __call__(self, t: np.ndarray) -> np.ndarray:
+        return self.spline(np.asarray(t) / self.k)
+
+
+def _rolled(cache: dict, i: int, p: Any, start: np.ndarray, end: np.ndarray, s: float,
+            r: np.ndarray, k: float, retime: bool) -> tuple[float, Any]:
+    """Motion ``i`` rolled out at time scale ``k``: its duration [s] and pose spline."""
     from scipy.interpolate import CubicSpline
 
-    ks = [_time_scale(p, s, time_scale, new_factors if i >= since else {}, pinned)
-          * stretch.get(i, 1.0) for i, p in enumerate(seq.parts)]
+    if retime and k != 1.0:
+        runs, spline = _rolled(cache, i, p, start, end, s, r, 1.0, False)
+        return runs * k, _Stretched(spline, k)
+    key = (i, s, r.tobytes(), k)
+    if key not in cache:
+        tt, yy = _roll_move(p.dmp, start, end, s, r, k * p.dmp.execution_time_)
+        cache[key] = (float(tt[-1]), CubicSpline(tt, yy, axis=0))
+    return cache[key]
+
+
+def _plans(seq: DmpSequence, p0: np.ndarray, s: float, r: np.ndarray, time_scale: float,
+           per_part: list[dict[str, float]], pinned: tuple[str, ...],
+           stretch: dict[int, float], cache: dict, retime: bool = False) -> list[_Plan]:
+    """Every part on one clock, each motion rolled out (``per_part``: the intensity's
+    multipliers of each part)."""
+    ks = [_time_scale(p, s, time_scale, per_part[i], pinned) * stretch.get(i, 1.0)
+          for i, p in enumerate(seq.parts)]
     plans, t0 = [], 0.0
     for i, p in enumerate(seq.parts):
-        factors = new_factors if i >= since else {}
+        factors = per_part[i]
         start = _map_pose(p.start, p0, s, r)
         if p.dmp is not None:
             k = ks[i]
             end = _map_pose(p.end, p0, s, r)
-            key = (i, s, r.tobytes(), k)
-            if key not in cache:
-                tt, yy = _roll_move(p.dmp, start, end, s, r, k * p.dmp.execution_time_)
-                cache[key] = (float(tt[-1]), CubicSpline(tt, yy, axis=0))
-            runs, spline = cache[key]
+            runs, spline = _rolled(cache, i, p, start, end, s, r, k, retime)
             plans.append(_Plan(p.kind, t0, k * p.duration, t0 - k * p.lead, runs, spline,
                                start))
         elif p.kind == "shiver":

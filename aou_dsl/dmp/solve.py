@@ -2,7 +2,9 @@
 
 The hand's poses are solved by the compiler's inverse kinematics
 (:func:`aou_dsl.robot.ik.solve_path`, gaze locked on the new goal since the poses
-are), warm-started from the sequence's start configuration. A hold repeats the joint
+are): at waypoints spaced as the compiler's, with its pull toward the arm's posture, then
+every sample exactly from the spline through them (:func:`_reference`), so that the
+redundancy is resolved as in a compile and never drifts. A hold repeats the joint
 configuration of its pose (a pause is all joints at rest); a shiver adds its offset to
 the shiver joint, as the compiler does. Velocities and accelerations are differentiated
 from the positions (the shiver's are analytic). Then the same safety replay as
@@ -48,24 +50,74 @@ def _rot(quat: np.ndarray) -> np.ndarray:
     return np.array([pr.matrix_from_quaternion(q) for q in quat])
 
 
-def _follow(arm: Any, pos: np.ndarray, rot: np.ndarray, q: np.ndarray
+def _progress(pos: np.ndarray, quat: np.ndarray) -> np.ndarray:
+    """The hand's progress along the path at every sample, counted in the compiler's
+    waypoint spacings (:data:`aou_dsl.compiler.pipeline.STEP_LENGTH` of travel,
+    ``STEP_ANGLE`` of turn, whichever is more): constant through a hold."""
+    from ..compiler.pipeline import STEP_ANGLE, STEP_LENGTH
+
+    dp = np.linalg.norm(np.diff(pos, axis=0), axis=1) / STEP_LENGTH
+    da = 2.0 * np.linalg.norm(np.diff(quat, axis=0), axis=1) / STEP_ANGLE
+    return np.concatenate([[0.0], np.cumsum(np.maximum(dp, da))])
+
+
+def _reference(arm: Any, pos: np.ndarray, quat: np.ndarray, rot: np.ndarray,
+               seed: np.ndarray) -> tuple[np.ndarray, int, str]:
+    """Joint positions near each pose that resolve the arm's redundancy as the compiler
+    does: its inverse kinematics (the posture pulled in the null space) at waypoints one
+    spacing apart along the hand's path, from ``seed`` (the first pose's solution), and
+    a cubic spline through them over the progress, so that a hold keeps one
+    configuration and a long sequence does not drift along the self-motion. Returns
+    them (N, n), and the first sample that could not be reached (-1: none) with why."""
+    import pytransform3d.rotations as pr
+    from scipy.interpolate import CubicSpline
+
+    from ..robot.ik import solve_path
+
+    c = _progress(pos, quat)
+    if c[-1] < 1e-9:
+        return np.tile(seed, (len(pos), 1)), -1, ""
+    steps = max(1, int(np.ceil(c[-1] - 1e-6)))
+    at = np.linspace(0.0, c[-1], steps + 1)
+    moving = np.concatenate([[True], np.diff(c) > 0])  # the first sample of each hold
+    cm = c[moving]
+    p = np.column_stack([np.interp(at, cm, pos[moving, j]) for j in range(3)])
+    q4 = np.column_stack([np.interp(at, cm, quat[moving, j]) for j in range(4)])
+    targets = [(p[k], pr.matrix_from_quaternion(q4[k] / np.linalg.norm(q4[k])))
+               for k in range(1, len(at))]
+    got = solve_path(arm, targets, seed)
+    if not got.ok:
+        assert got.failure is not None
+        bad = int(np.searchsorted(c, at[1 + got.failure.index]))
+        return np.empty((0, arm.n)), min(bad, len(c) - 1), got.failure.status.value
+    return CubicSpline(at, np.vstack([seed, got.q]), axis=0)(c), -1, ""
+
+
+def _follow(arm: Any, pos: np.ndarray, rot: np.ndarray, ref: np.ndarray
             ) -> tuple[np.ndarray, int, str]:
-    """Damped least squares along dense poses, each solve warm-started from the last, with
-    no pull toward a posture (a pull at every millisecond would swing the null space):
-    the redundancy moves only as the hand does. Returns the joint path (N, n), and the
-    index of the first pose it could not follow (-1: none) with why."""
+    """Damped least squares to each pose from its reference configuration
+    (:func:`_reference`), without a pull: the exact pose, the redundancy the
+    reference's. Returns the joint path (N, n), and the index of the first pose it
+    could not follow (-1: none) with why."""
     import pinocchio as pin
 
     model, data, fid = arm.model, arm.model.createData(), arm.frame_id
     out = np.empty((len(pos), arm.n))
     damped = 1e-8 * np.eye(6)
+    converged = False
     for i in range(len(pos)):
+        if converged and i > 0 and np.array_equal(pos[i], pos[i - 1]) \
+                and np.array_equal(rot[i], rot[i - 1]) and np.array_equal(ref[i], ref[i - 1]):
+            out[i] = out[i - 1]  # a hold: the pose the last solve reached already
+            continue
+        q = ref[i].copy()
         target = pin.SE3(rot[i], pos[i])
         for _ in range(30):
             pin.computeJointJacobians(model, data, q)
             dm = pin.updateFramePlacement(model, data, fid).actInv(target)
             err = pin.log6(dm).vector
-            if float(np.abs(err).max()) < 1e-9:
+            converged = float(np.abs(err).max()) < 1e-9
+            if converged:
                 break
             je = -pin.Jlog6(dm.inverse()) @ pin.getFrameJacobian(model, data, fid, pin.LOCAL)
             q = q - je.T @ np.linalg.solve(je @ je.T + damped, err)
@@ -78,8 +130,26 @@ def _follow(arm: Any, pos: np.ndarray, rot: np.ndarray, q: np.ndarray
     return out, -1, ""
 
 
-def to_trajectory(seq: DmpSequence, ro: Rollout, where: Span) -> Any:
+def _unchanged(ro: Rollout, prior: Rollout) -> int:
+    """How many first samples of ``ro`` are those of ``prior``: same time, pose, part and
+    shiver."""
+    n = min(len(ro.t), len(prior.t))
+    same = ((ro.t[:n] == prior.t[:n]) & (ro.part[:n] == prior.part[:n])
+            & np.all(ro.pos[:n] == prior.pos[:n], axis=1)
+            & np.all(ro.quat[:n] == prior.quat[:n], axis=1)
+            & np.all(ro.shiver[:, :n] == prior.shiver[:, :n], axis=0))
+    return int(np.argmin(same)) if not same.all() else n
+
+
+def to_trajectory(seq: DmpSequence, ro: Rollout, where: Span,
+                  reuse: tuple[Rollout, Any] | None = None) -> Any:
     """The joint trajectory of ``ro``.
+
+    Args:
+        reuse: a rollout of the same sequence and its joint trajectory (made by this
+            function): the samples ``ro`` shares with it from the start keep their
+            joint positions, and only the rest is solved, continued from the last kept
+            one (a running behaviour whose later parts changed, :mod:`.intensity`).
 
     Raises:
         AouError: D603 when the inverse kinematics cannot follow the poses.
@@ -89,21 +159,34 @@ def to_trajectory(seq: DmpSequence, ro: Rollout, where: Span) -> Any:
     from ..robot.load import load_arm
 
     arm = load_arm(seq.robot, seq.ee_frame)
-    rot = _rot(ro.quat)
-    # The start as the compiler reaches it: by continuation from the arm's posture.
-    first = solve_path(arm, [(ro.pos[0], rot[0])])
-    if not first.ok:
-        assert first.failure is not None
-        raise AouError(diag("D603", "the arm cannot reach the rolled-out start: "
-                            f"{first.failure.status.value}", where, time=0.0))
-    q, bad, why = _follow(arm, ro.pos, rot, first.q[0].copy())
+    js = arm.joint_names.index(seq.shiver_joint)
+    keep = _unchanged(ro, reuse[0]) if reuse is not None else 0
+    if keep > 1:
+        assert reuse is not None
+        kept = np.array(reuse[1].q[:keep], dtype=float)
+        kept[:, js] -= reuse[0].shiver[0, :keep]
+        seed = kept[-1].copy()
+    else:
+        keep, kept = 0, np.empty((0, arm.n))
+        first = solve_path(arm, [(ro.pos[0], _rot(ro.quat[:1])[0])])
+        if not first.ok:
+            assert first.failure is not None
+            raise AouError(diag("D603", "the arm cannot reach the rolled-out start: "
+                                f"{first.failure.status.value}", where, time=0.0))
+        seed = first.q[0].copy()
+    pos, quat = ro.pos[keep:], ro.quat[keep:]
+    rot = _rot(quat)
+    ref, bad, why = _reference(arm, pos, quat, rot, seed)
+    if bad < 0:
+        q, bad, why = _follow(arm, pos, rot, ref)
     if bad >= 0:
+        bad += keep
         kind = ro.parts[ro.part[bad]][0]
         raise AouError(diag("D603", f"the arm cannot follow the rolled-out {kind} at "
                             f"t={ro.t[bad]:.3f}s: {why}", where, time=float(ro.t[bad])))
+    q = np.vstack([kept, q])
     qd = np.gradient(q, ro.t, axis=0)
     qdd = np.gradient(qd, ro.t, axis=0)
-    js = arm.joint_names.index(seq.shiver_joint)
     shaking = ro.shiver[0] != 0.0
     q[:, js] += ro.shiver[0]
     qd[shaking, js] = ro.shiver[1, shaking]

@@ -19,6 +19,10 @@ was along the old one, so the reach goes on from where it was instead of startin
 transition is checked like any trajectory (:func:`aou_dsl.check`); the plan was
 checked when it was compiled. Inactive needs no plan: the arm brakes to rest and holds.
 docs/synthesis.md has the details.
+
+With ``through_dmp=True`` a reach the regulator starts follows its plan's DMPs, and a new
+intensity level of the same state moves through them without a re-plan
+(:mod:`.dmp_follow`, docs/dmp.md).
 """
 
 from __future__ import annotations
@@ -37,6 +41,7 @@ if TYPE_CHECKING:
     import numpy as np
 
     from ..core.trajectory import Trajectory
+    from .dmp_follow import DmpRun
 
 __all__ = ["PATH", "Hysteresis", "Regulator", "Replan", "from_uncertainty"]
 
@@ -123,11 +128,14 @@ class Regulator:
         transition_scale: fraction of the arm's planning velocity and acceleration limits
             and of its jerk limits that the transition may use (raised where the plan's
             state at the join needs more).
+        through_dmp: follow a started reach as its plan's DMP rollout, and change its
+            intensity through the DMPs (:meth:`change_intensity`); needs the ``dmp``
+            extra.
     """
 
     def __init__(self, robot: str = "panda", goal: tuple[float, float, float] | None = None,
                  *, hysteresis: Hysteresis | None = None, intensity_step: float = 0.25,
-                 transition_scale: float = 0.25):
+                 transition_scale: float = 0.25, through_dmp: bool = False):
         from ..robot.load import load_arm
 
         if not 0.0 < intensity_step <= 1.0 or not 0.0 < transition_scale <= 1.0:
@@ -139,6 +147,10 @@ class Regulator:
         self.intensity_step = intensity_step
         self.transition_scale = transition_scale
         self.expressed: tuple[State, float] | None = None
+        self.through_dmp = through_dmp
+        #: the reach followed as DMPs (None: a compiled plan), and each plan's sequence
+        self._dmp: DmpRun | None = None
+        self._sequences: dict[int, tuple] = {}
         self._u: float | None = None
         self._plans: dict[str, Trajectory] = {}  # by text: levels may share a file
         self._texts: dict[tuple[State, float], str] = {}
@@ -250,6 +262,9 @@ class Regulator:
         if choice is None and not restart:
             return None
         state, level = choice or self.expressed  # type: ignore[misc]
+        if (self._dmp is not None and not restart and self.expressed is not None
+                and state is self.expressed[0]):
+            return self.change_intensity(q, qd, qdd, level, point=(c, v), elapsed=elapsed)
         return self.replan(q, qd, qdd, state, level, restart=restart, point=(c, v),
                            elapsed=elapsed)
 
@@ -269,9 +284,16 @@ class Regulator:
         x = self._state(q, qd, qdd)
         phase = None if restart else self._phase(x, elapsed)
         timings["phase"] = time.perf_counter() - start
+        self._dmp = None
         if state is State.INACTIVE:
             traj, join, trans = brake_and_hold(self, x, timings)
             self._last = (traj, 0.0, trans, 0.0, phase or 0.0)
+        elif self.through_dmp and (restart or self._last is None):
+            from .dmp_follow import start as start_dmp
+
+            traj, self._dmp, trans = start_dmp(self, state, level, x, timings)
+            join = 0.0
+            self._last = (traj, 0.0, trans, float(self._dmp.rollout.t[-1]), 0.0)
         else:
             t0 = time.perf_counter()
             plan = self.plan(state, level)
@@ -282,6 +304,34 @@ class Regulator:
         c, v = point if point is not None else CANONICAL[state]
         return Replan(traj.with_(title=f"{state} at intensity {level:g}"), state, level, c, v,
                       join, trans, time.perf_counter() - start, timings)
+
+    def change_intensity(self, q, qd, qdd, level: float, *,
+                         point: tuple[float, float] | None = None,
+                         elapsed: float | None = None) -> Replan:
+        """Move the running reach to intensity ``level`` through its DMPs, without a
+        re-plan (arguments as :meth:`update`'s; see :mod:`.dmp_follow`): the trajectory
+        returned starts at the arm's sample of the one it follows.
+
+        Raises:
+            AouError: I504 when the reach does not follow DMPs (``through_dmp`` and a
+                started reach); C306 when the changed motion fails a check.
+        """
+        from .dmp_follow import change
+
+        if self._dmp is None or self.expressed is None or self._last is None:
+            raise AouError(diag(I504, "no reach follows DMPs: make the regulator with "
+                                "through_dmp=True and start a reach first", _WHERE))
+        start = time.perf_counter()
+        timings: dict[str, float] = {}
+        x = self._state(q, qd, qdd)
+        state, level = self.expressed[0], self.level(level)
+        traj, self._dmp, at = change(self, self._dmp, self._last[0], level, x, elapsed,
+                                     timings)
+        self._last = (traj, at, 0.0, float(self._dmp.rollout.t[-1]), 0.0)
+        self.expressed = (state, level)
+        c, v = point if point is not None else CANONICAL[state]
+        return Replan(traj.with_(title=f"{state} at intensity {level:g}"), state, level, c, v,
+                      at, 0.0, time.perf_counter() - start, timings)
 
     def _phase(self, x, elapsed: float | None) -> float:
         """How far along its reach the arm is, in [0, 1] (0 before any plan)."""
