@@ -25,3 +25,42 @@ def fails_with(code: str, fn, *args, **kw):
     (d,) = err.value.diagnostics
     assert d.code == code, d.message
     return d
+
+
+# --- Running on several workers (pytest-xdist, `--dist loadgroup` in pyproject.toml) ---------
+
+#: Modules whose tests share a cached build at module level (not a fixture, so not seen
+#: by the rule below): they run on one worker, which builds it once.
+SHARED_MODULE_CACHE = frozenset({"test_ros_export.py"})
+
+
+def _module_scoped_fixtures(item: pytest.Item) -> list[str]:
+    """The fixtures of ``item`` set up once per module (a compiled behaviour, a loaded
+    robot, a browser, a language server...)."""
+    info = getattr(item, "_fixtureinfo", None)
+    if info is None:
+        return []
+    return [name for name, defs in info.name2fixturedefs.items()
+            if defs and defs[-1].scope == "module"]
+
+
+def _group_of(item: pytest.Item) -> str | None:
+    """The xdist group of a test that shares set-up with others of its module: split
+    over two workers, that set-up would run once on each."""
+    module = item.path.name
+    if module in SHARED_MODULE_CACHE or _module_scoped_fixtures(item):
+        return module
+    return None
+
+
+@pytest.hookimpl(tryfirst=True)  # before xdist reads the groups
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Keep the tests that share a module's set-up on one worker, and on the workers
+    hand the slow tests out first, so that no long test starts last while the others
+    have finished (loadgroup hands out the largest groups first, then the single tests
+    in this order). One process keeps the files' order: the modules' set-up runs once."""
+    for item in items:
+        if item.get_closest_marker("xdist_group") is None and (group := _group_of(item)):
+            item.add_marker(pytest.mark.xdist_group(group))
+    if hasattr(config, "workerinput"):  # a worker of pytest-xdist
+        items.sort(key=lambda item: item.get_closest_marker("slow") is None)

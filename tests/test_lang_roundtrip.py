@@ -27,6 +27,11 @@ MAX_REFUSED = 0.10
 
 _WORK = Path(tempfile.mkdtemp(prefix="aou-roundtrip-"))
 
+#: The per-file tests of a sweep and its refusal share run on one worker (pytest-xdist),
+#: where the share reads the outcomes the per-file tests left in ``_outcome``'s cache.
+DEFAULT_SWEEP = pytest.mark.xdist_group("lang_roundtrip-default")
+SLOW_SWEEP = pytest.mark.xdist_group("lang_roundtrip-slow")
+
 
 @functools.cache
 def _cases(n: int, seed: int) -> tuple[langgen.Case, ...]:
@@ -106,6 +111,7 @@ def test_lint_never_crashes_on_valid_files(case):
     assert rc in (0, 1), f"lint exit {rc} on\n{case.text}\n{out[-2000:]}"
 
 
+@DEFAULT_SWEEP
 @pytest.mark.parametrize("i", range(DEFAULT_N))
 def test_compiled_file_shows_what_it_declares(i):
     """A generated file compiles without crashing, and the oracle's reading, the
@@ -113,12 +119,14 @@ def test_compiled_file_shows_what_it_declares(i):
     _check_one(_outcome(DEFAULT_N, DEFAULT_SEED, i))
 
 
+@DEFAULT_SWEEP
 def test_few_valid_files_are_refused():
     """Fewer than 10% of valid generated files are refused by lint or compile."""
     _check_refused(DEFAULT_N, DEFAULT_SEED)
 
 
 @pytest.mark.slow
+@SLOW_SWEEP
 @pytest.mark.parametrize("i", range(SLOW_N))
 def test_compiled_file_shows_what_it_declares_bulk(i):
     """The same round trip over 1000 seeded files."""
@@ -126,6 +134,7 @@ def test_compiled_file_shows_what_it_declares_bulk(i):
 
 
 @pytest.mark.slow
+@SLOW_SWEEP
 def test_few_valid_files_are_refused_bulk():
     """Fewer than 10% of 1000 valid generated files are refused by lint or compile."""
     _check_refused(SLOW_N, SLOW_SEED)
