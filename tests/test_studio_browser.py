@@ -29,6 +29,8 @@ from aou_dsl.api import compile as aou_compile
 from aou_dsl.api import lint, measure
 from aou_dsl.lang.descriptors import REGISTRY
 
+from .test_studio_forms import PEEK  # a sequence file: sliders scale its statements
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CHROMIUM = next((p for p in (os.environ.get("AOU_CHROMIUM"), shutil.which("chromium"),
                              "/usr/bin/chromium") if p and os.path.exists(p)), None)
@@ -337,18 +339,6 @@ def test_a_recording_plays_in_the_page_with_its_measured_episodes(tmp_path, open
     assert sorted(os.listdir(tmp_path)) == ["hesitant.aou", "rec.csv"]
 
 
-PEEK = """\
-behaviour peek : curious
-sequence {
-  approach 0.08m a=0.09
-  pause 1.25s
-  gaze horizontal 20deg
-  pause 1.25s
-  gaze horizontal -20deg   # the other side
-  pause 1.25s
-  approach a=0.09
-}
-"""
 
 
 def test_a_sequence_gets_its_sliders_in_the_page_and_saves_them(tmp_path, open_page):
