@@ -19,6 +19,7 @@ from ..core.diagnostics import AouError, Diagnostic, Severity, Span
 from ..core.rules import category
 from ..editor import cmd_server
 from .args import EXIT_ERRORS, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, build_parser
+from .endings import CtrlC, extra_missing, internal
 from .fmt import cmd_fmt
 from .report import format_json, format_suppressed
 from .report import print_diagnostics as _print_diags
@@ -373,42 +374,30 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command is None:
         parser.print_help(sys.stderr)
         return EXIT_USAGE
+    with CtrlC() as ctrl_c:
+        return _run(args, ctrl_c)
+
+
+def _run(args: argparse.Namespace, ctrl_c: CtrlC) -> int:
     try:
         return _COMMANDS[args.command](args)
     except AouError as err:
         return _fail(err)
     except ImportError as exc:
-        if args.command in ("plot", "render", "variants") and exc.name:
-            print(f"aouc: this command needs the media extra ({exc.name} is missing): "
-                  "pip install '.[media]' in aou's folder (the one with pyproject.toml)",
-                  file=sys.stderr)
-            return EXIT_USAGE
-        if args.command == "studio" and exc.name:
-            print(f"aouc: this command needs the studio extra ({exc.name} is missing): "
-                  "pip install '.[studio]' in aou's folder (the one with pyproject.toml)",
-                  file=sys.stderr)
-            return EXIT_USAGE
-        if exc.name and exc.name.split(".")[0] in ("movement_primitives", "pytransform3d"):
-            print(f"aouc: this command needs the dmp extra ({exc.name} is missing): "
-                  "pip install '.[dmp]' in aou's folder (the one with pyproject.toml)",
-                  file=sys.stderr)
-            return EXIT_USAGE
-        return _internal(exc, args.debug)
+        extra = None if ctrl_c.seen else extra_missing(args.command, exc)
+        if extra is None:
+            return internal(exc, args.debug, ctrl_c)
+        print(f"aouc: this command needs the {extra} extra ({exc.name} is missing): "
+              f"pip install '.[{extra}]' in aou's folder (the one with pyproject.toml)",
+              file=sys.stderr)
+        return EXIT_USAGE
     except KeyboardInterrupt:
         print("aouc: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
     except BrokenPipeError:
         return EXIT_OK
     except Exception as exc:  # noqa: BLE001 - the last line of defence
-        return _internal(exc, args.debug)
-
-
-def _internal(exc: BaseException, debug: bool) -> int:
-    if debug:
-        raise exc
-    print(f"aouc: internal error: {type(exc).__name__}: {exc} (rerun with --debug for the "
-          "traceback, and please report it)", file=sys.stderr)
-    return EXIT_USAGE
+        return internal(exc, args.debug, ctrl_c)
 
 
 if __name__ == "__main__":  # pragma: no cover
