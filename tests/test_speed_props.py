@@ -166,7 +166,7 @@ def test_no_distance_changes_faster_than_its_bound(robot):
     tr = Trajectory(np.arange(len(q)) / RATE, q, load_arm(robot).joint_names, robot, None,
                     goal)
     replay(tr)  # builds and keeps the scene
-    scene, geo = replay_module._scene(robot, replay_module.SceneOptions())
+    scene, geo = replay_module.check_scene(robot, replay_module.SceneOptions())
     scene.pb.resetBasePositionAndOrientation(scene.target, goal, (0, 0, 0, 1),
                                              physicsClientId=scene.client)
     sweep = Sweep(scene, geo, q, None)
@@ -283,7 +283,7 @@ def test_the_lean_toppra_gives_the_stock_law():
     parametrisation is the stock TOPPRA's, bit for bit."""
     from aou_dsl.compiler import topp
 
-    toppra = topp._import_toppra()
+    toppra = topp.import_toppra()
     rng = np.random.default_rng(2)
     arm = load_arm("panda")
     for k in range(8):

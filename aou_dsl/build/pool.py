@@ -78,14 +78,14 @@ def preload(robots: Iterable[str], options: BuildOptions | None = None) -> None:
     why."""
     import importlib
 
-    from ..compiler.topp import _import_toppra
+    from ..compiler.topp import import_toppra
     from ..robot.bullet import import_pybullet
     from ..robot.load import load_arm, load_robot
-    from ..safety.replay import _scene
+    from ..safety.replay import check_scene
 
     for name in _STAGES:
         importlib.import_module(name)
-    _import_toppra()
+    import_toppra()
     import_pybullet()
     opts = options or BuildOptions()
     for robot in dict.fromkeys(robots):
@@ -93,7 +93,7 @@ def preload(robots: Iterable[str], options: BuildOptions | None = None) -> None:
             load_robot(robot, opts.package_dirs)
             load_arm(robot, None, opts.package_dirs)
             if opts.check:
-                _scene(robot, opts.scene)
+                check_scene(robot, opts.scene)
         except Exception:  # noqa: BLE001,S112 - the build of a file naming it says why
             continue
 

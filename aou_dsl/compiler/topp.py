@@ -19,7 +19,7 @@ import numpy as np
 
 from .timelaw import TimeLaw
 
-__all__ = ["grid", "parametrize"]
+__all__ = ["grid", "import_toppra", "parametrize"]
 
 
 class _LazyModule(types.ModuleType):
@@ -30,7 +30,7 @@ class _LazyModule(types.ModuleType):
 
 
 @functools.cache
-def _import_toppra():
+def import_toppra():
     """toppra, imported without matplotlib.
 
     toppra's algorithm module imports ``matplotlib.pyplot`` at its top, for plotting
@@ -68,7 +68,7 @@ def _constraints(jv: tuple[float, ...], ja: tuple[float, ...], a: float, vmax: f
     """TOPP-RA's joint velocity and acceleration constraints, the virtual joint last.
     They do not depend on the path, and building one formats its limits as text (slow),
     so they are made once per set of limits."""
-    constraint = _import_toppra().constraint
+    constraint = import_toppra().constraint
     vlim = np.column_stack([-np.append(jv, vmax), np.append(jv, vmax)])
     alim = np.column_stack([-np.append(ja, a), np.append(ja, a)])
     return (constraint.JointVelocityConstraint(vlim),
@@ -82,7 +82,7 @@ def _lean_toppra():
     same solver calls with the same arguments in the same order (the seidel solver
     warm-starts from its previous call), so the same law to the last bit, about a sixth
     faster on aou's paths. ``tests/test_speed_props.py`` compares the two."""
-    stock: Any = _import_toppra().algorithm.TOPPRA  # an untyped library's class
+    stock: Any = import_toppra().algorithm.TOPPRA  # an untyped library's class
     nan = float("nan")
 
     class LeanTOPPRA(stock):
@@ -154,7 +154,7 @@ def parametrize(s_way: np.ndarray, q_way: np.ndarray, a: float, vmax: float,
         ``(law, spline, None)`` on success, where ``spline`` is the path (joints and the
         virtual coordinate last); ``(None, None, reason)`` when TOPP-RA fails.
     """
-    toppra = _import_toppra()
+    toppra = import_toppra()
     algo = toppra.algorithm
     aug = np.column_stack([q_way, s_way])
     path = toppra.SplineInterpolator(s_way, aug)

@@ -38,7 +38,7 @@ from .limits import Check, check_limits
 from .sweep import CONTACT_MARGIN, QUERY_RANGE, Geometry, Memo, Sweep, geometry
 from .urdf_fk import kept_chain_fk, urdf_chain
 
-__all__ = ["CheckReport", "replay"]
+__all__ = ["CheckReport", "check_scene", "replay"]
 
 #: PyBullet and Pinocchio must agree on the end-effector pose within these.
 AGREE_POSITION = 1e-3  # m
@@ -112,7 +112,7 @@ def replay(tr: Trajectory, *, options: SceneOptions | None = None,
     checks = check_limits(arm, t, q, qd, qdd)
     goal = tuple(float(x) for x in tr.goal) if tr.goal is not None else None
     options = options or SceneOptions(package_dirs=tr.package_dirs)
-    scene, geo = _scene(tr.robot, options)
+    scene, geo = check_scene(tr.robot, options)
     if scene.target is not None:  # the scene's cube stands at the goal (or far away)
         scene.pb.resetBasePositionAndOrientation(scene.target, goal or _AWAY, (0, 0, 0, 1),
                                                  physicsClientId=scene.client)
@@ -151,7 +151,7 @@ _AWAY = (0.0, 0.0, -100.0)
 
 
 @functools.lru_cache(maxsize=8)
-def _scene(robot: str, options: SceneOptions) -> tuple[Scene, Geometry]:
+def check_scene(robot: str, options: SceneOptions) -> tuple[Scene, Geometry]:
     """A scene per robot and options, kept with its geometry: loading the URDF is the
     slow part. Each replay sets the joint states, the cube's place and the physics
     settings it relies on."""
