@@ -132,20 +132,31 @@ def test_the_saved_text_keeps_its_layout_and_measures_the_new_value(form, tmp_pa
             assert build.measured.descriptors[other] == was
 
 
-def test_save_of_a_one_line_file_writes_the_motion_shown(tmp_path):
+def _paused_and_saved(path, text: str, form: str, check):
+    """``text`` opened in a studio: its sliders are those of ``form``; the pause set to
+    2 s (``check(studio, motion)`` then) and saved. The motion shown."""
     pytest.importorskip("viser", reason="the studio extra is missing: pip install '.[studio]'")
     from aou_dsl.studio.app import Studio
 
-    path = tmp_path / "one.aou"
-    path.write_text(ONE_LINE)
+    path.write_text(text)
     studio = Studio(str(path), port=0, watch=False).start()
     try:
-        assert set(studio.sliders.values()) == SETS["one line"]
+        assert set(studio.sliders.values()) == SETS[form]
         m = studio.set_values({**studio.sliders.values(), "pause_duration": 2.0})
-        assert m.ok and studio.shown is m
+        assert m.ok
+        check(studio, m)
         studio.save()
     finally:
         studio.close()
+    return m
+
+
+def test_save_of_a_one_line_file_writes_the_motion_shown(tmp_path):
+    def shown(studio, m):
+        assert studio.shown is m
+
+    path = tmp_path / "one.aou"
+    m = _paused_and_saved(path, ONE_LINE, "one line", shown)
     assert path.read_text() == ONE_LINE.replace("1.67s", "2s")
     build = aou_compile(str(path))
     assert build.ok
@@ -176,19 +187,11 @@ def test_a_blend_gets_an_intensity_slider_that_writes_it_again(tmp_path):
 
 
 def test_a_sequence_file_is_shaped_and_saved(tmp_path):
-    pytest.importorskip("viser", reason="the studio extra is missing: pip install '.[studio]'")
-    from aou_dsl.studio.app import Studio
+    def slider_moved(studio, m):
+        assert studio.sliders.values()["pause_duration"] == pytest.approx(2.0)
 
     path = tmp_path / "peek.aou"
-    path.write_text(PEEK)
-    studio = Studio(str(path), port=0, watch=False).start()
-    try:
-        assert set(studio.sliders.values()) == SETS["sequence"]
-        m = studio.set_values({**studio.sliders.values(), "pause_duration": 2.0})
-        assert m.ok and studio.sliders.values()["pause_duration"] == pytest.approx(2.0)
-        studio.save()
-    finally:
-        studio.close()
+    m = _paused_and_saved(path, PEEK, "sequence", slider_moved)
     assert path.read_text() == PEEK.replace("1.25s", "2s")
     build = aou_compile(str(path))
     assert build.ok and np.array_equal(build.trajectory.q, m.trajectory.q)
