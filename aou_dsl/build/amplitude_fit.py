@@ -13,13 +13,12 @@ offered.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from typing import Any
 
 from ..core.codes import C308
 from ..core.diagnostics import Severity
 from ..lang.linter import lint_source
-from .reach_fit import Statement
+from .reach_fit import Statement, offered
 
 __all__ = ["with_amplitude_fit"]
 
@@ -51,13 +50,7 @@ def with_amplitude_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...
     again = lint_source(text, lint.path)
     if b.state is not None and (again.cv is None or again.cv.state != b.state):
         return res  # the smaller shiver would express another state: nothing to offer
-    record = {"line": st.line, "col": st.col, "end_col": st.stop + 1, "key": "angle",
-              "declared": st.written, "fitted": fitted.written, "unit": st.unit,
-              "bound": bound / st.scale, "joint": d.fields.get("joint"),
-              "limit": d.fields.get("limit"), "descriptor": st.descriptor,
-              "statement": stmt}
-    hint = f"write `{stmt}` at line {st.line}"
-    res.diagnostics = [replace(x, hint=f"{hint}; or {x.hint}" if x.hint else hint,
-                               fields={**x.fields, "reach": [record]}) if x is d else x
-                       for x in res.diagnostics]
+    record = st.record(fitted.written, stmt, bound, d.fields.get("joint"),
+                       d.fields.get("limit"))
+    res.diagnostics = [offered(x, [record]) if x is d else x for x in res.diagnostics]
     return res

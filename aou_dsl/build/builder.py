@@ -165,17 +165,16 @@ def build_lint(lint: FileResult, options: BuildOptions | None = None,
     from .every_change import with_every_change
     from .reach_fit import with_reach_fit
 
-    def one(linted: FileResult) -> BuildResult:  # a refusal's hint: every change
+    def one(linted: FileResult) -> BuildResult:  # a refusal's hint: the value that fits
         res = with_reach_fit(_build_lint(linted, opts), opts.robot, opts.package_dirs)
-        res = with_amplitude_fit(res, opts.robot, opts.package_dirs)
-        return with_every_change(res, opts.package_dirs)
+        return with_amplitude_fit(res, opts.robot, opts.package_dirs)
 
     if opts.fit:
         from .fit_loop import fit_loop
 
         res = fit_loop(lint, one)
-    else:
-        res = one(lint)
+    else:  # the hint of a refusal: every change the file needs, at once
+        res = with_every_change(one(lint), one)
     res.diagnostics = said_once(res.diagnostics)
     return res
 

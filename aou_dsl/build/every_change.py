@@ -1,78 +1,168 @@
-"""A too-fast refusal's hint with every change it needs: in a ``sequence`` several shiver
-(or tilt) statements may each be too fast for the arm, and the compiler stops at the
-first. Its hint (``write `f=1.4Hz``\\ ``) is applied, the file compiled again, and the
-next statement's edit added (``; and `f=1.2Hz` at line 9``) until none is refused: so
-applying the hint compiles in one round. A file with one statement of that kind (every
-descriptor-form file) is not compiled again.
+"""A refusal's hint with every change at once: the one place that turns a refused build
+into the values that make the file compile, for the hint without ``--fit``.
+
+The compiler stops at its first refusal, and a refusal's own hint answers that refusal
+only (a slower shiver, a shorter retreat, a nearer ``start``). A file may be refused for
+more than one reason (out of reach and too fast for the wrist; two shivers of a
+``sequence`` each too fast): applying the first hint would only reveal the next. So the
+hint's own edit is applied, and where the file is then still refused, the rest is found
+by the machinery of ``--fit`` (:func:`~aou_dsl.build.fit_loop.fit_loop`: the fewest
+values changed by the least, the state and the order of values kept). The hint then
+names every changed statement, and its field ``edits`` holds them as text edits
+(``line``, ``col``, ``end_line``, ``end_col`` of the statement as written, ``text`` to
+write there), so an editor applies them at once. When no set of changes is found, the
+hint gives what it can and says what is then still refused (``edits_complete``
+false).
 """
 
 from __future__ import annotations
 
+import re
+from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
-from ..core.codes import C308, C309
-from ..core.diagnostics import Diagnostic, Severity
-from ..lang.linter import lint_source
+from ..core.diagnostics import Diagnostic, Severity, Span, has_errors
+from ..lang.linter import FileResult, lint_source
 
-__all__ = ["with_every_change"]
+__all__ = ["statement_edits", "with_every_change"]
 
-#: Statements more than this are not followed in one refusal.
-MOST = 6
-_KIND = {C308: "shiver", C309: "tilt"}
+#: The start distance a start pose refusal's hint gives.
+_START = re.compile(r"`(start \d+cm)`")
 
 
-def _edit(d: Diagnostic) -> str | None:
-    """The edit a too-fast refusal's hint writes (None: it has none)."""
-    if d.code not in _KIND or d.severity is not Severity.ERROR or d.fix is None \
-            or not (d.hint or "").startswith("write `"):
-        return None
-    return d.fix.text
-
-
-def _next(text: str, path: str, robot: str, package_dirs: tuple[str, ...], code: str
-          ) -> Diagnostic | None:
-    """The refusal of ``code`` compiling ``text`` on ``robot`` (None: none)."""
-    from ..compiler.pipeline import CompileOptions, compile_behaviour
-
-    lint = lint_source(text, path)
-    if not lint.ok or lint.behaviour is None:
-        return None
-    b = lint.behaviour
-    b = b.replace(settings=b.settings.replace(robot=robot))
-    res = compile_behaviour(b, CompileOptions(package_dirs=package_dirs), lint.timeline)
-    return next((d for d in res.diagnostics if d.code == code and _edit(d)), None)
-
-
-def with_every_change(res: Any, package_dirs: tuple[str, ...]) -> Any:
-    """``res`` (a build result) with its too-fast refusal's hint extended by the edits
-    of the same kind the other statements need (field ``also``: line, col, edit)."""
-    from ..compiler.fitting import apply_edit
-
-    lint, b = res.lint, res.lint.behaviour
-    d = next((x for x in res.diagnostics if _edit(x)), None)
-    if d is None or b is None or lint.source is None or d.span.path != lint.path or len(
-            {p.span for p in b.primitives if p.kind == _KIND[d.code]}) < 2:
+def with_every_change(res: Any, build: Callable[[FileResult], Any]) -> Any:
+    """``res`` (a build result) with the hint of its first refusal that has an edit
+    completed by every other change the file needs to compile (see the module).
+    ``build`` builds a linted file as ``res`` was built (the reach and amplitude hints
+    included, not this completion)."""
+    lint = res.lint
+    if lint.source is None or lint.behaviour is None or not has_errors(res.diagnostics):
         return res
-    text, at, edit = lint.source, d.span, _edit(d)
-    also: list[dict[str, Any]] = []
-    for _ in range(MOST):
-        assert edit is not None
-        text = apply_edit(text, at, edit)
-        nxt = _next(text, lint.path, b.settings.robot, package_dirs, d.code)
-        if nxt is None:
+    for d in res.diagnostics:
+        own = _own(lint, d) if d.severity is Severity.ERROR else None
+        if own is not None:
             break
-        at, edit = nxt.span, _edit(nxt)
-        if (at.line, at.col) == (d.span.line, d.span.col) or any(
-                (a["line"], a["col"]) == (at.line, at.col) for a in also):
-            return res  # the same statement again: no hint is sure to end it
-        also.append({"line": at.line, "col": at.col, "end_col": at.end_col, "edit": edit})
     else:
         return res
-    if not also:
+    final, left = _complete(lint, own, build)
+    edits = statement_edits(lint, final)
+    if not edits:
         return res
-    more = "; ".join(f"`{a['edit']}` in the {_KIND[d.code]} at line {a['line']}"
-                     for a in also)
-    res.diagnostics = [replace(x, hint=f"{x.hint}; and {more}", fields={
-        **x.fields, "also": also}) if x is d else x for x in res.diagnostics]
+    hint = d.hint if final == own else _said(d, edits)
+    if left is not None:
+        hint = f"{hint}; not every refusal is answered: then {left.code} at line " \
+            f"{left.span.line} ({left.message})"
+    fields = {**d.fields, "edits": edits, "edits_complete": left is None}
+    res.diagnostics = [replace(x, hint=hint, fields=fields) if x is d else x
+                       for x in res.diagnostics]
     return res
+
+
+def _own(lint: FileResult, d: Diagnostic) -> str | None:
+    """The file's text with ``d``'s own hint applied (None: the hint is no edit)."""
+    from ..compiler.fitting import Change, apply, apply_edit
+
+    text = lint.source
+    assert text is not None
+    if d.span.path != lint.path or d.span.line < 1:
+        return None
+    if d.fix is not None and d.fix.key is not None and (d.hint or "").startswith("write `"):
+        return apply_edit(text, d.fix.span, d.fix.text)
+    if d.fields.get("reach"):
+        return apply(text, [Change(Span(d.span.path, r["line"], r["col"], r["line"],
+                                        r["end_col"]), r["key"], r["declared"], r["fitted"],
+                                   r["unit"], None, None, None) for r in d.fields["reach"]])
+    start = _START.search(d.hint or "")
+    spans = lint.behaviour.settings.spans if lint.behaviour is not None else {}
+    if start and spans.get("start") == d.span and d.span.line == d.span.end_line:
+        row = text.split("\n")[d.span.line - 1]
+        lines = text.split("\n")
+        lines[d.span.line - 1] = row[:d.span.col - 1] + start[1] + row[d.span.end_col - 1:]
+        return "\n".join(lines)
+    return None
+
+
+def _complete(lint: FileResult, own: str, build: Callable[[FileResult], Any]
+              ) -> tuple[str, Diagnostic | None]:
+    """The text with every change the file needs, from ``own`` (the hint applied), and
+    the first refusal left (None: it compiles)."""
+    from .fit_loop import fit_loop
+
+    again = lint_source(own, lint.path)
+    if not again.ok:
+        return own, next((x for x in again.diagnostics if x.severity is Severity.ERROR),
+                         None)
+    first = [build(again)]
+    if not has_errors(first[0].diagnostics):
+        return own, None
+    fit = fit_loop(again, lambda linted: first.pop() if first else build(linted))
+    left = next((x for x in fit.diagnostics if x.severity is Severity.ERROR), None)
+    return fit.fitted_source or own, left
+
+
+def _statements(lint: FileResult, keys: set[str]) -> list[Span]:
+    """The spans of the file's settings of ``keys`` and of its statements, in order."""
+    b = lint.behaviour
+    assert b is not None
+    spans = [s for k, s in b.settings.spans.items() if k in keys]
+    spans += [p.span for p in b.primitives]
+    return sorted(set(spans), key=lambda s: (s.line, s.col))
+
+
+def statement_edits(lint: FileResult, final: str) -> list[dict[str, Any]]:
+    """Each statement of ``lint`` written otherwise in ``final`` (the same statements,
+    some values changed): its span as written and the text to write there."""
+    after = lint_source(final, lint.path)
+    if after.behaviour is None or lint.behaviour is None or lint.source is None:
+        return []
+    keys = {k for k, s in lint.behaviour.settings.spans.items() if s.path == lint.path
+            and s.line >= 1} & set(after.behaviour.settings.spans)
+    was, now = _statements(lint, keys), _statements(after, keys)
+    if len(was) != len(now):
+        return []
+    out = []
+    for a, b in zip(was, now, strict=True):
+        old, new = _text(lint.source, a), _text(final, b)
+        if old != new:
+            out.append({"line": a.line, "col": a.col, "end_line": a.end_line,
+                        "end_col": a.end_col, "text": new, "was": old})
+    return out
+
+
+def _text(text: str, s: Span) -> str:
+    """The source a one-line span covers."""
+    return text.split("\n")[s.line - 1][s.col - 1:s.end_col - 1]
+
+
+def _keys(stmt: str) -> list[str]:
+    """A statement's keyed values (``f=1.4Hz``, ``for 2s``), in order."""
+    return re.findall(r"\w+=\S+|for\s+\S+", stmt)
+
+
+def _key_edit(e: dict[str, Any]) -> str | None:
+    """The keyed values an edit changes (``f=1.2Hz for 3s``), when it changes nothing
+    else (None: it changes a positional value too)."""
+    def rest(stmt: str) -> str:
+        return " ".join(re.sub(r"\w+=\S+|for\s+\S+", " ", stmt).split())
+
+    if rest(e["was"]) != rest(e["text"]):
+        return None
+    changed = [k for k in _keys(e["text"]) if k not in _keys(e["was"])]
+    return " ".join(changed) or None
+
+
+def _said(d: Diagnostic, edits: list[dict[str, Any]]) -> str:
+    """The hint of every edit. When each changes only keyed values (``f=``, ``a=``,
+    ``v=``, ``for``) and the refused statement is among them, it is said as the
+    compiler's own (``write `f=1.4Hz```) and the others' (``; and `f=1.2Hz` in the
+    shiver at line 7``); otherwise as whole statements (```retreat 0.195m` at line
+    5``)."""
+    mine = [e for e in edits if (e["line"], e["col"]) == (d.span.line, d.span.col)]
+    keyed = {id(e): _key_edit(e) for e in edits}
+    if mine and d.fix is not None and all(keyed.values()):
+        others = [e for e in edits if e is not mine[0]]
+        more = "; ".join(f"`{keyed[id(e)]}` in the {e['text'].split()[0]} at line "
+                         f"{e['line']}" for e in others)
+        return f"write `{keyed[id(mine[0])]}`" + (f"; and {more}" if more else "")
+    return "write " + "; ".join(f"`{e['text']}` at line {e['line']}" for e in edits)

@@ -36,7 +36,7 @@ from ..core.codes import C301, C302, C303
 from ..core.diagnostics import Diagnostic, Severity, Span, diag
 from ..lang.linter import FileResult, lint_source
 
-__all__ = ["REACH", "STEPS", "Statement", "with_reach_fit"]
+__all__ = ["REACH", "STEPS", "Statement", "offered", "with_reach_fit"]
 
 #: The refusals a reach fit answers.
 REACH = (C301, C302, C303)
@@ -81,6 +81,15 @@ class Statement:
             self.dim, self.scale = _UNITS[self.unit]
             self.value = float(self.written) * self.scale  # SI, signed
             self.descriptor = _descriptor(words)
+
+    def record(self, fitted: str, stmt: str, bound: float, joint: str | None,
+               limit: str | None) -> dict[str, Any]:
+        """The change of this value to ``fitted`` (as written; ``stmt`` the statement
+        then), under ``bound`` (SI), as a refusal's field ``reach`` holds it."""
+        return {"line": self.line, "col": self.col, "end_col": self.stop + 1,
+                "key": self.dim, "declared": self.written, "fitted": fitted,
+                "unit": self.unit, "bound": bound / self.scale, "joint": joint,
+                "limit": limit, "descriptor": self.descriptor, "statement": stmt}
 
     def with_value(self, si: float) -> tuple[str, str]:
         """The statement and the file's text with the magnitude ``si`` (SI) written in
@@ -214,12 +223,9 @@ def _fits(lint: FileResult, d: Diagnostic, robot: str, package_dirs: tuple[str, 
         if not follows(new_text, path, last):
             return f"`{stmt}` is not followed either"
         changes = [c for c in changes if (c["line"], c["col"]) != (st.line, st.col)]
-        changes.append({"line": st.line, "col": st.col, "end_col": int(was[2]),
-                        "key": st.dim, "declared": was[0], "fitted":
-                        Statement(new_text, st.line, st.col, st.col + len(stmt))
-                        .written, "unit": st.unit, "bound": bound / st.scale,
-                        "joint": failure, "limit": _LIMIT.get(code, "reach"),
-                        "descriptor": st.descriptor, "statement": stmt})
+        fitted = Statement(new_text, st.line, st.col, st.col + len(stmt)).written
+        changes.append(st.record(fitted, stmt, bound, failure, _LIMIT.get(code, "reach"))
+                       | {"end_col": int(was[2]), "declared": was[0]})
         text = new_text
         again = lint_source(text, path)
         failed = reaches(again.timeline) if again.timeline is not None else (-1, None)
@@ -270,8 +276,15 @@ def with_reach_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...]) -
             out.append(replace(d, hint=f"{d.hint}; {why}" if d.hint else why,
                                fields={**d.fields, "reach_fit": found}))
             continue
-        said = "; ".join(f"`{c['statement']}` at line {c['line']}" for c in found)
-        hint = f"write {said}" + (f"; or {d.hint}" if d.hint else "")
-        out.append(replace(d, hint=hint, fields={**d.fields, "reach": found}))
+        out.append(offered(d, found))
     res.diagnostics = out
     return res
+
+
+def offered(d: Diagnostic, records: list[dict[str, Any]]) -> Diagnostic:
+    """``d`` with the changes ``records`` (a reach's, a shiver amplitude's) as its hint
+    (``write `gaze horizontal 46.1deg` at line 5``, before what it said) and its field
+    ``reach`` (read by ``--fit``)."""
+    said = "; ".join(f"`{c['statement']}` at line {c['line']}" for c in records)
+    hint = f"write {said}" + (f"; or {d.hint}" if d.hint else "")
+    return replace(d, hint=hint, fields={**d.fields, "reach": records})

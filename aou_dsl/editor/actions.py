@@ -35,21 +35,38 @@ def _overlaps(a: types.Range, b: types.Range) -> bool:
 
 
 def _action(doc: Document, d: Diagnostic) -> types.CodeAction:
-    assert d.fix is not None
-    span, text = resolve(d.fix, doc.lines)
-    title = f"{d.code}: write `{text.strip()}`"
-    edit = types.TextEdit(range=to_range(span, doc.lines), new_text=text)
+    """The quick fix of ``d``: every edit of its hint (a refusal's, which may change
+    several statements: one workspace edit, applied at once), else its one ``fix``."""
+    every = d.fields.get("edits")
+    if every:
+        edits = [types.TextEdit(range=to_range(Span(doc.path, e["line"], e["col"],
+                                                     e["end_line"], e["end_col"]),
+                                               doc.lines), new_text=e["text"])
+                 for e in every]
+        said = "; ".join(f"`{e['text']}`" for e in every)
+        title = f"{d.code}: write {said}"
+    else:
+        assert d.fix is not None
+        span, text = resolve(d.fix, doc.lines)
+        title = f"{d.code}: write `{text.strip()}`"
+        edits = [types.TextEdit(range=to_range(span, doc.lines), new_text=text)]
     return types.CodeAction(
         title=title, kind=types.CodeActionKind.QuickFix, is_preferred=True,
         diagnostics=[to_lsp(d, doc.lines)],
-        edit=types.WorkspaceEdit(changes={doc.uri: [edit]}))
+        edit=types.WorkspaceEdit(changes={doc.uri: edits}))
+
+
+def _fixable(doc: Document, d: Diagnostic) -> bool:
+    """Whether ``d``'s hint is an edit of this document."""
+    if d.fields.get("edits"):
+        return d.span.path == doc.path
+    return d.fix is not None and d.fix.span.path == doc.path
 
 
 def code_actions(doc: Document, rng: types.Range) -> list[types.CodeAction]:
     """A quick fix for each diagnostic at ``rng`` whose hint is an edit."""
     return [_action(doc, d) for d in doc.diagnostics
-            if d.fix is not None and d.fix.span.path == doc.path
-            and _overlaps(to_range(d.span, doc.lines), rng)]
+            if _fixable(doc, d) and _overlaps(to_range(d.span, doc.lines), rng)]
 
 
 def format_edits(doc: Document) -> list[types.TextEdit] | None:

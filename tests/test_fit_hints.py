@@ -1,0 +1,164 @@
+"""A refusal's hint carries every change the file needs, at once: the compiler stops at
+its first refusal, but the hint of that refusal also names what the arm would refuse
+next (a shiver too fast after a reach; a second shiver of a sequence), so that applying
+it once compiles. Its field ``edits`` holds the same changes as text edits (the span of
+each statement as written and the text to write there), which the editor applies as one
+quick fix.
+
+The oracle is the compiler itself: the edits applied once, the file is compiled again
+and no refusal is left."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+from aou_dsl.build.builder import build_source
+from aou_dsl.lang.linter import lint_source
+
+from . import langgen
+from .test_fit_reach import apply_hint
+
+#: The arms of the generated sets: small ones (the Z1, the UR3, the Kinova) refuse
+#: reaches, the UR5's slow wrist refuses shivers.
+ROBOTS = ("z1", "ur3", "kinova", "ur5")
+
+
+def apply_edits(text: str, edits: list[dict]) -> str:
+    """``text`` with each edit's span replaced by its text (from the last edit to the
+    first, so the earlier spans stay valid)."""
+    lines = text.split("\n")
+    for e in sorted(edits, key=lambda e: (e["line"], e["col"]), reverse=True):
+        assert e["line"] == e["end_line"], e
+        row = lines[e["line"] - 1]
+        assert row[e["col"] - 1:e["end_col"] - 1] == e["was"], (row, e)
+        lines[e["line"] - 1] = row[:e["col"] - 1] + e["text"] + row[e["end_col"] - 1:]
+    return "\n".join(lines)
+
+
+def _errors(res) -> list:
+    return [d for d in res.diagnostics if d.severity.name == "ERROR"]
+
+
+def _says_what_to_write(d) -> bool:
+    """A refusal whose hint is a change of the file: a value to write, or the `start`
+    at which every pose is within reach."""
+    return (d.hint or "").startswith("write `") or bool(re.search(r"`start \d+cm`",
+                                                                  d.hint or ""))
+
+
+def _one_round(text: str, robot: str, seen: dict[str, int]) -> None:
+    """Every refusal of ``text`` on ``robot`` whose hint says what to write: its edits,
+    applied once, compile with no refusal; the hint names each edit."""
+    res = build_source(text, "gen.aou", robot=robot, check=False)
+    for d in _errors(res):
+        if not _says_what_to_write(d):
+            continue
+        seen[d.code] = seen.get(d.code, 0) + 1
+        edits = d.fields.get("edits")
+        assert edits and d.fields["edits_complete"], (text, robot, d.code, d.hint)
+        for e in edits:  # the words say what the fields do
+            keyed = " ".join(k for k in re.findall(r"\w+=\S+|for\s+\S+", e["text"])
+                             if k not in e["was"])
+            assert f"`{e['text']}`" in d.hint or (
+                keyed and f"`{keyed}`" in d.hint), (d.hint, e)
+        if len(edits) > 1:
+            seen["several"] = seen.get("several", 0) + 1
+        fixed = apply_edits(text, edits)
+        if d.hint.startswith("write `"):  # as a person applies it, from the words
+            assert apply_hint(text, d) == fixed, (text, d.hint)
+        again = build_source(fixed, "gen.aou", robot=robot, check=False)
+        assert not _errors(again), (text, robot, d.hint,
+                                    [(x.code, x.message) for x in _errors(again)])
+
+
+def _faster(text: str) -> str:
+    """``text`` with its shivers three times as fast and its gazes and retreats wider,
+    where the language allows it: files an arm refuses for more than one reason."""
+    def shiver(m: re.Match) -> str:
+        return f"f={min(float(m[1]) * 3, 8):.3g}Hz"
+
+    def wider(m: re.Match) -> str:
+        return f"{m[1]}{min(abs(float(m[2])) * 1.6, 85):.4g}deg"
+
+    out = []
+    for row in text.split("\n"):
+        if "shiver" in row:
+            row = re.sub(r"f=([0-9.]+)Hz", shiver, row)
+        row = re.sub(r"(gaze \w+ -?)([0-9.]+)deg", wider, row)
+        row = re.sub(r"(retreat )([0-9.]+)m\b", lambda m: f"{m[1]}"
+                     f"{min(float(m[2]) * 2, 0.4):.3g}m", row)
+        out.append(row)
+    faster = "\n".join(out)
+    return faster if lint_source(faster, "gen.aou").ok else text
+
+
+def test_a_reach_and_a_shiver_too_fast_are_answered_by_one_hint():
+    """On the UR3 a 0.4 m retreat is out of reach and a 3 Hz shiver too fast for the
+    wrist: the compiler refuses the retreat; its hint also gives the slower shiver,
+    and applied once the file compiles."""
+    text = ("behaviour f : fearful\nrobot ur3\napproach a=0.1\npause 1.25s x4\n"
+            "retreat 0.4m a=0.5\nshiver 6deg f=3Hz for 3s\n")
+    (d,) = _errors(build_source(text, "two.aou", check=False))
+    assert d.code in ("C301", "C302", "C303") and d.span.line == 5
+    assert [e["line"] for e in d.fields["edits"]] == [5, 6], d.hint
+    assert re.search(r"`shiver 6deg f=[0-9.]+Hz[^`]*` at line 6", d.hint), d.hint
+    fixed = apply_edits(text, d.fields["edits"])
+    again = build_source(fixed, "two.aou")
+    assert again.ok, (fixed, [(x.code, x.message) for x in again.diagnostics])
+    assert again.lint.cv.state.value == "fearful"
+
+
+def test_a_start_out_of_reach_and_a_shiver_too_fast_are_answered_by_one_hint():
+    """The start pose beyond the Z1's reach: the hint's `start` and the slower shiver
+    the Z1's wrist then needs are one quick fix."""
+    text = "robot z1\nstart 0.9m\napproach a=0.1\npause 1s\nshiver 5deg f=6Hz\n"
+    (d,) = _errors(build_source(text, "s.aou", check=False))
+    assert d.span.line == 2 and "`start " in d.hint, d.hint
+    lines = [e["line"] for e in d.fields["edits"]]
+    assert lines == [2, 5], d.hint
+    again = build_source(apply_edits(text, d.fields["edits"]), "s.aou", check=False)
+    assert not _errors(again), [(x.code, x.message) for x in again.diagnostics]
+
+
+def test_a_hint_that_cannot_answer_everything_says_so():
+    """A 1 m start the Z1 reaches nowhere near, with a shiver too fast: the hint's edit
+    is said, with what is then still refused, and ``edits_complete`` is false."""
+    text = "robot z1\nsequence {\n  approach 0.1m\n  pause 1s\n  shiver 5deg f=8Hz\n" \
+        "  gaze horizontal 80deg\n  shiver 40deg f=8Hz\n}\n"
+    res = build_source(text, "s.aou", check=False)
+    for d in _errors(res):
+        if d.fields.get("edits_complete") is False:
+            assert "not every refusal is answered" in d.hint, d.hint
+            left = build_source(apply_edits(text, d.fields["edits"]), "s.aou", check=False)
+            assert _errors(left)
+            return
+        if d.fields.get("edits"):  # answered in full after all: the oracle says so
+            fixed = apply_edits(text, d.fields["edits"])
+            assert not _errors(build_source(fixed, "s.aou", check=False))
+            return
+    pytest.skip("no refusal with an edit")
+
+
+def test_applying_any_refusals_hint_once_compiles_over_a_generated_set():
+    """Generated files on small arms, and the same files with faster shivers and wider
+    gazes and retreats (refused for two reasons at once): every refusal whose hint says
+    what to write compiles once its edits are applied, in one round."""
+    seen: dict[str, int] = {}
+    for i, case in enumerate(langgen.random_cases(24, seed=11)):
+        robot = ROBOTS[i % len(ROBOTS)]
+        _one_round(case.text, robot, seen)
+        _one_round(_faster(case.text), robot, seen)
+    assert seen.get("C308") and any(seen.get(c) for c in ("C301", "C302", "C303")), seen
+    assert seen.get("several"), seen  # hints that change more than one statement
+
+
+@pytest.mark.slow
+def test_applying_any_refusals_hint_once_compiles_over_a_bigger_generated_set():
+    seen: dict[str, int] = {}
+    for i, case in enumerate(langgen.random_cases(160, seed=23)):
+        robot = ROBOTS[i % len(ROBOTS)]
+        _one_round(case.text, robot, seen)
+        _one_round(_faster(case.text), robot, seen)
+    assert seen.get("C308") and seen.get("C309") and seen.get("several"), seen
