@@ -57,7 +57,7 @@ def _one_round(text: str, robot: str, seen: dict[str, int]) -> None:
             continue
         seen[d.code] = seen.get(d.code, 0) + 1
         edits = d.fields.get("edits")
-        assert edits and d.fields["edits_complete"], (text, robot, d.code, d.hint)
+        assert edits, (text, robot, d.code, d.hint)
         for e in edits:  # the words say what the fields do
             keyed = " ".join(k for k in re.findall(r"\w+=\S+|for\s+\S+", e["text"])
                              if k not in e["was"])
@@ -67,8 +67,16 @@ def _one_round(text: str, robot: str, seen: dict[str, int]) -> None:
             seen["several"] = seen.get("several", 0) + 1
         fixed = apply_edits(text, edits)
         if d.hint.startswith("write `"):  # as a person applies it, from the words
-            assert apply_hint(text, d) == fixed, (text, d.hint)
+            assert apply_hint(text, d).split() == fixed.split(), (text, d.hint)
         again = build_source(fixed, "gen.aou", robot=robot, check=False)
+        if not d.fields["edits_complete"]:  # said so: what is then refused, and why
+            seen["said not answered"] = seen.get("said not answered", 0) + 1
+            assert "; not every refusal is answered: then " in d.hint, d.hint
+            (left, *_) = _errors(again)
+            assert f"then {left.code} at line {left.span.line}" in d.hint, d.hint
+            fit = build_source(text, "gen.aou", robot=robot, check=False, fit=True)
+            assert _errors(fit), (text, d.hint)  # --fit finds no answer either
+            continue
         assert not _errors(again), (text, robot, d.hint,
                                     [(x.code, x.message) for x in _errors(again)])
 
@@ -146,7 +154,7 @@ def test_applying_any_refusals_hint_once_compiles_over_a_generated_set():
     gazes and retreats (refused for two reasons at once): every refusal whose hint says
     what to write compiles once its edits are applied, in one round."""
     seen: dict[str, int] = {}
-    for i, case in enumerate(langgen.random_cases(24, seed=11)):
+    for i, case in enumerate(langgen.random_cases(24, seed=23)):
         robot = ROBOTS[i % len(ROBOTS)]
         _one_round(case.text, robot, seen)
         _one_round(_faster(case.text), robot, seen)
@@ -157,7 +165,7 @@ def test_applying_any_refusals_hint_once_compiles_over_a_generated_set():
 @pytest.mark.slow
 def test_applying_any_refusals_hint_once_compiles_over_a_bigger_generated_set():
     seen: dict[str, int] = {}
-    for i, case in enumerate(langgen.random_cases(160, seed=23)):
+    for i, case in enumerate(langgen.random_cases(160, seed=11)):
         robot = ROBOTS[i % len(ROBOTS)]
         _one_round(case.text, robot, seen)
         _one_round(_faster(case.text), robot, seen)

@@ -51,8 +51,7 @@ def with_every_change(res: Any, build: Callable[[FileResult], Any]) -> Any:
         return res
     hint = d.hint if final == own else _said(d, edits)
     if left is not None:
-        hint = f"{hint}; not every refusal is answered: then {left.code} at line " \
-            f"{left.span.line} ({left.message})"
+        hint = f"{hint}; not every refusal is answered: then {left}"
     fields = {**d.fields, "edits": edits, "edits_complete": left is None}
     res.diagnostics = [replace(x, hint=hint, fields=fields) if x is d else x
                        for x in res.diagnostics]
@@ -84,21 +83,30 @@ def _own(lint: FileResult, d: Diagnostic) -> str | None:
 
 
 def _complete(lint: FileResult, own: str, build: Callable[[FileResult], Any]
-              ) -> tuple[str, Diagnostic | None]:
+              ) -> tuple[str, str | None]:
     """The text with every change the file needs, from ``own`` (the hint applied), and
-    the first refusal left (None: it compiles)."""
+    what is then still refused, in words (None: it compiles)."""
     from .fit_loop import fit_loop
 
     again = lint_source(own, lint.path)
     if not again.ok:
-        return own, next((x for x in again.diagnostics if x.severity is Severity.ERROR),
-                         None)
+        return own, _left(again.diagnostics)
     first = [build(again)]
     if not has_errors(first[0].diagnostics):
         return own, None
     fit = fit_loop(again, lambda linted: first.pop() if first else build(linted))
-    left = next((x for x in fit.diagnostics if x.severity is Severity.ERROR), None)
-    return fit.fitted_source or own, left
+    done = fit.lint.source or own  # the text of the last build (fitted or not)
+    return done, _left(fit.diagnostics) if has_errors(fit.diagnostics) else None
+
+
+def _left(diagnostics: list[Diagnostic]) -> str:
+    """The first refusal of ``diagnostics``, and why the fit did not answer it."""
+    from ..core.codes import C314
+
+    d = next(x for x in diagnostics if x.severity is Severity.ERROR)
+    why = [x.message for x in diagnostics if x.code == C314 and x.message.startswith(
+        "not fitted")]
+    return f"{d.code} at line {d.span.line} ({d.message})" + "".join(f"; {w}" for w in why)
 
 
 def _statements(lint: FileResult, keys: set[str]) -> list[Span]:
