@@ -131,22 +131,27 @@ def test_a_start_out_of_reach_and_a_shiver_too_fast_are_answered_by_one_hint():
 
 
 def test_a_hint_that_cannot_answer_everything_says_so():
-    """A 1 m start the Z1 reaches nowhere near, with a shiver too fast: the hint's edit
-    is said, with what is then still refused, and ``edits_complete`` is false."""
-    text = "robot z1\nsequence {\n  approach 0.1m\n  pause 1s\n  shiver 5deg f=8Hz\n" \
-        "  gaze horizontal 80deg\n  shiver 40deg f=8Hz\n}\n"
-    res = build_source(text, "s.aou", check=False)
-    for d in _errors(res):
-        if d.fields.get("edits_complete") is False:
-            assert "not every refusal is answered" in d.hint, d.hint
-            left = build_source(apply_edits(text, d.fields["edits"]), "s.aou", check=False)
-            assert _errors(left)
-            return
-        if d.fields.get("edits"):  # answered in full after all: the oracle says so
-            fixed = apply_edits(text, d.fields["edits"])
-            assert not _errors(build_source(fixed, "s.aou", check=False))
-            return
-    pytest.skip("no refusal with an edit")
+    """Two shivers too fast for the UR3's wrist in an inactive sequence: the first is
+    slowed as its hint says, but slowing the second as well would make the file read
+    curious, so ``--fit`` refuses it. The hint gives its own edit, says what is then
+    still refused and why, and its edits are marked incomplete."""
+    text = ("behaviour b : inactive\nsequence {\n  pause 1350ms\n  approach\n"
+            "  gaze horizontal 18.7deg\n  pause 0.516s\n  retreat 0.0425m a=0.107\n"
+            "  gaze horizontal 24.4deg\n  pause 553ms\n  shiver 7.56deg f=2.04Hz for 1.53s x2\n"
+            "  pause 1.3s; gaze horizontal 15.8deg\n  shiver 4.79deg f=2.32Hz\n"
+            "  pause 0.352s\n  retreat 0.0433m a=0.0512 x2\n  pause 1.15s\n}\n"
+            "from (-0.65, -0.1, 0.75); start 30.4cm\n")
+    (d,) = _errors(build_source(text, "s.aou", robot="ur3", check=False))
+    assert d.code == "C308" and d.span.line == 10
+    assert d.fields["edits_complete"] is False
+    assert [e["line"] for e in d.fields["edits"]] == [10]
+    assert "not every refusal is answered: then C308 at line 12" in d.hint, d.hint
+    assert "would make the file express `curious`, not `inactive`" in d.hint, d.hint
+    left = build_source(apply_edits(text, d.fields["edits"]), "s.aou", robot="ur3",
+                        check=False)
+    assert [(x.code, x.span.line) for x in _errors(left)] == [("C308", 12)]
+    fit = build_source(text, "s.aou", robot="ur3", check=False, fit=True)
+    assert _errors(fit)  # --fit gives no answer either
 
 
 def test_applying_any_refusals_hint_once_compiles_over_a_generated_set():
