@@ -49,7 +49,7 @@ def with_every_change(res: Any, build: Callable[[FileResult], Any]) -> Any:
     edits = statement_edits(lint, final)
     if not edits:
         return res
-    hint = d.hint if final == own else _said(d, edits)
+    hint = d.hint if final == own else _said(d, edits) + _otherwise(d.hint)
     if left is not None:
         hint = f"{hint}; not every refusal is answered: then {left}"
     fields = {**d.fields, "edits": edits, "edits_complete": left is None}
@@ -141,6 +141,11 @@ def statement_edits(lint: FileResult, final: str) -> list[dict[str, Any]]:
 def _text(text: str, s: Span) -> str:
     """The source a one-line span covers."""
     return text.split("\n")[s.line - 1][s.col - 1:s.end_col - 1]
+
+
+def _otherwise(hint: str | None) -> str:
+    """What a hint offers instead of its edit (``; or move the goal ...``), kept."""
+    return "; or " + hint.split("; or ", 1)[1] if hint and "; or " in hint else ""
 
 
 def _keys(stmt: str) -> list[str]:
