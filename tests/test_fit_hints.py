@@ -175,3 +175,20 @@ def test_applying_any_refusals_hint_once_compiles_over_a_bigger_generated_set():
         _one_round(case.text, robot, seen)
         _one_round(_faster(case.text), robot, seen)
     assert seen.get("C308") and seen.get("C309") and seen.get("several"), seen
+
+
+def test_aouc_compile_prints_the_hint_with_every_change(tmp_path, capsys):
+    """`aouc compile` refuses the file, writes nothing, and its hint line names both
+    statements to change, as words a person applies."""
+    from aou_dsl.cli.commands import main
+
+    src = tmp_path / "two.aou"
+    src.write_text("behaviour f : fearful\nrobot ur3\napproach a=0.1\npause 1.25s x4\n"
+                   "retreat 0.4m a=0.5\nshiver 6deg f=3Hz for 3s\n")
+    assert main(["compile", str(src), "-o", str(tmp_path / "out"), "--no-check"]) != 0
+    err = capsys.readouterr().err
+    said = err.split("[error]", 1)[1]  # the refusal, then its source line and hint
+    hint = next(ln for ln in said.splitlines() if ln.strip().startswith("= hint:"))
+    assert re.search(r"`retreat [0-9.]+m a=0\.5` at line 5; `shiver 6deg f=[0-9.]+Hz"
+                     r"[^`]*` at line 6", hint), hint
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
