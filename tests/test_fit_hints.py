@@ -65,6 +65,8 @@ def _one_round(text: str, robot: str, seen: dict[str, int]) -> None:
                 keyed and f"`{keyed}`" in d.hint), (d.hint, e)
         if len(edits) > 1:
             seen["several"] = seen.get("several", 0) + 1
+        if len({e["text"].split()[0] for e in edits}) > 1:  # e.g. a gaze and a tilt
+            seen["kinds"] = seen.get("kinds", 0) + 1
         fixed = apply_edits(text, edits)
         if d.hint.startswith("write `"):  # as a person applies it, from the words
             assert apply_hint(text, d).split() == fixed.split(), (text, d.hint)
@@ -165,6 +167,7 @@ def test_applying_any_refusals_hint_once_compiles_over_a_generated_set():
         _one_round(_faster(case.text), robot, seen)
     assert seen.get("C308") and any(seen.get(c) for c in ("C301", "C302", "C303")), seen
     assert seen.get("several"), seen  # hints that change more than one statement
+    assert seen.get("kinds"), seen  # ... of more than one kind
 
 
 @pytest.mark.slow
