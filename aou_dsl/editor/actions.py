@@ -38,6 +38,7 @@ def _action(doc: Document, d: Diagnostic) -> types.CodeAction:
     """The quick fix of ``d``: every edit of its hint (a refusal's, which may change
     several statements: one workspace edit, applied at once), else its one ``fix``."""
     every = d.fields.get("edits")
+    preferred = d.fields.get("edits_complete", True)  # not when it leaves a refusal
     if every:
         edits = [types.TextEdit(range=to_range(Span(doc.path, e["line"], e["col"],
                                                      e["end_line"], e["end_col"]),
@@ -51,7 +52,7 @@ def _action(doc: Document, d: Diagnostic) -> types.CodeAction:
         title = f"{d.code}: write `{text.strip()}`"
         edits = [types.TextEdit(range=to_range(span, doc.lines), new_text=text)]
     return types.CodeAction(
-        title=title, kind=types.CodeActionKind.QuickFix, is_preferred=True,
+        title=title, kind=types.CodeActionKind.QuickFix, is_preferred=preferred,
         diagnostics=[to_lsp(d, doc.lines)],
         edit=types.WorkspaceEdit(changes={doc.uri: edits}))
 
