@@ -61,8 +61,9 @@ def _one_round(text: str, robot: str, seen: dict[str, int]) -> None:
         for e in edits:  # the words say what the fields do
             keyed = " ".join(k for k in re.findall(r"\w+=\S+|for\s+\S+", e["text"])
                              if k not in e["was"])
-            assert f"`{e['text']}`" in d.hint or (
-                keyed and f"`{keyed}`" in d.hint), (d.hint, e)
+            added = e["text"].removeprefix(e["was"]).lstrip("; ")  # a setting written
+            assert f"`{e['text']}`" in d.hint or (keyed and f"`{keyed}`" in d.hint) or (
+                added and f"`{added}`" in d.hint), (d.hint, e)
         if len(edits) > 1:
             seen["several"] = seen.get("several", 0) + 1
         if len({e["text"].split()[0] for e in edits}) > 1:  # e.g. a gaze and a tilt
@@ -129,6 +130,22 @@ def test_a_start_out_of_reach_and_a_shiver_too_fast_are_answered_by_one_hint():
     lines = [e["line"] for e in d.fields["edits"]]
     assert lines == [2, 5], d.hint
     again = build_source(apply_edits(text, d.fields["edits"]), "s.aou", check=False)
+    assert not _errors(again), [(x.code, x.message) for x in again.diagnostics]
+
+
+def test_a_file_without_start_gets_the_start_that_fits_as_an_edit():
+    """The Kinova reaches no start pose 0.3 m from that goal (the default: the file has
+    no `start`): the hint's `start` is written after the `goal` it points at, with the
+    slower shiver the wrist then needs, and the file compiles."""
+    text = "robot kinova\ngoal (0.3, 0.0, 0.6)\napproach a=0.1\npause 1s\nshiver 5deg f=6Hz\n"
+    (d,) = _errors(build_source(text, "s.aou", check=False))
+    assert d.span.line == 2 and re.search(r"; start \d+cm` at line 2", d.hint), d.hint
+    first, second = d.fields["edits"]
+    assert re.fullmatch(r"goal \(0\.3, 0\.0, 0\.6\); start \d+cm", first["text"]), first
+    assert second["line"] == 5 and "f=6Hz" not in second["text"]
+    fixed = apply_edits(text, d.fields["edits"])
+    assert apply_hint(text, d).split() == fixed.split(), d.hint
+    again = build_source(fixed, "s.aou", check=False)
     assert not _errors(again), [(x.code, x.message) for x in again.diagnostics]
 
 

@@ -74,10 +74,16 @@ def _own(lint: FileResult, d: Diagnostic) -> str | None:
                                    r["unit"], None, None, None) for r in d.fields["reach"]])
     start = _START.search(d.hint or "")
     spans = lint.behaviour.settings.spans if lint.behaviour is not None else {}
-    if start and spans.get("start") == d.span and d.span.line == d.span.end_line:
+    if start and d.span in spans.values() and d.span.line == d.span.end_line:
         row = text.split("\n")[d.span.line - 1]
         lines = text.split("\n")
-        lines[d.span.line - 1] = row[:d.span.col - 1] + start[1] + row[d.span.end_col - 1:]
+        # the `start` line changed, or, in a file without one, written after the
+        # setting the refusal points at (`goal (0.3, 0, 0.6); start 21cm`)
+        now = start[1] if spans.get("start") == d.span else f"{_text(text, d.span)}; " \
+            f"{start[1]}" if "start" not in spans else None
+        if now is None:
+            return None
+        lines[d.span.line - 1] = row[:d.span.col - 1] + now + row[d.span.end_col - 1:]
         return "\n".join(lines)
     return None
 
@@ -129,9 +135,15 @@ def statement_edits(lint: FileResult, final: str) -> list[dict[str, Any]]:
     was, now = _statements(lint, keys), _statements(after, keys)
     if len(was) != len(now):
         return []
+    added = [s for k, s in after.behaviour.settings.spans.items() if k not in keys
+             and k not in lint.behaviour.settings.spans and s.path == lint.path]
     out = []
     for a, b in zip(was, now, strict=True):
         old, new = _text(lint.source, a), _text(final, b)
+        for n in added:  # a setting written after a statement (`goal (...); start 21cm`)
+            if n.line == b.line and b.col < n.col and not any(
+                    c.line == b.line and b.col < c.col < n.col for c in now):
+                new = final.split("\n")[b.line - 1][b.col - 1:n.end_col - 1]
         if old != new:
             out.append({"line": a.line, "col": a.col, "end_line": a.end_line,
                         "end_col": a.end_col, "text": new, "was": old})
