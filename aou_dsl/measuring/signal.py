@@ -16,6 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .savgol import savgol, savgol_weights
+
 __all__ = [
     "Grid",
     "JointNoise",
@@ -195,22 +197,18 @@ def smooth(x: np.ndarray, window: int, deriv: int, h: float, order: int = 3) -> 
     the local polynomial of degree ``order`` through ``window`` samples. Window 3 is the
     central difference. Near the ends the polynomial is fitted to the first or last
     window."""
-    from scipy.signal import savgol_filter
-
     n = len(x)
     w = min(window, n if n % 2 else n - 1)
     if w < 3:
         return np.gradient(x, h, axis=0) if deriv == 1 else (
             x if deriv == 0 else np.zeros_like(x))
-    return savgol_filter(x, w, min(order, w - 1), deriv=deriv, delta=h, axis=0)
+    return savgol(x, w, min(order, w - 1), deriv, h)
 
 
 @functools.lru_cache(maxsize=256)
 def sg_coefficients(window: int, order: int, deriv: int, h: float) -> np.ndarray:
-    """The Savitzky-Golay filter's weights for the centre sample (cached)."""
-    from scipy.signal import savgol_coeffs
-
-    return savgol_coeffs(window, min(order, window - 1), deriv=deriv, delta=h, use="dot")
+    """The Savitzky-Golay filter's weights for the centre sample (cached, read-only)."""
+    return savgol_weights(window, min(order, window - 1), deriv, h)
 
 
 def filter_at(x: np.ndarray, window: int, deriv: int, h: float, lo: int, hi: int,
