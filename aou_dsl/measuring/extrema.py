@@ -28,56 +28,71 @@ def maxima(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     change = np.flatnonzero(x[1:] != x[:-1]) + 1
     starts = np.concatenate([[0], change])
     ends = np.concatenate([change - 1, [n - 1]])
-    inner = (starts >= 1) & (ends <= n - 2)
-    starts, ends = starts[inner], ends[inner]
-    higher = (x[starts - 1] < x[starts]) & (x[ends + 1] < x[ends])
-    peaks = (starts[higher] + ends[higher]) // 2
-    return peaks, _prominences(x, peaks)
+    crest = ((starts == 0) | (x[np.maximum(starts - 1, 0)] < x[starts])) & (
+        (ends == n - 1) | (x[np.minimum(ends + 1, n - 1)] < x[ends]))
+    peak = crest & (starts >= 1) & (ends <= n - 2)
+    first, last = starts[peak], ends[peak]
+    marks = np.union1d(np.concatenate([starts[crest], ends[crest]]), [0, n - 1])
+    prominences = _prominences(x, marks, first, last)
+    return (first + last) // 2, prominences
 
 
-def _prominences(x: np.ndarray, peaks: np.ndarray) -> np.ndarray:
-    """The prominence of each of ``peaks`` in ``x``.
+def _prominences(x: np.ndarray, marks: np.ndarray, first: np.ndarray,
+                 last: np.ndarray) -> np.ndarray:
+    """The prominence of each peak, the run of equal samples ``first``..``last``.
 
-    Each side is walked by doubling tables (the maximum and the minimum of every block
-    of 1, 2, 4, ... samples): from the largest block down, a peak's reach is extended
-    by the next block when no sample in it is higher than the peak, and the block's
-    minimum joins the side's base. So every peak walks in log(len(x)) vectorised steps,
-    whatever the distance to its bases."""
-    if len(peaks) == 0:
+    Walking from a peak, the first sample higher than it lies on the flank of a crest
+    higher than it (a run of equal samples with no higher neighbour), or is an end of
+    ``x``. So each side is a walk over ``marks`` (both ends of every crest, and both
+    ends of ``x``) to the first one higher than the peak, and the base is the lowest
+    sample of the stretches between the marks walked over. Both are looked up in
+    doubling tables (the highest mark and the lowest stretch of every block of 1, 2, 4,
+    ... consecutive marks): from the largest block down, a peak's walk goes on over
+    the next block when no mark in it is higher than the peak. So every peak walks in
+    log(len(marks)) vectorised steps, whatever the distance to its bases."""
+    if len(first) == 0:
         return np.zeros(0)
-    highs, lows = _block_tables(x)
-    top = x[peaks]
-    left = _base(highs, lows, peaks, top, -1)
-    right = _base(highs, lows, peaks, top, +1)
+    stretch = np.minimum.reduceat(x, marks)  # x[marks[j]:marks[j + 1]], and x[-1]
+    highs, lows = _block_tables(x[marks]), _block_tables(stretch, np.minimum)
+    top = x[first]
+    left = _walk(highs, lows, np.searchsorted(marks, first), top, -1)
+    right = _walk(highs, lows, np.searchsorted(marks, last), top, +1)
     return top - np.maximum(left, right)
 
 
-def _block_tables(x: np.ndarray) -> tuple[list[np.ndarray], list[np.ndarray]]:
-    """``highs[k][i]`` and ``lows[k][i]``: the maximum and the minimum of
-    ``x[i:i + 2**k]``, for every block that fits in ``x``."""
-    highs, lows = [x], [x]
+def _block_tables(v: np.ndarray, pick: np.ufunc = np.maximum) -> list[np.ndarray]:
+    """``table[k][i]``: ``pick`` (the maximum, or the minimum) of ``v[i:i + 2**k]``, for
+    every block that fits in ``v``."""
+    table = [v]
     size = 1
-    while 2 * size <= len(x):
-        hi, lo = highs[-1], lows[-1]
-        highs.append(np.maximum(hi[:-size], hi[size:]))
-        lows.append(np.minimum(lo[:-size], lo[size:]))
+    while 2 * size <= len(v):
+        prev = table[-1]
+        table.append(pick(prev[:-size], prev[size:]))
         size *= 2
-    return highs, lows
+    return table
 
 
-def _base(highs: list[np.ndarray], lows: list[np.ndarray], peaks: np.ndarray,
+def _walk(highs: list[np.ndarray], lows: list[np.ndarray], at: np.ndarray,
           top: np.ndarray, way: int) -> np.ndarray:
-    """The lowest sample from each peak (itself included) walking ``way`` (-1 left, +1
-    right) up to, not including, the first sample higher than the peak."""
-    n = len(highs[0])
-    reach = peaks.copy()  # the farthest sample walked so far
+    """From mark ``at`` of each peak, walking ``way`` (-1 left, +1 right) over the marks
+    no higher than the peak's ``top``: the lowest sample met, up to (not including) the
+    first mark higher than the peak, or to the end of ``x``."""
+    m = len(highs[0])
+    reach = at.copy()  # the farthest mark walked to so far
     base = top.copy()
     for k in range(len(highs) - 1, -1, -1):
         size = 1 << k
-        first = reach - size if way < 0 else reach + 1  # the next block's first sample
-        fits = (first >= 0) & (first + size <= n)
-        at = np.where(fits, first, 0)
-        step = fits & (highs[k][at] <= top)
-        base = np.where(step, np.minimum(base, lows[k][at]), base)
-        reach = np.where(step, reach + way * size, reach)
+        marks = reach - size if way < 0 else reach + 1  # the next block's first mark
+        fits = (marks >= 0) & (marks + size <= m)
+        marks = np.where(fits, marks, 0)
+        step = fits & (highs[k][marks] <= top)
+        stretches = marks if way < 0 else np.where(step, reach, 0)  # their first one
+        np.minimum(base, lows[k][stretches], out=base, where=step)
+        reach += np.where(step, way * size, 0)
+    # The stretch that ends (left) or starts (right) at the mark the walk stopped at.
+    if way < 0:
+        more = reach > 0
+        np.minimum(base, lows[0][np.maximum(reach - 1, 0)], out=base, where=more)
+    else:
+        np.minimum(base, lows[0][reach], out=base)
     return base

@@ -63,20 +63,31 @@ def savgol(x: np.ndarray, window: int, order: int, deriv: int = 0,
     most ``len(x)``, ``order`` under ``window``. A sample within ``window // 2`` of an
     end takes the polynomial fitted to the first (or last) ``window`` samples."""
     x = np.asarray(x, dtype=np.float64)
-    weights = savgol_weights(window, order, deriv, delta, reverse=True)
+    weights, mirror = _applied_weights(window, order, deriv, delta)
     out = np.empty_like(x)
     half = window // 2
-    out[half:len(x) - half] = _correlate(x, weights)
-    _fit_end(x, out, slice(0, window), slice(0, half), order, deriv, delta)
     n = len(x)
+    _correlate(x, weights, mirror, out[half:n - half])
+    _fit_end(x, out, slice(0, window), slice(0, half), order, deriv, delta)
     _fit_end(x, out, slice(n - window, n), slice(n - half, n), order, deriv, delta)
     return out
 
 
+@functools.lru_cache(maxsize=256)
+def _applied_weights(window: int, order: int, deriv: int, delta: float
+                     ) -> tuple[np.ndarray, int]:
+    """The weights the filter applies (:func:`savgol_weights` solved in reverse), and
+    whether they are mirrored (:func:`_mirror`)."""
+    weights = savgol_weights(window, order, deriv, delta, reverse=True)
+    return weights, _mirror(weights)
+
+
 def _mirror(weights: np.ndarray) -> int:
     """1 when the weights are symmetric about their centre, -1 when antisymmetric, else
-    0 (each within :data:`_MIRROR_TOLERANCE`)."""
+    0 (each within :data:`_MIRROR_TOLERANCE`; an even count is neither)."""
     half = len(weights) // 2
+    if len(weights) % 2 == 0:
+        return 0
     left, right = weights[:half][::-1], weights[half + 1:]
     if np.all(np.abs(right - left) <= _MIRROR_TOLERANCE):
         return 1
@@ -85,29 +96,31 @@ def _mirror(weights: np.ndarray) -> int:
     return 0
 
 
-def _correlate(x: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """``sum_k weights[k] * x[i - m + k]`` for every ``i`` with ``m`` samples on either
-    side, one weight at a time across all samples. Mirrored weights multiply the sum (or
-    difference) of their two samples, outermost pair first, after the centre term."""
+def _correlate(x: np.ndarray, weights: np.ndarray, mirror: int, out: np.ndarray) -> None:
+    """``out[i - m] = sum_k weights[k] * x[i - m + k]`` for every ``i`` with ``m`` samples
+    on either side, one weight at a time across all samples. Mirrored weights multiply
+    the sum (or difference) of their two samples, outermost pair first, after the centre
+    term."""
     w = len(weights)
     half = w // 2
-    n = len(x) - 2 * half
+    n = len(out)
+    term = np.empty_like(out)
 
     def shifted(k: int) -> np.ndarray:
         return x[k:k + n]
 
-    mirror = _mirror(weights) if w % 2 else 0
     if mirror:
-        acc = shifted(half) * weights[half]
+        np.multiply(shifted(half), weights[half], out=out)
+        combine = np.add if mirror > 0 else np.subtract
         for k in range(half):
-            pair = shifted(k) + shifted(w - 1 - k) if mirror > 0 else (
-                shifted(k) - shifted(w - 1 - k))
-            acc += pair * weights[k]
-        return acc
-    acc = shifted(w - 1) * weights[w - 1]
+            combine(shifted(k), shifted(w - 1 - k), out=term)
+            term *= weights[k]
+            out += term
+        return
+    np.multiply(shifted(w - 1), weights[w - 1], out=out)
     for k in range(w - 1):
-        acc += shifted(k) * weights[k]
-    return acc
+        np.multiply(shifted(k), weights[k], out=term)
+        out += term
 
 
 def _fit_end(x: np.ndarray, out: np.ndarray, window: slice, place: slice, order: int,
@@ -117,7 +130,7 @@ def _fit_end(x: np.ndarray, out: np.ndarray, window: slice, place: slice, order:
     if place.stop <= place.start:
         return
     seg = x[window].reshape(window.stop - window.start, -1)
-    coeffs = _polyfit(np.arange(0, len(seg), dtype=np.float64), seg, order)
+    coeffs = _polyfit(seg, order)
     coeffs = _derivative(coeffs, deriv)
     at = np.arange(place.start - window.start, place.stop - window.start,
                    dtype=np.float64).reshape(-1, 1)
@@ -127,16 +140,25 @@ def _fit_end(x: np.ndarray, out: np.ndarray, window: slice, place: slice, order:
     out[place] = (values / (delta ** deriv)).reshape((len(at),) + x.shape[1:])
 
 
-def _polyfit(t: np.ndarray, y: np.ndarray, order: int) -> np.ndarray:
+def _polyfit(y: np.ndarray, order: int) -> np.ndarray:
     """Coefficients (highest power first, one column per column of ``y``) of the
-    least-squares polynomial through ``(t, y)``, its powers scaled to unit norm for
-    the solve."""
+    least-squares polynomial through ``(k, y[k])``, ``k = 0, 1, 2, ...``."""
+    lhs, scale = _edge_design(len(y), order)
+    rcond = len(y) * np.finfo(np.float64).eps
+    coeffs = np.linalg.lstsq(lhs, y, rcond=rcond)[0]
+    return (coeffs.T / scale).T
+
+
+@functools.lru_cache(maxsize=64)
+def _edge_design(window: int, order: int) -> tuple[np.ndarray, np.ndarray]:
+    """The powers of ``0, 1, .. window - 1`` (highest first) as the end fits solve
+    them, each scaled to unit norm (a better conditioned solve), and the scales.
+    Read-only: they are cached."""
+    t = np.arange(0, window, dtype=np.float64)
     lhs = t[:, None] ** np.arange(order, -1, -1, dtype=np.float64)[None, :]
     scale = np.sqrt(np.sum(lhs * lhs, axis=0))
     lhs /= scale
-    rcond = len(t) * np.finfo(np.float64).eps
-    coeffs = np.linalg.lstsq(lhs, y, rcond=rcond)[0]
-    return (coeffs.T / scale).T
+    return _frozen(lhs), _frozen(scale)
 
 
 def _derivative(coeffs: np.ndarray, deriv: int) -> np.ndarray:
