@@ -211,15 +211,15 @@ def sg_coefficients(window: int, order: int, deriv: int, h: float) -> np.ndarray
     return savgol_weights(window, min(order, window - 1), deriv, h)
 
 
-def filter_at(x: np.ndarray, window: int, deriv: int, h: float, lo: int, hi: int,
+def filter_at(x: np.ndarray, window: int, deriv: int, h: float, at: np.ndarray,
               order: int = 3) -> np.ndarray:
-    """:func:`smooth` of ``x`` evaluated only at samples ``lo``..``hi`` (inclusive), each
-    of which must have ``window // 2`` samples on either side."""
+    """:func:`smooth` of ``x`` evaluated only at the samples ``at``, each of which must
+    have ``window // 2`` samples on either side: each is the weights' dot product with
+    its own window of samples, whatever the other samples hold."""
     half = window // 2
     c = sg_coefficients(window, order, deriv, h)
-    seg = x[lo - half:hi + half + 1]
-    views = np.lib.stride_tricks.sliding_window_view(seg, window, axis=0)
-    return views @ c
+    windows = x[np.asarray(at)[:, None] + np.arange(-half, half + 1)]  # (K, window, ...)
+    return np.moveaxis(windows, 1, -1) @ c
 
 
 def slope_gain(window: int, h: float) -> float:
