@@ -99,10 +99,11 @@ def _residuals(t: np.ndarray, q: np.ndarray) -> np.ndarray:
     x = t[idx]
     tn = t[nb]
     w = np.ones_like(tn)
-    for a in range(4):
-        for m in range(4):
-            if m != a:
-                w[a] *= (x - tn[m]) / (tn[a] - tn[m])
+    others = np.ones(4, bool)[:, None]
+    for m in range(4):  # each neighbour's weight takes the factors of the others in turn
+        others[m] = False
+        w *= np.divide(x - tn[m], tn - tn[m], out=np.ones_like(tn), where=others)
+        others[m] = True
     fit = np.einsum("ak,akj->kj", w, q[nb])
     return (q[idx] - fit) / np.sqrt(1.0 + (w * w).sum(axis=0))[:, None]
 
