@@ -125,17 +125,25 @@ def _uniform_gain(w: int, h: float) -> float:
     return float(np.linalg.norm(_uniform_weights(w, h)))
 
 
+def _runs_of(v: np.ndarray, w: int) -> np.ndarray:
+    """Every run of ``w`` consecutive samples of the 1-D ``v``, (len(v) - w + 1, w): a
+    read-only view (NumPy's sliding window view, without its checks)."""
+    step = v.strides[0]
+    return np.lib.stride_tricks.as_strided(v, (len(v) - w + 1, w), (step, step),
+                                           writeable=False)
+
+
 def curvatures(t: np.ndarray, x: np.ndarray, w: int) -> tuple[np.ndarray, np.ndarray]:
     """Over every run of ``w`` (>= 3) consecutive samples of ``x`` at times ``t``: the
     second derivative of the least-squares quadratic in time, and its std per unit of
     white noise on ``x``. Run ``k`` covers samples ``k``..``k + w - 1``."""
-    xw = np.lib.stride_tricks.sliding_window_view(x, w)
+    xw = _runs_of(x, w)
     steps = t[1:] - t[:-1]
     if len(steps):
         mean = float(steps.mean())
         if float(steps.max() - steps.min()) <= 1e-9 * mean:  # one clock
             return xw @ _uniform_weights(w, mean), np.full(len(xw), _uniform_gain(w, mean))
-    tw = np.lib.stride_tricks.sliding_window_view(t, w)
+    tw = _runs_of(t, w)
     centre = tw.mean(axis=1, keepdims=True)
     half = np.maximum(0.5 * (tw[:, -1] - tw[:, 0]), 1e-300)[:, None]
     z = (tw - centre) / half  # in [-1, 1]: well conditioned at any clock
