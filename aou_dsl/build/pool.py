@@ -43,8 +43,7 @@ _STOP_TIMEOUT = 2.0
 #: by each worker when its first build needs it: slower, never different.
 _STAGES = ("aou_dsl.build.builder", "aou_dsl.compiler.pipeline", "aou_dsl.compiler.output",
            "aou_dsl.compiler.branches", "aou_dsl.safety.replay", "aou_dsl.safety.controllers",
-           "aou_dsl.measuring.measured", "aou_dsl.lang.declared", "scipy.interpolate",
-           "scipy.signal")
+           "aou_dsl.measuring.measured", "aou_dsl.lang.declared", "scipy.interpolate")
 
 
 def default_jobs() -> int:

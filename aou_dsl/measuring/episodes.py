@@ -275,10 +275,9 @@ def _self_check(c: Context, peak: float, at: int, window: int, u: np.ndarray,
     half = window // 2
     near = np.unique(np.clip(np.linspace(at - half, at + half, 5).round().astype(int),
                              half, n - 1 - half))
-    lo, hi = int(near[0]), int(near[-1])
     q = c.q[near]
-    qd = filter_at(c.q, window, 1, h, lo, hi)[near - lo]
-    qdd = filter_at(c.q, window, 2, h, lo, hi)[near - lo]
+    qd = filter_at(c.q, window, 1, h, near)
+    qdd = filter_at(c.q, window, 2, h, near)
     joint_side = classical_acceleration(c.arm, q, qd, qdd) @ u
     noise = max(sd, sigma_x * curvature_gain(window, h))
     bound = 1.25 * float(np.abs(joint_side).max()) + 4.0 * noise

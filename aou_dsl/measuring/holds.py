@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .extrema import maxima
 from .onset import REST_SPEED, carried_edge, soft_pause
 from .signal import NOISE_SIGMAS, odd, runs, sg_coefficients, slope_gain, smooth
 
@@ -273,8 +274,6 @@ def _dips(r: Rest, taken: np.ndarray) -> list[tuple[float, float, int]]:
     them, that fall under 30 % of the peaks on both sides. Where the leading joint
     reverses, the instant is its velocity's zero crossing; else the motion on each side
     is followed to zero as beside a rest. (stop, start, sample) each."""
-    from scipy.signal import find_peaks
-
     n = len(r.level)
     # The level at the samples (even places) and between them (odd places): at a
     # reversal the level there, else the larger of the two (never a minimum).
@@ -284,10 +283,10 @@ def _dips(r: Rest, taken: np.ndarray) -> list[tuple[float, float, int]]:
     cross, lead, between = _crossings(r)
     seq[2 * cross + 1] = np.minimum(between, seq[2 * cross + 1])
     joint = dict(zip(cross.tolist(), lead.tolist(), strict=True))
-    idx, props = find_peaks(-seq, prominence=0.0)
+    idx, prominences = maxima(-seq)
     out = []
     v = r.v if r.carried is None else r.carried[0]
-    for m, prom in zip(idx.tolist(), props["prominences"].tolist(), strict=True):
+    for m, prom in zip(idx.tolist(), prominences.tolist(), strict=True):
         k = m // 2
         if taken[k] or (m % 2 and taken[k + 1]) or seq[m] > 0.3 * (seq[m] + prom):
             continue

@@ -119,16 +119,31 @@ def _uniform_weights(w: int, h: float) -> np.ndarray:
     return 2.0 * d / (float(d @ d) * h * h)
 
 
+@functools.lru_cache(maxsize=512)
+def _uniform_gain(w: int, h: float) -> float:
+    """The norm of :func:`_uniform_weights`: the reading's std per unit of white noise."""
+    return float(np.linalg.norm(_uniform_weights(w, h)))
+
+
+def _runs_of(v: np.ndarray, w: int) -> np.ndarray:
+    """Every run of ``w`` consecutive samples of the 1-D ``v``, (len(v) - w + 1, w): a
+    read-only view (NumPy's sliding window view, without its checks)."""
+    step = v.strides[0]
+    return np.lib.stride_tricks.as_strided(v, (len(v) - w + 1, w), (step, step),
+                                           writeable=False)
+
+
 def curvatures(t: np.ndarray, x: np.ndarray, w: int) -> tuple[np.ndarray, np.ndarray]:
     """Over every run of ``w`` (>= 3) consecutive samples of ``x`` at times ``t``: the
     second derivative of the least-squares quadratic in time, and its std per unit of
     white noise on ``x``. Run ``k`` covers samples ``k``..``k + w - 1``."""
-    xw = np.lib.stride_tricks.sliding_window_view(x, w)
-    steps = np.diff(t)
-    if len(steps) and float(np.ptp(steps)) <= 1e-9 * float(steps.mean()):  # one clock
-        c = _uniform_weights(w, float(steps.mean()))
-        return xw @ c, np.full(len(xw), float(np.linalg.norm(c)))
-    tw = np.lib.stride_tricks.sliding_window_view(t, w)
+    xw = _runs_of(x, w)
+    steps = t[1:] - t[:-1]
+    if len(steps):
+        mean = float(steps.mean())
+        if float(steps.max() - steps.min()) <= 1e-9 * mean:  # one clock
+            return xw @ _uniform_weights(w, mean), np.full(len(xw), _uniform_gain(w, mean))
+    tw = _runs_of(t, w)
     centre = tw.mean(axis=1, keepdims=True)
     half = np.maximum(0.5 * (tw[:, -1] - tw[:, 0]), 1e-300)[:, None]
     z = (tw - centre) / half  # in [-1, 1]: well conditioned at any clock
@@ -157,7 +172,7 @@ def _run(t: np.ndarray, a: int, b: int, level: float, noise: float, shortest: fl
     w = min(max(3, int(math.ceil(shortest / step - 1e-9)) + 1), length)
     while w < length:
         # The gain of a run on an even clock of the phase's mean step.
-        gain = float(np.linalg.norm(_uniform_weights(w, step)))
+        gain = _uniform_gain(w, step)
         if noise * gain <= resolution * level:
             break
         w = min(w + max(1, w // 8), length)

@@ -16,6 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .savgol import savgol, savgol_weights
+
 __all__ = [
     "Grid",
     "JointNoise",
@@ -97,10 +99,11 @@ def _residuals(t: np.ndarray, q: np.ndarray) -> np.ndarray:
     x = t[idx]
     tn = t[nb]
     w = np.ones_like(tn)
-    for a in range(4):
-        for m in range(4):
-            if m != a:
-                w[a] *= (x - tn[m]) / (tn[a] - tn[m])
+    others = np.ones(4, bool)[:, None]
+    for m in range(4):  # each neighbour's weight takes the factors of the others in turn
+        others[m] = False
+        w *= np.divide(x - tn[m], tn - tn[m], out=np.ones_like(tn), where=others)
+        others[m] = True
     fit = np.einsum("ak,akj->kj", w, q[nb])
     return (q[idx] - fit) / np.sqrt(1.0 + (w * w).sum(axis=0))[:, None]
 
@@ -195,33 +198,29 @@ def smooth(x: np.ndarray, window: int, deriv: int, h: float, order: int = 3) -> 
     the local polynomial of degree ``order`` through ``window`` samples. Window 3 is the
     central difference. Near the ends the polynomial is fitted to the first or last
     window."""
-    from scipy.signal import savgol_filter
-
     n = len(x)
     w = min(window, n if n % 2 else n - 1)
     if w < 3:
         return np.gradient(x, h, axis=0) if deriv == 1 else (
             x if deriv == 0 else np.zeros_like(x))
-    return savgol_filter(x, w, min(order, w - 1), deriv=deriv, delta=h, axis=0)
+    return savgol(x, w, min(order, w - 1), deriv, h)
 
 
 @functools.lru_cache(maxsize=256)
 def sg_coefficients(window: int, order: int, deriv: int, h: float) -> np.ndarray:
-    """The Savitzky-Golay filter's weights for the centre sample (cached)."""
-    from scipy.signal import savgol_coeffs
-
-    return savgol_coeffs(window, min(order, window - 1), deriv=deriv, delta=h, use="dot")
+    """The Savitzky-Golay filter's weights for the centre sample (cached, read-only)."""
+    return savgol_weights(window, min(order, window - 1), deriv, h)
 
 
-def filter_at(x: np.ndarray, window: int, deriv: int, h: float, lo: int, hi: int,
+def filter_at(x: np.ndarray, window: int, deriv: int, h: float, at: np.ndarray,
               order: int = 3) -> np.ndarray:
-    """:func:`smooth` of ``x`` evaluated only at samples ``lo``..``hi`` (inclusive), each
-    of which must have ``window // 2`` samples on either side."""
+    """:func:`smooth` of ``x`` evaluated only at the samples ``at``, each of which must
+    have ``window // 2`` samples on either side: each is the weights' dot product with
+    its own window of samples, whatever the other samples hold."""
     half = window // 2
     c = sg_coefficients(window, order, deriv, h)
-    seg = x[lo - half:hi + half + 1]
-    views = np.lib.stride_tricks.sliding_window_view(seg, window, axis=0)
-    return views @ c
+    windows = x[np.asarray(at)[:, None] + np.arange(-half, half + 1)]  # (K, window, ...)
+    return np.moveaxis(windows, 1, -1) @ c
 
 
 def slope_gain(window: int, h: float) -> float:

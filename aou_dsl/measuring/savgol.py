@@ -1,0 +1,177 @@
+"""The Savitzky-Golay filter, written for the measurement: the value or a derivative, at
+each sample, of the polynomial fitted by least squares to the window around it.
+
+The measurement derives its thresholds from these numbers, so they must not move by a
+bit from one release to the next. The filter therefore does its arithmetic in one fixed
+order, the order of the library routine the measurement was first calibrated with (the
+weights from a least-squares solve; a symmetric or antisymmetric set of weights applied
+to mirrored pairs of samples, outermost pair first; the ends fitted with their own
+polynomial). It needs only NumPy: importing SciPy's signal package costs a cold command
+about a second (tests/test_savgol.py holds the two to the same bits).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+
+__all__ = ["savgol", "savgol_weights"]
+
+#: How far two mirrored weights may differ and still count as equal (or opposite), so
+#: that the pair is summed before it is weighted.
+_MIRROR_TOLERANCE = float(np.finfo(float).eps)
+
+
+@functools.lru_cache(maxsize=256)
+def savgol_weights(window: int, order: int, deriv: int, delta: float,
+                   reverse: bool = False) -> np.ndarray:
+    """Weights ``c`` such that ``c @ x[i - m:i + m + 1]`` is the ``deriv``-th derivative at
+    the centre of the polynomial of degree ``order`` fitted by least squares to the
+    ``window`` samples ``x`` (``m = window // 2``), ``delta`` apart. With ``reverse`` the
+    weights are solved for the samples in reverse order, then put back in order (the
+    same numbers up to rounding; the filter uses these). Read-only: they are cached.
+
+    The derivative at the centre is ``deriv!`` times the polynomial's coefficient of
+    ``x**deriv``, so the weights are the minimum-norm solution of ``A c = e`` where row
+    ``k`` of ``A`` holds the offsets to the power ``k``."""
+    half, rem = divmod(window, 2)
+    centre = half if rem else half - 0.5
+    if deriv > order:
+        return _frozen(np.zeros(window))
+    offsets = np.arange(-centre, window - centre, dtype=np.float64)
+    if reverse:
+        offsets = offsets[::-1]
+    design = offsets ** np.arange(order + 1, dtype=np.float64).reshape(-1, 1)
+    target = np.zeros(order + 1)
+    target[deriv] = float(math.factorial(deriv)) / (delta ** deriv)
+    rcond = np.finfo(np.float64).eps * max(design.shape)
+    weights = np.linalg.lstsq(design, target, rcond=rcond)[0]
+    return _frozen(weights[::-1].copy() if reverse else weights)
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    """``a`` made read-only (a cached array is shared by every caller)."""
+    a.flags.writeable = False
+    return a
+
+
+def savgol(x: np.ndarray, window: int, order: int, deriv: int = 0,
+           delta: float = 1.0) -> np.ndarray:
+    """The filter along axis 0 of ``x`` (float64, 1-D or more), ``window`` odd and at
+    most ``len(x)``, ``order`` under ``window``. A sample within ``window // 2`` of an
+    end takes the polynomial fitted to the first (or last) ``window`` samples."""
+    x = np.asarray(x, dtype=np.float64)
+    weights, mirror = _applied_weights(window, order, deriv, delta)
+    out = np.empty_like(x)
+    half = window // 2
+    n = len(x)
+    _correlate(x, weights, mirror, out[half:n - half])
+    _fit_end(x, out, slice(0, window), slice(0, half), order, deriv, delta)
+    _fit_end(x, out, slice(n - window, n), slice(n - half, n), order, deriv, delta)
+    return out
+
+
+@functools.lru_cache(maxsize=256)
+def _applied_weights(window: int, order: int, deriv: int, delta: float
+                     ) -> tuple[np.ndarray, int]:
+    """The weights the filter applies (:func:`savgol_weights` solved in reverse), and
+    whether they are mirrored (:func:`_mirror`)."""
+    weights = savgol_weights(window, order, deriv, delta, reverse=True)
+    return weights, _mirror(weights)
+
+
+def _mirror(weights: np.ndarray) -> int:
+    """1 when the weights are symmetric about their centre, -1 when antisymmetric, else
+    0 (each within :data:`_MIRROR_TOLERANCE`; an even count is neither)."""
+    half = len(weights) // 2
+    if len(weights) % 2 == 0:
+        return 0
+    left, right = weights[:half][::-1], weights[half + 1:]
+    if np.all(np.abs(right - left) <= _MIRROR_TOLERANCE):
+        return 1
+    if np.all(np.abs(right + left) <= _MIRROR_TOLERANCE):
+        return -1
+    return 0
+
+
+def _correlate(x: np.ndarray, weights: np.ndarray, mirror: int, out: np.ndarray) -> None:
+    """``out[i - m] = sum_k weights[k] * x[i - m + k]`` for every ``i`` with ``m`` samples
+    on either side, one weight at a time across all samples. Mirrored weights multiply
+    the sum (or difference) of their two samples, outermost pair first, after the centre
+    term."""
+    w = len(weights)
+    half = w // 2
+    n = len(out)
+    term = np.empty_like(out)
+
+    def shifted(k: int) -> np.ndarray:
+        return x[k:k + n]
+
+    if mirror:
+        np.multiply(shifted(half), weights[half], out=out)
+        combine = np.add if mirror > 0 else np.subtract
+        for k in range(half):
+            combine(shifted(k), shifted(w - 1 - k), out=term)
+            term *= weights[k]
+            out += term
+        return
+    np.multiply(shifted(w - 1), weights[w - 1], out=out)
+    for k in range(w - 1):
+        np.multiply(shifted(k), weights[k], out=term)
+        out += term
+
+
+def _fit_end(x: np.ndarray, out: np.ndarray, window: slice, place: slice, order: int,
+             deriv: int, delta: float) -> None:
+    """``out[place]``: the ``deriv``-th derivative of the polynomial of degree ``order``
+    fitted by least squares to ``x[window]`` (each column on its own)."""
+    if place.stop <= place.start:
+        return
+    seg = x[window].reshape(window.stop - window.start, -1)
+    coeffs = _polyfit(seg, order)
+    coeffs = _derivative(coeffs, deriv)
+    at = np.arange(place.start - window.start, place.stop - window.start,
+                   dtype=np.float64).reshape(-1, 1)
+    values = np.zeros_like(at)
+    for row in coeffs:  # Horner's scheme, highest power first
+        values = values * at + row
+    out[place] = (values / (delta ** deriv)).reshape((len(at),) + x.shape[1:])
+
+
+def _polyfit(y: np.ndarray, order: int) -> np.ndarray:
+    """Coefficients (highest power first, one column per column of ``y``) of the
+    least-squares polynomial through ``(k, y[k])``, ``k = 0, 1, 2, ...``."""
+    lhs, scale = _edge_design(len(y), order)
+    rcond = len(y) * np.finfo(np.float64).eps
+    coeffs = np.linalg.lstsq(lhs, y, rcond=rcond)[0]
+    return (coeffs.T / scale).T
+
+
+@functools.lru_cache(maxsize=64)
+def _edge_design(window: int, order: int) -> tuple[np.ndarray, np.ndarray]:
+    """The powers of ``0, 1, .. window - 1`` (highest first) as the end fits solve
+    them, each scaled to unit norm (a better conditioned solve), and the scales.
+    Read-only: they are cached."""
+    t = np.arange(0, window, dtype=np.float64)
+    lhs = t[:, None] ** np.arange(order, -1, -1, dtype=np.float64)[None, :]
+    scale = np.sqrt(np.sum(lhs * lhs, axis=0))
+    lhs /= scale
+    return _frozen(lhs), _frozen(scale)
+
+
+def _derivative(coeffs: np.ndarray, deriv: int) -> np.ndarray:
+    """The ``deriv``-th derivative of polynomials given by their coefficients (highest
+    power first, one polynomial per column): the top rows kept, each multiplied by its
+    power once per differentiation."""
+    n = len(coeffs)
+    if deriv == 0:
+        return coeffs
+    if n <= deriv:
+        return np.zeros_like(coeffs[:1])
+    out = coeffs[:-deriv].copy()
+    for k in range(deriv):
+        powers = np.arange(n - k - 1, deriv - k - 1, -1, dtype=np.float64)
+        out *= powers.reshape((n - deriv,) + (1,) * (out.ndim - 1))
+    return out
