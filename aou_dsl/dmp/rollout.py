@@ -172,15 +172,18 @@ def _roll_move(dmp: Any, start: np.ndarray, goal: np.ndarray, s: float, r: np.nd
     d.execution_time_ = duration
     d.forcing_term_pos.weights_ = s * r @ wp
     d.forcing_term_rot.weights_ = r @ wr
-    d.dt_ = ROLL_DT
+    d.dt_, run_t = _grid(duration)
     d.configure(start_y=start, goal_y=goal)
-    t, y = d.open_loop(run_t=duration)
+    t, y = d.open_loop(run_t=run_t)
     t = np.asarray(t) - t[0]
     y = np.asarray(y, dtype=float)
     x = np.clip(t / duration, 0.0, 1.0)
     h0, h1 = _quintic(x)
     dt = float(t[-1] - t[-2])
-    miss, v_end = goal[:3] - y[-1, :3], (y[-1, :3] - y[-2, :3]) / dt
+    # The end's velocity to second order: a backward difference is the velocity half a
+    # step earlier, and missed it by half a step of the deceleration still left there.
+    miss = goal[:3] - y[-1, :3]
+    v_end = (3.0 * y[-1, :3] - 4.0 * y[-2, :3] + y[-3, :3]) / (2.0 * dt)
     y[:, :3] += np.outer(h0, miss) - np.outer(h1 * duration, v_end)
     turn = pr.compact_axis_angle_from_quaternion(
         pr.concatenate_quaternions(goal[3:], pr.q_conj(y[-1, 3:])))
@@ -190,6 +193,24 @@ def _roll_move(dmp: Any, start: np.ndarray, goal: np.ndarray, s: float, r: np.nd
     fade = np.column_stack([np.cos(angle), half * sinc[:, None]])
     y[:, 3:] = _qmul(fade, y[:, 3:])
     return t, y
+
+
+def _grid(duration: float) -> tuple[float, float]:
+    """The step [s] of a motion's rollout and the run time to ask the library for, so
+    that its last sample falls exactly at ``duration``. The library steps from 0 while
+    below ``run_t + dt``; asked for ``duration`` itself, at a duration that is not a
+    whole number of :data:`ROLL_DT` (most time scales but 1), or is one but for rounding,
+    its last sample fell up to a step past the end: the fade above then stopped a step
+    early and the motion ended with a velocity, a spike of the hand's acceleration where
+    its pose is held after it."""
+    steps = duration / ROLL_DT
+    if abs(steps - round(steps)) <= 1e-9 * max(steps, 1.0):
+        dt = ROLL_DT  # a whole number of steps (rounding aside)
+    else:
+        dt = duration / math.ceil(steps)
+    # Half a step short: the library's grid then stops at the last whole step, whatever
+    # the rounding of ``duration / dt``.
+    return dt, duration - 0.5 * dt
 
 
 def _shiver(tau: np.ndarray, amplitude: float, f: float, duration: float) -> np.ndarray:
@@ -313,7 +334,9 @@ def _rolled(cache: dict, i: int, p: Any, start: np.ndarray, end: np.ndarray, s: 
     key = (i, s, r.tobytes(), k)
     if key not in cache:
         tt, yy = _roll_move(p.dmp, start, end, s, r, k * p.dmp.execution_time_)
-        cache[key] = (float(tt[-1]), CubicSpline(tt, yy, axis=0))
+        # At rest at both ends (a DMP starts at rest; the fade stops it): a spline free
+        # there would start and stop with a velocity, a step where the pose is held.
+        cache[key] = (float(tt[-1]), CubicSpline(tt, yy, axis=0, bc_type="clamped"))
     return cache[key]
 
 
