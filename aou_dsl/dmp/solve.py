@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from ..core.codes import D603, D604, D605
 from ..core.diagnostics import AouError, Diagnostic, Span, diag, has_errors
 from .export import DmpSequence
 from .rollout import Rollout, roll
@@ -171,7 +172,7 @@ def to_trajectory(seq: DmpSequence, ro: Rollout, where: Span,
         first = solve_path(arm, [(ro.pos[0], _rot(ro.quat[:1])[0])])
         if not first.ok:
             assert first.failure is not None
-            raise AouError(diag("D603", "the arm cannot reach the rolled-out start: "
+            raise AouError(diag(D603, "the arm cannot reach the rolled-out start: "
                                 f"{first.failure.status.value}", where, time=0.0))
         seed = first.q[0].copy()
     pos, quat = ro.pos[keep:], ro.quat[keep:]
@@ -182,7 +183,7 @@ def to_trajectory(seq: DmpSequence, ro: Rollout, where: Span,
     if bad >= 0:
         bad += keep
         kind = ro.parts[ro.part[bad]][0]
-        raise AouError(diag("D603", f"the arm cannot follow the rolled-out {kind} at "
+        raise AouError(diag(D603, f"the arm cannot follow the rolled-out {kind} at "
                             f"t={ro.t[bad]:.3f}s: {why}", where, time=float(ro.t[bad])))
     q = np.vstack([kept, q])
     qd = np.gradient(q, ro.t, axis=0)
@@ -224,7 +225,7 @@ def solve(seq: DmpSequence, *, path: str = "<dmp>", check: bool = True,
             limit = f", limit {c.limit:.4g}" if c.limit is not None else ""
             value = f" reaches {c.value:.4g}" if c.value is not None else ""
             out.diagnostics.append(diag(
-                "D604", f"the rolled-out motion fails the {c.name} check at "
+                D604, f"the rolled-out motion fails the {c.name} check at "
                 f"t={(c.time or 0.0):.3f}s: {c.joint or ''}{value}{limit}", where,
                 check=c.name, time=c.time, joint=c.joint, value=c.value, limit=c.limit))
         if has_errors(out.diagnostics):
@@ -232,7 +233,7 @@ def solve(seq: DmpSequence, *, path: str = "<dmp>", check: bool = True,
     out.measured = m = measure(tr)
     for mm in compare(ro.predicted, m.descriptors):
         out.diagnostics.append(diag(
-            "D605", f"{mm.name}: the scaling rule predicts {_fmt(mm.declared)}, measured "
+            D605, f"{mm.name}: the scaling rule predicts {_fmt(mm.declared)}, measured "
             f"{_fmt(mm.measured)}", where, descriptor=mm.name, predicted=mm.declared,
             measured=mm.measured))
     return out
