@@ -19,9 +19,10 @@ The scaling rules (docs/dmp.md):
   a pause's hold, a motion's time scale (its acceleration), a shiver's amplitude. Counts
   and distances are the parts themselves: changing them needs a re-plan.
 
-The DMPs are rolled out every millisecond; what the DMP misses of its goal at its
-execution time (under 0.3 mm) is faded in over the motion by a quintic, so every motion
-ends exactly at rest at its goal. Each motion's DMP runs from a little before its slot
+The DMPs are rolled out on a grid of about :data:`ROLL_DT` that ends exactly at each
+motion's end (:func:`_grid`); what the DMP misses there of its goal (under 0.3 mm) and
+of rest is faded in over the motion by quintics, so every motion ends exactly at rest
+at its goal. Each motion's DMP runs from a little before its slot
 to a little after (its lead-in and run-out, :data:`aou_dsl.dmp.fit.PAD`); the hand's pose
 is the start pose moved by every motion's displacement, so these margins overlap their
 neighbours smoothly. The result is sampled at the sequence's rate.
@@ -164,7 +165,7 @@ def _quintic(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def _roll_move(dmp: Any, start: np.ndarray, goal: np.ndarray, s: float, r: np.ndarray,
                duration: float) -> tuple[np.ndarray, np.ndarray]:
-    """One motion rolled out every millisecond to ``duration``: times and poses (n, 7)."""
+    """One motion rolled out to ``duration``, ending there at rest: times and poses (n, 7)."""
     import pytransform3d.rotations as pr
 
     d = copy.deepcopy(dmp)
