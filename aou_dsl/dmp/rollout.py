@@ -181,8 +181,7 @@ def _roll_move(dmp: Any, start: np.ndarray, goal: np.ndarray, s: float, r: np.nd
     x = np.clip(t / duration, 0.0, 1.0)
     h0, h1 = _quintic(x)
     dt = float(t[-1] - t[-2])
-    # The end's velocity to second order: a backward difference is the velocity half a
-    # step earlier, and missed it by half a step of the deceleration still left there.
+    # The end's velocity to second order (a backward difference is half a step early).
     miss = goal[:3] - y[-1, :3]
     v_end = (3.0 * y[-1, :3] - 4.0 * y[-2, :3] + y[-3, :3]) / (2.0 * dt)
     y[:, :3] += np.outer(h0, miss) - np.outer(h1 * duration, v_end)
@@ -198,19 +197,13 @@ def _roll_move(dmp: Any, start: np.ndarray, goal: np.ndarray, s: float, r: np.nd
 
 def _grid(duration: float) -> tuple[float, float]:
     """The step [s] of a motion's rollout and the run time to ask the library for, so
-    that its last sample falls exactly at ``duration``. The library steps from 0 while
-    below ``run_t + dt``; asked for ``duration`` itself, at a duration that is not a
-    whole number of :data:`ROLL_DT` (most time scales but 1), or is one but for rounding,
-    its last sample fell up to a step past the end: the fade above then stopped a step
-    early and the motion ended with a velocity, a spike of the hand's acceleration where
-    its pose is held after it."""
+    that its last sample falls exactly at ``duration``. Asked for ``duration`` itself,
+    the library's grid ended up to a step past it at most time scales: the fade then
+    stopped a step early, leaving a velocity where the end pose is held."""
     steps = duration / ROLL_DT
-    if abs(steps - round(steps)) <= 1e-9 * max(steps, 1.0):
-        dt = ROLL_DT  # a whole number of steps (rounding aside)
-    else:
-        dt = duration / math.ceil(steps)
-    # Half a step short: the library's grid then stops at the last whole step, whatever
-    # the rounding of ``duration / dt``.
+    whole = abs(steps - round(steps)) <= 1e-9 * max(steps, 1.0)  # rounding aside
+    dt = ROLL_DT if whole else duration / math.ceil(steps)
+    # Half a step short: the library steps while below ``run_t + dt``.
     return dt, duration - 0.5 * dt
 
 
@@ -335,8 +328,7 @@ def _rolled(cache: dict, i: int, p: Any, start: np.ndarray, end: np.ndarray, s: 
     key = (i, s, r.tobytes(), k)
     if key not in cache:
         tt, yy = _roll_move(p.dmp, start, end, s, r, k * p.dmp.execution_time_)
-        # At rest at both ends (a DMP starts at rest; the fade stops it): a spline free
-        # there would start and stop with a velocity, a step where the pose is held.
+        # At rest at both ends (a free end would leave a velocity where the pose is held).
         cache[key] = (float(tt[-1]), CubicSpline(tt, yy, axis=0, bc_type="clamped"))
     return cache[key]
 
