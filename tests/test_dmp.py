@@ -125,7 +125,7 @@ def test_a_motion_ends_at_rest_at_any_time_scale(hesitant, k):
     sequence's rate, from any phase of the samples, the hand's acceleration (second
     differences) around the motion's start and end never leaves the range the motion's
     own acceleration spans over the same samples. A step of velocity would read as a
-    spike beyond it, as a reversal did at a time scale of 1.79 (3.6 % over its peak)."""
+    spike beyond it: a reversal rolled out at a time scale of 1.79 read 3.6 % over its rule."""
     from aou_dsl.dmp.rollout import _rolled
 
     _, seq = hesitant
