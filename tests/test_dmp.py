@@ -118,6 +118,38 @@ def test_intensity_moves_pauses_without_a_replan(hesitant):
                    out.measured.descriptors["pause_duration"])
 
 
+@pytest.mark.parametrize("k", [1.0, 1.37, 1.79])
+def test_a_motion_ends_at_rest_at_any_time_scale(hesitant, k):
+    """Each motion's rollout ends at its goal exactly at its (scaled) duration and at
+    rest, so that holding its end pose after it adds no step of velocity: read at the
+    sequence's rate, from any phase of the samples, the hand's acceleration (second
+    differences) around the motion's start and end never leaves the range the motion's
+    own acceleration spans over the same samples. A step of velocity would read as a
+    spike beyond it: a reversal rolled out at a time scale of 1.79 read 3.6 % over its rule."""
+    from aou_dsl.dmp.rollout import _rolled
+
+    _, seq = hesitant
+    h = 1.0 / seq.rate
+    for i, part in enumerate(seq.parts):
+        if part.dmp is None:
+            continue
+        runs, spline = _rolled({}, i, part, part.start, part.end, 1.0, np.eye(3), k, False)
+        assert runs == pytest.approx(k * part.dmp.execution_time_, abs=1e-9)
+        assert np.allclose(spline(runs), part.end, atol=1e-9)
+        fine = np.linspace(0.0, runs, 20001)
+        peak = float(np.abs(spline(fine, 2)[:, :3]).max())
+        for edge in (0.0, runs):
+            for shift in np.linspace(0.0, h, 5, endpoint=False):
+                t = edge + shift + h * np.arange(-5, 6)
+                read = np.diff(spline(np.clip(t, 0.0, runs))[:, :3], 2, axis=0) / h ** 2
+                for j, row in enumerate(read):
+                    span = np.linspace(t[j], t[j + 2], 401)
+                    inside = ((span > 0.0) & (span < runs))[:, None]
+                    acc = np.where(inside, spline(np.clip(span, 0.0, runs), 2)[:, :3], 0.0)
+                    beyond = np.maximum(row - acc.max(axis=0), acc.min(axis=0) - row)
+                    assert beyond.max() <= 1e-3 * peak, (part.kind, edge, shift, j)
+
+
 def test_unreachable_goal_is_refused_with_a_code(hesitant):
     """A goal far out of reach is refused (D603), not rolled out."""
     _, seq = hesitant

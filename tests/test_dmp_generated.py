@@ -73,13 +73,7 @@ def test_generated_sample_round_trips_through_dmps(case, tmp_path):
 
 
 #: Files the round trip does not yet pass, and why (known, open).
-KNOWN = {
-    "case_00061": "a retreat reversed into an approach without a pause (UR5), at K = 1.79: "
-                  "the rolled-out and the solved hand's peak are within 0.1 % of the rule, "
-                  "but the measurement reads the approach's speeding-up phase, which starts "
-                  "where the two motions' fitted tails overlap at the reversal, 3.6 % high "
-                  "(tolerance 3 %)",
-}
+KNOWN: dict[str, str] = {}
 
 
 def _marked(case):

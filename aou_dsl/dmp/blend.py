@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.codes import I504
+from ..core.codes import D606, I504
 from ..core.diagnostics import AouError, Span, diag
 from .export import MOVES, DmpSequence
 from .rollout import Rollout, roll
@@ -90,7 +90,7 @@ def change_goal(seq: DmpSequence, at: float, goal: tuple[float, float, float], *
     assert out is not None
     solved = Solved(out)
     solved.diagnostics.append(diag(
-        "D606", f"the goal change at t={at:.3f}s cannot be blended into the "
+        D606, f"the goal change at t={at:.3f}s cannot be blended into the "
         f"{out.parts[k][0]} within {BLEND_MARGIN:.0%} of its peak acceleration, even "
         "slowed 4x", where, time=at))
     return solved
@@ -113,7 +113,7 @@ def _solve(seq: DmpSequence, ro: Rollout, where: Span, check: bool) -> Solved:
         out.checks = report.checks
         for c in report.failed():
             out.diagnostics.append(diag(
-                "D606", f"the blended motion fails the {c.name} check at "
+                D606, f"the blended motion fails the {c.name} check at "
                 f"t={(c.time or 0.0):.3f}s: {c.joint or ''} {c.value} (limit {c.limit})",
                 where, check=c.name, time=c.time, joint=c.joint, value=c.value,
                 limit=c.limit))

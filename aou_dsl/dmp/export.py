@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from ..core.codes import D601
 from ..core.diagnostics import AouError, Span, diag
 
 __all__ = ["MOVES", "DmpPart", "DmpSequence", "to_dmp"]
@@ -135,7 +136,7 @@ def to_dmp(trajectory: Any, *, intensity: float = 0.5, behaviour: str | None = N
 
     tr = trajectory
     if not tr.episodes or tr.goal is None:
-        raise AouError(diag("D601", "the trajectory carries no episodes and goal of the "
+        raise AouError(diag(D601, "the trajectory carries no episodes and goal of the "
                             "compiler: only a compiled trajectory can become DMPs",
                             _span(tr), hint="compile the .aou file, or give the .json "
                             "`aouc compile` wrote"))

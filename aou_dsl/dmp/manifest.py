@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.codes import I502
+from ..core.codes import D602, I502
 from ..core.diagnostics import AouError, Span, diag
 from .export import MOVES, DmpPart, DmpSequence
 
@@ -122,7 +122,7 @@ def write_dmp(path: str, seq: DmpSequence, *, inputs: Any = ()) -> None:
 
 
 def _bad(path: str, what: str) -> AouError:
-    return AouError(diag("D602", f"`{path}` is not a readable .dmp folder: {what}",
+    return AouError(diag(D602, f"`{path}` is not a readable .dmp folder: {what}",
                          _where(path), hint="write one with `aouc compile FILE --format dmp`"))
 
 

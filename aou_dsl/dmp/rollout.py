@@ -19,9 +19,10 @@ The scaling rules (docs/dmp.md):
   a pause's hold, a motion's time scale (its acceleration), a shiver's amplitude. Counts
   and distances are the parts themselves: changing them needs a re-plan.
 
-The DMPs are rolled out every millisecond; what the DMP misses of its goal at its
-execution time (under 0.3 mm) is faded in over the motion by a quintic, so every motion
-ends exactly at rest at its goal. Each motion's DMP runs from a little before its slot
+The DMPs are rolled out on a grid of about :data:`ROLL_DT` that ends exactly at each
+motion's end (:func:`_grid`); what the DMP misses there of its goal (under 0.3 mm) and
+of rest is faded in over the motion by quintics, so every motion ends exactly at rest
+at its goal. Each motion's DMP runs from a little before its slot
 to a little after (its lead-in and run-out, :data:`aou_dsl.dmp.fit.PAD`); the hand's pose
 is the start pose moved by every motion's displacement, so these margins overlap their
 neighbours smoothly. The result is sampled at the sequence's rate.
@@ -164,7 +165,7 @@ def _quintic(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def _roll_move(dmp: Any, start: np.ndarray, goal: np.ndarray, s: float, r: np.ndarray,
                duration: float) -> tuple[np.ndarray, np.ndarray]:
-    """One motion rolled out every millisecond to ``duration``: times and poses (n, 7)."""
+    """One motion rolled out to ``duration``, ending there at rest: times and poses (n, 7)."""
     import pytransform3d.rotations as pr
 
     d = copy.deepcopy(dmp)
@@ -172,15 +173,17 @@ def _roll_move(dmp: Any, start: np.ndarray, goal: np.ndarray, s: float, r: np.nd
     d.execution_time_ = duration
     d.forcing_term_pos.weights_ = s * r @ wp
     d.forcing_term_rot.weights_ = r @ wr
-    d.dt_ = ROLL_DT
+    d.dt_, run_t = _grid(duration)
     d.configure(start_y=start, goal_y=goal)
-    t, y = d.open_loop(run_t=duration)
+    t, y = d.open_loop(run_t=run_t)
     t = np.asarray(t) - t[0]
     y = np.asarray(y, dtype=float)
     x = np.clip(t / duration, 0.0, 1.0)
     h0, h1 = _quintic(x)
     dt = float(t[-1] - t[-2])
-    miss, v_end = goal[:3] - y[-1, :3], (y[-1, :3] - y[-2, :3]) / dt
+    # The end's velocity to second order (a backward difference is half a step early).
+    miss = goal[:3] - y[-1, :3]
+    v_end = (3.0 * y[-1, :3] - 4.0 * y[-2, :3] + y[-3, :3]) / (2.0 * dt)
     y[:, :3] += np.outer(h0, miss) - np.outer(h1 * duration, v_end)
     turn = pr.compact_axis_angle_from_quaternion(
         pr.concatenate_quaternions(goal[3:], pr.q_conj(y[-1, 3:])))
@@ -190,6 +193,18 @@ def _roll_move(dmp: Any, start: np.ndarray, goal: np.ndarray, s: float, r: np.nd
     fade = np.column_stack([np.cos(angle), half * sinc[:, None]])
     y[:, 3:] = _qmul(fade, y[:, 3:])
     return t, y
+
+
+def _grid(duration: float) -> tuple[float, float]:
+    """The step [s] of a motion's rollout and the run time to ask the library for, so
+    that its last sample falls exactly at ``duration``. Asked for ``duration`` itself,
+    the library's grid ended up to a step past it at most time scales: the fade then
+    stopped a step early, leaving a velocity where the end pose is held."""
+    steps = duration / ROLL_DT
+    whole = abs(steps - round(steps)) <= 1e-9 * max(steps, 1.0)  # rounding aside
+    dt = ROLL_DT if whole else duration / math.ceil(steps)
+    # Half a step short: the library steps while below ``run_t + dt``.
+    return dt, duration - 0.5 * dt
 
 
 def _shiver(tau: np.ndarray, amplitude: float, f: float, duration: float) -> np.ndarray:
@@ -313,7 +328,8 @@ def _rolled(cache: dict, i: int, p: Any, start: np.ndarray, end: np.ndarray, s: 
     key = (i, s, r.tobytes(), k)
     if key not in cache:
         tt, yy = _roll_move(p.dmp, start, end, s, r, k * p.dmp.execution_time_)
-        cache[key] = (float(tt[-1]), CubicSpline(tt, yy, axis=0))
+        # At rest at both ends (a free end would leave a velocity where the pose is held).
+        cache[key] = (float(tt[-1]), CubicSpline(tt, yy, axis=0, bc_type="clamped"))
     return cache[key]
 
 

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..core.codes import C306
+from ..core.codes import C306, D604
 from ..core.diagnostics import AouError, Span, diag
 
 if TYPE_CHECKING:
@@ -92,7 +92,7 @@ def start(reg: Any, state: State, level: float, x: State3, timings: dict[str, fl
     tr = to_trajectory(seq, ro, _WHERE)
     timings["dmp"] = time.perf_counter() - clock
     if not _checked(reg, tr):
-        raise AouError(diag("D604", f"the DMP rollout of {state} at intensity {level:g} "
+        raise AouError(diag(D604, f"the DMP rollout of {state} at intensity {level:g} "
                             f"fails the checks on {reg.robot}", _WHERE))
     out, _, trans = join_plan(reg, tr, x, None, timings)
     return out, DmpRun(seq, ro, tr, cache, trans), trans
