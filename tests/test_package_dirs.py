@@ -67,7 +67,10 @@ def test_compile_check_measure_and_plot_find_the_meshes_through_it(vendor, capsy
     """compile (one process and --jobs 2, the same bytes), check, measure and plot of
     the compiled file each find the meshes through --package-dir."""
     root, urdf, pkgs = vendor
-    files = [str(BEHAVIOURS / f"{n}.aou") for n in ("curious", "confident")]
+    # three files: with --jobs 2 this process builds the shortest, then a worker joins
+    # (with two, the second would be built here too)
+    names = ("curious", "confident", "inactive")
+    files = [str(BEHAVIOURS / f"{n}.aou") for n in names]
     one, two = tmp_path / "one", tmp_path / "two"
     code, err = _run(capsys, "compile", *files, "--robot", urdf, "--package-dir", pkgs,
                      "-o", str(one) + "/")
@@ -75,7 +78,7 @@ def test_compile_check_measure_and_plot_find_the_meshes_through_it(vendor, capsy
     code, err = _run(capsys, "compile", *files, "--robot", urdf, "--package-dir", pkgs,
                      "--jobs", "2", "-o", str(two) + "/")
     assert code == 0, err
-    for n in ("curious", "confident"):
+    for n in names:
         assert (one / f"{n}.json").read_bytes() == (two / f"{n}.json").read_bytes()
     traj = str(one / "curious.json")
     code, err = _run(capsys, "check", traj, "--robot", urdf, "--package-dir", pkgs)

@@ -1,16 +1,19 @@
 """A batch on this machine's cores that is never slower than one process: this process
 builds too, and workers join as soon as they can take a file.
 
-On Linux (:func:`~aou_dsl.build.pool.can_fork`) this process lints every file, loads what
-the builds need (the libraries and the robots the files name; ``--jobs 1`` loads the same
-at its first build) and forks ``jobs - 1`` workers, which start warm in milliseconds.
+On Linux (:func:`~aou_dsl.build.pool.can_fork`) this process lints every file, builds
+the shortest one itself (which loads the libraries and its robot, as ``--jobs 1`` does
+at its first build), then loads the other robots the files name and forks ``jobs - 1``
+workers, which start warm in milliseconds. A batch with nothing left but one file (or
+copies of one) is built here to the end: a worker would add its start and save nothing.
 Elsewhere the workers are fresh interpreters that import, load and build a small
 behaviour first (about a second on a quiet machine, more than a small batch gains), so
 this process does not wait for them. Either way it builds the files itself, shortest
 first, and each worker that is ready takes the longest file not yet taken, one at a
 time, the next one handed to it the moment it sends a result back (not when this
 process is between two of its own builds); a batch that ends before any worker is
-ready was built as ``--jobs 1`` builds it.
+ready was built as ``--jobs 1`` builds it. Files with the same text go to one process
+together: after the first, a copy costs what a warm rebuild costs, in that process only.
 Results come back in the order of the inputs, each the same as ``build_file`` of its
 path.
 """
@@ -51,42 +54,43 @@ def _robots(lints: list[FileResult], options: BuildOptions) -> tuple[str, ...]:
 
 
 class _Queue:
-    """The files not yet taken, longest motion first: this process takes from the short
-    end, the workers from the long end. A worker's next file is handed out by the pool's
-    thread as its last result comes back (a done-callback), so no worker waits for this
-    process to finish a build of its own."""
+    """The groups of files not yet taken, longest motion first: this process takes from
+    the short end, the workers from the long end. Files with one text are one group,
+    built by one process, so a copy costs what a rebuild in a warm process costs (the
+    compiler's caches are per process). A worker's next group is handed out by the
+    pool's thread as its last results come back (a done-callback), so no worker waits
+    for this process to finish a build of its own."""
 
-    def __init__(self, lints: list[FileResult], options: BuildOptions, encode: str | None,
-                 pool: BuildPool):
-        from .pool import _cost
-
+    def __init__(self, lints: list[FileResult], groups: list[tuple[int, ...]],
+                 options: BuildOptions, encode: str | None, pool: BuildPool):
         self.lints, self.options, self.encode, self.pool = lints, options, encode, pool
-        self.todo = deque(sorted(range(len(lints)), key=lambda k: -_cost(lints[k])))
+        self.todo = deque(groups)
         self.lock = threading.Lock()
-        self.sent: dict[int, Future] = {}
+        self.sent: dict[tuple[int, ...], Future] = {}
         self.chains = 0  # workers being fed
 
-    def shortest(self) -> int | None:
+    def shortest(self) -> tuple[int, ...] | None:
         with self.lock:
             return self.todo.pop() if self.todo else None
 
     def feed(self, last: Future | None = None) -> None:
-        """Hand a worker the longest file left (after ``last``, its previous one, unless
+        """Hand a worker the longest group left (after ``last``, its previous one, unless
         that one failed or was cancelled: the pool is being stopped)."""
-        from .pool import _build_linted
+        from .pool import build_group
 
         if last is not None and (last.cancelled() or last.exception() is not None):
             return
         with self.lock:
             if not self.todo:
                 return
-            k = self.todo.popleft()
+            group = self.todo.popleft()
             try:
-                f = self.pool.submit(_build_linted, self.lints[k], self.options, self.encode)
+                f = self.pool.submit(build_group, [self.lints[k] for k in group],
+                                     self.options, self.encode)
             except RuntimeError:  # the pool is stopped or broken: this process builds it
-                self.todo.appendleft(k)
+                self.todo.appendleft(group)
                 return
-            self.sent[k] = f
+            self.sent[group] = f
         f.add_done_callback(self.feed)
 
     def start_ready(self) -> None:
@@ -99,14 +103,31 @@ class _Queue:
         with self.lock:
             return [f for f in self.sent.values() if not f.done()]
 
-    def finished(self) -> list[tuple[int, Future]]:
+    def finished(self) -> list[tuple[tuple[int, ...], Future]]:
         with self.lock:
-            return [(k, f) for k, f in self.sent.items() if f.done()]
+            return [(g, f) for g, f in self.sent.items() if f.done()]
+
+
+def _groups(lints: list[FileResult]) -> list[tuple[int, ...]]:
+    """The files' indices grouped by text (a file lint refuses is a group of its own),
+    each group in input order, the groups longest motion first."""
+    from .pool import _cost
+
+    by_text: dict[object, list[int]] = {}
+    for k, lint in enumerate(lints):
+        key = lint.source if _buildable(lint) and lint.source is not None else k
+        by_text.setdefault(key, []).append(k)
+    return sorted((tuple(g) for g in by_text.values()), key=lambda g: -_cost(lints[g[0]]))
 
 
 def shared_map(paths: list[str], options: BuildOptions, jobs: int,
                encode: str | None = None) -> Iterator[BuildResult]:
     """Build ``paths`` on this process and ``jobs - 1`` workers; results in input order.
+
+    Where workers are forked, this process first builds the shortest group itself: the
+    workers are then copies of a warm process, and a batch whose rest is a single group
+    is built here to the end, as ``jobs=1`` builds it (a worker would only add its start
+    to the time).
 
     Args:
         paths: ``.aou`` files.
@@ -116,41 +137,60 @@ def shared_map(paths: list[str], options: BuildOptions, jobs: int,
             :func:`~aou_dsl.build.parallel.build_many` says).
     """
     from ..lang.linter import lint_file
-    from .pool import BuildPool
+    from .pool import BuildPool, can_fork
 
     lints = [lint_file(p) for p in paths]
+    session = Session(options)
+    groups = _groups(lints)
+    results: list[BuildResult | None] = [None] * len(lints)
+    if can_fork():
+        while groups:  # up to the shortest file that compiles (lint's refusals are free)
+            group = groups.pop()
+            for k in group:
+                results[k] = _build_here(lints[k], session, options, encode)
+            if _buildable(lints[group[0]]):
+                break
+        if sum(_buildable(lints[g[0]]) for g in groups) < 2:
+            for group in groups:
+                for k in group:
+                    results[k] = _build_here(lints[k], session, options, encode)
+            yield from (r for r in results if r is not None)
+            return
     pool = BuildPool(jobs - 1, robots=_robots(lints, options), options=options, wait=False)
     try:
-        yield from _run(_Queue(lints, options, encode, pool), Session(options))
+        yield from _run(_Queue(lints, groups, options, encode, pool), session, results)
     finally:
         pool.terminate()  # workers still warming up are not waited for
 
 
-def _run(queue: _Queue, session: Session) -> Iterator[BuildResult]:
+def _run(queue: _Queue, session: Session, results: list[BuildResult | None]
+         ) -> Iterator[BuildResult]:
     """This process's side: its own builds, the workers' results gathered, every result
-    yielded in input order as soon as those before it are."""
-    results: list[BuildResult | None] = [None] * len(queue.lints)
+    (those already in ``results`` too) yielded in input order as soon as those before it
+    are."""
     done = 0
     while done < len(results):
         queue.start_ready()
-        k = queue.shortest()
-        if k is not None:
-            results[k] = _build_here(queue, session, k)
+        group = queue.shortest()
+        if group is not None:
+            for k in group:
+                results[k] = _build_here(queue.lints[k], session, queue.options, queue.encode)
         else:
             wait(queue.pending(), timeout=_POLL, return_when=FIRST_COMPLETED)
-        for j, f in queue.finished():
-            if results[j] is None:
-                results[j] = f.result()
+        for got, f in queue.finished():
+            if results[got[0]] is None:
+                for k, res in zip(got, f.result(), strict=True):
+                    results[k] = res
         while done < len(results) and (ready := results[done]) is not None:
             yield ready
             done += 1
 
 
-def _build_here(queue: _Queue, session: Session, k: int) -> BuildResult:
+def _build_here(lint: FileResult, session: Session, options: BuildOptions,
+                encode: str | None) -> BuildResult:
     from .builder import build_lint
     from .pool import _pack
 
-    lint = queue.lints[k]
     if _buildable(lint) and lint.source is not None:
-        return _pack(session.build(lint.source, lint.path), queue.encode)
-    return build_lint(lint, queue.options)  # refused by lint (or unread): nothing to compile
+        return _pack(session.build(lint.source, lint.path), encode)
+    return build_lint(lint, options)  # refused by lint (or unread): nothing to compile

@@ -29,7 +29,7 @@ if TYPE_CHECKING:
     from ..lang.linter import FileResult
     from .builder import BuildResult
 
-__all__ = ["BuildPool", "can_fork", "default_jobs", "encoded", "preload"]
+__all__ = ["BuildPool", "build_group", "can_fork", "default_jobs", "encoded", "preload"]
 
 #: Files linted and handed out at once, per worker, the longest motions first: a
 #: short file last keeps no core idle at the end while another builds a long one.
@@ -103,6 +103,13 @@ def _build_linted(lint: FileResult, options: BuildOptions, encode: str | None
     from .builder import build_lint
 
     return _pack(build_lint(lint, options), encode)
+
+
+def build_group(lints: list[FileResult], options: BuildOptions, encode: str | None
+                ) -> list[BuildResult]:
+    """The builds of files the parent has linted, one after another in this worker (files
+    with one text: after the first, each costs what a warm process's rebuild costs)."""
+    return [_build_linted(lint, options, encode) for lint in lints]
 
 
 
