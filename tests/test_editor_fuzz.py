@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import asyncio
 import random
-import sys
 from pathlib import Path
 
 import pytest
@@ -14,7 +13,9 @@ import pytest
 pytest.importorskip("pygls", reason="the lsp extra (pygls) is not installed")
 pytest_lsp = pytest.importorskip("pytest_lsp", reason="pytest-lsp is not installed")
 from lsprotocol import types  # noqa: E402
-from pytest_lsp import ClientServerConfig, LanguageClient  # noqa: E402
+from pytest_lsp import LanguageClient  # noqa: E402
+
+from .lsp_server import server_client  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 SEEDS = [p.read_text(encoding="utf-8") for p in sorted(ROOT.glob("behaviours/*.aou"))] + [
@@ -26,14 +27,7 @@ JUNK = ["1.", "1e", "-", ".5e-", "0,5", "20°", "x", "x1.5", "=", "a=", "(", ")"
         "1e308m", "pause 0.1s", "approach -5mm", "tilt 90deg v=500deg/s"]
 
 
-@pytest_lsp.fixture(
-    config=ClientServerConfig(server_command=[sys.executable, "-m", "aou_dsl", "server"]))
-async def client(lsp_client: LanguageClient):
-    await lsp_client.initialize_session(types.InitializeParams(
-        capabilities=types.ClientCapabilities(), root_uri=ROOT.as_uri(),
-        initialization_options={"compileOnType": False}))
-    yield
-    await lsp_client.shutdown_session()
+client = server_client()
 
 
 def _position(text: str, offset: int) -> types.Position:

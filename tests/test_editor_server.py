@@ -4,7 +4,6 @@ pytest-lsp's client."""
 from __future__ import annotations
 
 import asyncio
-import sys
 from pathlib import Path
 
 import pytest
@@ -12,24 +11,17 @@ import pytest
 pytest.importorskip("pygls", reason="the lsp extra (pygls) is not installed")
 pytest_lsp = pytest.importorskip("pytest_lsp", reason="pytest-lsp is not installed")
 from lsprotocol import types  # noqa: E402
-from pytest_lsp import ClientServerConfig, LanguageClient  # noqa: E402
+from pytest_lsp import LanguageClient  # noqa: E402
 
 from aou_dsl.lang.linter import lint_source  # noqa: E402
+
+from .lsp_server import server_client  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 pytestmark = pytest.mark.asyncio(loop_scope="module")
 
 
-@pytest_lsp.fixture(
-    config=ClientServerConfig(server_command=[sys.executable, "-m", "aou_dsl", "server"]),
-    scope="module")
-async def client(lsp_client: LanguageClient):
-    await lsp_client.initialize_session(types.InitializeParams(
-        capabilities=types.ClientCapabilities(),
-        root_uri=ROOT.as_uri(),
-        initialization_options={"compileOnType": False}))
-    yield
-    await lsp_client.shutdown_session()
+client = server_client("module")
 
 
 _N = iter(range(10_000))
