@@ -77,9 +77,10 @@ class Sweep:
 
 @pytest.fixture(scope="session")
 def sweep(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory) -> Sweep:
-    """Session-scoped, so that xdist keeps no module's tests together for it. On a
-    pytest-xdist worker the base temporary folder is the run's own, one per worker;
-    its parent, shared by the workers, holds the records."""
+    """The sweeps' folders. Session-scoped: a module-scoped fixture would put all the
+    module's tests on one worker (tests/conftest.py keeps those together). On a
+    pytest-xdist worker the base temporary folder is the worker's own; its parent, the
+    run's, shared by the workers, holds the records."""
     base = tmp_path_factory.getbasetemp()
     shared = base.parent if hasattr(request.config, "workerinput") else base
     records = shared / "lang-roundtrip-records"
