@@ -53,7 +53,32 @@ def _group_of(item: pytest.Item) -> str | None:
     return None
 
 
-@pytest.hookimpl(tryfirst=True)  # before xdist reads the groups
+def _xdist_groups(item: pytest.Item) -> str | None:
+    """The name pytest-xdist gives the groups of ``item`` (its ``xdist_group`` marks)."""
+    names = {str(mark.args[0] if mark.args else mark.kwargs.get("name", "default"))
+             for mark in item.iter_markers("xdist_group")}
+    return "_".join(sorted(names)) or None
+
+
+def _show_group_to_xdist(item: pytest.Item) -> None:
+    """Put ``item``'s group where the scheduler of pytest-xdist reads it: after an ``@``
+    at the end of the test's id. pytest-xdist (3.8) writes it to ``item._nodeid``, which
+    pytest 9.2 no longer reads (its ids are structured, in ``item._id``): there every
+    group was silently ignored, each module's shared set-up ran on both workers and a
+    module-scoped fixture was set up twice. Where pytest-xdist's own suffix took (on
+    an older pytest, or on marks it saw), nothing is done."""
+    group = _xdist_groups(item)
+    if group is None or "@" in item.nodeid:
+        return
+    try:
+        from _pytest.nodeid import NodeId
+    except ImportError:  # a pytest whose ids are plain strings, as pytest-xdist expects
+        item._nodeid = f"{item.nodeid}@{group}"
+    else:
+        item._id = NodeId.parse(f"{item.nodeid}@{group}")
+
+
+@pytest.hookimpl(trylast=True)  # after pytest-xdist's own hook, which names the groups
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Keep the tests that share a module's set-up on one worker, and on the workers
     hand the slow tests out first, so that no long test starts last while the others
@@ -64,3 +89,6 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             item.add_marker(pytest.mark.xdist_group(group))
     if hasattr(config, "workerinput"):  # a worker of pytest-xdist
         items.sort(key=lambda item: item.get_closest_marker("slow") is None)
+        if config.getvalue("loadgroup"):
+            for item in items:
+                _show_group_to_xdist(item)

@@ -12,7 +12,8 @@ trajectory whose measured descriptors equal the declared ones.
 from __future__ import annotations
 
 import functools
-import tempfile
+import json
+import os
 from pathlib import Path
 
 import pytest
@@ -25,22 +26,66 @@ DEFAULT_N, DEFAULT_SEED = 200, 44
 SLOW_N, SLOW_SEED = 1000, 12
 MAX_REFUSED = 0.10
 
-_WORK = Path(tempfile.mkdtemp(prefix="aou-roundtrip-"))
-
-#: The per-file tests of a sweep and its refusal share run on one worker (pytest-xdist),
-#: where the share reads the outcomes the per-file tests left in ``_outcome``'s cache.
-DEFAULT_SWEEP = pytest.mark.xdist_group("lang_roundtrip-default")
-SLOW_SWEEP = pytest.mark.xdist_group("lang_roundtrip-slow")
-
 
 @functools.cache
 def _cases(n: int, seed: int) -> tuple[langgen.Case, ...]:
     return tuple(langgen.random_cases(n, seed))
 
 
-@functools.cache
-def _outcome(n: int, seed: int, i: int) -> Outcome:
-    return run_case(_cases(n, seed)[i], _WORK / f"s{seed}")
+class Sweep:
+    """The outcomes of a seeded sweep of generated files, each found once per run.
+
+    A file is linted and compiled in this process's own folder (``work``); what a
+    refusal-share test needs of it (status and codes) is also recorded in ``records``,
+    one folder for the whole run that every pytest-xdist worker shares. The per-file
+    tests spread over the workers, so the share reads the outcomes the other worker
+    found instead of compiling those files again; a file nobody has compiled yet it
+    compiles itself, so the share never depends on the order the tests ran in."""
+
+    def __init__(self, work: Path, records: Path) -> None:
+        self.work, self.records = work, records
+        self._found: dict[tuple[int, int, int], Outcome] = {}
+
+    def outcome(self, n: int, seed: int, i: int) -> Outcome:
+        """File ``i`` of the sweep, linted, compiled and read back (and recorded)."""
+        key = (n, seed, i)
+        if key not in self._found:
+            found = run_case(_cases(n, seed)[i], self.work / f"s{seed}")
+            self._record(key, {"status": found.status,
+                               "codes": found.lint_codes + found.compile_codes})
+            self._found[key] = found
+        return self._found[key]
+
+    def refusal(self, n: int, seed: int, i: int) -> dict:
+        """File ``i``'s status and codes, from the record any worker left, or found now."""
+        path = self._path((n, seed, i))
+        if path.is_file():
+            return json.loads(path.read_text())
+        found = self.outcome(n, seed, i)
+        return {"status": found.status, "codes": found.lint_codes + found.compile_codes}
+
+    def _path(self, key: tuple[int, int, int]) -> Path:
+        return self.records / "{}-{}-{}.json".format(*key)
+
+    def _record(self, key: tuple[int, int, int], what: dict) -> None:
+        """Written whole (a temporary name, then renamed): the other worker may read it."""
+        path = self._path(key)
+        part = path.with_name(f"{path.name}.{os.getpid()}.part")
+        part.write_text(json.dumps(what))
+        os.replace(part, path)
+
+
+@pytest.fixture(scope="session")
+def sweep(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory) -> Sweep:
+    """The sweeps' folders. Session-scoped: a module-scoped fixture would put all the
+    module's tests on one worker (tests/conftest.py keeps those together). On a
+    pytest-xdist worker the base temporary folder is the worker's own; its parent, the
+    run's, shared by the workers, holds the records."""
+    base = tmp_path_factory.getbasetemp()
+    shared = base.parent if hasattr(request.config, "workerinput") else base
+    records = shared / "lang-roundtrip-records"
+    records.mkdir(exist_ok=True)
+    return Sweep(tmp_path_factory.mktemp("lang-roundtrip"), records)
 
 
 def _explain(o: Outcome) -> str:
@@ -55,11 +100,11 @@ def _check_one(o: Outcome) -> None:
     assert not o.certain, "the trajectory does not show what the file declares:\n" + _explain(o)
 
 
-def _check_refused(n: int, seed: int) -> None:
-    outs = [_outcome(n, seed, i) for i in range(n)]
-    refused = [o for o in outs if o.status.endswith("refused")]
+def _check_refused(sweep: Sweep, n: int, seed: int) -> None:
+    outs = [sweep.refusal(n, seed, i) for i in range(n)]
+    refused = [o for o in outs if o["status"].endswith("refused")]
     share = len(refused) / n
-    codes = sorted({c for o in refused for c in o.lint_codes + o.compile_codes})
+    codes = sorted({c for o in refused for c in o["codes"]})
     assert share < MAX_REFUSED, f"{share:.0%} of valid files refused (codes {codes})"
 
 
@@ -102,39 +147,35 @@ def test_generated_expectations_are_complete():
 @settings(max_examples=25, deadline=None,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(langgen.aou_cases())
-def test_lint_never_crashes_on_valid_files(case):
+def test_lint_never_crashes_on_valid_files(sweep, case):
     """Linting any generated file ends with exit 0 or 1, never a crash or a usage error."""
-    path = _WORK / "hyp" / f"{case.stem}.aou"
+    path = sweep.work / "hyp" / f"{case.stem}.aou"
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(case.text)
     rc, out = cli(["lint", "--format", "json", str(path)])
     assert rc in (0, 1), f"lint exit {rc} on\n{case.text}\n{out[-2000:]}"
 
 
-@DEFAULT_SWEEP
 @pytest.mark.parametrize("i", range(DEFAULT_N))
-def test_compiled_file_shows_what_it_declares(i):
+def test_compiled_file_shows_what_it_declares(sweep, i):
     """A generated file compiles without crashing, and the oracle's reading, the
     document's measured and its declared descriptors all equal the file's declaration."""
-    _check_one(_outcome(DEFAULT_N, DEFAULT_SEED, i))
+    _check_one(sweep.outcome(DEFAULT_N, DEFAULT_SEED, i))
 
 
-@DEFAULT_SWEEP
-def test_few_valid_files_are_refused():
+def test_few_valid_files_are_refused(sweep):
     """Fewer than 10% of valid generated files are refused by lint or compile."""
-    _check_refused(DEFAULT_N, DEFAULT_SEED)
+    _check_refused(sweep, DEFAULT_N, DEFAULT_SEED)
 
 
 @pytest.mark.slow
-@SLOW_SWEEP
 @pytest.mark.parametrize("i", range(SLOW_N))
-def test_compiled_file_shows_what_it_declares_bulk(i):
+def test_compiled_file_shows_what_it_declares_bulk(sweep, i):
     """The same round trip over 1000 seeded files."""
-    _check_one(_outcome(SLOW_N, SLOW_SEED, i))
+    _check_one(sweep.outcome(SLOW_N, SLOW_SEED, i))
 
 
 @pytest.mark.slow
-@SLOW_SWEEP
-def test_few_valid_files_are_refused_bulk():
+def test_few_valid_files_are_refused_bulk(sweep):
     """Fewer than 10% of 1000 valid generated files are refused by lint or compile."""
-    _check_refused(SLOW_N, SLOW_SEED)
+    _check_refused(sweep, SLOW_N, SLOW_SEED)
