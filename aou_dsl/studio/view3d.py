@@ -9,6 +9,7 @@ viser's URDF helper. The hand's pose comes from aou's own forward kinematics
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -88,6 +89,10 @@ class Arm:
         self.actuated: tuple[str, ...] = tuple(self.urdf.get_actuated_joint_names())
         self.track: Track | None = None
         self._sight: Any = None
+        # The player's thread and the build's (drawing a new motion at t = 0) both pose
+        # the arm: two first poses at once would each add the line of sight, the second
+        # replacing the first, whose handle one of them would then keep and write to.
+        self._posing = threading.Lock()
 
     def show(self, tr: Trajectory) -> None:
         """Draw ``tr``: its path coloured by episode and the goal (:meth:`pose` poses the
@@ -116,6 +121,10 @@ class Arm:
 
     def pose(self, t: float) -> None:
         """The arm at time ``t`` from the start, with its line of sight."""
+        with self._posing:
+            self._pose(t)
+
+    def _pose(self, t: float) -> None:
         tk = self.track
         if tk is None:
             return
