@@ -1,5 +1,7 @@
 """Shared fixtures: paths to the shipped behaviours and the test fixture folders."""
 
+import signal
+import threading
 from pathlib import Path
 
 import pytest
@@ -8,6 +10,16 @@ ROOT = Path(__file__).resolve().parent.parent
 BEHAVIOURS = ROOT / "behaviours"
 INVALID = Path(__file__).resolve().parent / "invalid"
 VALID = Path(__file__).resolve().parent / "valid"
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """Ctrl-C reaches the commands the tests start as it does in a terminal. A test run
+    started in the background by a shell without job control inherits SIGINT ignored,
+    and every command started from it would too (exec keeps an ignored signal ignored),
+    so the tests that press Ctrl-C on one would see nothing happen."""
+    if threading.current_thread() is threading.main_thread() and \
+            signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.fixture

@@ -2,7 +2,10 @@
 shortest file first (so the workers are copies of a warm process), a batch with one file
 left to compile after it never starts a worker, and copies of one text stay together."""
 
+import multiprocessing
 import shutil
+import subprocess
+import sys
 
 import pytest
 
@@ -13,11 +16,13 @@ from aou_dsl.compiler.output import encode
 from aou_dsl.core.options import BuildOptions
 from aou_dsl.lang.linter import lint_file
 
-from .conftest import BEHAVIOURS, INVALID
+from .conftest import BEHAVIOURS, INVALID, ROOT
 
 OPTIONS = BuildOptions(rate=100.0)
 
-pytestmark = pytest.mark.skipif(not pool.can_fork(), reason="workers are spawned here")
+forking = pytest.mark.skipif(
+    not sys.platform.startswith("linux") or "fork" not in multiprocessing.get_all_start_methods(),
+    reason="workers are spawned here")
 
 
 class _Started(Exception):
@@ -28,23 +33,42 @@ def _no_pool(*args, **kwargs):
     raise _Started
 
 
+def _ran_alone(name: str) -> bool:
+    """Whether the test ``name`` was run in a fresh pytest, and passed there: it must be
+    where this process runs another thread (a pytest-xdist worker's), because a pool
+    here would not fork."""
+    if pool.can_fork():
+        return False
+    proc = subprocess.run([sys.executable, "-m", "pytest", "-q", "-n", "0", "-p",
+                           "no:cacheprovider", f"{__file__}::{name}"], capture_output=True,
+                          text=True, cwd=ROOT, check=False)
+    assert proc.returncode == 0 and "1 passed" in proc.stdout, proc.stdout[-3000:]
+    return True
+
+
 def _documents(results) -> list[bytes | None]:
     return [None if r.document is None else encode(r.document, "json") for r in results]
 
 
+@forking
 def test_two_files_and_refused_ones_never_start_a_worker(monkeypatch):
     """Two files that compile: the shortest builds here and warms this process; the
     other alone would gain nothing from a worker but its start. Files lint refuses cost
     nothing and do not count."""
     paths = [str(BEHAVIOURS / "curious.aou"), "no/such/file.aou",
              str(INVALID / "invalid_bad_character.aou"), str(BEHAVIOURS / "confident.aou")]
+    if _ran_alone("test_two_files_and_refused_ones_never_start_a_worker"):
+        return
     monkeypatch.setattr(pool, "BuildPool", _no_pool)
     got = list(build_many(paths, OPTIONS, jobs=2))
     assert [r.path for r in got] == paths
     assert _documents(got) == _documents(build_file(p, OPTIONS) for p in paths)
 
 
+@forking
 def test_three_files_start_a_worker(monkeypatch):
+    if _ran_alone("test_three_files_start_a_worker"):
+        return
     paths = [str(BEHAVIOURS / f"{n}.aou") for n in ("curious", "confident", "hesitant")]
     monkeypatch.setattr(pool, "BuildPool", _no_pool)
     with pytest.raises(_Started):
@@ -63,7 +87,10 @@ def test_copies_of_a_text_are_one_group_longest_motion_first(tmp_path):
     assert batch._groups(lints) == [(0, 2), (3,), (1, 4), (5,), (6,)]
 
 
+@forking
 def test_copies_split_across_a_worker_give_what_each_build_alone_gives(tmp_path):
+    if _ran_alone("test_copies_split_across_a_worker_give_what_each_build_alone_gives"):
+        return
     paths = []
     for k in range(3):
         for name in ("hesitant", "confident", "curious"):
