@@ -74,18 +74,20 @@ def _own(lint: FileResult, d: Diagnostic) -> str | None:
                                    r["unit"], None, None, None) for r in d.fields["reach"]])
     start = _START.search(d.hint or "")
     spans = lint.behaviour.settings.spans if lint.behaviour is not None else {}
-    if start and d.span in spans.values() and d.span.line == d.span.end_line:
-        row = text.split("\n")[d.span.line - 1]
-        lines = text.split("\n")
-        # the `start` line changed, or, in a file without one, written after the
-        # setting the refusal points at (`goal (0.3, 0, 0.6); start 21cm`)
-        now = start[1] if spans.get("start") == d.span else f"{_text(text, d.span)}; " \
-            f"{start[1]}" if "start" not in spans else None
-        if now is None:
-            return None
-        lines[d.span.line - 1] = row[:d.span.col - 1] + now + row[d.span.end_col - 1:]
-        return "\n".join(lines)
-    return None
+    if not (start and d.span in spans.values() and d.span.line == d.span.end_line):
+        return None
+    # the `start` line changed, or, in a file without one, written after the setting
+    # the refusal points at (`goal (0.3, 0, 0.6); start 21cm`)
+    if spans.get("start") == d.span:
+        now = start[1]
+    elif "start" not in spans:
+        now = f"{_text(text, d.span)}; {start[1]}"
+    else:
+        return None
+    lines = text.split("\n")
+    row = lines[d.span.line - 1]
+    lines[d.span.line - 1] = row[:d.span.col - 1] + now + row[d.span.end_col - 1:]
+    return "\n".join(lines)
 
 
 def _complete(lint: FileResult, own: str, build: Callable[[FileResult], Any]

@@ -10,7 +10,6 @@ joint by joint (docs/measure.md explains the choices).
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 
@@ -206,9 +205,9 @@ def smooth(x: np.ndarray, window: int, deriv: int, h: float, order: int = 3) -> 
     return savgol(x, w, min(order, w - 1), deriv, h)
 
 
-@functools.lru_cache(maxsize=256)
 def sg_coefficients(window: int, order: int, deriv: int, h: float) -> np.ndarray:
-    """The Savitzky-Golay filter's weights for the centre sample (cached, read-only)."""
+    """The Savitzky-Golay filter's weights for the centre sample (cached by
+    :func:`~.savgol.savgol_weights`, read-only)."""
     return savgol_weights(window, min(order, window - 1), deriv, h)
 
 
