@@ -14,7 +14,7 @@ import os
 import sys
 from collections.abc import Callable, Sequence
 
-from ..core.codes import C306, C311
+from ..core.codes import C306, C311, C320, C321
 from ..core.diagnostics import AouError, Diagnostic, Severity, Span
 from ..core.rules import category
 from ..editor import cmd_server
@@ -207,11 +207,13 @@ def _cmd_check(args: argparse.Namespace) -> int:
 
 
 def _check_diagnostics(path: str, report) -> list[Diagnostic]:
-    """A failed check as the code compile gives it (C311 the controller's jerk, C306 the
-    rest): ``check`` never fails without a code."""
+    """A failed check as the code compile gives it (C311 the controller's jerk, C320 the
+    torque, C321 the tracking error, C306 the rest): ``check`` never fails without a
+    code."""
     from ..core.diagnostics import diag
 
-    out = [diag(C311 if c.name == "joint-jerk" else C306,
+    codes = {"joint-jerk": C311, "joint-torque": C320, "tracking-error": C321}
+    out = [diag(codes.get(c.name, C306),
                 f"{c.name} check failed" + ("" if c.time is None else f" at t={c.time:.3f}s")
                 + f": {c.detail}", Span.whole_file(path), check=c.name, time=c.time,
                 joint=c.joint, value=c.value, limit=c.limit) for c in report.failed()]
