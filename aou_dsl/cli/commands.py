@@ -197,13 +197,31 @@ def _cmd_check(args: argparse.Namespace) -> int:
     report = check(tr, dynamic=not args.no_dynamic, controller=args.controller,
                    **_scene_kw(args))
     failed = _check_diagnostics(args.path, report)
+    if args.format != "json":
+        print(format_check(args.path, tr.robot, tr.t, report))
+    tracking: dict | None = None
+    if args.track:
+        from .track_cmd import run_tracking
+
+        try:
+            more, tracking = run_tracking(args, tr, _behaviour(args.path),
+                                          reads=_reads(args, [args.path]), out=sys.stdout)
+        except AouError as err:
+            return _fail(err)
+        failed += more
     if args.format == "json":
         print(format_json({"path": args.path, **report.to_json(),
+                           **({"tracking": tracking} if args.track else {}),
                            "diagnostics": [d.to_json() for d in failed]}))
-    else:
-        print(format_check(args.path, tr.robot, tr.t, report))
     _print_diags(failed)
-    return EXIT_ERRORS if failed else EXIT_OK
+    return EXIT_ERRORS if any(d.severity == Severity.ERROR for d in failed) else EXIT_OK
+
+
+def _behaviour(path: str):
+    """The lint of a ``.aou`` file (what --track judges against), None for a trajectory."""
+    from ..lang.linter import lint_file
+
+    return lint_file(path) if path.endswith(".aou") else None
 
 
 def _check_diagnostics(path: str, report) -> list[Diagnostic]:
