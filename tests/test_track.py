@@ -10,7 +10,7 @@ import pytest
 
 pytest.importorskip("mujoco")
 
-from aou_dsl.cli.commands import EXIT_ERRORS, EXIT_OK, main  # noqa: E402
+from aou_dsl.cli.commands import EXIT_OK, main  # noqa: E402
 from aou_dsl.core.servo_specs import PANDA, SERVOS  # noqa: E402
 from aou_dsl.core.trajectory import Trajectory  # noqa: E402
 from aou_dsl.robot.load import load_arm  # noqa: E402
@@ -101,7 +101,7 @@ def test_fearful_on_the_panda_loses_its_shiver_to_plain_set_points(fearful_panda
     the report says."""
     argv = ["check", str(BEHAVIOURS / "fearful.aou"), "--no-dynamic", "--track",
             "--tracked", str(fearful_panda), "--format", "json"]
-    assert main(argv) == EXIT_ERRORS
+    assert main(argv) == EXIT_OK  # a warning: the motion is as safe as the plan
     out = capsys.readouterr()
     doc = json.loads(out.out)
     modes = {m["mode"]: {d["descriptor"]: d for d in m["descriptors"]}
@@ -113,7 +113,7 @@ def test_fearful_on_the_panda_loses_its_shiver_to_plain_set_points(fearful_panda
     (lost,) = [d for d in doc["diagnostics"] if d["code"] == "C322"
                and d["fields"]["descriptor"] == "shiver_amplitude"]
     assert "feedforward" in lost["fields"]["keeps"] and "--servo feedforward" in lost["hint"]
-    assert lost["line"] == 8  # the shiver statement
+    assert lost["line"] == 8 and lost["severity"] == "warning"  # at the shiver statement
     assert main(["measure", str(fearful_panda), "--format", "json"]) == EXIT_OK
     measured = json.loads(capsys.readouterr().out)["descriptors"]["shiver_amplitude"]
     assert measured == pytest.approx(pos["measured"], rel=1e-6)
@@ -129,6 +129,21 @@ def test_feedforward_mode_keeps_the_shiver_and_says_which_modes_keep_it(capsys):
     line = next(ln for ln in out.out.splitlines() if "the shiver (6 deg declared)" in ln)
     assert "under plain position set-points" in line and "Kept by: feedforward, torque." in line
     assert "max tracking error per joint" in out.out
+
+
+def test_compile_track_writes_the_plan_and_the_tracked_recording(tmp_path, capsys):
+    """compile --track: the trajectory is written (tracking warns, it does not refuse),
+    the report goes to standard error, the tracked motion to --tracked."""
+    out, rec = tmp_path / "f.json", tmp_path / "f-tracked.csv"
+    assert main(["compile", str(BEHAVIOURS / "fearful.aou"), "--no-check", "--track",
+                 "-o", str(out), "--tracked", str(rec)]) == EXIT_OK
+    err = capsys.readouterr().err
+    assert "tracked through the servos of panda" in err and " C322 " in err
+    assert json.loads(out.read_text())["qd"]
+    assert rec.read_text().splitlines()[0] == "# format: aou-trajectory/1"
+    assert main(["measure", str(rec)]) == EXIT_OK
+    assert main(["compile", str(BEHAVIOURS / "fearful.aou"), "-o", str(out),
+                 "--tracked", str(rec)]) == 2  # --tracked without --track
 
 
 def test_an_arm_without_a_servo_table_gets_the_generic_one_and_a_warning(capsys):

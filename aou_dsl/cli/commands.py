@@ -18,7 +18,7 @@ from ..core.codes import C306, C311, C320, C321
 from ..core.diagnostics import AouError, Diagnostic, Severity, Span
 from ..core.rules import category
 from ..editor import cmd_server
-from .args import EXIT_ERRORS, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, build_parser
+from .args import EXIT_ERRORS, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, build_parser, usage_error
 from .endings import CtrlC, extra_missing, internal
 from .fmt import cmd_fmt
 from .report import format_json, format_suppressed
@@ -147,11 +147,15 @@ def _cmd_compile(args: argparse.Namespace) -> int:
         from .fitted import fitted_usage
 
         return fitted_usage("compile")
+    if args.tracked and (len(inputs) != 1 or not args.track):
+        return usage_error("compile", "--tracked needs --track and one .aou input")
     results = build_many(sources, options, args.jobs or default_jobs(), cluster=args.cluster,
                          encode=fmt)  # the workers encode; this process writes bytes
     worst = EXIT_OK
     for k, ((src, _), dest, res) in enumerate(zip(inputs, dests, results, strict=True), 1):
         _print_diags(res.diagnostics, sources={src: res.lint.source or ""})
+        if res.ok and res.document is not None and args.track:
+            res = _tracked(args, res, reads)
         if not res.ok or res.document is None:
             worst = max(worst, _exit_for(res.diagnostics))
             print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)
@@ -172,6 +176,23 @@ def _cmd_compile(args: argparse.Namespace) -> int:
 
             worst = max(worst, write_fitted(args.write_fitted, res, sources))
     return worst
+
+
+def _tracked(args: argparse.Namespace, res, reads: list[str]):
+    """``compile --track``: the report on standard error, its warnings (C322, C323); a
+    file whose tracking cannot be simulated fails (nothing written)."""
+    from dataclasses import replace
+
+    from .track_cmd import run_tracking
+
+    try:
+        more, _ = run_tracking(args, res.trajectory, res.lint, reads=reads, out=sys.stderr)
+    except AouError as err:
+        more = list(err.diagnostics)
+    _print_diags(more, sources={res.lint.path: res.lint.source or ""})
+    if any(d.severity == Severity.ERROR for d in more):
+        return replace(res, diagnostics=[*res.diagnostics, *more])  # ok: False
+    return res
 
 
 # --- check, measure ---------------------------------------------------------------------
@@ -204,8 +225,9 @@ def _cmd_check(args: argparse.Namespace) -> int:
         from .track_cmd import run_tracking
 
         try:
-            more, tracking = run_tracking(args, tr, _behaviour(args.path),
-                                          reads=_reads(args, [args.path]), out=sys.stdout)
+            more, tracking = run_tracking(
+                args, tr, _behaviour(args.path), reads=_reads(args, [args.path]),
+                out=None if args.format == "json" else sys.stdout)
         except AouError as err:
             return _fail(err)
         failed += more

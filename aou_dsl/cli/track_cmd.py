@@ -86,9 +86,9 @@ def tracked_document(report, mode: str) -> dict:
 
 
 def run_tracking(args: argparse.Namespace, tr, behaviour, *, reads: list[str],
-                 out: IO[str]) -> tuple[list[Diagnostic], dict | None]:
+                 out: IO[str] | None) -> tuple[list[Diagnostic], dict | None]:
     """Track ``tr`` (judged against ``behaviour``, a lint or None), print the report on
-    ``out`` unless ``--format json`` (then it is returned), write ``--tracked``.
+    ``out`` (None: not printed; it is returned as JSON), write ``--tracked``.
 
     Returns:
         the diagnostics (C322, C323) and the report as JSON.
@@ -107,7 +107,7 @@ def run_tracking(args: argparse.Namespace, tr, behaviour, *, reads: list[str],
     robot_span = Span.whole_file("<command line>" if getattr(args, "robot", None)
                                  else tr.path)
     diags = report.diagnostics(robot_span)
-    if getattr(args, "format", None) != "json":
+    if out is not None:
         print(format_tracking(report), file=out)
     if dest:
         doc = tracked_document(report, args.servo)

@@ -26,13 +26,14 @@ CHECK_RULES = [
          "A joint that cannot follow the plan draws a different motion, and a controller "
          "watching its following error stops the arm.",
          "aouc check fast.json   # a shoulder swinging at 4 Hz"),
-    Rule(C322, "lost-under-tracking", _E,
+    Rule(C322, "lost-under-tracking", _W,
          "With --track, the motion the arm's servos give (simulated through the servo "
          "mode of --servo) shows a descriptor outside its tolerance of the declared one; "
          "the message names the descriptor, the value the arm gives, and a servo mode "
          "that keeps it.",
          "Servos filter motion: a fast shiver sent as plain position set-points reaches "
-         "the arm smaller and late, so the arm does not show what the file declares.",
+         "the arm smaller and late, so the arm does not show what the file declares. A "
+         "warning: the motion is as safe as the plan; what a person sees differs.",
          "aouc check behaviours/fearful.aou --track --servo position"),
     Rule(C323, "generic-servo", _W,
          "With --track, the arm has no servo table (gains, damping, armature, force "
