@@ -182,3 +182,46 @@ def test_every_shipped_behaviour_tracks_on_every_arm(robot, name, capsys):
         assert m["descriptors"] is not None
         if m["mode"] == "torque":
             assert max(m["tracking_max_rad"].values()) < np.radians(1.0)
+
+
+# --- a robot description's [servo] table -------------------------------------------------
+
+def test_a_description_gives_its_own_servo_table(tmp_path):
+    """Identified values in a robot description are what --track simulates: one number
+    for every joint or one per joint; a description without a table keeps the built-in
+    arm's; a named published table is that table."""
+    from aou_dsl.safety.track import arm_servo
+
+    own = tmp_path / "own.toml"
+    own.write_text('robot = "panda"\n[servo]\nkp = [900, 900, 900, 900, 300, 300, 300]\n'
+                   'kv = 30\nrate = 500\nmodes = ["position"]\nsource = "our lab, 2026"\n')
+    table, generic = arm_servo(str(own))
+    assert not generic and table.kp == (900.0,) * 4 + (300.0,) * 3
+    assert table.kv == (30.0,) * 7 and table.rate == 500.0 and table.modes == ("position",)
+    assert table.damping == (0.0,) * 7 and table.source == "our lab, 2026"
+    plain = tmp_path / "plain.toml"
+    plain.write_text('robot = "panda"\n')
+    assert arm_servo(str(plain)) == (PANDA, False)
+    named = tmp_path / "named.toml"
+    named.write_text('robot = "panda"\n[servo]\ntable = "kinova_gen3"\n')
+    assert arm_servo(str(named))[0] == SERVOS["kinova_gen3"]
+
+
+@pytest.mark.parametrize(("servo", "words"), [
+    ("kp = [1, 2]", "one per arm joint"),
+    ("kp = -5", "must be a number from 0"),
+    ("kq = 5", "unknown key `kq`"),
+    ("kv = 5", "needs `kp`"),
+    ('modes = ["velocity"]\nkp = 5', "`modes` must be a list"),
+    ('table = "no_such_arm"', "names no table aou knows"),
+])
+def test_a_bad_servo_table_is_refused_with_what_is_wrong(tmp_path, servo, words):
+    from aou_dsl.core.diagnostics import AouError
+    from aou_dsl.safety.track import arm_servo
+
+    path = tmp_path / "bad.toml"
+    path.write_text(f'robot = "panda"\n[servo]\n{servo}\n')
+    with pytest.raises(AouError) as err:
+        arm_servo(str(path))
+    (d,) = err.value.diagnostics
+    assert d.code == "V109" and words in d.message, d.message

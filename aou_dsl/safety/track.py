@@ -69,30 +69,56 @@ def arm_servo(robot: str, package_dirs: tuple[str, ...] = ()) -> tuple[ServoTabl
 
     A robot description's ``[servo]`` table comes first, then a built-in arm's table
     (a description that extends a built-in arm keeps its table), then the generic servo.
+
+    Raises:
+        AouError: V109 for a ``[servo]`` table that does not fit the arm.
     """
     from ..robot.load import load_robot
 
     r = load_robot(robot, package_dirs)
-    own = getattr(r.spec, "servo", None)
-    if isinstance(own, ServoTable):
-        return own, False
-    for name in (robot, getattr(r.spec, "name", "")):
-        table = servo_table(name)
-        if table is not None:
-            return table, False
-    base = _extends(r)
-    if base and servo_table(base) is not None:
-        return servo_table(base), False  # type: ignore[return-value]
-    return generic_table(len(r.spec.arm_joints)), True
+    n = len(r.spec.arm_joints)
+    if r.description:
+        from ..robot.description import read_description
+
+        desc = read_description(r.description)
+        if desc.servo is not None:
+            return _own_table(r.description, desc.servo, n), False
+        if desc.robot and servo_table(desc.robot) is not None:
+            return servo_table(desc.robot), False  # type: ignore[return-value]
+    table = servo_table(robot)
+    return (table, False) if table is not None else (generic_table(n), True)
 
 
-def _extends(r) -> str:
-    """The built-in arm a robot description extends ("" for none)."""
-    if not getattr(r, "description", ""):
-        return ""
-    from ..robot.description import read_description
+def _own_table(path: str, servo: dict, n: int) -> ServoTable:
+    """A description's ``[servo]`` table (checked by the reader) made to the arm's
+    ``n`` joints: a named published table, or the gains given (one number for every
+    joint, or one per joint; kv, damping and armature 0 and the URDF's effort limits
+    where it gives none; 1 kHz and every mode unless it says)."""
+    from ..core.codes import V109
+    from ..core.diagnostics import AouError, Span, diag
+    from ..core.servo_specs import SERVOS
 
-    return read_description(r.description).robot
+    def bad(message: str) -> AouError:
+        return AouError(diag(V109, f"robot description `{path}`: [servo] {message}",
+                             Span.whole_file(path)))
+
+    if "table" in servo:
+        table = servo_table(servo["table"])
+        if table is None:
+            raise bad(f"names no table aou knows: `{servo['table']}` (tables: "
+                      f"{', '.join(sorted(SERVOS))})")
+        if table.n != n:
+            raise bad(f"table `{servo['table']}` is for {table.n} joints, the arm has {n}")
+        return table
+    rows = {}
+    for key in ("kp", "kv", "damping", "armature", "force"):
+        v = servo.get(key, (0.0,))
+        if len(v) not in (1, n):
+            raise bad(f"`{key}` has {len(v)} numbers: give one, or one per arm joint ({n})")
+        rows[key] = tuple(v) * n if len(v) == 1 else tuple(v)
+    return ServoTable(**rows, rate=servo.get("rate", 1000.0),
+                      modes=servo.get("modes", MODES),
+                      source=servo.get("source", f"the robot description `{path}`"))
 
 
 @functools.lru_cache(maxsize=8)
