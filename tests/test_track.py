@@ -225,3 +225,32 @@ def test_a_bad_servo_table_is_refused_with_what_is_wrong(tmp_path, servo, words)
         arm_servo(str(path))
     (d,) = err.value.diagnostics
     assert d.code == "V109" and words in d.message, d.message
+
+
+def test_tracked_never_overwrites_an_input(tmp_path, capsys):
+    """--tracked goes through the output rule: the behaviour itself is refused (I502)
+    before any simulation, and left as it was."""
+    src = tmp_path / "f.aou"
+    src.write_text((BEHAVIOURS / "inactive.aou").read_text())
+    before = src.read_bytes()
+    assert main(["check", str(src), "--no-dynamic", "--track", "--tracked", str(src)]) == 2
+    assert " I502 " in capsys.readouterr().err and src.read_bytes() == before
+
+
+@pytest.mark.slow
+def test_the_vendor_gen3_with_its_published_servos_keeps_the_shiver_with_feedforward(
+        tmp_path, capsys):
+    """The Gen3 URDF in the tests, described with Menagerie's Gen3 table: fearful (fitted
+    to the arm) loses part of its shiver to plain set-points, and feed-forward keeps it."""
+    from .test_fit import GEN3
+
+    desc = tmp_path / "gen3.toml"
+    desc.write_text(f'urdf = "{GEN3}"\n[servo]\ntable = "kinova_gen3"\n')
+    main(["check", str(BEHAVIOURS / "fearful.aou"), "--robot", str(desc), "--fit",
+          "--no-dynamic", "--no-collision-check", "--track", "--format", "json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["tracking"]["servo"]["source"].startswith("MuJoCo Menagerie")
+    shiver = {m["mode"]: next(d for d in m["descriptors"]
+                              if d["descriptor"] == "shiver_amplitude")
+              for m in doc["tracking"]["modes"]}
+    assert not shiver["position"]["ok"] and shiver["feedforward"]["ok"]
