@@ -254,3 +254,12 @@ def test_the_vendor_gen3_with_its_published_servos_keeps_the_shiver_with_feedfor
                               if d["descriptor"] == "shiver_amplitude")
               for m in doc["tracking"]["modes"]}
     assert not shiver["position"]["ok"] and shiver["feedforward"]["ok"]
+
+
+def test_a_behaviour_the_arm_refuses_is_not_tracked_and_the_user_is_told_to_fit(capsys):
+    """Fearful's shiver is too fast for the Kinova as written (C308): --track says there
+    is no motion to track and that --fit gives one."""
+    assert main(["check", str(BEHAVIOURS / "fearful.aou"), "--robot", "kinova",
+                 "--track"]) == 1
+    err = capsys.readouterr().err
+    assert " C308 " in err and "add --fit" in err

@@ -206,7 +206,16 @@ def _cmd_check(args: argparse.Namespace) -> int:
         from .fitted import check_fitted
 
         return check_fitted(args, _read_kw(args))
-    tr = read_trajectory(args.path, **_read_kw(args))
+    try:
+        tr = read_trajectory(args.path, **_read_kw(args))
+    except AouError as err:
+        if args.track and args.path.endswith(".aou"):  # nothing to track: say how
+            code = _fail(err)
+            print("aouc check: the arm refuses the behaviour as written, so there is no "
+                  "motion to track; add --fit to track it fitted to the arm",
+                  file=sys.stderr)
+            return code
+        raise
     from ..robot import robot_diagnostics
 
     named = Span.whole_file("<command line>" if args.robot else args.path)  # the robot
