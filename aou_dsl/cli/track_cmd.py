@@ -37,6 +37,8 @@ def format_tracking(report) -> str:
         speed = report.duration / k.seconds if k.seconds > 0 else float("inf")
         err = " ".join(f"{x:.3g}" for x in np.degrees(k.error_max))
         mark = " (chosen)" if r.mode == report.selected else ""
+        if r.mode not in s.modes:
+            mark += " (not offered by the arm's controller)"
         lines.append(f"  {r.mode:12s} {speed:>7.0f}x  {err}{mark}")
     if report.plan is not None:
         head = "".join(f" {_SHORT[r.mode]:>13s}" for r in report.results)
