@@ -228,8 +228,8 @@ def test_a_bad_servo_table_is_refused_with_what_is_wrong(tmp_path, servo, words)
 
 
 def test_tracked_never_overwrites_an_input(tmp_path, capsys):
-    """--tracked goes through the output rule: the behaviour itself is refused (I502)
-    before any simulation, and left as it was."""
+    """--tracked goes through the output rule: the behaviour itself is refused (I502,
+    exit 2) before the tracking is simulated, and left as it was."""
     src = tmp_path / "f.aou"
     src.write_text((BEHAVIOURS / "inactive.aou").read_text())
     before = src.read_bytes()

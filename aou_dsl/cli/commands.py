@@ -155,7 +155,9 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     for k, ((src, _), dest, res) in enumerate(zip(inputs, dests, results, strict=True), 1):
         _print_diags(res.diagnostics, sources={src: res.lint.source or ""})
         if res.ok and res.document is not None and args.track:
-            res = _tracked(args, res, reads)
+            from .track_cmd import compile_tracked
+
+            res = compile_tracked(args, res, reads)
         if not res.ok or res.document is None:
             worst = max(worst, _exit_for(res.diagnostics))
             print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)
@@ -178,44 +180,20 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     return worst
 
 
-def _tracked(args: argparse.Namespace, res, reads: list[str]):
-    """``compile --track``: the report on standard error, its warnings (C322, C323); a
-    file whose tracking cannot be simulated fails (nothing written)."""
-    from dataclasses import replace
-
-    from .track_cmd import run_tracking
-
-    try:
-        more, _ = run_tracking(args, res.trajectory, res.lint, reads=reads, out=sys.stderr)
-    except AouError as err:
-        more = list(err.diagnostics)
-    _print_diags(more, sources={res.lint.path: res.lint.source or ""})
-    if any(d.severity == Severity.ERROR for d in more):
-        return replace(res, diagnostics=[*res.diagnostics, *more])  # ok: False
-    return res
-
-
 # --- check, measure ---------------------------------------------------------------------
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
     from ..api import check, read_trajectory
     from .report import format_check
+    from .track_cmd import check_tracking, nothing_to_track
 
     if args.fit or args.write_fitted:
         from .fitted import check_fitted
 
         return check_fitted(args, _read_kw(args))
-    try:
+    with nothing_to_track(args):  # the arm refuses the file: --track says what to do
         tr = read_trajectory(args.path, **_read_kw(args))
-    except AouError as err:
-        if args.track and args.path.endswith(".aou"):  # nothing to track: say how
-            code = _fail(err)
-            print("aouc check: the arm refuses the behaviour as written, so there is no "
-                  "motion to track; add --fit to track it fitted to the arm",
-                  file=sys.stderr)
-            return code
-        raise
     from ..robot import robot_diagnostics
 
     named = Span.whole_file("<command line>" if args.robot else args.path)  # the robot
@@ -229,30 +207,15 @@ def _cmd_check(args: argparse.Namespace) -> int:
     failed = _check_diagnostics(args.path, report)
     if args.format != "json":
         print(format_check(args.path, tr.robot, tr.t, report))
-    tracking: dict | None = None
-    if args.track:
-        from .track_cmd import run_tracking
-
-        try:
-            more, tracking = run_tracking(
-                args, tr, _behaviour(args.path), reads=_reads(args, [args.path]),
-                out=None if args.format == "json" else sys.stdout)
-        except AouError as err:
-            return _fail(err)
-        failed += more
+    more, tracking = check_tracking(args, tr, _reads(args, [args.path])) if args.track \
+        else ([], None)
+    failed += more
     if args.format == "json":
         print(format_json({"path": args.path, **report.to_json(),
                            **({"tracking": tracking} if args.track else {}),
                            "diagnostics": [d.to_json() for d in failed]}))
     _print_diags(failed)
     return EXIT_ERRORS if any(d.severity == Severity.ERROR for d in failed) else EXIT_OK
-
-
-def _behaviour(path: str):
-    """The lint of a ``.aou`` file (what --track judges against), None for a trajectory."""
-    from ..lang.linter import lint_file
-
-    return lint_file(path) if path.endswith(".aou") else None
 
 
 def _check_diagnostics(path: str, report) -> list[Diagnostic]:

@@ -6,17 +6,45 @@ mode written as a recording ``aouc measure`` reads."""
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+import sys
+from collections.abc import Iterator
 from typing import IO
 
 import numpy as np
 
-from ..core.diagnostics import Diagnostic, Span
+from ..core.diagnostics import AouError, Diagnostic, Span
 from ..version import __version__
 
-__all__ = ["format_tracking", "run_tracking", "tracked_document"]
+__all__ = ["check_tracking", "compile_tracked", "format_tracking", "nothing_to_track",
+           "run_tracking", "tracked_document"]
+
+
+@contextlib.contextmanager
+def nothing_to_track(args: argparse.Namespace) -> Iterator[None]:
+    """Around the compile of ``aouc check FILE.aou --track``: when the arm refuses the
+    file there is no motion to track; say so, and how to get one, before its errors."""
+    try:
+        yield
+    except AouError:
+        if getattr(args, "track", False) and args.path.endswith(".aou"):
+            print("aouc check --track: nothing to track, the arm refuses the behaviour as "
+                  "written (below); add --fit to track it fitted to the arm", file=sys.stderr)
+        raise
 
 _SHORT = {"position": "position", "feedforward": "feedforward", "torque": "torque"}
+
+
+def _shiver_descriptor() -> str:
+    """The descriptor of a shiver's amplitude, by its kind in the descriptor table."""
+    from ..lang.descriptors import REGISTRY
+
+    return next(d.name for d in REGISTRY.values() if d.kind == "shiver"
+                and d.key == "amplitude")
+
+
+_SHIVER = _shiver_descriptor()
 
 
 def _v(v) -> str:
@@ -59,14 +87,14 @@ def format_tracking(report) -> str:
             lines.append(f"  {r.mode}: {n} of {len(r.verdict.rows)} descriptors within "
                          f"tolerance; reads as {cv.state.value} (C={cv.C:+.2f} "
                          f"V={cv.V:+.2f})")
-        shiver = next(w for w in report.plan.rows if w.name == "shiver_amplitude")
+        shiver = next(w for w in report.plan.rows if w.name == _SHIVER)
         if isinstance(shiver.declared, float) and shiver.declared > 0:
             parts = []
             for r in report.results:
-                got = next(x for x in r.verdict.rows if x.name == "shiver_amplitude")
+                got = next(x for x in r.verdict.rows if x.name == _SHIVER)
                 share = (got.measured or 0.0) / shiver.declared
                 parts.append(f"{share:.0%} under {MODE_WORDS[r.mode]}")
-            keep = report.keeps("shiver_amplitude")
+            keep = report.keeps(_SHIVER)
             lines.append(f"  the shiver ({shiver.declared:.3g} deg declared): the arm shows "
                          + "; ".join(parts) + ". "
                          + (f"Kept by: {', '.join(keep)}." if keep
@@ -118,3 +146,36 @@ def run_tracking(args: argparse.Namespace, tr, behaviour, *, reads: list[str],
         write_atomic(dest, data, inputs=reads)
     return diags, report.to_json()
 
+
+
+def check_tracking(args: argparse.Namespace, tr, reads: list[str]
+                   ) -> tuple[list[Diagnostic], dict | None]:
+    """``aouc check --track``: a ``.aou`` file's motion judged against it, a trajectory
+    file's tracking error alone; the report on standard output (text) or returned (JSON).
+
+    Raises:
+        AouError: what cannot be tracked or written (the command's exit says which).
+    """
+    from ..lang.linter import lint_file
+
+    behaviour = lint_file(args.path) if args.path.endswith(".aou") else None
+    return run_tracking(args, tr, behaviour, reads=reads,
+                        out=None if args.format == "json" else sys.stdout)
+
+
+def compile_tracked(args: argparse.Namespace, res, reads: list[str]):
+    """``compile --track``: the report on standard error, its warnings (C322, C323); a
+    file whose tracking cannot be simulated fails (nothing written)."""
+    from dataclasses import replace
+
+    from ..core.diagnostics import Severity
+    from .report import print_diagnostics
+
+    try:
+        more, _ = run_tracking(args, res.trajectory, res.lint, reads=reads, out=sys.stderr)
+    except AouError as err:
+        more = list(err.diagnostics)
+    print_diagnostics(more, sources={res.lint.path: res.lint.source or ""})
+    if any(d.severity == Severity.ERROR for d in more):
+        return replace(res, diagnostics=[*res.diagnostics, *more])  # ok: False
+    return res
