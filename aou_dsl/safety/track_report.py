@@ -86,7 +86,8 @@ class TrackReport:
             out.append(diag(
                 C322, f"{w.name}: declared {declared}, the arm shows "
                 f"{_text(w.measured, w.unit)}{share} under {MODE_WORDS[self.selected]} "
-                f"(tolerance +-{_text(w.tolerance)})", w.span,
+                + ("(it must be absent)" if w.tolerance is None
+                   else f"(tolerance +-{_text(w.tolerance)})"), w.span,
                 hint=(f"send it with --servo {keep[0]} ({MODE_WORDS[keep[0]]}), which keeps "
                       "it" if keep else "no servo mode of this arm keeps it"),
                 descriptor=w.name, declared=w.declared, measured=w.measured,
