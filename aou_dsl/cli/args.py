@@ -160,6 +160,21 @@ def _fit(p: argparse.ArgumentParser) -> None:
                    help="with --fit: write the fitted behaviour there (one input)")
 
 
+def _track(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--track", action="store_true",
+                   help="simulate the arm tracking the motion through its servos (MuJoCo; "
+                   "the `track` extra) in each servo mode, and judge what it shows "
+                   "(docs/checks.md)")
+    p.add_argument("--servo", choices=("position", "feedforward", "torque"),
+                   default="position",
+                   help="with --track: how the trajectory is sent, the mode whose losses "
+                   "are errors (position: plain set-points, the default; feedforward: "
+                   "with velocities; torque: computed torque)")
+    p.add_argument("--tracked", metavar="FILE",
+                   help="with --track: write the tracked motion (--servo's) as a recording "
+                   "(.json or .csv) that `aouc measure` reads")
+
+
 def _scene(p: argparse.ArgumentParser) -> None:
     p.add_argument("--target-size", type=LENGTH, default=0.05, metavar="M",
                    help="edge of the target cube at the goal, in metres (default 0.05)")
@@ -230,6 +245,7 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     _controller(comp)
     _scene(comp)
     _fit(comp)
+    _track(comp)
     c["check"] = chk = sub.add_parser(
         "check", help="replay a behaviour or trajectory in PyBullet and report every check")
     chk.add_argument("path", metavar="FILE", help="a .aou file or a trajectory file")
@@ -241,6 +257,7 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     _controller(chk)
     _recording(chk)
     _scene(chk)
+    _track(chk)
     c["plot"] = plot = sub.add_parser(
         "plot", help="velocity profile of a behaviour or trajectory, or the C-V map (--cv)")
     plot.add_argument("paths", nargs="+", metavar="FILE")

@@ -14,11 +14,11 @@ import os
 import sys
 from collections.abc import Callable, Sequence
 
-from ..core.codes import C306, C311
+from ..core.codes import C306, C311, C320, C321
 from ..core.diagnostics import AouError, Diagnostic, Severity, Span
 from ..core.rules import category
 from ..editor import cmd_server
-from .args import EXIT_ERRORS, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, build_parser
+from .args import EXIT_ERRORS, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, build_parser, usage_error
 from .endings import CtrlC, extra_missing, internal
 from .fmt import cmd_fmt
 from .report import format_json, format_suppressed
@@ -147,11 +147,17 @@ def _cmd_compile(args: argparse.Namespace) -> int:
         from .fitted import fitted_usage
 
         return fitted_usage("compile")
+    if args.tracked and (len(inputs) != 1 or not args.track):
+        return usage_error("compile", "--tracked needs --track and one .aou input")
     results = build_many(sources, options, args.jobs or default_jobs(), cluster=args.cluster,
                          encode=fmt)  # the workers encode; this process writes bytes
     worst = EXIT_OK
     for k, ((src, _), dest, res) in enumerate(zip(inputs, dests, results, strict=True), 1):
         _print_diags(res.diagnostics, sources={src: res.lint.source or ""})
+        if res.ok and res.document is not None and args.track:
+            from .track_cmd import compile_tracked
+
+            res = compile_tracked(args, res, reads)
         if not res.ok or res.document is None:
             worst = max(worst, _exit_for(res.diagnostics))
             print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)
@@ -180,12 +186,14 @@ def _cmd_compile(args: argparse.Namespace) -> int:
 def _cmd_check(args: argparse.Namespace) -> int:
     from ..api import check, read_trajectory
     from .report import format_check
+    from .track_cmd import check_tracking, nothing_to_track
 
     if args.fit or args.write_fitted:
         from .fitted import check_fitted
 
         return check_fitted(args, _read_kw(args))
-    tr = read_trajectory(args.path, **_read_kw(args))
+    with nothing_to_track(args):  # the arm refuses the file: --track says what to do
+        tr = read_trajectory(args.path, **_read_kw(args))
     from ..robot import robot_diagnostics
 
     named = Span.whole_file("<command line>" if args.robot else args.path)  # the robot
@@ -197,21 +205,27 @@ def _cmd_check(args: argparse.Namespace) -> int:
     report = check(tr, dynamic=not args.no_dynamic, controller=args.controller,
                    **_scene_kw(args))
     failed = _check_diagnostics(args.path, report)
+    if args.format != "json":
+        print(format_check(args.path, tr.robot, tr.t, report))
+    more, tracking = check_tracking(args, tr, _reads(args, [args.path])) if args.track \
+        else ([], None)
+    failed += more
     if args.format == "json":
         print(format_json({"path": args.path, **report.to_json(),
+                           **({"tracking": tracking} if args.track else {}),
                            "diagnostics": [d.to_json() for d in failed]}))
-    else:
-        print(format_check(args.path, tr.robot, tr.t, report))
     _print_diags(failed)
-    return EXIT_ERRORS if failed else EXIT_OK
+    return EXIT_ERRORS if any(d.severity == Severity.ERROR for d in failed) else EXIT_OK
 
 
 def _check_diagnostics(path: str, report) -> list[Diagnostic]:
-    """A failed check as the code compile gives it (C311 the controller's jerk, C306 the
-    rest): ``check`` never fails without a code."""
+    """A failed check as the code compile gives it (C311 the controller's jerk, C320 the
+    torque, C321 the tracking error, C306 the rest): ``check`` never fails without a
+    code."""
     from ..core.diagnostics import diag
 
-    out = [diag(C311 if c.name == "joint-jerk" else C306,
+    codes = {"joint-jerk": C311, "joint-torque": C320, "tracking-error": C321}
+    out = [diag(codes.get(c.name, C306),
                 f"{c.name} check failed" + ("" if c.time is None else f" at t={c.time:.3f}s")
                 + f": {c.detail}", Span.whole_file(path), check=c.name, time=c.time,
                 joint=c.joint, value=c.value, limit=c.limit) for c in report.failed()]

@@ -58,6 +58,27 @@ def check_fitted(args: argparse.Namespace, read_kw: dict) -> int:
     report = check(tr, dynamic=not args.no_dynamic, controller=args.controller,
                    target_size=args.target_size,
                    table_height=None if args.no_table else args.table_height)
+    tracking = None
+    if getattr(args, "track", False):  # judged against the fitted text
+        from ..lang.linter import lint_source
+        from .track_cmd import run_tracking
+
+        lint = (lint_source(res.fitted_source, args.path) if res.fitted_source is not None
+                else res.lint)
+        if args.format != "json":
+            print(format_check(args.path, tr.robot, tr.t, report))
+        try:
+            more, tracking = run_tracking(args, tr, lint, reads=[args.path],
+                                          out=None if args.format == "json" else sys.stdout)
+        except AouError as err:
+            more = list(err.diagnostics)
+        for d in more:
+            print(format_text(d, lint.source if d.span.path == lint.path else None),
+                  file=sys.stderr)
+        bad = any(d.severity is Severity.ERROR for d in [*res.diagnostics, *more])
+        if args.format == "json":
+            print(format_json({"path": args.path, **report.to_json(), "tracking": tracking}))
+        return EXIT_OK if report.ok and not bad else EXIT_ERRORS
     if args.format == "json":
         print(format_json({"path": args.path, **report.to_json()}))
     else:

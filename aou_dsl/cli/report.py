@@ -134,7 +134,8 @@ def format_check(path: str, robot: str, t, report) -> str:
         d = report.dynamic
         lines.append(f"  dynamic replay at {d['physics_rate_hz']:.0f} Hz: tracking max "
                      f"{d['tracking_max_rad']:.2e} rad, RMS {d['tracking_rms_rad']:.2e} rad; "
-                     f"peak torque {d['torque_max_ratio'] * 100:.0f} % of the effort limit")
+                     f"peak torque {d['torque_max_ratio'] * 100:.0f} % of the effort limit "
+                     "(inverse dynamics)")
     return "\n".join(lines)
 
 

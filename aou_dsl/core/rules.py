@@ -17,6 +17,7 @@ example triggers its own code (the architecture tests run them).
 from __future__ import annotations
 
 from .rule_model import Category, Rule, Severity
+from .rules_check import CHECK_RULES
 
 __all__ = ["RULES", "Category", "Rule", "Severity", "category"]
 
@@ -264,6 +265,7 @@ _RULE_LIST = [
          "The fitted behaviour keeps its state and the order of its values (docs/robots.md "
          "gives the rule); --write-fitted writes the file so the change is reviewed.",
          "robot ur5\nshiver 6deg f=2.5Hz\npause 1s"),
+    *CHECK_RULES,  # what `aouc check` alone says: torques, tracking
     # --- D: behaviours as Dynamic Movement Primitives ------------------------------------
     Rule("D601", "dmp-needs-episodes", _E,
          "Only a compiled trajectory (with the compiler's episodes and goal) can become a "

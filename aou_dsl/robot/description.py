@@ -20,6 +20,16 @@ what aou would otherwise derive.
     allowed_contacts = [["link6", "gripper_base"]]
     [sources]                       # optional: where your numbers come from
     joint_accel = "vendor datasheet, rev. 3, table 2"
+    [servo]                         # optional: the joints' servos, for --track
+    kp = [3000.0, 3000.0, 3000.0, 1000.0, 1000.0, 1000.0]   # N m/rad
+    kv = 100.0                      # N m s/rad: one number, or one per arm joint
+    damping = 1.0                   # N m s/rad
+    armature = 0.1                  # kg m^2
+    force = [150.0, 150.0, 150.0, 28.0, 28.0, 28.0]          # N m (default: the URDF's)
+    rate = 500.0                    # Hz, the controller's
+    modes = ["position", "feedforward"]
+    source = "identified on our arm, report 12"
+    # or: table = "kinova_gen3", a published table aou knows
 
 Every key but ``urdf``/``robot`` is optional. Values are checked here (types, lengths,
 signs); names are checked against the URDF when the robot loads.
@@ -39,7 +49,7 @@ from ..core.codes import V109
 from ..core.diagnostics import AouError, Span, diag
 from ..core.inputs import read_input_text
 
-__all__ = ["KEYS", "Description", "read_description"]
+__all__ = ["KEYS", "SERVO_KEYS", "Description", "read_description"]
 
 _VEC3 = ("goal", "from")
 _RATES = ("joint_accel", "joint_jerk", "joint_velocity")
@@ -48,7 +58,12 @@ _ANGLES = ("ee_roll",)
 _NAMES = ("ee_frame", "shiver_joint", "forward")
 #: Every key a robot description may have.
 KEYS = ("urdf", "robot", "package_dirs", "arm_joints", "posture", "allowed_contacts",
-        "sources", *_NAMES, *_VEC3, *_RATES, *_SCALARS, *_ANGLES)
+        "sources", *_NAMES, *_VEC3, *_RATES, *_SCALARS, *_ANGLES, "servo")
+#: The keys of a ``[servo]`` table: gains and the like (one number, or one per arm
+#: joint), the controller's rate, its modes, the source, or a published table's name.
+SERVO_GAINS = ("kp", "kv", "damping", "armature", "force")
+SERVO_KEYS = (*SERVO_GAINS, "rate", "modes", "source", "table")
+_SERVO_MODES = ("position", "feedforward", "torque")
 FORWARD = ("+x", "-x", "+y", "-y", "+z", "-z")
 #: The ranges numbers may take: key -> (least, greatest, least included, in words).
 _RANGES: dict[str, tuple[float, float, bool, str]] = {
@@ -84,6 +99,7 @@ class Description:
     package_dirs: tuple[str, ...] = ()
     pins: dict[str, Any] = field(default_factory=dict)
     sources: dict[str, str] = field(default_factory=dict)
+    servo: dict[str, Any] | None = None
 
 
 def _line(text: str, key: str) -> int:
@@ -128,7 +144,44 @@ def _check(key: str, value: Any) -> tuple[Any, str | None]:
     if key == "sources":
         ok = isinstance(value, dict) and all(isinstance(v, str) for v in value.values())
         return (dict(value), None) if ok else (None, "must be a table of texts")
+    if key == "servo":
+        return _check_servo(value)
     return _check_number(key, value)
+
+
+def _check_servo(value: Any) -> tuple[Any, str | None]:
+    """A ``[servo]`` table: its gains as tuples, checked; None and what is wrong."""
+    if not isinstance(value, dict):
+        return None, f"must be a table with keys {', '.join(SERVO_KEYS)}"
+    out: dict[str, Any] = {}
+    for k, v in value.items():
+        if k not in SERVO_KEYS:
+            return None, f"has an unknown key `{k}` (keys: {', '.join(SERVO_KEYS)})"
+        if k in SERVO_GAINS:
+            nums = _numbers([v] if isinstance(v, int | float) and not isinstance(v, bool)
+                            else v)
+            if not nums or min(nums) < 0 or max(nums) > _MAX_RATE:
+                return None, (f"`{k}` must be a number from 0 to {_MAX_RATE:g}, or a list "
+                              "of them (one per arm joint)")
+            if k == "kp" and min(nums) <= 0:
+                return None, "`kp` must be above 0"
+            out[k] = tuple(nums)
+        elif k == "rate":
+            ok = isinstance(v, int | float) and not isinstance(v, bool) and 1 <= v <= 1e5
+            if not ok:
+                return None, "`rate` must be a number of Hz from 1 to 100000"
+            out[k] = float(v)
+        elif k == "modes":
+            if not isinstance(v, list) or not v or any(m not in _SERVO_MODES for m in v):
+                return None, f"`modes` must be a list of {', '.join(_SERVO_MODES)}"
+            out[k] = tuple(v)
+        elif not isinstance(v, str) or not v:
+            return None, f"`{k}` must be a non-empty text"
+        else:
+            out[k] = v
+    if "table" not in out and "kp" not in out:
+        return None, "needs `kp` (and the other gains), or `table`, a published table's name"
+    return out, None
 
 
 def _check_number(key: str, value: Any) -> tuple[Any, str | None]:
@@ -216,6 +269,7 @@ def _checked(path: str, text: str, doc: dict[str, Any]) -> Description:
                  for d in values.pop("package_dirs", ()))
     sources = values.pop("sources", {})
     robot = values.pop("robot", "")
+    servo = values.pop("servo", None)
     if "from" in values:
         values["start_direction"] = values.pop("from")
-    return Description(path, urdf, robot, dirs, values, sources)
+    return Description(path, urdf, robot, dirs, values, sources, servo)

@@ -13,7 +13,7 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-__all__ = ["DescriptionFile"]
+__all__ = ["DescriptionFile", "ServoTable"]
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
@@ -21,6 +21,28 @@ Rate = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
 Name = Annotated[str, Field(min_length=1)]
 Vec3 = tuple[Finite, Finite, Finite]
 Rates = Rate | Annotated[list[Rate], Field(min_length=1)]
+
+
+Gains = NonNegative | Annotated[list[NonNegative], Field(min_length=1)]
+
+
+class ServoTable(BaseModel):
+    """The arm's servos, for ``--track``: gains per joint (one number, or one per arm
+    joint), the controller's rate and modes, where the numbers come from; or ``table``,
+    a published table aou knows."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    kp: Gains | None = Field(None, description="[N m/rad]")
+    kv: Gains | None = Field(None, description="[N m s/rad]")
+    damping: Gains | None = Field(None, description="joint damping [N m s/rad]")
+    armature: Gains | None = Field(None, description="reflected motor inertia [kg m^2]")
+    force: Gains | None = Field(None, description="[N m]; default: the URDF's effort limit")
+    rate: Rate | None = Field(None, description="the controller's rate [Hz]")
+    modes: Annotated[list[Literal["position", "feedforward", "torque"]],
+                     Field(min_length=1)] | None = None
+    source: Name | None = Field(None, description="where the numbers come from")
+    table: Name | None = Field(None, description="a published table aou knows")
 
 
 class DescriptionFile(BaseModel):
@@ -55,3 +77,4 @@ class DescriptionFile(BaseModel):
     ee_roll: Finite | None = Field(None, description="[rad] about forward")
     allowed_contacts: list[tuple[Name, Name]] | None = None
     sources: dict[str, str] | None = Field(None, description="where each value comes from")
+    servo: ServoTable | None = Field(None, description="the joints' servos, for --track")

@@ -1,0 +1,181 @@
+"""``--track`` of ``aouc check`` and ``aouc compile``: the plan tracked through the arm's
+servos in each mode (:mod:`aou_dsl.safety.track_report`), printed as a table, its
+diagnostics (C322, C323), and with ``--tracked FILE`` the tracked motion of the chosen
+mode written as a recording ``aouc measure`` reads."""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import sys
+from collections.abc import Iterator
+from typing import IO
+
+import numpy as np
+
+from ..core.diagnostics import AouError, Diagnostic, Span
+from ..version import __version__
+
+__all__ = ["check_tracking", "compile_tracked", "format_tracking", "nothing_to_track",
+           "run_tracking", "tracked_document"]
+
+
+@contextlib.contextmanager
+def nothing_to_track(args: argparse.Namespace) -> Iterator[None]:
+    """Around the compile of ``aouc check FILE.aou --track``: when the arm refuses the
+    file there is no motion to track; say so, and how to get one, before its errors."""
+    try:
+        yield
+    except AouError:
+        if getattr(args, "track", False) and args.path.endswith(".aou"):
+            print("aouc check --track: nothing to track, the arm refuses the behaviour as "
+                  "written (below); add --fit to track it fitted to the arm", file=sys.stderr)
+        raise
+
+_SHORT = {"position": "position", "feedforward": "feedforward", "torque": "torque"}
+
+
+def _shiver_descriptor() -> str:
+    """The descriptor of a shiver's amplitude, by its kind in the descriptor table."""
+    from ..lang.descriptors import REGISTRY
+
+    return next(d.name for d in REGISTRY.values() if d.kind == "shiver"
+                and d.key == "amplitude")
+
+
+_SHIVER = _shiver_descriptor()
+
+
+def _v(v) -> str:
+    return "absent" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
+
+
+def format_tracking(report) -> str:
+    """The report as text: the servo, each mode's speed and tracking error, every
+    descriptor declared beside what each mode gives, and what becomes of the shiver."""
+    from ..safety.track_report import MODE_WORDS
+
+    s = report.servo
+    lines = [f"tracked through the servos of {report.robot} at {s.rate:g} Hz "
+             f"({s.source}), {report.duration:.2f} s of motion"]
+    lines.append(f"  {'mode':12s} {'speed':>9s}  max tracking error per joint [deg]")
+    for r in report.results:
+        k = r.tracked
+        speed = report.duration / k.seconds if k.seconds > 0 else float("inf")
+        err = " ".join(f"{x:.3g}" for x in np.degrees(k.error_max))
+        mark = " (chosen)" if r.mode == report.selected else ""
+        if r.mode not in s.modes:
+            mark += " (not offered by the arm's controller)"
+        lines.append(f"  {r.mode:12s} {speed:>7.0f}x  {err}{mark}")
+    if report.plan is not None:
+        head = "".join(f" {_SHORT[r.mode]:>13s}" for r in report.results)
+        lines.append(f"  {'descriptor':24s} {'declared':>9s} {'tolerance':>10s} {'plan':>9s}"
+                     f"{head}")
+        for i, w in enumerate(report.plan.rows):
+            tol = "-" if w.tolerance is None else (
+                "exact" if w.tolerance == 0 else f"+-{w.tolerance:.3g}")
+            cells = ""
+            for r in report.results:
+                x = r.verdict.rows[i]
+                cells += f" {_v(x.measured):>8s} {'pass' if x.ok else 'FAIL'}"
+            lines.append(f"  {w.name:24s} {_v(w.declared):>9s} {tol:>10s} "
+                         f"{_v(w.measured):>9s}{cells}  {w.unit}")
+        for r in report.results:
+            n = sum(x.ok for x in r.verdict.rows)
+            cv = r.verdict.measured_cv
+            lines.append(f"  {r.mode}: {n} of {len(r.verdict.rows)} descriptors within "
+                         f"tolerance; reads as {cv.state.value} (C={cv.C:+.2f} "
+                         f"V={cv.V:+.2f})")
+        shiver = next(w for w in report.plan.rows if w.name == _SHIVER)
+        if isinstance(shiver.declared, float) and shiver.declared > 0:
+            parts = []
+            for r in report.results:
+                got = next(x for x in r.verdict.rows if x.name == _SHIVER)
+                share = (got.measured or 0.0) / shiver.declared
+                parts.append(f"{share:.0%} under {MODE_WORDS[r.mode]}")
+            keep = report.keeps(_SHIVER)
+            lines.append(f"  the shiver ({shiver.declared:.3g} deg declared): the arm shows "
+                         + "; ".join(parts) + ". "
+                         + (f"Kept by: {', '.join(keep)}." if keep
+                            else "No servo mode of this arm keeps it."))
+    return "\n".join(lines)
+
+
+def tracked_document(report, mode: str) -> dict:
+    """The tracked motion of ``mode`` as an ``aou-trajectory/1`` recording (positions
+    only, as a logged arm gives them), with what tracked it."""
+    tr = report.result(mode).tracked.trajectory
+    return {"format": "aou-trajectory/1", "generator": f"aouc {__version__}",
+            "robot": tr.robot, "ee_frame": tr.ee_frame, "joint_names": list(tr.joint_names),
+            **({"goal": {"position": [float(x) for x in tr.goal]}} if tr.goal is not None
+               else {}),
+            "tracked": {"servo_mode": mode, "rate_hz": report.servo.rate,
+                        "servo_source": report.servo.source},
+            "t": [float(x) for x in tr.t], "q": tr.q.tolist()}
+
+
+def run_tracking(args: argparse.Namespace, tr, behaviour, *, reads: list[str],
+                 out: IO[str] | None) -> tuple[list[Diagnostic], dict | None]:
+    """Track ``tr`` (judged against ``behaviour``, a lint or None), print the report on
+    ``out`` (None: not printed; it is returned as JSON), write ``--tracked``.
+
+    Returns:
+        the diagnostics (C322, C323) and the report as JSON.
+
+    Raises:
+        AouError: what tracking or writing raises.
+    """
+    from ..compiler.output import encode
+    from ..core.files import guard_output, write_atomic
+    from ..safety.track_report import track_modes
+
+    dest = getattr(args, "tracked", None)
+    if dest:
+        guard_output(dest, reads)
+    report = track_modes(tr, behaviour, selected=args.servo)
+    robot_span = Span.whole_file("<command line>" if getattr(args, "robot", None)
+                                 else tr.path)
+    diags = report.diagnostics(robot_span)
+    if out is not None:
+        print(format_tracking(report), file=out)
+    if dest:
+        doc = tracked_document(report, args.servo)
+        fmt = "csv" if dest.lower().endswith(".csv") and "goal" in doc else "json"
+        data = encode(doc, "csv") if fmt == "csv" else (json.dumps(doc) + "\n").encode()
+        write_atomic(dest, data, inputs=reads)
+    return diags, report.to_json()
+
+
+
+def check_tracking(args: argparse.Namespace, tr, reads: list[str]
+                   ) -> tuple[list[Diagnostic], dict | None]:
+    """``aouc check --track``: a ``.aou`` file's motion judged against it, a trajectory
+    file's tracking error alone; the report on standard output (text) or returned (JSON).
+
+    Raises:
+        AouError: what cannot be tracked or written (the command's exit says which).
+    """
+    from ..lang.linter import lint_file
+
+    behaviour = lint_file(args.path) if args.path.endswith(".aou") else None
+    return run_tracking(args, tr, behaviour, reads=reads,
+                        out=None if args.format == "json" else sys.stdout)
+
+
+def compile_tracked(args: argparse.Namespace, res, reads: list[str]):
+    """``compile --track``: the report on standard error, its warnings (C322, C323); a
+    file whose tracking cannot be simulated fails (nothing written)."""
+    from dataclasses import replace
+
+    from ..core.diagnostics import Severity
+    from .report import print_diagnostics
+
+    try:
+        more, _ = run_tracking(args, res.trajectory, res.lint, reads=reads, out=sys.stderr)
+    except AouError as err:
+        more = list(err.diagnostics)
+    print_diagnostics(more, sources={res.lint.path: res.lint.source or ""})
+    if any(d.severity == Severity.ERROR for d in more):
+        return replace(res, diagnostics=[*res.diagnostics, *more])  # ok: False
+    return res
