@@ -82,6 +82,11 @@ def _cmd_lint(args: argparse.Namespace) -> int:
         print(format_json({"files": [r.to_json() for r in results],
                            "problems": [d.to_json() for d in problems],
                            "summary": {str(k): v for k, v in counts.items()}}))
+    elif args.format == "sarif":
+        from .sarif import format_sarif
+
+        sys.stdout.write(format_sarif([*problems, *(d for r in results for d in r.diagnostics)],
+                                      successful=not io_errors))
     else:
         _print_diags(problems, args.format)
         for r in results:
@@ -129,13 +134,23 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     if problems:
         _print_diags(problems)
         return EXIT_USAGE
+    if args.no_output and (args.output or args.format or args.write_fitted):
+        print("aouc compile: --no-output writes nothing, so it takes no -o, --format or "
+              "--write-fitted", file=sys.stderr)
+        return EXIT_USAGE
+    if args.changed_since:
+        inputs = _changed(inputs, args.changed_since)
     sources = [src for src, _ in inputs]
     reads = _reads(args, sources)
     try:
-        dests, fmt = output_paths(inputs, args.output, args.format)
+        dests, fmt = ([None] * len(inputs), None) if args.no_output else \
+            output_paths(inputs, args.output, args.format)
         check_format(args.output, args.format, FORMATS)  # --format csv -o x.json
         for dest in dests:  # before any work: the output rule
-            guard_output(dest, reads, bag=fmt in FOLDER_FORMATS)
+            if dest is not None:
+                guard_output(dest, reads, bag=fmt in FOLDER_FORMATS)
+        if args.sarif:
+            guard_output(args.sarif, [*reads, *(d for d in dests if d is not None)])
     except AouError as err:
         return _fail(err)
     options = BuildOptions(robot=args.robot, rate=args.rate, check=not args.no_check,
@@ -150,11 +165,19 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     results = build_many(sources, options, args.jobs or default_jobs(), cluster=args.cluster,
                          encode=fmt)  # the workers encode; this process writes bytes
     worst = EXIT_OK
+    found: list[Diagnostic] = []  # for --sarif
     for k, ((src, _), dest, res) in enumerate(zip(inputs, dests, results, strict=True), 1):
         _print_diags(res.diagnostics, sources={src: res.lint.source or ""})
+        found += res.diagnostics
         if not res.ok or res.document is None:
             worst = max(worst, _exit_for(res.diagnostics))
             print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)
+            continue
+        if dest is None:  # --no-output
+            print(f"[{k}/{len(inputs)}] {src}: built and checked, nothing written "
+                  "(--no-output)", file=sys.stderr)
+            if has_errors(res.diagnostics):
+                worst = max(worst, EXIT_ERRORS)
             continue
         try:
             write_compiled(dest, res, fmt, inputs=reads)
@@ -171,7 +194,33 @@ def _cmd_compile(args: argparse.Namespace) -> int:
             from .fitted import write_fitted
 
             worst = max(worst, write_fitted(args.write_fitted, res, sources))
+    if args.sarif:
+        worst = max(worst, _write_sarif(args.sarif, found, reads))
     return worst
+
+
+def _changed(inputs: list[tuple[str, str | None]], ref: str) -> list[tuple[str, str | None]]:
+    """The inputs that changed since the git revision ``ref`` (``--changed-since``)."""
+    from .changed import changed_since
+
+    changed = changed_since(ref)
+    kept = [i for i in inputs if os.path.realpath(i[0]) in changed]
+    print(f"aouc compile: {_count(len(kept), 'file')} of {len(inputs)} changed since {ref}",
+          file=sys.stderr)
+    return kept
+
+
+def _write_sarif(path: str, found: list[Diagnostic], reads: list[str]) -> int:
+    """``--sarif FILE``: the batch's diagnostics as a SARIF log, written whole."""
+    from ..core.files import write_atomic
+    from .sarif import format_sarif
+
+    usage = any(category(d.code).is_usage for d in found)
+    try:
+        write_atomic(path, format_sarif(found, successful=not usage).encode(), inputs=reads)
+    except AouError as err:
+        return _fail(err)
+    return EXIT_OK
 
 
 # --- check, measure ---------------------------------------------------------------------
@@ -181,16 +230,14 @@ def _cmd_check(args: argparse.Namespace) -> int:
     from ..api import check, read_trajectory
     from .report import format_check
 
+    if args.format == "sarif":
+        return _check_sarif(args)
     if args.fit or args.write_fitted:
         from .fitted import check_fitted
 
         return check_fitted(args, _read_kw(args))
     tr = read_trajectory(args.path, **_read_kw(args))
-    from ..robot import robot_diagnostics
-
-    named = Span.whole_file("<command line>" if args.robot else args.path)  # the robot
-    refused = robot_diagnostics(tr.robot, collision_check=not args.no_collision_check,
-                                span=named, package_dirs=tr.package_dirs)
+    refused = _robot_refusals(args, tr)
     _print_diags(refused)
     if any(d.severity == Severity.ERROR for d in refused):
         return EXIT_ERRORS
@@ -204,6 +251,42 @@ def _cmd_check(args: argparse.Namespace) -> int:
         print(format_check(args.path, tr.robot, tr.t, report))
     _print_diags(failed)
     return EXIT_ERRORS if failed else EXIT_OK
+
+
+def _robot_refusals(args: argparse.Namespace, tr) -> list[Diagnostic]:
+    """What the arm itself is refused for (a robot file whose meshes collide at rest...)."""
+    from ..robot import robot_diagnostics
+
+    named = Span.whole_file("<command line>" if args.robot else args.path)  # the robot
+    return robot_diagnostics(tr.robot, collision_check=not args.no_collision_check,
+                             span=named, package_dirs=tr.package_dirs)
+
+
+def _check_sarif(args: argparse.Namespace) -> int:
+    """``aouc check --format sarif``: the refusals of the compile and the failed checks as
+    one SARIF log on standard output, whatever the outcome; the exit status as ever."""
+    from ..api import check, read_trajectory
+    from .sarif import format_sarif
+
+    if args.fit or args.write_fitted:
+        print("aouc check: --format sarif does not go with --fit or --write-fitted (a fit "
+              "reports a changed text, not findings in the file)", file=sys.stderr)
+        return EXIT_USAGE
+    found: list[Diagnostic] = []
+    try:
+        tr = read_trajectory(args.path, **_read_kw(args))
+        found += _robot_refusals(args, tr)
+        if not any(d.severity == Severity.ERROR for d in found):
+            found += _check_diagnostics(args.path, check(
+                tr, dynamic=not args.no_dynamic, controller=args.controller,
+                **_scene_kw(args)))
+    except AouError as err:  # refused: the compile's diagnostics are the findings
+        found += err.diagnostics
+    usage = any(category(d.code).is_usage for d in found)
+    sys.stdout.write(format_sarif(found, successful=not usage))
+    if not any(d.severity == Severity.ERROR for d in found):
+        return EXIT_OK
+    return _exit_for(found)
 
 
 def _check_diagnostics(path: str, report) -> list[Diagnostic]:
