@@ -143,7 +143,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     sources = [src for src, _ in inputs]
     reads = _reads(args, sources)
     try:
-        dests, fmt = ([None] * len(inputs), None) if args.no_output else \
+        dests, fmt = ([None] * len(inputs), "json") if args.no_output else \
             output_paths(inputs, args.output, args.format)
         check_format(args.output, args.format, FORMATS)  # --format csv -o x.json
         for dest in dests:  # before any work: the output rule
@@ -163,7 +163,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
 
         return fitted_usage("compile")
     results = build_many(sources, options, args.jobs or default_jobs(), cluster=args.cluster,
-                         encode=fmt)  # the workers encode; this process writes bytes
+                         encode=None if args.no_output else fmt)  # the workers encode
     worst = EXIT_OK
     found: list[Diagnostic] = []  # for --sarif
     for k, ((src, _), dest, res) in enumerate(zip(inputs, dests, results, strict=True), 1):
