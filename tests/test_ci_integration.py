@@ -201,7 +201,7 @@ def test_changed_since_builds_only_what_changed_and_writes_nothing(lab_repo,
                 "--sarif", "found.sarif", cwd=lab_repo)
     assert run.returncode == 1, run.stderr  # fast.aou is refused
     assert "2 files of 3 changed since main" in run.stderr
-    assert "hesitant.aou: built and checked, nothing written" in run.stderr
+    assert "hesitant.aou (nothing written):" in run.stderr
     assert "fast.aou: failed" in run.stderr and "confident" not in run.stderr
     assert _listing(lab_repo) == before | {"found.sarif"}
     log = json.loads((lab_repo / "found.sarif").read_text())

@@ -21,7 +21,9 @@ from ..editor import cmd_server
 from .args import EXIT_ERRORS, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, build_parser
 from .endings import CtrlC, extra_missing, internal
 from .fmt import cmd_fmt
-from .report import format_json, format_suppressed
+from .lint_cmd import cmd_lint
+from .lint_cmd import count as _count
+from .report import format_json
 from .report import print_diagnostics as _print_diags
 from .tools import cmd_robot, cmd_rules, cmd_synth
 
@@ -63,47 +65,7 @@ def _reads(args: argparse.Namespace, paths: Sequence[str]) -> list[str]:
     return files_read(paths, getattr(args, "robot", None))
 
 
-def _count(n: int, noun: str) -> str:
-    """``1 error``, ``2 errors``."""
-    return f"{n} {noun}{'s' * (n != 1)}"
-
-
 # --- lint, rules, explain ---------------------------------------------------------------
-
-
-def _cmd_lint(args: argparse.Namespace) -> int:
-    from ..lang.linter import lint_paths, severity_counts
-
-    results, problems = lint_paths(args.paths)
-    counts = severity_counts(results)
-    io_errors = bool(problems) or any(category(d.code).is_usage
-                                      for r in results for d in r.diagnostics)
-    if args.format == "json":
-        print(format_json({"files": [r.to_json() for r in results],
-                           "problems": [d.to_json() for d in problems],
-                           "summary": {str(k): v for k, v in counts.items()}}))
-    elif args.format == "sarif":
-        from .sarif import format_sarif
-
-        sys.stdout.write(format_sarif([*problems, *(d for r in results for d in r.diagnostics)],
-                                      successful=not io_errors))
-    else:
-        _print_diags(problems, args.format)
-        for r in results:
-            _print_diags(r.diagnostics, args.format, {r.path: r.source or ""}, sys.stdout)
-            note = format_suppressed(r.path, r.suppressed)
-            if note:
-                print(note)
-        if args.format == "text":
-            print(f"{_count(len(results), 'file')} checked: "
-                  f"{_count(counts[Severity.ERROR], 'error')}, "
-                  f"{_count(counts[Severity.WARNING], 'warning')}, "
-                  f"{_count(counts[Severity.NOTE], 'note')}", file=sys.stderr)
-    if io_errors:
-        return EXIT_USAGE
-    if counts[Severity.ERROR] or (args.strict and counts[Severity.WARNING]):
-        return EXIT_ERRORS
-    return EXIT_OK
 
 
 def _cmd_explain(args: argparse.Namespace) -> int:
@@ -128,29 +90,27 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     from ..core.files import check_format, guard_output
     from ..core.options import BuildOptions, SceneOptions
     from ..lang.linter import collect_inputs
+    from .ci_cmd import keep_changed, no_output_misused, write_sarif
     from .dmp_cmd import write_compiled
 
     inputs, problems = collect_inputs(args.paths)
     if problems:
         _print_diags(problems)
         return EXIT_USAGE
-    if args.no_output and (args.output or args.format or args.write_fitted):
-        print("aouc compile: --no-output writes nothing, so it takes no -o, --format or "
-              "--write-fitted", file=sys.stderr)
+    if no_output_misused(args):
         return EXIT_USAGE
     if args.changed_since:
-        inputs = _changed(inputs, args.changed_since)
+        inputs = keep_changed(inputs, args.changed_since)
     sources = [src for src, _ in inputs]
     reads = _reads(args, sources)
     try:
         dests, fmt = ([None] * len(inputs), "json") if args.no_output else \
             output_paths(inputs, args.output, args.format)
         check_format(args.output, args.format, FORMATS)  # --format csv -o x.json
-        for dest in dests:  # before any work: the output rule
-            if dest is not None:
-                guard_output(dest, reads, bag=fmt in FOLDER_FORMATS)
+        for to in filter(None, dests):  # before any work: the output rule
+            guard_output(to, reads, bag=fmt in FOLDER_FORMATS)
         if args.sarif:
-            guard_output(args.sarif, [*reads, *(d for d in dests if d is not None)])
+            guard_output(args.sarif, [*reads, *filter(None, dests)])
     except AouError as err:
         return _fail(err)
     options = BuildOptions(robot=args.robot, rate=args.rate, check=not args.no_check,
@@ -173,20 +133,16 @@ def _cmd_compile(args: argparse.Namespace) -> int:
             worst = max(worst, _exit_for(res.diagnostics))
             print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)
             continue
-        if dest is None:  # --no-output
-            print(f"[{k}/{len(inputs)}] {src}: built and checked, nothing written "
-                  "(--no-output)", file=sys.stderr)
-            if has_errors(res.diagnostics):
-                worst = max(worst, EXIT_ERRORS)
-            continue
         try:
-            write_compiled(dest, res, fmt, inputs=reads)
+            if dest is not None:  # else --no-output
+                write_compiled(dest, res, fmt, inputs=reads)
         except AouError as err:
             worst = max(worst, _fail(err))
             continue
         tr = res.trajectory
         note = " (checks skipped)" if args.no_check else ""
-        print(f"[{k}/{len(inputs)}] {src} -> {dest}: {tr.duration:.2f} s of motion, "
+        to = f" -> {dest}" if dest else " (nothing written)"
+        print(f"[{k}/{len(inputs)}] {src}{to}: {tr.duration:.2f} s of motion, "
               f"{len(tr.t)} samples, compiled in {res.seconds:.2f} s{note}", file=sys.stderr)
         if has_errors(res.diagnostics):
             worst = max(worst, EXIT_ERRORS)
@@ -195,32 +151,9 @@ def _cmd_compile(args: argparse.Namespace) -> int:
 
             worst = max(worst, write_fitted(args.write_fitted, res, sources))
     if args.sarif:
-        worst = max(worst, _write_sarif(args.sarif, found, reads))
+        worst = max(worst, write_sarif(args.sarif, found, reads))
     return worst
 
-
-def _changed(inputs: list[tuple[str, str | None]], ref: str) -> list[tuple[str, str | None]]:
-    """The inputs that changed since the git revision ``ref`` (``--changed-since``)."""
-    from .changed import changed_since
-
-    changed = changed_since(ref)
-    kept = [i for i in inputs if os.path.realpath(i[0]) in changed]
-    print(f"aouc compile: {_count(len(kept), 'file')} of {len(inputs)} changed since {ref}",
-          file=sys.stderr)
-    return kept
-
-
-def _write_sarif(path: str, found: list[Diagnostic], reads: list[str]) -> int:
-    """``--sarif FILE``: the batch's diagnostics as a SARIF log, written whole."""
-    from ..core.files import write_atomic
-    from .sarif import format_sarif
-
-    usage = any(category(d.code).is_usage for d in found)
-    try:
-        write_atomic(path, format_sarif(found, successful=not usage).encode(), inputs=reads)
-    except AouError as err:
-        return _fail(err)
-    return EXIT_OK
 
 
 # --- check, measure ---------------------------------------------------------------------
@@ -228,16 +161,19 @@ def _write_sarif(path: str, found: list[Diagnostic], reads: list[str]) -> int:
 
 def _cmd_check(args: argparse.Namespace) -> int:
     from ..api import check, read_trajectory
+    from .ci_cmd import robot_refusals
     from .report import format_check
 
     if args.format == "sarif":
-        return _check_sarif(args)
+        from .ci_cmd import check_sarif
+
+        return check_sarif(args, _read_kw(args), _scene_kw(args), _check_diagnostics)
     if args.fit or args.write_fitted:
         from .fitted import check_fitted
 
         return check_fitted(args, _read_kw(args))
     tr = read_trajectory(args.path, **_read_kw(args))
-    refused = _robot_refusals(args, tr)
+    refused = robot_refusals(args, tr)
     _print_diags(refused)
     if any(d.severity == Severity.ERROR for d in refused):
         return EXIT_ERRORS
@@ -251,42 +187,6 @@ def _cmd_check(args: argparse.Namespace) -> int:
         print(format_check(args.path, tr.robot, tr.t, report))
     _print_diags(failed)
     return EXIT_ERRORS if failed else EXIT_OK
-
-
-def _robot_refusals(args: argparse.Namespace, tr) -> list[Diagnostic]:
-    """What the arm itself is refused for (a robot file whose meshes collide at rest...)."""
-    from ..robot import robot_diagnostics
-
-    named = Span.whole_file("<command line>" if args.robot else args.path)  # the robot
-    return robot_diagnostics(tr.robot, collision_check=not args.no_collision_check,
-                             span=named, package_dirs=tr.package_dirs)
-
-
-def _check_sarif(args: argparse.Namespace) -> int:
-    """``aouc check --format sarif``: the refusals of the compile and the failed checks as
-    one SARIF log on standard output, whatever the outcome; the exit status as ever."""
-    from ..api import check, read_trajectory
-    from .sarif import format_sarif
-
-    if args.fit or args.write_fitted:
-        print("aouc check: --format sarif does not go with --fit or --write-fitted (a fit "
-              "reports a changed text, not findings in the file)", file=sys.stderr)
-        return EXIT_USAGE
-    found: list[Diagnostic] = []
-    try:
-        tr = read_trajectory(args.path, **_read_kw(args))
-        found += _robot_refusals(args, tr)
-        if not any(d.severity == Severity.ERROR for d in found):
-            found += _check_diagnostics(args.path, check(
-                tr, dynamic=not args.no_dynamic, controller=args.controller,
-                **_scene_kw(args)))
-    except AouError as err:  # refused: the compile's diagnostics are the findings
-        found += err.diagnostics
-    usage = any(category(d.code).is_usage for d in found)
-    sys.stdout.write(format_sarif(found, successful=not usage))
-    if not any(d.severity == Severity.ERROR for d in found):
-        return EXIT_OK
-    return _exit_for(found)
 
 
 def _check_diagnostics(path: str, report) -> list[Diagnostic]:
@@ -440,7 +340,7 @@ def _cmd_dmp(args: argparse.Namespace) -> int:
 
 
 _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
-    "lint": _cmd_lint, "rules": cmd_rules, "explain": _cmd_explain,
+    "lint": cmd_lint, "rules": cmd_rules, "explain": _cmd_explain,
     "compile": _cmd_compile, "check": _cmd_check, "measure": _cmd_measure,
     "plot": _cmd_plot, "render": _cmd_render, "variants": _cmd_variants,
     "robot": cmd_robot, "synth": cmd_synth, "studio": _cmd_studio,
