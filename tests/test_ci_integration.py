@@ -294,18 +294,22 @@ def test_hooks_run_under_pre_commit_as_the_manifest_says(tmp_path):
 
 
 @pytest.mark.slow
-def test_hooks_install_from_this_checkout_with_try_repo(tmp_path):
-    """`pre-commit try-repo` with this checkout: pre-commit installs aou into its own
-    environment (`language: python`) and each hook behaves (minutes: the install)."""
+def test_hooks_install_from_this_checkout_as_a_users_config_says(tmp_path):
+    """A user's `.pre-commit-config.yaml` naming this repository (its path and HEAD, as
+    a lab names its git URL and a tag): pre-commit installs aou into its own environment
+    (`language: python`, once for the three hooks) and each hook behaves. Minutes: the
+    install."""
     repo = _commit_repo(tmp_path)
     head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True,
                           text=True).stdout.strip()
     if not head:
         pytest.skip("this checkout is not a git repository")
+    hooks = [{"id": h["id"]} for h in HOOKS]
+    (repo / ".pre-commit-config.yaml").write_text(
+        yaml.safe_dump({"repos": [{"repo": str(ROOT), "rev": head, "hooks": hooks}]}))
 
     def run(hook: str, *files: str):
-        return _pre_commit(repo, "try-repo", str(ROOT), hook, "--files", *files,
-                           home=tmp_path / "home")
+        return _pre_commit(repo, "run", hook, "--files", *files, home=tmp_path / "home")
 
     _assert_hooks_behave(run)
 
