@@ -217,7 +217,9 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     c["lint"] = lint = sub.add_parser(
         "lint", help="check .aou files against the language and the C-V model")
     lint.add_argument("paths", nargs="+", metavar="PATH", help=".aou files or folders")
-    lint.add_argument("--format", choices=("text", "json", "github"), default="text")
+    lint.add_argument("--format", choices=("text", "json", "github", "sarif"), default="text",
+                      help="github: annotations; sarif: a SARIF 2.1.0 log for code "
+                      "scanning (docs/ci.md)")
     lint.add_argument("--strict", action="store_true", help="warnings fail too (exit 1)")
     c["explain"] = ex = sub.add_parser("explain", help="show the timeline a file compiles to")
     ex.add_argument("path", metavar="FILE")
@@ -241,6 +243,15 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
                       "`cluster` extra; docs/speed.md)")
     comp.add_argument("--no-check", action="store_true",
                       help="skip the safety checks (recorded in the output)")
+    comp.add_argument("--no-output", action="store_true",
+                      help="build and check, write no trajectory (a CI or pre-commit "
+                      "check; not with -o)")
+    comp.add_argument("--changed-since", metavar="REF",
+                      help="build only the files among PATH that changed since the git "
+                      "revision REF, or are new (docs/ci.md)")
+    comp.add_argument("--sarif", metavar="FILE",
+                      help="also write every diagnostic of the batch as a SARIF 2.1.0 log "
+                      "(docs/ci.md)")
     _collision(comp)
     _controller(comp)
     _scene(comp)
@@ -249,7 +260,9 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     c["check"] = chk = sub.add_parser(
         "check", help="replay a behaviour or trajectory in PyBullet and report every check")
     chk.add_argument("path", metavar="FILE", help="a .aou file or a trajectory file")
-    chk.add_argument("--format", choices=("text", "json"), default="text")
+    chk.add_argument("--format", choices=("text", "json", "sarif"), default="text",
+                     help="sarif: the compile's refusals and the failed checks as a SARIF "
+                     "2.1.0 log (docs/ci.md)")
     _fit(chk)
     chk.add_argument("--no-dynamic", action="store_true",
                      help="kinematic checks only (skip the physics replay)")

@@ -21,7 +21,9 @@ from ..editor import cmd_server
 from .args import EXIT_ERRORS, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, build_parser, usage_error
 from .endings import CtrlC, extra_missing, internal
 from .fmt import cmd_fmt
-from .report import format_json, format_suppressed
+from .lint_cmd import cmd_lint
+from .lint_cmd import count as _count
+from .report import format_json
 from .report import print_diagnostics as _print_diags
 from .tools import cmd_robot, cmd_rules, cmd_synth
 
@@ -63,42 +65,7 @@ def _reads(args: argparse.Namespace, paths: Sequence[str]) -> list[str]:
     return files_read(paths, getattr(args, "robot", None))
 
 
-def _count(n: int, noun: str) -> str:
-    """``1 error``, ``2 errors``."""
-    return f"{n} {noun}{'s' * (n != 1)}"
-
-
 # --- lint, rules, explain ---------------------------------------------------------------
-
-
-def _cmd_lint(args: argparse.Namespace) -> int:
-    from ..lang.linter import lint_paths, severity_counts
-
-    results, problems = lint_paths(args.paths)
-    counts = severity_counts(results)
-    io_errors = bool(problems) or any(category(d.code).is_usage
-                                      for r in results for d in r.diagnostics)
-    if args.format == "json":
-        print(format_json({"files": [r.to_json() for r in results],
-                           "problems": [d.to_json() for d in problems],
-                           "summary": {str(k): v for k, v in counts.items()}}))
-    else:
-        _print_diags(problems, args.format)
-        for r in results:
-            _print_diags(r.diagnostics, args.format, {r.path: r.source or ""}, sys.stdout)
-            note = format_suppressed(r.path, r.suppressed)
-            if note:
-                print(note)
-        if args.format == "text":
-            print(f"{_count(len(results), 'file')} checked: "
-                  f"{_count(counts[Severity.ERROR], 'error')}, "
-                  f"{_count(counts[Severity.WARNING], 'warning')}, "
-                  f"{_count(counts[Severity.NOTE], 'note')}", file=sys.stderr)
-    if io_errors:
-        return EXIT_USAGE
-    if counts[Severity.ERROR] or (args.strict and counts[Severity.WARNING]):
-        return EXIT_ERRORS
-    return EXIT_OK
 
 
 def _cmd_explain(args: argparse.Namespace) -> int:
@@ -123,19 +90,27 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     from ..core.files import check_format, guard_output
     from ..core.options import BuildOptions, SceneOptions
     from ..lang.linter import collect_inputs
+    from .ci_cmd import keep_changed, no_output_misused, write_sarif
     from .dmp_cmd import write_compiled
 
     inputs, problems = collect_inputs(args.paths)
     if problems:
         _print_diags(problems)
         return EXIT_USAGE
+    if no_output_misused(args):
+        return EXIT_USAGE
+    if args.changed_since:
+        inputs = keep_changed(inputs, args.changed_since)
     sources = [src for src, _ in inputs]
     reads = _reads(args, sources)
     try:
-        dests, fmt = output_paths(inputs, args.output, args.format)
+        dests, fmt = ([None] * len(inputs), "json") if args.no_output else \
+            output_paths(inputs, args.output, args.format)
         check_format(args.output, args.format, FORMATS)  # --format csv -o x.json
-        for dest in dests:  # before any work: the output rule
-            guard_output(dest, reads, bag=fmt in FOLDER_FORMATS)
+        for to in filter(None, dests):  # before any work: the output rule
+            guard_output(to, reads, bag=fmt in FOLDER_FORMATS)
+        if args.sarif:
+            guard_output(args.sarif, [*reads, *filter(None, dests)])
     except AouError as err:
         return _fail(err)
     options = BuildOptions(robot=args.robot, rate=args.rate, check=not args.no_check,
@@ -150,26 +125,30 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     if args.tracked and (len(inputs) != 1 or not args.track):
         return usage_error("compile", "--tracked needs --track and one .aou input")
     results = build_many(sources, options, args.jobs or default_jobs(), cluster=args.cluster,
-                         encode=fmt)  # the workers encode; this process writes bytes
+                         encode=None if args.no_output else fmt)  # the workers encode
     worst = EXIT_OK
+    found: list[Diagnostic] = []  # for --sarif
     for k, ((src, _), dest, res) in enumerate(zip(inputs, dests, results, strict=True), 1):
         _print_diags(res.diagnostics, sources={src: res.lint.source or ""})
         if res.ok and res.document is not None and args.track:
             from .track_cmd import compile_tracked
 
             res = compile_tracked(args, res, reads)
+        found += res.diagnostics
         if not res.ok or res.document is None:
             worst = max(worst, _exit_for(res.diagnostics))
             print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)
             continue
         try:
-            write_compiled(dest, res, fmt, inputs=reads)
+            if dest is not None:  # else --no-output
+                write_compiled(dest, res, fmt, inputs=reads)
         except AouError as err:
             worst = max(worst, _fail(err))
             continue
         tr = res.trajectory
         note = " (checks skipped)" if args.no_check else ""
-        print(f"[{k}/{len(inputs)}] {src} -> {dest}: {tr.duration:.2f} s of motion, "
+        to = f" -> {dest}" if dest else " (nothing written)"
+        print(f"[{k}/{len(inputs)}] {src}{to}: {tr.duration:.2f} s of motion, "
               f"{len(tr.t)} samples, compiled in {res.seconds:.2f} s{note}", file=sys.stderr)
         if has_errors(res.diagnostics):
             worst = max(worst, EXIT_ERRORS)
@@ -177,7 +156,10 @@ def _cmd_compile(args: argparse.Namespace) -> int:
             from .fitted import write_fitted
 
             worst = max(worst, write_fitted(args.write_fitted, res, sources))
+    if args.sarif:
+        worst = max(worst, write_sarif(args.sarif, found, reads))
     return worst
+
 
 
 # --- check, measure ---------------------------------------------------------------------
@@ -185,20 +167,21 @@ def _cmd_compile(args: argparse.Namespace) -> int:
 
 def _cmd_check(args: argparse.Namespace) -> int:
     from ..api import check, read_trajectory
+    from .ci_cmd import robot_refusals
     from .report import format_check
     from .track_cmd import check_tracking, nothing_to_track
 
+    if args.format == "sarif":
+        from .ci_cmd import check_sarif
+
+        return check_sarif(args, _read_kw(args), _scene_kw(args), _check_diagnostics)
     if args.fit or args.write_fitted:
         from .fitted import check_fitted
 
         return check_fitted(args, _read_kw(args))
     with nothing_to_track(args):  # the arm refuses the file: --track says what to do
         tr = read_trajectory(args.path, **_read_kw(args))
-    from ..robot import robot_diagnostics
-
-    named = Span.whole_file("<command line>" if args.robot else args.path)  # the robot
-    refused = robot_diagnostics(tr.robot, collision_check=not args.no_collision_check,
-                                span=named, package_dirs=tr.package_dirs)
+    refused = robot_refusals(args, tr)
     _print_diags(refused)
     if any(d.severity == Severity.ERROR for d in refused):
         return EXIT_ERRORS
@@ -371,7 +354,7 @@ def _cmd_dmp(args: argparse.Namespace) -> int:
 
 
 _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
-    "lint": _cmd_lint, "rules": cmd_rules, "explain": _cmd_explain,
+    "lint": cmd_lint, "rules": cmd_rules, "explain": _cmd_explain,
     "compile": _cmd_compile, "check": _cmd_check, "measure": _cmd_measure,
     "plot": _cmd_plot, "render": _cmd_render, "variants": _cmd_variants,
     "robot": cmd_robot, "synth": cmd_synth, "studio": _cmd_studio,
