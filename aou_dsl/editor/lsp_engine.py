@@ -21,11 +21,11 @@ threads, so each has a session of its own;
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from ..core.diagnostics import RULES, AouError, Diagnostic, Rule
+from ..core.memo import cached
 
 if TYPE_CHECKING:
     from ..build.session import Session
@@ -61,7 +61,7 @@ class Built:
     _lint: Any = field(default=None, repr=False)
 
 
-@functools.cache
+@cached(maxsize=2)
 def _session(thread: str) -> Session:
     """The warm session of the typing thread (``"typing"``) or of the compile worker
     (``"compile"``)."""
@@ -75,7 +75,7 @@ def lint(text: str, path: str) -> FileResult:
     return _session("typing").lint(text, path)
 
 
-@functools.cache
+@cached(maxsize=1)
 def _trees() -> Relinter:
     """What the outline's parses keep of each file (on the typing thread): a request
     after an edit parses only the statement the edit changed."""
