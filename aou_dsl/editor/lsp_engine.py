@@ -103,6 +103,16 @@ def rule(code: str) -> Rule | None:
     return RULES.get(code.upper())
 
 
+def robot_files_key(lint: FileResult | None, robot: str | None) -> tuple:
+    """The content of the files of the robot a build of ``lint`` uses (``robot``, else
+    the file's own): a build kept for the same text is kept for these files only."""
+    from ..robot.load import robot_key
+
+    name = robot or (lint.behaviour.settings.robot if lint is not None
+                     and lint.behaviour is not None else None)
+    return robot_key(name) if name else ()
+
+
 def compile_only(text: str, path: str, robot: str | None = None) -> Built | None:
     """The compile alone (no checks, no measuring): the C-codes of the compiler, sooner
     than :func:`build`'s, which then reuses the compile. None when there is nothing to
