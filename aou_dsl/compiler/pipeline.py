@@ -118,14 +118,18 @@ def _start_configuration(arm: ArmModel, frame: ReachFrame, pose: Pose,
     """IK of the start pose, by continuation from the robot's posture (or from
     ``seed``). The same reach always starts the same way, so the result is kept for
     recompilations."""
-    probe = Keyed((arm.key, arm.frame_id, frame.goal.tobytes(), frame.R0.tobytes(), pose,
-                   seed), (arm, frame.target(pose), seed))
-    return _solved_start(probe) if arm.key else _solved_start.__wrapped__(probe)
+    if not arm.key:  # an arm not loaded from files: nothing to know it by
+        return _solve_start(arm, frame.target(pose), seed)
+    key = (arm.key, arm.frame_id, frame.goal.tobytes(), frame.R0.tobytes(), pose, seed)
+    return _solved_start(Keyed(key, (arm, frame.target(pose), seed)))
 
 
 @cached(maxsize=64)
 def _solved_start(probe: Keyed):
-    arm, target, seed = probe.value
+    return _solve_start(*probe.value)
+
+
+def _solve_start(arm, target, seed):
     return solve_path(arm, [target], None if seed is None else np.array(seed, float))
 
 

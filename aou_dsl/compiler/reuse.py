@@ -62,12 +62,15 @@ def _solved(probe: Keyed):
 def timed_path(arm, frame, ep, q, options, s, q_path):
     """:func:`time_path` of an episode's solved path; kept like :func:`solved_path`."""
     if not arm.key:
-        return _timed.__wrapped__(Keyed((), (arm, s, q_path, ep)))
+        return _time(arm, s, q_path, ep)
     key = (*_motion_key(arm, frame, ep, q, options), "timed")
     return _timed(Keyed(key, (arm, s, q_path, ep)))
 
 
 @cached(maxsize=256)
 def _timed(probe: Keyed):
-    arm, s, q_path, ep = probe.value
+    return _time(*probe.value)
+
+
+def _time(arm, s, q_path, ep):
     return time_path(arm, s, q_path, ep.a, ep.vmax, cartesian=KINDS[ep.kind].translation)

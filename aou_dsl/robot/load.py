@@ -62,13 +62,16 @@ def load_robot(robot: str, package_dirs: Sequence[str] = ()) -> Robot:
             file that cannot be read.
     """
     dirs = package_dirs_of(package_dirs)
-    return _load(robot, dirs, robot_key(robot, dirs))
+    return _load(robot, dirs, robot_key(robot, dirs, meshes=False))
 
 
-def robot_key(robot: str, package_dirs: Sequence[str] = ()) -> tuple:
+def robot_key(robot: str, package_dirs: Sequence[str] = (), *, meshes: bool = True
+              ) -> tuple:
     """What a loaded ``robot`` depends on: each file it is made from (the robot file,
-    the URDF it names, the URDF's meshes: :func:`~.files_read.robot_files`) with the
-    SHA-256 of its bytes. A cache of anything made from the robot holds it in its key.
+    the URDF it names and, with ``meshes``, the URDF's meshes:
+    :func:`~.files_read.robot_files`) with the SHA-256 of its bytes. A cache of anything
+    made from the robot holds it in its key; what is made from the joints alone (the
+    arm's model, its limits) does without the meshes.
 
     One ``stat`` per file: the files are found again only when one of them changed (a
     description may then name another URDF), and a file is hashed only when its
@@ -77,9 +80,11 @@ def robot_key(robot: str, package_dirs: Sequence[str] = ()) -> tuple:
     dirs = package_dirs_of(package_dirs)
     kept = _FILES.get((robot, dirs))
     if kept is not None:
-        key = files_key(kept[0])
-        if key == kept[1]:
+        paths, key, head = kept
+        if meshes and files_key(paths) == key:
             return key
+        if not meshes and files_key(paths[:head]) == key[:head]:
+            return key[:head]
     from .files_read import robot_files
 
     try:
@@ -87,8 +92,9 @@ def robot_key(robot: str, package_dirs: Sequence[str] = ()) -> tuple:
     except Exception:  # noqa: BLE001 - the load itself says what is wrong
         paths = () if robot in ROBOTS else (robot,)
     key = files_key(paths)
-    _FILES.put((robot, dirs), (paths, key))
-    return key
+    head = min(len(paths), (0 if robot in ROBOTS else 1) + 1)  # the robot file, its URDF
+    _FILES.put((robot, dirs), (paths, key, head))
+    return key if meshes else key[:head]
 
 
 @cached(maxsize=16)
@@ -181,7 +187,8 @@ def _tmp_dir() -> str:
 
 @cached(maxsize=16)
 def _scene_file(robot: str, dirs: tuple[str, ...], visuals: bool, key: tuple) -> str:
-    r = _load(robot, dirs, key)
+    """:func:`scene_urdf` of the robot whose files (meshes included) are ``key``."""
+    r = load_robot(robot, dirs)
     text, missing = scene_xml(r.urdf, r.package_dirs, r.gaze, visuals=visuals)
     if missing:
         raise AouError(diag(
@@ -224,7 +231,7 @@ def load_arm(robot: str, ee_frame: str | None = None,
         AouError: V109 for an unknown robot or a robot file aou cannot use (I501 when it
             cannot be read), R402 for a frame the model lacks (listing the valid ones).
     """
-    key = robot_key(robot, package_dirs)
+    key = robot_key(robot, package_dirs, meshes=False)
     return _arm(robot, ee_frame, package_dirs, frame, key)
 
 

@@ -112,12 +112,13 @@ def replay(tr: Trajectory, *, options: SceneOptions | None = None,
     checks = check_limits(arm, t, q, qd, qdd)
     goal = tuple(float(x) for x in tr.goal) if tr.goal is not None else None
     options = options or SceneOptions(package_dirs=tr.package_dirs)
-    scene, geo = check_scene(tr.robot, options)
+    key = robot_key(tr.robot, options.package_dirs)
+    scene, geo = _check_scene(tr.robot, options, key)
     if scene.target is not None:  # the scene's cube stands at the goal (or far away)
         scene.pb.resetBasePositionAndOrientation(scene.target, goal or _AWAY, (0, 0, 0, 1),
                                                  physicsClientId=scene.client)
     frame = tr.ee_frame or arm.spec.ee_frame
-    memo = _memo(tr.robot, options, goal, robot_key(tr.robot, options.package_dirs))
+    memo = _memo(tr.robot, options, goal, key)
     memo.trim()
     sweep = Sweep(scene, geo, q, scene.link_index.get(frame, scene.joint_index.get(frame)),
                   target=goal is not None, memo=memo)
