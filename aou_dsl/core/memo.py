@@ -27,6 +27,7 @@ import os
 import sys
 import threading
 import time
+import types
 from collections import OrderedDict
 from collections.abc import Callable, Hashable, Iterable
 from dataclasses import dataclass, field
@@ -263,8 +264,9 @@ def _size_of(obj: Any, seen: set[int], depth: int = 0) -> int:
         size = sys.getsizeof(obj)
     except TypeError:
         size = 0
-    if depth >= _SIZE_DEPTH or isinstance(obj, (str, bytes, int, float, type)):
-        return size
+    if depth >= _SIZE_DEPTH or isinstance(obj, (str, bytes, int, float, type,
+                                                types.ModuleType, types.FunctionType)):
+        return size  # a module or a function is the program's, not the cache's
     if isinstance(obj, dict):
         return size + sum(_size_of(k, seen, depth + 1) + _size_of(v, seen, depth + 1)
                           for k, v in list(obj.items()))
