@@ -291,3 +291,26 @@ def test_the_studio_s_watcher_and_engine_see_an_edited_robot_file(tmp_path):
     (tmp_path / "arm.toml").write_text(SLOW)
     m = engine.build((tmp_path / "f.aou").read_text(), path)
     assert not m.ok and "C308" in {d.code for d in m.diagnostics}
+
+
+def test_the_studio_page_shows_the_refusal_after_the_robot_file_changes(tmp_path):
+    """``aouc studio`` on the file, watching: the robot file edited on disk, the page's
+    diagnostics show the shiver's refusal (the motion shown stays the last good one)."""
+    pytest.importorskip("viser", reason="the studio extra is missing")
+    pytest.importorskip("watchfiles")
+    from aou_dsl.studio.app import Studio
+
+    (tmp_path / "arm.toml").write_text(FAST)
+    studio = Studio(_fearful(tmp_path), port=0).start()
+    try:
+        assert 'data-code="C308"' not in studio.diags.content
+        time.sleep(0.3)  # the watch is set up
+        (tmp_path / "arm.toml").write_text(SLOW)
+        for _ in range(300):
+            if 'data-code="C308"' in studio.diags.content:
+                break
+            time.sleep(0.1)
+        assert 'data-code="C308"' in studio.diags.content, studio.diags.content
+        assert studio.shown is not None and studio.shown.ok
+    finally:
+        studio.close()
