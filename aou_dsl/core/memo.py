@@ -214,7 +214,7 @@ _DIGESTS = table("aou_dsl.core.memo.file_digest", FILES_KEPT)
 def _stamp(path: str) -> tuple[int, int, int, int] | None:
     try:
         st = os.stat(path)
-    except (OSError, ValueError):
+    except (OSError, ValueError, TypeError):  # not there, a NUL in it, not a path
         return None
     return st.st_size, st.st_mtime_ns, st.st_ino, st.st_dev
 
