@@ -174,7 +174,8 @@ def test_each_layer_states_its_public_face():
 
 def test_no_module_level_mutable_state():
     """No ``global`` statement, and no module-level dict, list or set that the module then
-    changes (caches belong to ``functools.cache`` or to a session object)."""
+    changes (caches belong to the registry of ``aou_dsl.core.memo`` or to a session
+    object)."""
     offenders = []
     for p in PACKAGE.rglob("*.py"):
         text = p.read_text()
@@ -198,6 +199,48 @@ def test_no_module_level_mutable_state():
                 line = text[: mutated.start()].count("\n") + 1
                 offenders.append(f"{p.relative_to(ROOT)}:{line}: {name} is changed")
     assert not offenders, offenders
+
+
+#: What makes a process-wide cache outside the registry of ``core/memo.py``.
+_UNREGISTERED = ("cache", "lru_cache")
+
+
+def _unregistered_caches(text: str, where: str) -> list[str]:
+    """Each use of ``functools.cache`` or ``functools.lru_cache`` in ``text`` (as a
+    decorator, called, or imported by name). ``functools.cached_property`` is a value
+    kept on one object, not process-wide, and is allowed."""
+    offenders = []
+    for node in ast.walk(ast.parse(text)):
+        if isinstance(node, ast.Attribute) and node.attr in _UNREGISTERED and \
+                isinstance(node.value, ast.Name) and node.value.id == "functools":
+            offenders.append(f"{where}:{node.lineno}: functools.{node.attr}")
+        elif isinstance(node, ast.ImportFrom) and node.module == "functools":
+            offenders += [f"{where}:{node.lineno}: from functools import {a.name}"
+                          for a in node.names if a.name in _UNREGISTERED]
+    return sorted(offenders, key=lambda o: int(o.split(":")[1]))
+
+
+def test_every_cache_is_made_by_the_registry():
+    """No module keeps a ``functools`` cache: each cache is made by
+    ``aou_dsl.core.memo`` (``cached``, ``table``), where every one is registered, so
+    a session reaches, measures and clears it (``core/memo.py`` itself aside)."""
+    offenders = []
+    for p in sorted(PACKAGE.rglob("*.py")):
+        if p != PACKAGE / "core" / "memo.py":
+            offenders += _unregistered_caches(p.read_text(), str(p.relative_to(ROOT)))
+    assert not offenders, offenders
+
+
+def test_a_planted_functools_cache_is_found():
+    """The registry check is not vacuous: each way of writing a functools cache fails."""
+    planted = ("import functools\n\n@functools.cache\ndef f(x):\n    return x\n\n"
+               "@functools.lru_cache(maxsize=8)\ndef g(x):\n    return x\n\n"
+               "h = functools.lru_cache(None)(len)\n"
+               "from functools import cache as kept\n\n"
+               "class A:\n    @functools.cached_property\n    def a(self):\n        return 1\n")
+    assert [o.split(": ", 1)[1] for o in _unregistered_caches(planted, "x.py")] == [
+        "functools.cache", "functools.lru_cache", "functools.lru_cache",
+        "from functools import cache"]
 
 
 def test_architecture_page_names_only_modules_that_exist():

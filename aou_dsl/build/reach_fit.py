@@ -26,7 +26,6 @@ state is not offered.
 
 from __future__ import annotations
 
-import functools
 import math
 import re
 from dataclasses import replace
@@ -34,6 +33,7 @@ from typing import Any
 
 from ..core.codes import C301, C302, C303
 from ..core.diagnostics import Diagnostic, Severity, Span, diag
+from ..core.memo import cached
 from ..lang.linter import FileResult, lint_source
 
 __all__ = ["REACH", "STEPS", "Statement", "offered", "with_reach_fit"]
@@ -243,11 +243,13 @@ def _fits(lint: FileResult, d: Diagnostic, robot: str, package_dirs: tuple[str, 
     return f"more than {MOST} statements would change"
 
 
-@functools.lru_cache(maxsize=32)
+@cached(maxsize=32)
 def _remembered(source: str, path: str, robot: str, package_dirs: tuple[str, ...],
-                code: str, span: Span, joint: str | None) -> list[dict[str, Any]] | str:
-    """:func:`_fits`, kept for the last texts: an editor builds the same text again
-    (a refusal's search costs about a second)."""
+                code: str, span: Span, joint: str | None, key: tuple
+                ) -> list[dict[str, Any]] | str:
+    """:func:`_fits`, kept for the last texts and robot files (``key``: their
+    content): an editor builds the same text again (a refusal's search costs about a
+    second)."""
     lint = lint_source(source, path)
     if lint.behaviour is None or lint.timeline is None:
         return "the file does not lint"
@@ -268,8 +270,11 @@ def with_reach_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...]) -
                 "time") or d.span.path != lint.path or d.span.line < 1:
             out.append(d)
             continue
-        found = _remembered(lint.source, lint.path, robot or b.settings.robot, package_dirs,
-                            d.code, d.span, d.fields.get("joint"))
+        from ..robot.load import robot_key
+
+        arm = robot or b.settings.robot
+        found = _remembered(lint.source, lint.path, arm, package_dirs, d.code, d.span,
+                            d.fields.get("joint"), robot_key(arm, package_dirs))
         found = found if isinstance(found, str) else [dict(c) for c in found]
         if isinstance(found, str):
             why = f"no smaller angle or distance is offered: {found}"

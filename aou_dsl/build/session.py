@@ -10,10 +10,16 @@ each stage, keyed by that stage's inputs:
 - ``lint``: by the text and its path; a changed text of a file is linted from the
   statements kept of its last lints, so an edit parses only what it changed;
 - ``build`` (compile, check, measure): by the linted behaviour and timeline (their values
-  and source positions, which the build's diagnostics point at), the file's path and the
-  :class:`~aou_dsl.core.options.BuildOptions`. A change that leaves them as they were (a
-  comment at the end of a line, trailing spaces) lints again but builds nothing; a changed
-  descriptor builds again.
+  and source positions, which the build's diagnostics point at), the file's path, the
+  :class:`~aou_dsl.core.options.BuildOptions` and the content of the robot's files (its
+  description, URDF and meshes: :func:`~aou_dsl.robot.load.robot_key`). A change that
+  leaves them as they were (a comment at the end of a line, trailing spaces) lints again
+  but builds nothing; a changed descriptor, or a robot file edited on disk, builds again.
+
+Below a session, every cache of the process is in one registry
+(:mod:`aou_dsl.core.memo`), each keyed by what its result depends on, files by their
+content: :meth:`Session.stats` tells what each holds, :meth:`Session.clear` empties them
+all, after which a build is the very build of a new process.
 
 A session is not shared between threads without a lock of the caller's; each worker
 process of a pool holds its own.
@@ -22,10 +28,12 @@ process of a pool holds its own.
 from __future__ import annotations
 
 import os
-from collections import OrderedDict
 from collections.abc import Hashable
 from typing import TYPE_CHECKING, Any
 
+from ..core.memo import CacheStats, Table
+from ..core.memo import clear as clear_caches
+from ..core.memo import stats as cache_stats
 from ..core.options import BuildOptions
 
 if TYPE_CHECKING:
@@ -53,20 +61,15 @@ def warm(robots: tuple[str, ...] = ("panda",), options: BuildOptions | None = No
         build_source(_WARM, "<warm-up>", options, robot=r)
 
 
-class _Kept(OrderedDict):
-    """The last ``size`` results of one stage, most recent last."""
-
-    def __init__(self, size: int):
-        super().__init__()
-        self.size = size
+class _Kept(Table):
+    """The last ``size`` results of one stage of one session, most recent last."""
 
     def get_or(self, key: Hashable, make: Any) -> Any:
-        if key in self:
-            self.move_to_end(key)
-            return self[key]
-        value = self[key] = make()
-        while len(self) > self.size:
-            self.popitem(last=False)
+        miss = _Kept
+        value = self.get(key, miss)
+        if value is miss:
+            value = make()
+            self.put(key, value)
         return value
 
 
@@ -90,10 +93,30 @@ class Session:
         self.options = options or BuildOptions()
         from ..lang.relint import Relinter
 
-        self._lints = _Kept(keep)
+        self._keep = keep
+        self._lints = _Kept("session.lint", keep)
         self._relinter = Relinter(keep)
-        self._builds = _Kept(keep)
+        self._builds = _Kept("session.build", keep)
         self.runs = {"lint": 0, "build": 0}
+
+    def clear(self) -> None:
+        """Forget every kept result, this session's and every cache of the process
+        (:func:`aou_dsl.core.memo.clear`): the next build is made from nothing, as a new
+        process makes it. The caches themselves never hold a result made from a robot
+        file since edited; this is for a figure of a cold pipeline, or memory."""
+        from ..lang.relint import Relinter
+
+        self._lints.clear()
+        self._builds.clear()
+        self._relinter = Relinter(self._keep)
+        clear_caches()
+
+    def stats(self) -> dict[str, CacheStats]:
+        """Per cache, by name: hits, misses, entries, size bound and bytes (about), of
+        this session's stages (``session.lint``, ``session.build``) and of every cache
+        of the process (:func:`aou_dsl.core.memo.stats`)."""
+        return {"session.lint": self._lints.stats(), "session.build": self._builds.stats(),
+                **cache_stats()}
 
     def warm(self, robot: str | None = None) -> None:
         """Load ``robot`` (the options' robot, else the Panda) and run every stage once
@@ -129,7 +152,10 @@ class Session:
             self.runs["build"] += 1
             return build_lint(_fresh(linted), opts)
 
-        key = (_behaviour_key(linted), path, opts)
+        from ..robot.load import robot_key
+
+        robot = opts.robot or linted.behaviour.settings.robot
+        key = (_behaviour_key(linted), path, opts, robot_key(robot, opts.package_dirs))
         return self._builds.get_or(key, run)
 
     def build_file(self, path: str, options: BuildOptions | None = None,

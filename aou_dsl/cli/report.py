@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import functools
 import json
 import math
 import sys
 
 from ..core.diagnostics import Diagnostic
+from ..core.memo import cached
 
 __all__ = [
     "print_diagnostics",
@@ -23,7 +23,7 @@ __all__ = [
 
 #: The most characters of a source line an excerpt shows.
 EXCERPT = 120
-@functools.lru_cache(maxsize=2)
+@cached(maxsize=2)
 def _lines(source: str) -> list[str]:
     """The lines of ``source``, split once however many diagnostics point into it."""
     return source.splitlines()

@@ -10,11 +10,11 @@ frequency that fits, need no sampling of the episode itself.
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
 
+from ..core.memo import cached
 from ..lang.primitives import MIN_ANGLE, MIN_SHIVER_F
 from ..robot.kinematics import ArmModel
 from .fits import TimingFailure, largest_fitting, times
@@ -81,7 +81,7 @@ def shiver_offset(tau: np.ndarray, amplitude: float, f: float, duration: float
     return x, xd, xdd, xddd
 
 
-@functools.lru_cache(maxsize=64)
+@cached(maxsize=64)
 def _unit_peaks(cycles: float) -> tuple[float, float, float]:
     """Peak speed, acceleration and jerk of a shiver of unit peak-to-peak amplitude at
     1 Hz lasting ``cycles`` cycles. Any shiver is this one scaled, ``x(t) = A g(f t)``:

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..core.codes import C303, C304, C305, C308, C309, V124
 from ..core.diagnostics import AouError, Diagnostic, Fix, diag, has_errors
-from ..core.memo import Keyed
+from ..core.memo import Keyed, cached
 from ..core.trajectory import Trajectory
 from ..lang.ir import Behaviour
 from ..lang.layout import layout
@@ -99,7 +99,7 @@ def _waypoints(ep: Episode, frame: ReachFrame, opts: CompileOptions
     return _kept_waypoints(Keyed(key, (ep, frame, step)))
 
 
-@functools.lru_cache(maxsize=256)
+@cached(maxsize=256)
 def _kept_waypoints(probe: Keyed) -> tuple[np.ndarray, list[tuple[np.ndarray, np.ndarray]]]:
     ep, frame, step = probe.value
     n = max(MIN_WAYPOINTS, math.ceil(ep.path_length / step) + 1)
@@ -118,14 +118,18 @@ def _start_configuration(arm: ArmModel, frame: ReachFrame, pose: Pose,
     """IK of the start pose, by continuation from the robot's posture (or from
     ``seed``). The same reach always starts the same way, so the result is kept for
     recompilations."""
-    key = (arm.spec.name, arm.frame_id, frame.goal.tobytes(), frame.R0.tobytes(), pose,
-           seed)
+    if not arm.key:  # an arm not loaded from files: nothing to know it by
+        return _solve_start(arm, frame.target(pose), seed)
+    key = (arm.key, arm.frame_id, frame.goal.tobytes(), frame.R0.tobytes(), pose, seed)
     return _solved_start(Keyed(key, (arm, frame.target(pose), seed)))
 
 
-@functools.lru_cache(maxsize=64)
+@cached(maxsize=64)
 def _solved_start(probe: Keyed):
-    arm, target, seed = probe.value
+    return _solve_start(*probe.value)
+
+
+def _solve_start(arm, target, seed):
     return solve_path(arm, [target], None if seed is None else np.array(seed, float))
 
 

@@ -8,7 +8,6 @@ a joint path with the path coordinate appended as a *virtual joint* (see
 
 from __future__ import annotations
 
-import functools
 import importlib
 import logging
 import sys
@@ -17,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from ..core.memo import cached
 from .timelaw import TimeLaw
 
 __all__ = ["grid", "import_toppra", "parametrize"]
@@ -29,7 +29,7 @@ class _LazyModule(types.ModuleType):
         return getattr(importlib.import_module(self.__name__), attr)
 
 
-@functools.cache
+@cached(maxsize=1)
 def import_toppra():
     """toppra, imported without matplotlib.
 
@@ -63,7 +63,7 @@ def import_toppra():
     return toppra
 
 
-@functools.lru_cache(maxsize=256)
+@cached(maxsize=256)
 def _constraints(jv: tuple[float, ...], ja: tuple[float, ...], a: float, vmax: float):
     """TOPP-RA's joint velocity and acceleration constraints, the virtual joint last.
     They do not depend on the path, and building one formats its limits as text (slow),
@@ -75,7 +75,7 @@ def _constraints(jv: tuple[float, ...], ja: tuple[float, ...], a: float, vmax: f
             constraint.JointAccelerationConstraint(alim))
 
 
-@functools.cache
+@cached(maxsize=1)
 def _lean_toppra():
     """toppra's ``TOPPRA`` whose two per-stage steps (the backward pass's controllable
     set, the forward pass's greedy step) skip their per-call allocations and checks: the

@@ -6,7 +6,8 @@ that every edit raises: a compile asked for an older generation is skipped if it
 not started, and its result dropped if it has; only the newest text's diagnostics are
 ever published. The diagnostics go out as soon as the build is done; the compiled
 episodes' figures (for hover) are worked out after, in the same thread. A compile of
-the text and robot last compiled (a save without an edit) reuses that result.
+the text and robot last compiled (a save without an edit) reuses that result, unless a
+file of the robot (its description, URDF, meshes) changed on disk since.
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ class Compiles:
         self._log = log
         self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="aou-compile")
         self._timers: dict[str, asyncio.TimerHandle] = {}
-        self._last: dict[str, tuple[str, str | None, engine.Built]] = {}
+        self._last: dict[str, tuple[str, str | None, tuple, engine.Built]] = {}
 
     def request(self, doc: Document, delay: float, robot: str | None) -> None:
         """Compile ``doc`` as it is now, after ``delay`` seconds without a newer edit."""
@@ -52,8 +53,9 @@ class Compiles:
             return
         text, path = doc.text, doc.path
         last = self._last.get(doc.uri)
-        if last is not None and last[:2] == (text, robot):
-            self._accept(doc, gen, last[2])
+        files = engine.robot_files_key(doc.lint, robot)
+        if last is not None and last[:3] == (text, robot, files):
+            self._accept(doc, gen, last[3])
             return
 
         def job() -> engine.Built | None:
@@ -70,7 +72,7 @@ class Compiles:
             return engine.shown(built) if doc.generation == gen and not doc.closed else None
 
         def then(built: engine.Built) -> None:
-            self._last[doc.uri] = (text, robot, built)
+            self._last[doc.uri] = (text, robot, files, built)
             self._submit(loop, figures, built, lambda b: None)
 
         self._submit(loop, job, None, lambda b: self._accept(doc, gen, b, then))

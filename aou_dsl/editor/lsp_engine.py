@@ -21,11 +21,11 @@ threads, so each has a session of its own;
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from ..core.diagnostics import RULES, AouError, Diagnostic, Rule
+from ..core.memo import cached
 
 if TYPE_CHECKING:
     from ..build.session import Session
@@ -61,7 +61,7 @@ class Built:
     _lint: Any = field(default=None, repr=False)
 
 
-@functools.cache
+@cached(maxsize=2)
 def _session(thread: str) -> Session:
     """The warm session of the typing thread (``"typing"``) or of the compile worker
     (``"compile"``)."""
@@ -75,7 +75,7 @@ def lint(text: str, path: str) -> FileResult:
     return _session("typing").lint(text, path)
 
 
-@functools.cache
+@cached(maxsize=1)
 def _trees() -> Relinter:
     """What the outline's parses keep of each file (on the typing thread): a request
     after an edit parses only the statement the edit changed."""
@@ -101,6 +101,16 @@ def format_text(text: str, path: str) -> str | None:
 
 def rule(code: str) -> Rule | None:
     return RULES.get(code.upper())
+
+
+def robot_files_key(lint: FileResult | None, robot: str | None) -> tuple:
+    """The content of the files of the robot a build of ``lint`` uses (``robot``, else
+    the file's own): a build kept for the same text is kept for these files only."""
+    from ..robot.load import robot_key
+
+    name = robot or (lint.behaviour.settings.robot if lint is not None
+                     and lint.behaviour is not None else None)
+    return robot_key(name) if name else ()
 
 
 def compile_only(text: str, path: str, robot: str | None = None) -> Built | None:

@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import dataclasses
 import enum
-import functools
 import math
 import types
 import typing
@@ -24,6 +23,7 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 from ..core.diagnostics import Span
+from ..core.memo import cached
 
 __all__ = ["DEFAULTS", "Behaviour", "Effort", "Model", "Node", "Settings", "State"]
 
@@ -84,7 +84,7 @@ def _check(obj: Any, name: str, value: Any, hint: Any) -> Any:
                     f", got {value!r}")
 
 
-@functools.cache
+@cached(maxsize=512)
 def _hints(cls: Any) -> dict[str, Any]:
     """The type hints of an IR class, resolved once per class."""
     return typing.get_type_hints(cls)

@@ -8,7 +8,6 @@ a statement is a keyword and its arguments. This stage only checks the shape;
 from __future__ import annotations
 
 import contextlib
-import functools
 import os
 import re
 import sys
@@ -22,6 +21,7 @@ from lark import Lark, Token, Transformer
 
 from ..core.codes import S001, S002, S003
 from ..core.diagnostics import AouError, Fix, Span, degree_fix, diag
+from ..core.memo import cached
 from ..core.units import lookalike_digit, parse_quantity
 
 __all__ = ["Colon", "KeyVal", "Quantity", "SequenceBlock", "Statement", "SyntaxTree",
@@ -94,7 +94,7 @@ class SyntaxTree:
 # --- Building the parser ----------------------------------------------------------------
 
 
-@functools.cache
+@cached(maxsize=1)
 def grammar_text() -> str:
     """The grammar, read from the installed package (``aou_dsl.grammar`` in the wheel).
 
@@ -130,7 +130,7 @@ def cache_dir() -> str | None:
     return os.path.join(base, "aou-dsl") if base and not base.startswith("~") else None
 
 
-@functools.cache
+@cached(maxsize=4)
 def _parser(start: str = "start") -> Lark:
     """The parser :func:`parse` uses (or, from ``start="statement"``,
     :func:`parse_statement`): LALR, building the syntax tree while it parses.

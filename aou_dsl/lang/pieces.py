@@ -18,13 +18,13 @@ its syntax error, or its tree, is then exactly the full parse's.
 from __future__ import annotations
 
 import dataclasses
-import functools
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 from ..core.diagnostics import Diagnostic, Span
+from ..core.memo import cached
 from .ir import Node
 from .layout import Laid
 from .parse import SequenceBlock, Statement, SyntaxTree, parse_statement
@@ -52,7 +52,7 @@ def _alone(line: str) -> bool:
         _SEQUENCE.match(line) is None
 
 
-@functools.cache
+@cached(maxsize=512)
 def _field_names(cls: type) -> tuple[str, ...]:
     return tuple(f.name for f in dataclasses.fields(cls))
 

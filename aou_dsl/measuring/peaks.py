@@ -45,12 +45,13 @@ its gaps are no curvature (a straight line drawn across a gap would be).
 
 from __future__ import annotations
 
-import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+
+from ..core.memo import cached
 
 __all__ = ["PhasePeak", "curvatures", "episode_peak", "path_travel", "phase_peak"]
 
@@ -110,7 +111,7 @@ def path_travel(s: np.ndarray, q: np.ndarray, noise: np.ndarray
     return None
 
 
-@functools.lru_cache(maxsize=512)
+@cached(maxsize=512)
 def _uniform_weights(w: int, h: float) -> np.ndarray:
     """The second-derivative weights of a least-squares quadratic through ``w`` samples
     ``h`` [s] apart (any ``w`` >= 3, odd or even)."""
@@ -119,7 +120,7 @@ def _uniform_weights(w: int, h: float) -> np.ndarray:
     return 2.0 * d / (float(d @ d) * h * h)
 
 
-@functools.lru_cache(maxsize=512)
+@cached(maxsize=512)
 def _uniform_gain(w: int, h: float) -> float:
     """The norm of :func:`_uniform_weights`: the reading's std per unit of white noise."""
     return float(np.linalg.norm(_uniform_weights(w, h)))

@@ -12,10 +12,11 @@ about a second (tests/test_savgol.py holds the two to the same bits).
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
+
+from ..core.memo import cached
 
 __all__ = ["savgol", "savgol_weights"]
 
@@ -24,7 +25,7 @@ __all__ = ["savgol", "savgol_weights"]
 _MIRROR_TOLERANCE = float(np.finfo(float).eps)
 
 
-@functools.lru_cache(maxsize=256)
+@cached(maxsize=256)
 def savgol_weights(window: int, order: int, deriv: int, delta: float,
                    reverse: bool = False) -> np.ndarray:
     """Weights ``c`` such that ``c @ x[i - m:i + m + 1]`` is the ``deriv``-th derivative at
@@ -73,7 +74,7 @@ def savgol(x: np.ndarray, window: int, order: int, deriv: int = 0,
     return out
 
 
-@functools.lru_cache(maxsize=256)
+@cached(maxsize=256)
 def _applied_weights(window: int, order: int, deriv: int, delta: float
                      ) -> tuple[np.ndarray, int]:
     """The weights the filter applies (:func:`savgol_weights` solved in reverse), and
@@ -149,7 +150,7 @@ def _polyfit(y: np.ndarray, order: int) -> np.ndarray:
     return (coeffs.T / scale).T
 
 
-@functools.lru_cache(maxsize=64)
+@cached(maxsize=64)
 def _edge_design(window: int, order: int) -> tuple[np.ndarray, np.ndarray]:
     """The powers of ``0, 1, .. window - 1`` (highest first) as the end fits solve
     them, each scaled to unit norm (a better conditioned solve), and the scales.

@@ -4,15 +4,16 @@ which), and the progress of the drawing on stderr."""
 
 from __future__ import annotations
 
-import functools
 import sys
 
 import numpy as np
 
+from ..core.memo import cached
+
 __all__ = ["caption", "progress_bar", "side_by_side"]
 
 
-@functools.cache
+@cached(maxsize=16)
 def _font(height: int):
     from PIL import ImageFont
 

@@ -15,7 +15,6 @@ display.
 
 from __future__ import annotations
 
-import functools
 import math
 import os
 from dataclasses import dataclass
@@ -25,6 +24,7 @@ import numpy as np
 
 from ..core.files import atomic
 from ..core.files import check_output as _check_output
+from ..core.memo import cached
 from .annotate import progress_bar
 
 __all__ = ["Camera", "frame_configurations", "frame_times", "render_configurations",
@@ -79,9 +79,16 @@ class _Stage:
     depth: np.ndarray  # (h * w) their depth (1: nothing there)
 
 
-@functools.lru_cache(maxsize=4)
 def _stage(robot: str, goal: tuple, options, camera: Camera) -> _Stage:
-    """The stage of a video, kept for the next one: loading the meshes takes a second."""
+    """The stage of a video, kept for the next one: loading the meshes takes a second
+    (kept by the robot's files' content too: an edited mesh is loaded again)."""
+    from ..robot.load import robot_key
+
+    return _kept_stage(robot, goal, options, camera, robot_key(robot, options.package_dirs))
+
+
+@cached(maxsize=4)
+def _kept_stage(robot: str, goal: tuple, options, camera: Camera, key: tuple) -> _Stage:
     from ..core.options import SceneOptions
     from ..robot.scene import Scene
 

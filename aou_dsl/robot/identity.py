@@ -14,14 +14,13 @@ pose from the file alone: the end-effector frame's definition and the robot's id
 
 from __future__ import annotations
 
-import functools
-import hashlib
 import os
 from dataclasses import replace
 from typing import Any
 
 from ..core.codes import R402
 from ..core.diagnostics import AouError, Span, diag
+from ..core.memo import file_digest
 from ..core.robot_specs import ROBOTS, RobotSpec
 from ..core.trajectory import FrameDefinition
 from .kinematics import ArmModel
@@ -42,14 +41,10 @@ def frame_definition(spec: RobotSpec) -> FrameDefinition:
     return FrameDefinition(spec.ee_frame, spec.ee_link, xyz, rpy)  # type: ignore[arg-type]
 
 
-@functools.cache
 def urdf_sha256(path: str) -> str:
-    """The SHA-256 of the file at ``path``, in hex ("" when it cannot be read)."""
-    try:
-        with open(path, "rb") as fh:
-            return hashlib.sha256(fh.read()).hexdigest()
-    except OSError:
-        return ""
+    """The SHA-256 of the file at ``path``, in hex ("" when it cannot be read): of its
+    bytes now, hashed again whenever the file changed."""
+    return file_digest(path)
 
 
 def _given_urdf(robot: str, spec: RobotSpec, description: str) -> str:

@@ -10,12 +10,12 @@ stays a margin inside the joint limits.
 from __future__ import annotations
 
 import enum
-import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.memo import cached
 from .kinematics import ArmModel
 
 __all__ = ["IKFailure", "IKResult", "IKStatus", "solve_path"]
@@ -135,7 +135,7 @@ _EYE6 = np.eye(6)
 _DAMPED = DAMPING * _EYE6
 
 
-@functools.cache
+@cached(maxsize=1)
 def _lapack() -> _Lapack:
     """The one :class:`_Lapack` of this process (its check runs once)."""
     return _Lapack()

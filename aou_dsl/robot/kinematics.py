@@ -9,7 +9,7 @@ commands that need kinematics pay for it.
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -35,6 +35,10 @@ class ArmModel:
         jmax: joint jerk limits from the robot's spec [rad/s^3], shape (n,).
         effort: joint effort limits from the URDF [N m] (inf where it gives none),
             shape (n,).
+        key: what the arm was made from, the content of its files included
+            (:func:`~aou_dsl.robot.load.robot_key`): the key of every cache of results
+            computed on the arm. An arm made by hand has none (``()``): nothing made from
+            it is cached.
     """
 
     spec: RobotSpec
@@ -46,6 +50,7 @@ class ArmModel:
     amax: np.ndarray
     effort: np.ndarray
     jmax: np.ndarray
+    key: Any = field(default=(), compare=False)
 
     @property
     def joint_names(self) -> tuple[str, ...]:

@@ -6,12 +6,16 @@ a robot description file (TOML). Each robot is loaded once per process
 Pinocchio from the joints alone (no mesh is read), and what no file pins is derived
 (:mod:`.derive`). :func:`scene_urdf` writes, once per process, the copy of the URDF that
 PyBullet loads.
+
+"Once" means once per content: every cache of a loaded robot is keyed by
+:func:`robot_key`, which holds the digest of each file the robot is made from (the
+robot description, the URDF, the meshes). A file edited while a tool runs makes the next
+look-up load the robot again.
 """
 
 from __future__ import annotations
 
 import atexit
-import functools
 import hashlib
 import os
 import shutil
@@ -21,6 +25,7 @@ from dataclasses import replace
 
 from ..core.codes import C312, R402, V109
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
+from ..core.memo import cached, files_key, table
 from ..core.options import package_dirs as package_dirs_of
 from ..core.robot_specs import ROBOT_FILE_TYPES, ROBOTS, UNSOURCED, RobotSpec, is_robot_file
 from ..core.trajectory import FrameDefinition
@@ -29,8 +34,11 @@ from .kinematics import ArmModel, arm_model, frame_id
 from .model import Robot, gaze_of, reduced_model
 from .urdf import read_urdf, scene_xml
 
-__all__ = ["Robot", "load_arm", "load_robot", "robot_diagnostics", "scene_urdf",
-           "unknown_robot"]
+__all__ = ["Robot", "load_arm", "load_robot", "robot_diagnostics", "robot_key",
+           "scene_urdf", "unknown_robot"]
+
+#: Per robot and package folders: the files it was last made from and their digests.
+_FILES = table("aou_dsl.robot.load.robot_files", 64)
 
 def unknown_robot(robot: str, span: Span) -> Diagnostic:
     """V109 for a name that is neither a built-in arm nor a robot file."""
@@ -53,11 +61,45 @@ def load_robot(robot: str, package_dirs: Sequence[str] = ()) -> Robot:
         AouError: V109 for an unknown robot or a robot file aou cannot use, I501 for a
             file that cannot be read.
     """
-    return _load(robot, package_dirs_of(package_dirs))
+    dirs = package_dirs_of(package_dirs)
+    return _load(robot, dirs, robot_key(robot, dirs, meshes=False))
 
 
-@functools.cache
-def _load(robot: str, dirs: tuple[str, ...]) -> Robot:
+def robot_key(robot: str, package_dirs: Sequence[str] = (), *, meshes: bool = True
+              ) -> tuple:
+    """What a loaded ``robot`` depends on: each file it is made from (the robot file,
+    the URDF it names and, with ``meshes``, the URDF's meshes:
+    :func:`~.files_read.robot_files`) with the SHA-256 of its bytes. A cache of anything
+    made from the robot holds it in its key; what is made from the joints alone (the
+    arm's model, its limits) does without the meshes.
+
+    One ``stat`` per file: the files are found again only when one of them changed (a
+    description may then name another URDF), and a file is hashed only when its
+    ``stat`` changed (:func:`~aou_dsl.core.memo.file_digest`). Never raises: a file
+    that cannot be read has the digest "" (the load says what is wrong with it)."""
+    dirs = package_dirs_of(package_dirs)
+    kept = _FILES.get((robot, dirs))
+    if kept is not None:
+        paths, key, head = kept
+        if meshes and files_key(paths) == key:
+            return key
+        if not meshes and files_key(paths[:head]) == key[:head]:
+            return key[:head]
+    from .files_read import robot_files
+
+    try:
+        paths = tuple(robot_files(robot, dirs))
+    except Exception:  # noqa: BLE001 - the load itself says what is wrong
+        paths = () if robot in ROBOTS else (robot,)
+    key = files_key(paths)
+    head = min(len(paths), (0 if robot in ROBOTS else 1) + 1)  # the robot file, its URDF
+    _FILES.put((robot, dirs), (paths, key, head))
+    return key if meshes else key[:head]
+
+
+@cached(maxsize=16)
+def _load(robot: str, dirs: tuple[str, ...], key: tuple) -> Robot:
+    """The robot, loaded; ``key`` (:func:`robot_key`) keeps the cache true to the files."""
     if robot in ROBOTS:
         return _builtin(robot, dirs)
     if not is_robot_file(robot) and not os.path.isfile(robot):
@@ -131,7 +173,7 @@ def robot_diagnostics(robot: str, *, collision_check: bool = True, span: Span | 
     return out
 
 
-@functools.cache
+@cached(maxsize=1)
 def _tmp_dir() -> str:
     """This process's folder for the copies PyBullet loads (``aou-robots-PID-...``),
     removed at exit; those of processes that were killed are removed here first."""
@@ -143,9 +185,10 @@ def _tmp_dir() -> str:
     return path
 
 
-@functools.cache
-def _scene_file(robot: str, dirs: tuple[str, ...], visuals: bool) -> str:
-    r = _load(robot, dirs)
+@cached(maxsize=16)
+def _scene_file(robot: str, dirs: tuple[str, ...], visuals: bool, key: tuple) -> str:
+    """:func:`scene_urdf` of the robot whose files (meshes included) are ``key``."""
+    r = load_robot(robot, dirs)
     text, missing = scene_xml(r.urdf, r.package_dirs, r.gaze, visuals=visuals)
     if missing:
         raise AouError(diag(
@@ -170,10 +213,10 @@ def scene_urdf(robot: str, *, visuals: bool = False, package_dirs: Sequence[str]
     Raises:
         AouError: V109 when a mesh the copy needs cannot be found.
     """
-    return _scene_file(robot, package_dirs_of(package_dirs), visuals)
+    dirs = package_dirs_of(package_dirs)
+    return _scene_file(robot, dirs, visuals, robot_key(robot, dirs))
 
 
-@functools.cache
 def load_arm(robot: str, ee_frame: str | None = None,
              package_dirs: tuple[str, ...] = (),
              frame: FrameDefinition | None = None) -> ArmModel:
@@ -188,8 +231,20 @@ def load_arm(robot: str, ee_frame: str | None = None,
         AouError: V109 for an unknown robot or a robot file aou cannot use (I501 when it
             cannot be read), R402 for a frame the model lacks (listing the valid ones).
     """
-    r = load_robot(robot, package_dirs)
-    arm = arm_model(r.spec, r.model, no_effort=r.no_effort)
+    key = robot_key(robot, package_dirs, meshes=False)
+    return _arm(robot, ee_frame, package_dirs, frame, key)
+
+
+@cached(maxsize=64)
+def _arm(robot: str, ee_frame: str | None, package_dirs: tuple[str, ...],
+         frame: FrameDefinition | None, key: tuple) -> ArmModel:
+    """:func:`load_arm` of the robot whose files are ``key``; the arm's
+    :attr:`~.kinematics.ArmModel.key` says all of it, for the caches of what is made
+    from the arm."""
+    dirs = package_dirs_of(package_dirs)
+    r = _load(robot, dirs, key)
+    arm = replace(arm_model(r.spec, r.model, no_effort=r.no_effort),
+                  key=(robot, dirs, ee_frame, frame, key))
     if frame is not None and not frame.is_link and (ee_frame in (None, frame.name)):
         from .identity import with_frame
 

@@ -10,14 +10,13 @@ on two (the row twice), as a batch of one can round differently from a larger ba
 
 from __future__ import annotations
 
-import functools
 import itertools
 from collections.abc import Callable
 from typing import cast
 
 import numpy as np
 
-from ..core.memo import Keyed
+from ..core.memo import Keyed, cached
 
 __all__ = ["RowMemo", "kept", "row_keys"]
 
@@ -110,7 +109,7 @@ def kept(owner: object, name: str, q: np.ndarray,
     return _memo(Keyed((id(owner), name), owner)).of(q, fn)
 
 
-@functools.lru_cache(maxsize=8)
+@cached(maxsize=8)
 def _memo(owner: Keyed) -> RowMemo:
     """One memo per owner and function (the key holds the owner, so its id stays its)."""
     return RowMemo()

@@ -26,16 +26,16 @@ against the URDF effort limits.
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..core.codes import R410
+from ..core.memo import cached
 from ..core.options import SceneOptions
 from ..core.trajectory import Trajectory
-from ..robot.load import load_arm
+from ..robot.load import load_arm, robot_key
 from ..robot.scene import Scene, urdf_path
 from .limits import Check, check_limits
 from .sweep import CONTACT_MARGIN, QUERY_RANGE, Geometry, Memo, Sweep, geometry
@@ -115,12 +115,13 @@ def replay(tr: Trajectory, *, options: SceneOptions | None = None,
     checks = check_limits(arm, t, q, qd, qdd)
     goal = tuple(float(x) for x in tr.goal) if tr.goal is not None else None
     options = options or SceneOptions(package_dirs=tr.package_dirs)
-    scene, geo = check_scene(tr.robot, options)
+    key = robot_key(tr.robot, options.package_dirs)
+    scene, geo = _check_scene(tr.robot, options, key)
     if scene.target is not None:  # the scene's cube stands at the goal (or far away)
         scene.pb.resetBasePositionAndOrientation(scene.target, goal or _AWAY, (0, 0, 0, 1),
                                                  physicsClientId=scene.client)
     frame = tr.ee_frame or arm.spec.ee_frame
-    memo = _memo(tr.robot, options, goal)
+    memo = _memo(tr.robot, options, goal, key)
     memo.trim()
     sweep = Sweep(scene, geo, q, scene.link_index.get(frame, scene.joint_index.get(frame)),
                   target=goal is not None, memo=memo)
@@ -157,17 +158,22 @@ def _bound(tr: Trajectory) -> None:
 _AWAY = (0.0, 0.0, -100.0)
 
 
-@functools.lru_cache(maxsize=8)
 def check_scene(robot: str, options: SceneOptions) -> tuple[Scene, Geometry]:
-    """A scene per robot and options, kept with its geometry: loading the URDF is the
-    slow part. Each replay sets the joint states, the cube's place and the physics
-    settings it relies on."""
+    """A scene per robot (its files' content included) and options, kept with its
+    geometry: loading the URDF is the slow part. Each replay sets the joint states, the
+    cube's place and the physics settings it relies on."""
+    return _check_scene(robot, options, robot_key(robot, options.package_dirs))
+
+
+@cached(maxsize=8)
+def _check_scene(robot: str, options: SceneOptions, key: tuple) -> tuple[Scene, Geometry]:
     scene = Scene(robot, _AWAY, options, visuals=False)
     return scene, geometry(scene, load_arm(robot, None, options.package_dirs).spec.allowed_contacts)
 
 
-@functools.lru_cache(maxsize=8)
-def _memo(robot: str, options: SceneOptions, goal: tuple[float, ...] | None) -> Memo:
+@cached(maxsize=8)
+def _memo(robot: str, options: SceneOptions, goal: tuple[float, ...] | None,
+          key: tuple) -> Memo:
     """What the sweeps in one scene with the cube at one goal measured, for the next
     replay there (a recompilation repeats most joint values: see :class:`.sweep.Memo`)."""
     return Memo()

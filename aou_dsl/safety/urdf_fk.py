@@ -8,7 +8,6 @@ PyBullet's link poses wherever PyBullet is put in a configuration.
 
 from __future__ import annotations
 
-import functools
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
@@ -16,6 +15,7 @@ import numpy as np
 
 from ..core.codes import R402
 from ..core.diagnostics import AouError, Span, diag
+from ..core.memo import cached, file_digest
 
 __all__ = ["Chain", "chain_fk", "kept_chain_fk", "urdf_chain"]
 
@@ -53,8 +53,8 @@ def _floats(text: str | None, default: str) -> list[float]:
     return [float(v) for v in (text or default).split()]
 
 
-@functools.cache
-def _model(urdf: str) -> tuple[frozenset[str], dict[str, tuple[str, ET.Element]]]:
+@cached(maxsize=16)
+def _model(urdf: str, digest: str) -> tuple[frozenset[str], dict[str, tuple[str, ET.Element]]]:
     """The link names, and ``link:<child>`` and ``joint:<name>`` -> (joint name, joint
     element)."""
     root = ET.parse(urdf).getroot()
@@ -68,16 +68,21 @@ def _model(urdf: str) -> tuple[frozenset[str], dict[str, tuple[str, ET.Element]]
     return frozenset(el.get("name", "") for el in root.iter("link")), joints
 
 
-@functools.lru_cache(maxsize=64)
 def urdf_chain(urdf: str, frame: str, columns: tuple[str, ...]) -> Chain:
     """The chain from the root to ``frame`` (a link, or a joint: its child link).
     Joints named in ``columns`` move with their column; other joints stay at zero.
-    Made once per file, frame and columns (a replay asks for it every time).
+    Made once per file (its content), frame and columns (a replay asks for it every
+    time).
 
     Raises:
         AouError: R402 when the URDF has no such link or joint.
     """
-    links, joints = _model(urdf)
+    return _chain(urdf, file_digest(urdf), frame, columns)
+
+
+@cached(maxsize=64)
+def _chain(urdf: str, digest: str, frame: str, columns: tuple[str, ...]) -> Chain:
+    links, joints = _model(urdf, digest)
     link = frame
     if frame not in links and "joint:" + frame in joints:  # a link's name wins, as in Pinocchio
         link = joints["joint:" + frame][1].find("child").get("link", "")  # type: ignore[union-attr]

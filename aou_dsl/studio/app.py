@@ -111,7 +111,9 @@ class Studio:
             from .watch import Watcher
 
             self.watcher: Watcher | None = Watcher(
-                self.path, lambda: self._guarded(self._changed))
+                self.path, lambda: self._guarded(self._changed), robot=self.engine.robot,
+                package_dirs=self.engine.package_dirs,
+                on_robot_change=lambda: self._guarded(self._robot_changed))
         else:
             self.watcher = None
         return self
@@ -361,6 +363,19 @@ class Studio:
         else:
             self._say(m, "The file on disk does not build; the motion shown is the last "
                       "good one.")
+
+    def _robot_changed(self) -> None:
+        """A file of the robot changed on disk (its description, URDF or a mesh): the
+        motion shown is built again on the robot as it is now."""
+        text = self.shown.text if self.shown is not None and self.shown.text else \
+            self.file_text
+        with self._busy:
+            m = self.engine.build(text, self.path)
+        if m.ok:
+            self._show(m)
+        else:
+            self._say(m, "The robot's files changed and this motion no longer builds on "
+                      "it; the motion shown is the last good one.")
 
 
 def _quiet():

@@ -11,13 +11,13 @@ same robot and goal always give the same limits.
 
 from __future__ import annotations
 
-import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ..compiler.fits import floor_sig
 from ..core.codes import C304
 from ..core.diagnostics import AouError, has_errors
+from ..core.memo import cached
 from ..lang.ir import DEFAULTS
 from ..lang.primitives import MIN_SHIVER_F, shiver_duration
 from .recipe import Recipe, descriptor
@@ -47,6 +47,8 @@ class Limits:
         accel: the most an approach or retreat may declare [m/s^2] (``MARGIN * reached``).
         roll_joint: the joint that rolls the hand about its forward axis.
         roll_v, roll_a: its planning limits times the margin [rad/s, rad/s^2].
+        arm: the content of the robot's files (:func:`~aou_dsl.robot.load.robot_key`):
+            what is kept per limits is kept per arm as it is now.
     """
 
     robot: str
@@ -56,6 +58,7 @@ class Limits:
     roll_joint: str
     roll_v: float
     roll_a: float
+    arm: tuple = field(default=(), repr=False)
 
 
 def robot_line(robot: str) -> str:
@@ -80,14 +83,21 @@ def _probe(robot: str, goal: tuple[float, float, float] | None) -> str:
             f"  pause 0.5s\n  retreat {back:g}m a={a:g}\n  pause 0.5s\n  approach a={a:g}\n}}\n")
 
 
-@functools.lru_cache(maxsize=16)
 def fit_limits(robot: str, goal: tuple[float, float, float] | None = None) -> Limits:
-    """The limits a behaviour synthesized for ``robot`` (and ``goal``) must keep.
+    """The limits a behaviour synthesized for ``robot`` (and ``goal``) must keep; kept
+    per robot (its files' content included) and goal.
 
     Raises:
         AouError: V109 for an unknown robot; the probe's diagnostics when the reach
             itself cannot be compiled on the arm (e.g. an unreachable goal).
     """
+    from ..robot.load import robot_key
+
+    return _fit_limits(robot, goal, robot_key(robot))
+
+
+@cached(maxsize=16)
+def _fit_limits(robot: str, goal: tuple[float, float, float] | None, key: tuple) -> Limits:
     from ..build.builder import build_source
     from ..robot.load import load_arm
 
@@ -100,7 +110,7 @@ def fit_limits(robot: str, goal: tuple[float, float, float] | None = None) -> Li
                    if d.code == C304), default=PROBE_ACCEL)
     j = arm.joint_names.index(arm.spec.shiver_joint)
     return Limits(robot, goal, reached, floor_sig(MARGIN * reached), arm.spec.shiver_joint,
-                  MARGIN * float(arm.plan_vmax[j]), MARGIN * float(arm.plan_amax[j]))
+                  MARGIN * float(arm.plan_vmax[j]), MARGIN * float(arm.plan_amax[j]), key)
 
 
 def _cap_accel(r: Recipe, kind: str, lim: Limits) -> Recipe:

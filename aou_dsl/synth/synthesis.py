@@ -27,14 +27,13 @@ saying where it came from.
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from ..core.codes import C304, C305, C308, C309, C311, I504
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
-from ..core.memo import Keyed
+from ..core.memo import Keyed, cached
 from ..lang.cv import CANONICAL, classify
 from ..lang.descriptors import REGISTRY, Descriptor
 from ..lang.ir import State
@@ -97,7 +96,7 @@ def _check_intensity(intensity: float) -> float:
     return float(intensity)
 
 
-@functools.cache
+@cached(maxsize=8)
 def study(state: State) -> Recipe:
     """The study's stimulus for ``state`` (the shipped hold for inactive)."""
     res = lint_source(STUDY_SOURCE[state], f"<study {state}>")
@@ -194,7 +193,7 @@ def _with_reading(text: str) -> str:
     return text[:at] + line + text[at:]
 
 
-@functools.lru_cache(maxsize=64)
+@cached(maxsize=64)
 def _floor(state: State, limits: Limits) -> float:
     """The weakest intensity (to 1/100) from which ``state`` reads as itself on the arm:
     an arm that cannot perform a study value (e.g. the fearful retreat's 2 m/s^2) may
@@ -282,7 +281,7 @@ def _maker(st: State | None, point: tuple[float, float] | None, intensity: float
 _LIMIT_CODES = frozenset({C304, C308, C309, C311})
 
 
-@functools.cache
+@cached(maxsize=1)
 def _session() -> Session:
     """The warm session synthesis and the live regulator build in: arms loaded once, the
     last builds kept, a changed text re-solving only the episodes it changed."""
@@ -309,7 +308,7 @@ def _failure(text: str) -> Diagnostic | None:
     return None
 
 
-@functools.lru_cache(maxsize=64)
+@cached(maxsize=64)
 def _ceiling(probe: Keyed) -> float | None:
     """:func:`_highest` kept per state, arm and lowest intensity (``probe.key``)."""
     make, lo = probe.value
