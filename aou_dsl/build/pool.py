@@ -123,12 +123,12 @@ def _pack(res: BuildResult, encode: str | None) -> BuildResult:
     document's lists of samples stay behind: the parent makes them again from the
     trajectory's arrays when it needs them, which travel as raw bytes (lists pickle
     float by float, which made reading the results back most of the parent's work)."""
-    if encode is not None and res.document is not None:
+    if encode is not None and res.header is not None:
         from ..compiler.output import FOLDER_FORMATS
         from ..compiler.output import encode as encode_doc
 
         if encode not in FOLDER_FORMATS:
-            setattr(res, _ENCODED, (encode, encode_doc(res.document, encode)))
+            setattr(res, _ENCODED, (encode, encode_doc(_encodable(res), encode)))
     res.drop_samples()
     return res
 
@@ -141,9 +141,23 @@ def encoded(res: BuildResult, fmt: str) -> bytes:
     done = getattr(res, _ENCODED, None)
     if done is not None and done[0] == fmt:
         return done[1]
-    if res.document is None:
+    if res.header is None:
         raise ValueError(f"{res.path}: the build failed, there is no document")
-    return encode(res.document, fmt)
+    return encode(_encodable(res), fmt)
+
+
+def _encodable(res: BuildResult) -> dict:
+    """A successful build's document to encode: its samples as the trajectory's arrays
+    (the same bytes as its lists, written without making them)."""
+    from ..compiler.output import array_document
+
+    tr = res.compiled.trajectory if res.compiled is not None else None
+    if tr is None:
+        document = res.document
+        assert document is not None
+        return document
+    assert res.header is not None
+    return array_document(res.header, tr)
 
 
 

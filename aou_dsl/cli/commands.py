@@ -152,7 +152,8 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     worst = EXIT_OK
     for k, ((src, _), dest, res) in enumerate(zip(inputs, dests, results, strict=True), 1):
         _print_diags(res.diagnostics, sources={src: res.lint.source or ""})
-        if not res.ok or res.document is None:
+        # the header, not res.document: that makes the samples' lists, in this process
+        if not res.ok or res.header is None:
             worst = max(worst, _exit_for(res.diagnostics))
             print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)
             continue
