@@ -137,6 +137,22 @@ def test_the_standard_module_writes_what_orjson_writes(monkeypatch):
         == _bits(table)
 
 
+def test_floats_of_less_precision_are_written_as_their_float64_by_either_encoder(
+        monkeypatch):
+    """orjson writes a float32 as the shortest float32 (``0.1``); its list holds the
+    float64 of it (``0.10000000149011612``): such a document is written the standard
+    module's way by both, so its bytes do not depend on the encoder installed."""
+    doc = {"a": np.array([0.1, 1e-07], dtype=np.float32), "b": [[1.0, np.float32(0.1)]],
+           "c": np.float16(0.1), "d": np.array([1, 2], dtype=np.int8), "e": np.bool_(True)}
+    fast = json_bytes(doc)
+    monkeypatch.setattr(output, "_FAST", False)
+    assert json_bytes(doc) == fast
+    back = json.loads(fast)
+    assert back["a"] == np.array([0.1, 1e-07], dtype=np.float32).astype(float).tolist()
+    assert back["b"][0][1] == float(np.float32(0.1)) != 0.1
+    assert back["c"] == float(np.float16(0.1)) and back["d"] == [1, 2] and back["e"] is True
+
+
 @pytest.mark.parametrize("encoder", ENCODERS, indirect=True)
 def test_a_lone_surrogate_is_written_as_its_escape(encoder):
     """A path from a file name that is not UTF-8 holds a lone surrogate, which orjson

@@ -27,6 +27,7 @@ import os
 import re
 import zipfile
 from bisect import bisect_right
+from itertools import chain
 from typing import Any
 
 import numpy as np
@@ -209,13 +210,38 @@ def _std_json(doc: Any) -> str:
     return _orjson_floats(text)
 
 
+_PLAIN = frozenset((float, int, str, bool, type(None)))
+
+
+def _orjson_writes_as_lists(value: Any) -> bool:
+    """Whether orjson writes every NumPy value in ``value`` as the standard module
+    writes its ``tolist()``: float64, integer and boolean ones do; a float32 it writes
+    as the shortest float32 (``0.1``), where its list holds the float64 of it
+    (``0.10000000149011612``)."""
+    if type(value) in _PLAIN:
+        return True
+    if isinstance(value, np.ndarray):
+        return value.dtype.kind in "biu" or value.dtype == np.float64
+    if isinstance(value, np.generic):
+        return not isinstance(value, np.floating) or isinstance(value, np.float64)
+    if isinstance(value, dict):
+        return all(map(_orjson_writes_as_lists, value.values()))
+    if isinstance(value, list | tuple):  # lists (of lists) of plain values: at C speed
+        kinds = set(map(type, value))
+        if kinds <= _PLAIN or (kinds == {list} and _PLAIN.issuperset(
+                map(type, chain.from_iterable(value)))):
+            return True
+        return all(map(_orjson_writes_as_lists, value))
+    return True
+
+
 def json_bytes(doc: Any, *, newline: bool = True) -> bytes:
     """``doc`` (dicts, lists, strings, numbers, None; NumPy arrays and scalars) as
     compact JSON in UTF-8, with a final newline unless ``newline`` is False: by orjson
     when it is installed (and writes floats as expected), else by the standard module,
     the same bytes either way. A lone surrogate in a string (a file name that is not
     UTF-8) is written as its ``\\u`` escape."""
-    if _FAST:
+    if _FAST and _orjson_writes_as_lists(doc):
         option = orjson.OPT_SERIALIZE_NUMPY | (orjson.OPT_APPEND_NEWLINE if newline else 0)
         try:
             return orjson.dumps(doc, option=option)
