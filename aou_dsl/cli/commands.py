@@ -130,12 +130,13 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     found: list[Diagnostic] = []  # for --sarif
     for k, ((src, _), dest, res) in enumerate(zip(inputs, dests, results, strict=True), 1):
         _print_diags(res.diagnostics, sources={src: res.lint.source or ""})
-        if res.ok and res.document is not None and args.track:
+        if res.ok and res.header is not None and args.track:
             from .track_cmd import compile_tracked
 
             res = compile_tracked(args, res, reads)
         found += res.diagnostics
-        if not res.ok or res.document is None:
+        # the header, not res.document: that makes the samples' lists, in this process
+        if not res.ok or res.header is None:
             worst = max(worst, _exit_for(res.diagnostics))
             print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)
             continue
