@@ -349,6 +349,14 @@ _RULE_LIST = [
          "image, a stream) from taking the machine's memory. Set AOU_MAX_INPUT_MB or "
          "AOU_MAX_SAMPLES to read larger ones.",
          "aouc measure huge.npz   # its q.npy claims 1,000,000,000 samples"),
+    Rule("R411", "noise-beyond-segmentation", _W,
+         "A recording's joint noise is more than its segmentation bears: copies of it "
+         "re-noised at the noise level aou estimated read a different count, or find a "
+         "descriptor present that the recording reads absent (or the reverse).",
+         "A count or a presence that the noise can flip is a guess, not a measurement; the "
+         "warning names the noise level and the descriptors it affects, and a judgement "
+         "against a behaviour file reads them as inconclusive.",
+         "aouc measure noisy.csv --robot panda   # 1e-3 rad of noise at 250 Hz"),
     Rule("I501", "cannot-read", _E,
          "An input file or folder cannot be read (missing, a directory, permissions, encoding).",
          "Nothing can be checked or compiled.",

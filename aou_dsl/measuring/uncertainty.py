@@ -1,0 +1,174 @@
+"""How much each measured descriptor can be trusted: a parametric bootstrap of the noise.
+
+A recording's joints carry noise whose level :func:`.signal.joint_noise` estimates joint
+by joint. The measurement is a chain of filters, thresholds, episode boundaries, fits and
+medians: no closed formula carries that noise through all of it. So it is carried by
+doing it again. The recording is smoothed (the measurement's own velocity filter, as a
+position filter), fresh noise at each joint's estimated level is added, and the copy is
+measured with the recording's own filters and thresholds (its noise pinned, not
+re-estimated). :data:`REPLICATES` copies give each descriptor a std; its 95 % interval is
+the value +- Student's t of that many copies times the std. The interval covers what the
+noise moves; docs/measure.md gives the coverage measured over simulated recordings.
+
+A count or a presence that differs between the copies is a segmentation the noise can
+flip: its interval spans what the copies read, and R411 names it with the noise level.
+A trajectory without noise (compiled, or computed by a planner) is measured exactly:
+every interval is the value itself.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.codes import R411
+from ..core.diagnostics import AouError, Span, diag
+from ..core.trajectory import Trajectory
+from ..lang.descriptors import REGISTRY
+from .episodes import COMPUTED_NOISE
+from .signal import JointNoise, short_window, smooth, to_grid, unwrap
+
+__all__ = ["REPLICATES", "Spread", "attach"]
+
+#: Re-noised copies measured per recording.
+REPLICATES = 10
+#: Two-sided 95 % quantile of Student's t with ``REPLICATES - 1`` degrees of freedom.
+T95 = 2.262
+#: The seed of the copies' noise: the same file gives the same intervals.
+SEED = 20240
+
+
+@dataclass(frozen=True)
+class Spread:
+    """A descriptor's uncertainty.
+
+    Attributes:
+        sd: the std the noise gives it (0 for a count the copies agree on; None when
+            absent or when the copies disagree on its presence).
+        low, high: its 95 % interval (a count's: the least and most the copies read;
+            None where it is absent in the recording and in every copy).
+        stable: whether every copy reads the same count, and the same presence.
+        absent_in: how many copies read it absent.
+    """
+
+    sd: float | None
+    low: float | int | None
+    high: float | int | None
+    stable: bool
+    absent_in: int = 0
+
+    def to_json(self) -> dict:
+        def r(v: float | int | None) -> float | int | None:
+            return round(v, 6) if isinstance(v, float) else v
+
+        return {"sd": r(self.sd), "low": r(self.low), "high": r(self.high),
+                "stable": self.stable, "absent_in_copies": self.absent_in}
+
+
+def exact(value: float | int | None) -> Spread:
+    """The spread of a value read without noise."""
+    return Spread(None if value is None else 0.0, value, value, True)
+
+
+def _copies(rec: Trajectory, cols: np.ndarray, jn: JointNoise, rng: np.random.Generator
+            ) -> list[Trajectory]:
+    """:data:`REPLICATES` copies of ``rec``: its arm joints smoothed, then fresh noise at
+    each moving joint's level; other columns as they are."""
+    t = np.asarray(rec.t, float)
+    q_all = np.asarray(rec.q, float)
+    q, _ = unwrap(q_all[:, cols])
+    level = jn.effective
+    h0 = float(np.median(np.diff(t)))
+    window = short_window(float(level.max()), h0)
+    grid = to_grid(t, q, window * h0)
+    base = smooth(grid.q, window, 0, grid.h, order=3) if window > 3 else grid.q
+    tt = t - t[0]
+    smooth_q = np.column_stack([np.interp(tt, grid.t, base[:, j]) for j in range(q.shape[1])])
+    moving = level > 0
+    smooth_q[:, ~moving] = q[:, ~moving]
+    out = []
+    for _ in range(REPLICATES):
+        qc = q_all.copy()
+        qc[:, cols] = smooth_q + rng.standard_normal(q.shape) * level
+        out.append(rec.with_(q=qc))
+    return out
+
+
+def _spread(name: str, value: float | int | None, reads: list[float | int | None]
+            ) -> Spread:
+    d = REGISTRY[name]
+    if d.is_count:
+        counts = [int(v or 0) for v in reads]
+        v = int(value or 0)
+        lo, hi = min([v, *counts]), max([v, *counts])
+        sd = float(np.std(counts, ddof=1)) if len(counts) > 1 else 0.0
+        return Spread(sd, lo, hi, lo == hi)
+    present = [float(v) for v in reads if v is not None]
+    absent = len(reads) - len(present)
+    if value is None:
+        if not present:
+            return Spread(None, None, None, True, absent)
+        return Spread(None, min(present), max(present), False, absent)
+    if len(present) < 2:
+        return Spread(None, float(value), float(value), False, absent)
+    sd = float(np.std(present, ddof=1))
+    half = T95 * sd
+    return Spread(sd, float(value) - half, float(value) + half, absent == 0, absent)
+
+
+def attach(m, rec: Trajectory, jn: JointNoise,
+           measure_once: Callable[[Trajectory, JointNoise | None], tuple]) -> None:
+    """Give ``m`` (a :class:`.measured.Measured` of ``rec``, whose joints' noise is
+    ``jn``) its uncertainty, and R411 when a count or a presence is not stable."""
+    value = m.descriptors
+    if float(jn.effective.max(initial=0.0)) <= COMPUTED_NOISE:
+        m.uncertainty = {k: exact(value[k]) for k in REGISTRY}
+        return
+    from ..robot.load import load_arm
+
+    arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
+    cols = rec.columns(arm.joint_names)
+    rng = np.random.default_rng(SEED)
+    reads = []
+    for copy in _copies(rec, cols, jn, rng):
+        try:
+            reads.append(measure_once(copy, jn)[0].descriptors)
+        except AouError:  # a copy the noise made unreadable adds nothing
+            continue
+    if len(reads) < 2:
+        m.uncertainty = {k: Spread(None, value[k], value[k], False) for k in REGISTRY}
+    else:
+        m.uncertainty = {k: _spread(k, value[k], [r[k] for r in reads]) for k in REGISTRY}
+    shaky = [k for k, s in m.uncertainty.items() if not s.stable]
+    if shaky:
+        noise = float(jn.effective.max())
+        what = "; ".join(_shaky_text(k, value[k], m.uncertainty[k], len(reads))
+                         for k in shaky)
+        m.diagnostics.append(diag(
+            R411, f"the joints' noise ({noise:.2g} rad) is more than this recording's "
+            f"segmentation bears: {what}. These descriptors are not to be trusted",
+            Span.whole_file(rec.path),
+            hint="log at a higher rate or with less noise; a longer pause or a slower "
+            "motion stands out of the noise better",
+            noise=noise, descriptors=shaky))
+
+
+def _shaky_text(name: str, value, s: Spread, n: int) -> str:
+    def v(x) -> str:
+        return "absent" if x is None else (f"{x:.4g}" if isinstance(x, float) else str(x))
+
+    if REGISTRY[name].is_count:
+        return f"{name} reads {v(value)}, from {s.low} to {s.high} in {n} re-noised copies"
+    return (f"{name} reads {v(value)}, absent in {s.absent_in} of {n} re-noised copies"
+            if s.absent_in else f"{name} reads {v(value)}, present in "
+            f"{n - s.absent_in} of {n} re-noised copies")
+
+
+def half_width(s: Spread, value: float | int | None) -> float | None:
+    """The interval's larger distance from the value (None when absent)."""
+    if value is None or s.low is None or s.high is None:
+        return None
+    return max(float(value) - float(s.low), float(s.high) - float(value))
+
