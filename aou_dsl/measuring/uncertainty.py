@@ -7,8 +7,10 @@ doing it again. The recording is smoothed (the measurement's own velocity filter
 position filter), fresh noise at each joint's estimated level is added, and the copy is
 measured with the recording's own filters and thresholds (its noise pinned, not
 re-estimated). :data:`REPLICATES` copies give each descriptor a std; its 95 % interval is
-the value +- Student's t of that many copies times the std. The interval covers what the
-noise moves; docs/measure.md gives the coverage measured over simulated recordings.
+the value +- Student's t of that many copies times the std, widened to take in the value
+less what the noise adds on average (the copies' mean beside the smoothed recording's
+own reading: the larger of noisy readings is biased up), and for a duration a sampling
+step at each edge. docs/measure.md gives the coverage measured over simulated recordings.
 
 A count or a presence that differs between the copies is a segmentation the noise can
 flip: its interval spans what the copies read, and R411 names it with the noise level.
@@ -74,8 +76,9 @@ def exact(value: float | int | None) -> Spread:
 
 def _copies(rec: Trajectory, cols: np.ndarray, jn: JointNoise, rng: np.random.Generator
             ) -> list[Trajectory]:
-    """:data:`REPLICATES` copies of ``rec``: its arm joints smoothed, then fresh noise at
-    each moving joint's level; other columns as they are."""
+    """``rec`` with its arm joints smoothed (the base), then :data:`REPLICATES` copies
+    of the base with fresh noise at each moving joint's level; other columns as they
+    are."""
     t = np.asarray(rec.t, float)
     q_all = np.asarray(rec.q, float)
     q, _ = unwrap(q_all[:, cols])
@@ -88,7 +91,9 @@ def _copies(rec: Trajectory, cols: np.ndarray, jn: JointNoise, rng: np.random.Ge
     smooth_q = np.column_stack([np.interp(tt, grid.t, base[:, j]) for j in range(q.shape[1])])
     moving = level > 0
     smooth_q[:, ~moving] = q[:, ~moving]
-    out = []
+    base_q = q_all.copy()
+    base_q[:, cols] = smooth_q
+    out = [rec.with_(q=base_q)]
     for _ in range(REPLICATES):
         qc = q_all.copy()
         qc[:, cols] = smooth_q + rng.standard_normal(q.shape) * level
@@ -96,26 +101,36 @@ def _copies(rec: Trajectory, cols: np.ndarray, jn: JointNoise, rng: np.random.Ge
     return out
 
 
-def _spread(name: str, value: float | int | None, reads: list[float | int | None]
-            ) -> Spread:
+def _spread(name: str, value: float | int | None, base: float | int | None,
+            reads: list[float | int | None], step: float) -> Spread:
+    """The spread of descriptor ``name`` read ``value`` in the recording, ``base`` in
+    its smoothed base and ``reads`` in the re-noised copies; ``step`` the sampling
+    step [s]."""
     d = REGISTRY[name]
     if d.is_count:
         counts = [int(v or 0) for v in reads]
-        v = int(value or 0)
-        lo, hi = min([v, *counts]), max([v, *counts])
+        v, b = int(value or 0), int(base or 0)
+        lo, hi = min([v, b, *counts]), max([v, b, *counts])
         sd = float(np.std(counts, ddof=1)) if len(counts) > 1 else 0.0
         return Spread(sd, lo, hi, lo == hi)
     present = [float(v) for v in reads if v is not None]
     absent = len(reads) - len(present)
     if value is None:
-        if not present:
+        if not present and base is None:
             return Spread(None, None, None, True, absent)
-        return Spread(None, min(present), max(present), False, absent)
-    if len(present) < 2:
-        return Spread(None, float(value), float(value), False, absent)
+        seen = present + ([] if base is None else [float(base)])
+        return Spread(None, min(seen), max(seen), False, absent)
+    v = float(value)
+    if len(present) < 2 or base is None:
+        return Spread(None, v, v, False, absent)
     sd = float(np.std(present, ddof=1))
-    half = T95 * sd
-    return Spread(sd, float(value) - half, float(value) + half, absent == 0, absent)
+    # What the noise adds on average (the larger of noisy readings is biased up, a
+    # peak-to-peak range grows with the noise): the copies' mean beside the base's.
+    corrected = v - (float(np.mean(present)) - float(base))
+    # Each of a duration's two edges falls on a sample: known to a step at best.
+    half = T95 * sd + (2 * step if d.unit == "s" else 0.0)
+    return Spread(sd, min(v, corrected) - half, max(v, corrected) + half, absent == 0,
+                  absent)
 
 
 def attach(m, rec: Trajectory, jn: JointNoise,
@@ -131,16 +146,23 @@ def attach(m, rec: Trajectory, jn: JointNoise,
     arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
     cols = rec.columns(arm.joint_names)
     rng = np.random.default_rng(SEED)
+    base, *copies = _copies(rec, cols, jn, rng)
     reads = []
-    for copy in _copies(rec, cols, jn, rng):
+    for copy in copies:
         try:
             reads.append(measure_once(copy, jn)[0].descriptors)
         except AouError:  # a copy the noise made unreadable adds nothing
             continue
-    if len(reads) < 2:
+    try:
+        smooth_read = measure_once(base, jn)[0].descriptors
+    except AouError:
+        smooth_read = None
+    if len(reads) < 2 or smooth_read is None:
         m.uncertainty = {k: Spread(None, value[k], value[k], False) for k in REGISTRY}
     else:
-        m.uncertainty = {k: _spread(k, value[k], [r[k] for r in reads]) for k in REGISTRY}
+        step = float(np.median(np.diff(np.asarray(rec.t, float))))
+        m.uncertainty = {k: _spread(k, value[k], smooth_read[k], [r[k] for r in reads],
+                                    step) for k in REGISTRY}
     shaky = [k for k, s in m.uncertainty.items() if not s.stable]
     if shaky:
         noise = float(jn.effective.max())
