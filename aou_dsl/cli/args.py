@@ -13,12 +13,14 @@ from collections.abc import Callable
 
 from ..version import __version__
 
-__all__ = ["EXIT_ERRORS", "EXIT_INTERRUPTED", "EXIT_OK", "EXIT_USAGE", "build_parser", "number",
-           "usage_error"]
+__all__ = ["EXIT_ERRORS", "EXIT_INCONCLUSIVE", "EXIT_INTERRUPTED", "EXIT_OK", "EXIT_USAGE",
+           "build_parser", "number", "usage_error"]
 
 EXIT_OK = 0
 EXIT_ERRORS = 1
 EXIT_USAGE = 2
+#: ``measure --against``: nothing failed, but the noise leaves a descriptor undecided.
+EXIT_INCONCLUSIVE = 3
 #: Interrupted (Ctrl-C): 128 + SIGINT, as shells report it.
 EXIT_INTERRUPTED = 130
 
@@ -272,7 +274,9 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     _recording(meas)
     meas.add_argument("--against", metavar="FILE.aou",
                       help="judge the motion against this behaviour: each descriptor "
-                      "declared vs measured with its tolerance; exit 1 when one is outside")
+                      "declared vs measured with its tolerance and the measured value's "
+                      "95 %% interval; exit 1 when one is outside, 3 when none is but one "
+                      "is inconclusive")
     meas.add_argument("--format", choices=("table", "json", "github"), default="table",
                       help="github: annotations (with --against)")
     c["robot"] = rob = sub.add_parser(

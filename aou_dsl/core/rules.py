@@ -357,6 +357,16 @@ _RULE_LIST = [
          "warning names the noise level and the descriptors it affects, and a judgement "
          "against a behaviour file reads them as inconclusive.",
          "aouc measure noisy.csv --robot panda   # 1e-3 rad of noise at 250 Hz"),
+    Rule("R412", "inconclusive", _W,
+         "A recording measured against a behaviour file shows a descriptor whose 95 % "
+         "interval straddles its tolerance's edge, or a count or presence its noise can "
+         "flip: neither a pass nor a fail.",
+         "Its noise leaves the descriptor undecided: passing it would claim what the "
+         "recording does not show, failing it would blame the motion for the logger's "
+         "noise. `aouc measure --against` exits 3 when nothing fails but something is "
+         "inconclusive.",
+         "aouc measure noisy.csv --against hesitant.aou   # approach 0.05 +- 0.004, "
+         "tolerance +-0.0015"),
     Rule("I501", "cannot-read", _E,
          "An input file or folder cannot be read (missing, a directory, permissions, encoding).",
          "Nothing can be checked or compiled.",

@@ -13,7 +13,8 @@ own reading: the larger of noisy readings is biased up), and for a duration a sa
 step at each edge. docs/measure.md gives the coverage measured over simulated recordings.
 
 A count or a presence that differs between the copies is a segmentation the noise can
-flip: its interval spans what the copies read, and R411 names it with the noise level.
+flip: its interval spans what the copies read, and R411 names it with the noise level;
+so does a value whose interval reaches more than 20 % of itself from it.
 A trajectory without noise (compiled, or computed by a planner) is measured exactly:
 every interval is the value itself.
 """
@@ -108,12 +109,12 @@ def _spread(name: str, value: float | int | None, base: float | int | None,
     step [s]."""
     d = REGISTRY[name]
     if d.is_count:
-        counts = [int(v or 0) for v in reads]
-        v, b = int(value or 0), int(base or 0)
-        lo, hi = min([v, b, *counts]), max([v, b, *counts])
+        counts = [int(c or 0) for c in reads]
+        n, b = int(value or 0), int(base or 0)
+        lo, hi = min([n, b, *counts]), max([n, b, *counts])
         sd = float(np.std(counts, ddof=1)) if len(counts) > 1 else 0.0
         return Spread(sd, lo, hi, lo == hi)
-    present = [float(v) for v in reads if v is not None]
+    present = [float(r) for r in reads if r is not None]
     absent = len(reads) - len(present)
     if value is None:
         if not present and base is None:
@@ -163,7 +164,7 @@ def attach(m, rec: Trajectory, jn: JointNoise,
         step = float(np.median(np.diff(np.asarray(rec.t, float))))
         m.uncertainty = {k: _spread(k, value[k], smooth_read[k], [r[k] for r in reads],
                                     step) for k in REGISTRY}
-    shaky = [k for k, s in m.uncertainty.items() if not s.stable]
+    shaky = [k for k, s in m.uncertainty.items() if not s.stable or _vague(k, value[k], s)]
     if shaky:
         noise = float(jn.effective.max())
         what = "; ".join(_shaky_text(k, value[k], m.uncertainty[k], len(reads))
@@ -177,15 +178,32 @@ def attach(m, rec: Trajectory, jn: JointNoise,
             noise=noise, descriptors=shaky))
 
 
+#: A value whose 95 % interval reaches further than this fraction of itself from it is
+#: too vague to report without a warning (near zero: :data:`VAGUE_TOLERANCES` times the
+#: descriptor's absolute tolerance).
+VAGUE = 0.2
+VAGUE_TOLERANCES = 3.0
+
+
+def _vague(name: str, value: float | int | None, s: Spread) -> bool:
+    half = half_width(s, value)
+    if half is None or REGISTRY[name].is_count or value is None:
+        return False
+    return half > max(VAGUE * abs(float(value)), VAGUE_TOLERANCES * REGISTRY[name].abs_tol)
+
+
 def _shaky_text(name: str, value, s: Spread, n: int) -> str:
     def v(x) -> str:
         return "absent" if x is None else (f"{x:.4g}" if isinstance(x, float) else str(x))
 
+    if s.stable:
+        return f"{name} reads {v(value)}, 95 % interval {v(s.low)} to {v(s.high)}"
+
     if REGISTRY[name].is_count:
         return f"{name} reads {v(value)}, from {s.low} to {s.high} in {n} re-noised copies"
-    return (f"{name} reads {v(value)}, absent in {s.absent_in} of {n} re-noised copies"
-            if s.absent_in else f"{name} reads {v(value)}, present in "
-            f"{n - s.absent_in} of {n} re-noised copies")
+    if value is None:
+        return f"{name} reads absent, present in {n - s.absent_in} of {n} re-noised copies"
+    return f"{name} reads {v(value)}, absent in {s.absent_in} of {n} re-noised copies"
 
 
 def half_width(s: Spread, value: float | int | None) -> float | None:
