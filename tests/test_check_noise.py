@@ -76,3 +76,22 @@ def test_a_real_violation_hidden_in_noise_still_fails(hesitant):
         assert acc.ok is not fails, acc
         if fails:
             assert acc.joint == "panda_joint2" and 2.8 <= acc.time <= 3.2
+
+
+def test_plot_of_a_recording_draws_the_filtered_speed_over_the_raw(hesitant):
+    """The speed panel of a noisy recording: the filtered speed (the filter measure and
+    check use) in front, the raw differences faint behind it. During the first pause
+    (the arm still, 2.5 to 3.8 s) the raw speed is mostly noise, the filtered one
+    several times quieter."""
+    from aou_dsl.media.plot import profile_data, profile_figure
+
+    rec = record(hesitant, Logger(rate=1000.0, jitter=0.05, noise=3e-4, seed=2),
+                 dynamic=False)
+    d = profile_data(_trajectory(rec))
+    assert len(d.raw_speed) == len(rec["t"]) and d.noise == pytest.approx(3e-4, rel=0.2)
+    still = (d.t > 2.5) & (d.t < 3.8)
+    raw_still = (d.raw_t > 2.5) & (d.raw_t < 3.8)
+    assert np.median(d.speed[still]) < 0.25 * np.median(d.raw_speed[raw_still])
+    lines = profile_figure(d).axes[0].get_lines()
+    assert [ln.get_alpha() is not None and ln.get_alpha() < 0.5 for ln in lines] == [
+        True, False]
