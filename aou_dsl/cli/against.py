@@ -54,14 +54,24 @@ def format_verdict(verdict) -> str:
     return "\n".join(lines)
 
 
-def cmd_measure_against(args: argparse.Namespace, read_kw: dict) -> int:
-    """Run ``aouc measure PATH --against FILE.aou`` (``read_kw``: how to read PATH)."""
-    from ..api import read_trajectory
+def cmd_measure_against(args: argparse.Namespace, read) -> int:
+    """Run ``aouc measure PATH --against FILE.aou`` (``read(path, args, **kw)`` reads
+    PATH). A recording that names no robot (a bare CSV without ``--robot``) is read
+    with the behaviour's."""
+    from ..core.diagnostics import AouError
     from ..lang.linter import lint_file
     from ..measuring.verdict import judge
 
     lint = lint_file(args.against)
-    verdict = judge(read_trajectory(args.path, **read_kw), lint)
+    try:
+        rec = read(args.path, args)
+    except AouError as e:
+        b = lint.behaviour
+        if args.robot or b is None or not any(
+                d.code == "I501" and "without its robot" in d.message for d in e.diagnostics):
+            raise
+        rec = read(args.path, args, robot=b.settings.robot)
+    verdict = judge(rec, lint)
     outside: list[Diagnostic] = verdict.outside() + verdict.undecided()
     sources = {lint.path: lint.source or ""}
     if args.format == "json":

@@ -56,6 +56,23 @@ def _read_kw(args: argparse.Namespace) -> dict:
             "package_dirs": _package_dirs(args)}
 
 
+def read_motion(path: str, args: argparse.Namespace, **kw):
+    """``path`` read as measure, check and plot read it: :func:`read_trajectory` with the
+    command's options (``kw`` overrides them), its columns renamed by ``--map``."""
+    from ..api import read_trajectory
+
+    options = _read_kw(args) | kw
+    spec = getattr(args, "map", None)
+    if not spec or path.endswith(".aou"):
+        return read_trajectory(path, **options)
+    from ..core.options import package_dirs as absolute
+    from ..measuring.columns import column_map
+    from ..measuring.recording import read_recording
+
+    options["package_dirs"] = absolute(options["package_dirs"])
+    return read_recording(path, columns=column_map(spec), **options)
+
+
 def _reads(args: argparse.Namespace, paths: Sequence[str]) -> list[str]:
     """Every file the command reads (the output rule keeps its outputs off them)."""
     from ..robot.files_read import files_read
@@ -178,14 +195,14 @@ def _cmd_compile(args: argparse.Namespace) -> int:
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
-    from ..api import check, read_trajectory
+    from ..api import check
     from .report import format_check
 
     if args.fit or args.write_fitted:
         from .fitted import check_fitted
 
         return check_fitted(args, _read_kw(args))
-    tr = read_trajectory(args.path, **_read_kw(args))
+    tr = read_motion(args.path, args)
     from ..robot import robot_diagnostics
 
     named = Span.whole_file("<command line>" if args.robot else args.path)  # the robot
@@ -221,15 +238,15 @@ def _check_diagnostics(path: str, report) -> list[Diagnostic]:
 
 
 def _cmd_measure(args: argparse.Namespace) -> int:
-    from ..api import measure, read_trajectory
+    from ..api import measure
     from ..lang.cv import missing_descriptors
     from .report import format_measured
 
     if args.against:
         from .against import cmd_measure_against
 
-        return cmd_measure_against(args, _read_kw(args))
-    tr = read_trajectory(args.path, **_read_kw(args))
+        return cmd_measure_against(args, read_motion)
+    tr = read_motion(args.path, args)
     m = measure(tr)
     missing = missing_descriptors(tr.goal)  # what the C-V point could not use
     if args.format == "json":
@@ -249,12 +266,13 @@ def _cmd_measure(args: argparse.Namespace) -> int:
 
 
 def _cmd_plot(args: argparse.Namespace) -> int:
-    from ..api import read_trajectory
     from ..core.files import check_output
     from ..lang.linter import lint_paths
     from ..media.plot import FORMATS, cv_figure, profile_data, profile_figure, save
 
     reads = _reads(args, args.paths)
+    if args.map and "=" not in args.map:  # a mapping file is an input too
+        reads.append(args.map)
     check_output(args.output, FORMATS, reads=reads)
     if args.cv:
         results, problems = lint_paths(args.paths)
@@ -267,7 +285,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
         print("aouc: plot takes one file (or --cv with several)", file=sys.stderr)
         return EXIT_USAGE
     else:
-        tr = read_trajectory(args.paths[0], **_read_kw(args))
+        tr = read_motion(args.paths[0], args)
         data = profile_data(tr)
         _print_diags(list(data.diagnostics))  # R405: no goal, no goal-distance panel
         fig = profile_figure(data)
