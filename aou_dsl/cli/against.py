@@ -58,6 +58,7 @@ def cmd_measure_against(args: argparse.Namespace, read) -> int:
     """Run ``aouc measure PATH --against FILE.aou`` (``read(path, args, **kw)`` reads
     PATH). A recording that names no robot (a bare CSV without ``--robot``) is read
     with the behaviour's."""
+    from ..core.codes import I501
     from ..core.diagnostics import AouError
     from ..lang.linter import lint_file
     from ..measuring.verdict import judge
@@ -68,7 +69,7 @@ def cmd_measure_against(args: argparse.Namespace, read) -> int:
     except AouError as e:
         b = lint.behaviour
         if args.robot or b is None or not any(
-                d.code == "I501" and "without its robot" in d.message for d in e.diagnostics):
+                d.code == I501 and "without its robot" in d.message for d in e.diagnostics):
             raise
         rec = read(args.path, args, robot=b.settings.robot)
     verdict = judge(rec, lint)

@@ -57,20 +57,18 @@ def _read_kw(args: argparse.Namespace) -> dict:
 
 
 def read_motion(path: str, args: argparse.Namespace, **kw):
-    """``path`` read as measure, check and plot read it: :func:`read_trajectory` with the
-    command's options (``kw`` overrides them), its columns renamed by ``--map``."""
+    """``path`` read with the command's options (``kw`` overrides them) and ``--map``."""
     from ..api import read_trajectory
 
-    options = _read_kw(args) | kw
-    spec = getattr(args, "map", None)
+    options, spec = _read_kw(args) | kw, getattr(args, "map", None)
     if not spec or path.endswith(".aou"):
         return read_trajectory(path, **options)
     from ..core.options import package_dirs as absolute
     from ..measuring.columns import column_map
     from ..measuring.recording import read_recording
 
-    options["package_dirs"] = absolute(options["package_dirs"])
-    return read_recording(path, columns=column_map(spec), **options)
+    dirs = {"package_dirs": absolute(options["package_dirs"])}
+    return read_recording(path, columns=column_map(spec), **(options | dirs))
 
 
 def _reads(args: argparse.Namespace, paths: Sequence[str]) -> list[str]:

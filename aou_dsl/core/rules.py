@@ -356,7 +356,7 @@ _RULE_LIST = [
          "A count or a presence that the noise can flip is a guess, not a measurement; the "
          "warning names the noise level and the descriptors it affects, and a judgement "
          "against a behaviour file reads them as inconclusive.",
-         "aouc measure noisy.csv --robot panda   # 1e-3 rad of noise at 250 Hz"),
+         "a 250 Hz recording of the hesitant behaviour with 1e-3 rad of joint noise"),
     Rule("R412", "inconclusive", _W,
          "A recording measured against a behaviour file shows a descriptor whose 95 % "
          "interval straddles its tolerance's edge, or a count or presence its noise can "
@@ -365,8 +365,8 @@ _RULE_LIST = [
          "recording does not show, failing it would blame the motion for the logger's "
          "noise. `aouc measure --against` exits 3 when nothing fails but something is "
          "inconclusive.",
-         "aouc measure noisy.csv --against hesitant.aou   # approach 0.05 +- 0.004, "
-         "tolerance +-0.0015"),
+         "a retreat's peak acceleration measured 0.1205 +- 0.009 m/s^2 against a declared "
+         "0.12 +- 0.0036"),
     Rule("I501", "cannot-read", _E,
          "An input file or folder cannot be read (missing, a directory, permissions, encoding).",
          "Nothing can be checked or compiled.",

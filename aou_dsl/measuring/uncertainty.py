@@ -43,10 +43,10 @@ T95 = 2.262
 #: The seed of the copies' noise: the same file gives the same intervals.
 SEED = 20240
 #: The error of placing a pause's edges where the motion beside it stops, as a fraction
-#: of the value of the descriptors a duration divides (the refinement's own error on
-#: noisy recordings, about 1 % of the duration over the generated recordings of the
-#: tests, whatever the noise: not something re-noised copies show).
-EDGES = {"pause_duration": 0.01, "tilt_velocity": 0.01}
+#: of a duration or of a speed over one (the refinement's own error on noisy recordings,
+#: about 1 % of the duration over the generated recordings of the tests, whatever the
+#: noise: not something re-noised copies show).
+EDGES = 0.01
 
 
 @dataclass(frozen=True)
@@ -138,7 +138,8 @@ def _spread(name: str, value: float | int | None, base: float | int | None,
     corrected = v - (float(np.mean(present)) - float(base))
     # Each of a duration's two edges falls on a sample (known to a step at best), and
     # is placed by following the motion beside it back to rest (its own error).
-    half = T95 * sd + (2 * step if d.unit == "s" else 0.0) + EDGES.get(name, 0.0) * abs(v)
+    timed = d.unit == "s" or d.unit.endswith("/s")  # a duration, or a speed over one
+    half = T95 * sd + (2 * step if d.unit == "s" else 0.0) + (EDGES * abs(v) if timed else 0.0)
     return Spread(sd, min(v, corrected) - half, max(v, corrected) + half, absent == 0,
                   absent)
 
