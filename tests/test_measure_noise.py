@@ -30,18 +30,12 @@ from aou_dsl.measuring.measured import Measured, measure
 from aou_dsl.measuring.verdict import FAIL, INCONCLUSIVE, PASS, _result
 
 from .conftest import BEHAVIOURS
+from .recsim import NOISE_LEVELS as NOISES
 from .recsim import Logger, record, to_csv_text
+from .recsim import noisy as logger
 from .test_recordings import build, generated
 
-NOISES = (1e-4, 3e-4, 6e-4, 1e-3)
 GOAL = ("--goal", "0.55,0,0.25")
-
-
-def logger(noise: float, rate: float, seed: int) -> Logger:
-    """A logger with encoder noise, a 5 % jittered clock, 0.5 % dropped samples and a
-    24-bit encoder's resolution."""
-    return Logger(rate=rate, jitter=0.05, drop=0.005, noise=noise, quantum=2.6e-7,
-                  seed=seed)
 
 
 def logged(doc: dict, log: Logger) -> tuple[dict, Measured]:
