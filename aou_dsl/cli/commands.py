@@ -58,6 +58,21 @@ def _read_kw(args: argparse.Namespace) -> dict:
             "package_dirs": _package_dirs(args)}
 
 
+def read_motion(path: str, args: argparse.Namespace, **kw):
+    """``path`` read with the command's options (``kw`` overrides them) and ``--map``."""
+    from ..api import read_trajectory
+
+    options, spec = _read_kw(args) | kw, getattr(args, "map", None)
+    if not spec or path.endswith(".aou"):
+        return read_trajectory(path, **options)
+    from ..core.options import package_dirs as absolute
+    from ..measuring.columns import column_map
+    from ..measuring.recording import read_recording
+
+    dirs = {"package_dirs": absolute(options["package_dirs"])}
+    return read_recording(path, columns=column_map(spec), **(options | dirs))
+
+
 def _reads(args: argparse.Namespace, paths: Sequence[str]) -> list[str]:
     """Every file the command reads (the output rule keeps its outputs off them)."""
     from ..robot.files_read import files_read
@@ -167,7 +182,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
-    from ..api import check, read_trajectory
+    from ..api import check
     from .ci_cmd import robot_refusals
     from .report import format_check
     from .track_cmd import check_tracking, nothing_to_track
@@ -181,7 +196,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
 
         return check_fitted(args, _read_kw(args))
     with nothing_to_track(args):  # the arm refuses the file: --track says what to do
-        tr = read_trajectory(args.path, **_read_kw(args))
+        tr = read_motion(args.path, args)
     refused = robot_refusals(args, tr)
     _print_diags(refused)
     if any(d.severity == Severity.ERROR for d in refused):
@@ -219,15 +234,15 @@ def _check_diagnostics(path: str, report) -> list[Diagnostic]:
 
 
 def _cmd_measure(args: argparse.Namespace) -> int:
-    from ..api import measure, read_trajectory
+    from ..api import measure
     from ..lang.cv import missing_descriptors
     from .report import format_measured
 
     if args.against:
         from .against import cmd_measure_against
 
-        return cmd_measure_against(args, _read_kw(args))
-    tr = read_trajectory(args.path, **_read_kw(args))
+        return cmd_measure_against(args, read_motion)
+    tr = read_motion(args.path, args)
     m = measure(tr)
     missing = missing_descriptors(tr.goal)  # what the C-V point could not use
     if args.format == "json":
@@ -247,12 +262,13 @@ def _cmd_measure(args: argparse.Namespace) -> int:
 
 
 def _cmd_plot(args: argparse.Namespace) -> int:
-    from ..api import read_trajectory
     from ..core.files import check_output
     from ..lang.linter import lint_paths
     from ..media.plot import FORMATS, cv_figure, profile_data, profile_figure, save
 
     reads = _reads(args, args.paths)
+    if args.map and "=" not in args.map:  # a mapping file is an input too
+        reads.append(args.map)
     check_output(args.output, FORMATS, reads=reads)
     if args.cv:
         results, problems = lint_paths(args.paths)
@@ -265,7 +281,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
         print("aouc: plot takes one file (or --cv with several)", file=sys.stderr)
         return EXIT_USAGE
     else:
-        tr = read_trajectory(args.paths[0], **_read_kw(args))
+        tr = read_motion(args.paths[0], args)
         data = profile_data(tr)
         _print_diags(list(data.diagnostics))  # R405: no goal, no goal-distance panel
         fig = profile_figure(data)

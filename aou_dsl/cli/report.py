@@ -139,6 +139,32 @@ def format_check(path: str, robot: str, t, report) -> str:
     return "\n".join(lines)
 
 
+def _interval(value, spread) -> str:
+    """A descriptor's 95 % interval beside its value: ``+- x`` around a value (``+0.1
+    -0.02`` when lopsided), ``4..6`` for a count or a presence the noise can flip,
+    ``exact`` for a value read without noise."""
+    if spread is None:
+        return ""
+    lo, hi = spread.low, spread.high
+    if value is None and spread.stable:
+        return ""
+    if value is None or isinstance(value, int) and not isinstance(value, bool):
+        if lo == hi and spread.stable:
+            return "exact"
+
+        def v(x) -> str:
+            return "absent" if x is None else (f"{x:.4g}" if isinstance(x, float) else str(x))
+        return f"({v(lo)}..{v(hi)})"
+    if lo is None or hi is None:
+        return "(unstable)"
+    up, down = hi - value, value - lo
+    if up <= 0 and down <= 0:
+        return "exact"
+    if abs(up - down) <= 0.1 * max(up, down):
+        return f"+- {max(up, down):.2g}"
+    return f"+{up:.2g} -{down:.2g}"
+
+
 def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = ()) -> str:
     """``aouc measure``: the eleven descriptors as a table, and the C-V point; ``missing``:
     the descriptors the point could not use (:func:`aou_dsl.lang.cv.missing_descriptors`)."""
@@ -149,7 +175,8 @@ def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = 
 
     for k, v in m.descriptors.items():
         val = "null" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
-        lines.append(f"  {k:<22} {val:>10} {REGISTRY[k].unit}".rstrip())
+        lines.append(f"  {k:<22} {val:>10} {_interval(v, m.uncertainty.get(k)):<14} "
+                     f"{REGISTRY[k].unit}".rstrip())
     los = m.line_of_sight
     if los is not None and len(los.angle):
         # The model assumes the hand looks at the goal throughout: how far it did not.

@@ -351,6 +351,24 @@ _RULE_LIST = [
          "image, a stream) from taking the machine's memory. Set AOU_MAX_INPUT_MB or "
          "AOU_MAX_SAMPLES to read larger ones.",
          "aouc measure huge.npz   # its q.npy claims 1,000,000,000 samples"),
+    Rule("R411", "noise-beyond-segmentation", _W,
+         "A recording's joint noise is more than its segmentation bears: copies of it "
+         "re-noised at the noise level aou estimated read a different count, or find a "
+         "descriptor present that the recording reads absent (or the reverse).",
+         "A count or a presence that the noise can flip is a guess, not a measurement; the "
+         "warning names the noise level and the descriptors it affects, and a judgement "
+         "against a behaviour file reads them as inconclusive.",
+         "a 250 Hz recording of the hesitant behaviour with 1e-3 rad of joint noise"),
+    Rule("R412", "inconclusive", _W,
+         "A recording measured against a behaviour file shows a descriptor whose 95 % "
+         "interval straddles its tolerance's edge, or a count or presence its noise can "
+         "flip: neither a pass nor a fail.",
+         "Its noise leaves the descriptor undecided: passing it would claim what the "
+         "recording does not show, failing it would blame the motion for the logger's "
+         "noise. `aouc measure --against` exits 3 when nothing fails but something is "
+         "inconclusive.",
+         "a retreat's peak acceleration measured 0.1205 +- 0.009 m/s^2 against a declared "
+         "0.12 +- 0.0036"),
     Rule("I501", "cannot-read", _E,
          "An input file or folder cannot be read (missing, a directory, permissions, encoding).",
          "Nothing can be checked or compiled.",
