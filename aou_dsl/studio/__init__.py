@@ -20,8 +20,10 @@ __all__ = ["serve"]
 def serve(path: str, *, robot: str | None = None, host: str = "127.0.0.1", port: int = 8080,
           compare: str | None = None, stop: threading.Event | None = None,
           package_dirs: tuple[str, ...] = (), fit: bool = False) -> int:
-    """Run the studio of ``path`` until interrupted (or ``stop`` is set); the exit status.
-    ``fit``: build as ``aouc compile --fit`` does.
+    """Run the studio of ``path`` until interrupted (or ``stop`` is set); the exit status
+    (130 after Ctrl-C, as every aouc command). ``fit``: build as ``aouc compile --fit``
+    does. The address printed carries the per-run token without which the studio
+    answers nothing.
 
     Raises:
         AouError: the file (or ``compare``) does not build, or the robot cannot be drawn.
@@ -46,6 +48,7 @@ def serve(path: str, *, robot: str | None = None, host: str = "127.0.0.1", port:
         (stop or threading.Event()).wait()
     except KeyboardInterrupt:  # the way to stop it
         print("aouc studio: stopped", file=sys.stderr)
+        return 130
     finally:
         studio.close()
     return 0
