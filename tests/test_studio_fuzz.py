@@ -25,7 +25,6 @@ import pytest
 pytest.importorskip("viser", reason="the studio extra is missing: pip install '.[studio]'")
 
 import msgspec
-import viser
 
 from .test_studio_gate import _open, _wait_idle
 

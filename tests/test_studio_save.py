@@ -6,7 +6,6 @@ line-like characters come before it. What it refuses is said in the page."""
 from __future__ import annotations
 
 import os
-import shutil
 import signal
 import socket
 import subprocess
