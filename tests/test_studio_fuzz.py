@@ -43,7 +43,8 @@ KINDS = ["ShareUrlRequest", "ShareUrlDisconnect", "GuiButtonHoldMessage",
 
 def _camera(rng: random.Random) -> dict:
     n = lambda: rng.choice(NUMBERS)  # noqa: E731
-    return {"type": "ViewerCameraMessage", "wxyz": [n() for _ in range(rng.choice((3, 4)))],
+    return {"type": "ViewerCameraMessage", "wxyz": rng.choice(
+                [[n() for _ in range(rng.choice((3, 4)))], None, 1.0, "wxyz"]),
             "position": [n(), n(), n()], "fov": n(), "near": n(), "far": n(),
             "image_height": rng.choice((480, -1, 2 ** 40, 1.5)),
             "image_width": rng.choice((640, 0, 2 ** 63)), "look_at": [n(), n(), n()],
@@ -58,7 +59,8 @@ def messages(studio, n: int, seed: int) -> list[bytes]:
     controls.update(time=player.time._impl.uuid, speed=player.speed._impl.uuid,
                     loop=player.loop._impl.uuid, pause=player.button._impl.uuid)
     save, reload = studio.save_button._impl.uuid, studio.reload_button._impl.uuid
-    uuids = [*controls.values(), save, reload, "no-such-control", ""]
+    uuids = [*controls.values(), save, reload, "no-such-control", "", None, 5, ["x"],
+             {"a": 1}]
     out = []
     for _ in range(n):
         roll = rng.random()

@@ -172,7 +172,8 @@ class Gate:
         return gated
 
     def _with_cookie(self, response: Any, path: str, port: int) -> Any:
-        if response is not None and self.query_token(path) is not None:
+        given = self.query_token(path)
+        if response is not None and given is not None and self._is_token(given):
             response.headers["Set-Cookie"] = (
                 f"{self.cookie(port)}={self.token}; Path=/; HttpOnly; SameSite=Strict")
         return response

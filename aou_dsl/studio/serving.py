@@ -20,6 +20,7 @@ Two things viser does not offer a hook for, done here in one place:
 
 from __future__ import annotations
 
+import functools
 import math
 import threading
 from collections.abc import Callable, Iterator
@@ -79,51 +80,72 @@ class Inbox:
     """The check of every message a page sends to ``server``: see the module's text.
     ``said(text)`` is told what was refused or changed (to show in the page)."""
 
-    #: The messages a page of the studio sends (its controls, and its camera).
-    KEPT = ("GuiUpdateMessage", "ViewerCameraMessage")
-
     def __init__(self, server: Any, said: Callable[[str], None]) -> None:
         from viser import _messages
 
         self.server, self.said = server, said
         self.refused = 0  # messages dropped or values changed
-        ws = server._websock_server
-        handlers: dict[type, list[Callable[..., Any]]] = ws._incoming_handlers
-        for cls in list(handlers):
-            if cls.__name__ not in self.KEPT:
-                ws.unregister_handler(cls)
+        try:  # viser's own tables: a version without them is refused, not run open
+            ws = server._websock_server
+            handlers: dict[type, list[Callable[..., Any]]] = ws._incoming_handlers
+            self._handles: dict[str, Any] = server.gui._gui_input_handle_from_uuid
+        except AttributeError:
+            server.stop()
+            raise RuntimeError("viser takes a page's messages otherwise than the studio "
+                               "knows: this version of viser cannot be guarded") from None
         update = _messages.GuiUpdateMessage
         self._gui = list(handlers.get(update, ()))
-        ws.unregister_handler(update)
+        if self._gui:
+            ws.unregister_handler(update)
         ws.register_handler(update, self._update)
-        camera = _messages.ViewerCameraMessage
-        self._camera = list(handlers.get(camera, ()))
-        if self._camera:
-            ws.unregister_handler(camera)
-            ws.register_handler(camera, self._camera_moved)
+        self._kept(ws, handlers)
+        ws.on_client_connect(self._connected)
+
+    def _connected(self, conn: Any) -> None:
+        """A page connected: of the handlers viser gave its connection (its camera, its
+        own controls: the studio has none), only the camera's stays, checked. Runs
+        before the connection's first message is read."""
+        self._kept(conn, conn._incoming_handlers, gui=False)
+
+    def _kept(self, owner: Any, handlers: dict[type, list[Callable[..., Any]]],
+              gui: bool = True) -> None:
+        """Of ``owner``'s ``handlers``, drop those of messages a page of the studio does
+        not send, and check the camera's before they run (``gui``: keep the controls'
+        too, already checked)."""
+        for cls in list(handlers):
+            name = cls.__name__
+            if name == "ViewerCameraMessage":
+                inner = list(handlers[cls])
+                owner.unregister_handler(cls)
+                owner.register_handler(cls, functools.partial(self._camera_moved, inner))
+            elif not (gui and name == "GuiUpdateMessage"):
+                owner.unregister_handler(cls)
 
     async def _update(self, client_id: int, message: Any) -> None:
         if not self._checked(message):
             return
         await _each(self._gui, client_id, message)
 
-    async def _camera_moved(self, client_id: int, message: Any) -> None:
-        numbers = (*message.wxyz, *message.position, message.fov, message.near,
-                   message.far, *message.look_at, *message.up_direction)
-        if (len(message.wxyz), len(message.position), len(message.look_at),
-                len(message.up_direction)) != (4, 3, 3, 3) or \
-                not all(_finite(x) for x in numbers) or \
-                not all(_whole(x) and 0 <= x <= 1 << 16
-                        for x in (message.image_height, message.image_width)):
+    async def _camera_moved(self, inner: list[Callable[..., Any]], client_id: int,
+                            message: Any) -> None:
+        if self._checked_camera(message):
+            await _each(inner, client_id, message)
+
+    def _checked_camera(self, message: Any) -> bool:
+        m = message
+        if not (_vector(m.wxyz, 4) and _vector(m.position, 3) and _vector(m.look_at, 3)
+                and _vector(m.up_direction, 3) and _vector((m.fov, m.near, m.far), 3)
+                and all(_whole(x) and 0 <= x <= 1 << 16
+                        for x in (m.image_height, m.image_width))):
             self.refused += 1
-            return
-        await _each(self._camera, client_id, message)
+            return False
+        return True
 
     def _checked(self, message: Any) -> bool:
         """Whether ``message`` may go on; it is made to hold the checked value."""
         import viser
 
-        handle = self.server.gui._gui_input_handle_from_uuid.get(message.uuid)
+        handle = self._handles.get(message.uuid) if isinstance(message.uuid, str) else None
         updates = message.updates
         if handle is None or not isinstance(updates, dict) or set(updates) != {"value"}:
             return self._refuse("the page may change a control's value, nothing else"
@@ -181,6 +203,11 @@ def _finite(x: Any) -> bool:
         return math.isfinite(float(x))
     except OverflowError:  # an integer past a float's range
         return False
+
+
+def _vector(xs: Any, n: int) -> bool:
+    """``xs`` is ``n`` finite numbers."""
+    return isinstance(xs, (list, tuple)) and len(xs) == n and all(_finite(x) for x in xs)
 
 
 def _whole(x: Any) -> bool:
