@@ -4,7 +4,10 @@ shape it live (the ``studio`` extra: viser, yourdfpy, watchfiles).
 - :mod:`.engine`: the one door to the pipeline (build, measure, keep the last good);
 - :mod:`.app`: the wiring; :mod:`.view3d`: the 3D scene; :mod:`.controls`: the player
   and the sliders; :mod:`.plots`: the numbers; :mod:`.edits`: Save's rewrite of the
-  text; :mod:`.watch`: reloading when the file changes on disk.
+  text; :mod:`.disk`: reading the file and Save's checks; :mod:`.watch`: reloading when
+  the file changes on disk;
+- :mod:`.gate`: only the printed address's page is answered (token, Host, Origin);
+  :mod:`.serving`: viser's server behind it, and the check of what a page sends.
 
 docs/studio.md says how to use it.
 """

@@ -23,7 +23,9 @@ import time
 from typing import TYPE_CHECKING, Any
 
 from ..core.diagnostics import AouError, Severity
+from .disk import Disk
 from .engine import Engine, Motion
+from .gate import Gate
 
 if TYPE_CHECKING:
     from ..core.trajectory import Trajectory
@@ -71,11 +73,7 @@ class Studio:
         self.drawn: Trajectory | None = None  # the motion playing
         self.previewed = 0  # counts the motions played before their checks
         self._busy = threading.Lock()
-        from .gate import Gate
-
-        self.gate = Gate(host)
-        from .disk import Disk
-
+        self.gate = Gate(host)  # the per-run token and the check of who asks
         self.disk = Disk(path)
         self.base_bytes = b""  # the file's bytes the sliders' text comes from
         self.shown_base = b""  # ... and those the motion shown comes from (Save's check)

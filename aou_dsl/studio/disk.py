@@ -71,11 +71,14 @@ class Disk:
                               "studio read it; saving would lose that edit. Reload takes "
                               "the file's text (the values set here go)")
         folder, name = os.path.split(self.target)
-        dfd = os.open(folder or ".", os.O_RDONLY | os.O_DIRECTORY)
         try:
-            self._replace(dfd, name, data)
-        finally:
-            os.close(dfd)
+            dfd = os.open(folder or ".", os.O_RDONLY | os.O_DIRECTORY)
+            try:
+                self._replace(dfd, name, data)
+            finally:
+                os.close(dfd)
+        except OSError as exc:  # a folder one may not write in, a full disk, ...
+            raise self._error(I502, "save into", exc.strerror or str(exc)) from None
 
     def _replace(self, dfd: int, name: str, data: bytes) -> None:
         before = self._plain(os.stat(name, dir_fd=dfd, follow_symlinks=False))
