@@ -209,3 +209,26 @@ def _wait_idle(studio, timeout: float = 120.0) -> None:
                 return
         time.sleep(0.1)
     raise AssertionError("the studio did not settle")
+
+
+def test_a_viser_that_serves_without_the_gate_is_refused_not_run_open(monkeypatch):
+    """Should viser ever bind its server without the ``websockets`` call the gate
+    wraps, or take a page's messages without the tables the check uses, the studio
+    refuses to start instead of serving unguarded."""
+    from aou_dsl.studio import serving
+
+    stopped = []
+
+    class Unguarded:  # binds some other way: the gate's wrapper is never called
+        def __init__(self, **kwargs):
+            pass
+
+        def stop(self):
+            stopped.append(True)
+
+    monkeypatch.setattr(viser, "ViserServer", Unguarded)
+    with pytest.raises(RuntimeError, match="without aou's check"):
+        serving.open_server(Gate(), "127.0.0.1", 0, "x")
+    with pytest.raises(RuntimeError, match="cannot be guarded"):
+        serving.Inbox(Unguarded(), print)
+    assert stopped == [True, True]
