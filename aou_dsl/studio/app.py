@@ -7,7 +7,12 @@ shown (:mod:`.plots`), Save writes (:mod:`.edits`), the file is watched (:mod:`.
 The file is the truth: the sliders edit its text (:func:`.edits.apply`), the engine
 builds that text, and Save writes the text of the motion shown, so the saved file
 compiles to exactly that motion. A text that fails shows its diagnostics and leaves the
-last good motion on screen. Nothing is written but the file given, and only on Save.
+last good motion on screen. Nothing is written but the file given, and only on Save
+(:mod:`.disk`: never over an edit made on disk since, nor through a link swapped in).
+
+Only the page the command printed drives it: the server answers requests that carry
+its address and its per-run token (:mod:`.gate`), and every value a page sends is
+checked before it reaches viser or the compiler (:mod:`.serving`).
 """
 
 from __future__ import annotations
@@ -18,7 +23,9 @@ import time
 from typing import TYPE_CHECKING, Any
 
 from ..core.diagnostics import AouError, Severity
+from .disk import Disk
 from .engine import Engine, Motion
+from .gate import Gate
 
 if TYPE_CHECKING:
     from ..core.trajectory import Trajectory
@@ -66,24 +73,25 @@ class Studio:
         self.drawn: Trajectory | None = None  # the motion playing
         self.previewed = 0  # counts the motions played before their checks
         self._busy = threading.Lock()
+        self.gate = Gate(host)  # the per-run token and the check of who asks
+        self.disk = Disk(path)
+        self.base_bytes = b""  # the file's bytes the sliders' text comes from
+        self.shown_base = b""  # ... and those the motion shown comes from (Save's check)
 
     # --- start and stop -------------------------------------------------------------
 
     def start(self) -> Studio:
         """Build the file, start serving, draw. Raises AouError when the first build of
         the file fails (there is nothing to show) or a robot cannot be drawn."""
-        from ..core.files import read_text
-
-        first = self._first_motion(read_text)
-        import viser
-
+        first = self._first_motion()
         from . import view3d as scene
         from .controls import Player, Sliders
+        from .serving import Inbox, open_server
 
         with _quiet():  # viser prints its own banner: `aouc studio:` says the address
-            self.server = viser.ViserServer(
-                host=self.host, port=self.asked_port, verbose=False,
-                label=f"aou studio: {os.path.basename(self.path)}")
+            self.server = open_server(self.gate, self.host, self.asked_port,
+                                      f"aou studio: {os.path.basename(self.path)}")
+        self.inbox = Inbox(self.server, self._told)
         self.server.scene.set_up_direction("+z")
         # Plain lights, no shadows nor environment map: a laptop without a GPU (or a
         # browser rendering WebGL in software) keeps a smooth frame rate.
@@ -118,11 +126,12 @@ class Studio:
             self.watcher = None
         return self
 
-    def _first_motion(self, read_text) -> Motion:
+    def _first_motion(self) -> Motion:
         if self.recording:
             first = self.engine.read(self.path)
         else:
-            self.file_text = self.base_text = read_text(self.path)
+            self.base_bytes = self.disk.read()
+            self.file_text = self.base_text = self.disk.text(self.base_bytes)
             first = self.engine.build(self.file_text, self.path)
         if not first.ok or first.trajectory is None:
             raise AouError([d for d in first.diagnostics if d.severity == Severity.ERROR])
@@ -147,8 +156,8 @@ class Studio:
 
     @property
     def url(self) -> str:
-        host = "localhost" if self.host in (LOCAL, "localhost") else self.host
-        return f"http://{host}:{self.port}"
+        """The page's address, with the token without which the studio answers nothing."""
+        return self.gate.url(self.port)
 
     def close(self) -> None:
         self._closed = True
@@ -166,7 +175,12 @@ class Studio:
         gui = self.server.gui
         if not self.recording:
             self.save_button = gui.add_button("Save", hint=f"write the values into {self.path}")
-            self.save_button.on_click(lambda _: self.save())
+            self.save_button.on_click(lambda _: self._guarded(self._save_clicked))
+            self.reload_button = gui.add_button(
+                "Reload", hint=f"take the text of {self.path} as it is on disk (the values "
+                "set here go)")
+            self.reload_button.on_click(lambda _: self._guarded(self.reload))
+        self.notice = gui.add_html("")  # what the page sent that was not taken as sent
         self.diags = gui.add_html("")
         if self.ghost is not None and self.compare_path:
             self.ghost_box = gui.add_checkbox(
@@ -216,6 +230,7 @@ class Studio:
 
         assert m.trajectory is not None
         self.shown = m
+        self.shown_base = self.base_bytes
         if not drawn:
             self._draw(m.trajectory)
         data = profile_data(m.trajectory)
@@ -332,37 +347,77 @@ class Studio:
                           verify=False)
 
     def save(self) -> str:
-        """Write the text of the motion shown into the file (atomic); the path."""
-        from ..core.files import write_atomic
+        """Write the text of the motion shown into the file (atomic); the path.
 
+        Raises:
+            AouError: I502 when the file is not written (said in the page too): the path
+                is now a link, a folder or a special file, or the file changed on disk
+                since the motion shown was read from it (Reload takes it).
+        """
         with self._busy:  # a build under way finishes first: Save writes what it shows
-            m = self.shown
-        if m is None or self.recording or m.text == self.file_text:
+            m, base = self.shown, self.shown_base
+        if m is None or self.recording or (m.text == self.file_text and
+                                           base == self.base_bytes):
             return self.path
-        write_atomic(self.path, m.text.encode())
+        data = m.text.encode()
+        if base.startswith(_BOM):  # the file's byte-order mark stays
+            data = _BOM + data
+        try:
+            self.disk.save(data, expect=base)
+        except AouError as err:
+            self._say(Motion(self.path, "", tuple(err.diagnostics)),
+                      "Nothing was saved: the file is as it was. Reload takes the text on "
+                      "disk (the values set here go).")
+            raise
         self.file_text = m.text
+        self.base_bytes = self.shown_base = data
         self.status.content += " · saved"
         return self.path
 
-    def _changed(self) -> None:
-        """The file changed on disk: it is the truth, build it (unsaved values go)."""
-        from ..core.files import read_text
-
+    def _save_clicked(self) -> None:
         try:
-            text = read_text(self.path)
+            self.save()
+        except AouError:  # said in the page
+            pass
+
+    def reload(self) -> Motion | None:
+        """Take the file's text as it is on disk (unsaved values go) and build it."""
+        return self._changed(force=True)
+
+    def _changed(self, force: bool = False) -> Motion | None:
+        """The file changed on disk: it is the truth, build it (unsaved values go). A
+        text that fails leaves the last good motion on screen, and Save refuses to write
+        it over the file."""
+        try:
+            data = self.disk.read()
+            text = self.disk.text(data)
         except AouError as err:
-            self._say(Motion(self.path, "", tuple(err.diagnostics)))
-            return
-        if text == self.file_text:
-            return
-        self.file_text = self.base_text = text
+            failed = Motion(self.path, "", tuple(err.diagnostics))
+            self._say(failed)
+            return failed
+        if data == self.base_bytes and not force:
+            return None  # what the studio read or saved last
+        self.file_text, self.base_text, self.base_bytes = text, text, data
         with self._busy:
             m = self.engine.build(text, self.path)
         if m.ok:
             self._show(m)
         else:
             self._say(m, "The file on disk does not build; the motion shown is the last "
-                      "good one.")
+                      "good one (Save will not write it over the file).")
+        return m
+
+    def _told(self, text: str) -> None:
+        """Say in the page what a page sent that was not taken as sent."""
+        import html
+
+        notice = getattr(self, "notice", None)
+        if notice is not None:
+            notice.content = f'<div id="aou-notice"><p>{html.escape(text)}</p></div>'
+
+
+#: UTF-8's byte-order mark, as some editors save it.
+_BOM = "\ufeff".encode()
 
     def _robot_changed(self) -> None:
         """A file of the robot changed on disk (its description, URDF or a mesh): the
