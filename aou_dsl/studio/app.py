@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 from ..core.diagnostics import AouError, Severity
 from .disk import Disk
 from .engine import Engine, Motion
+from .filing import Filing
 from .gate import Gate
 
 if TYPE_CHECKING:
@@ -37,7 +38,7 @@ __all__ = ["LOCAL", "Studio"]
 LOCAL = "127.0.0.1"
 
 
-class Studio:
+class Studio(Filing):
     """The studio of one file (a ``.aou`` file, or a recording to play).
 
     Args:
@@ -346,67 +347,6 @@ class Studio:
         return synthesize(origin.state, intensity=intensity, robot=robot, goal=goal,
                           verify=False)
 
-    def save(self) -> str:
-        """Write the text of the motion shown into the file (atomic); the path.
-
-        Raises:
-            AouError: I502 when the file is not written (said in the page too): the path
-                is now a link, a folder or a special file, or the file changed on disk
-                since the motion shown was read from it (Reload takes it).
-        """
-        with self._busy:  # a build under way finishes first: Save writes what it shows
-            m, base = self.shown, self.shown_base
-        if m is None or self.recording or (m.text == self.file_text and
-                                           base == self.base_bytes):
-            return self.path
-        data = m.text.encode()
-        if base.startswith(_BOM):  # the file's byte-order mark stays
-            data = _BOM + data
-        try:
-            self.disk.save(data, expect=base)
-        except AouError as err:
-            self._say(Motion(self.path, "", tuple(err.diagnostics)),
-                      "Nothing was saved: the file is as it was. Reload takes the text on "
-                      "disk (the values set here go).")
-            raise
-        self.file_text = m.text
-        self.base_bytes = self.shown_base = data
-        self.status.content += " · saved"
-        return self.path
-
-    def _save_clicked(self) -> None:
-        try:
-            self.save()
-        except AouError:  # said in the page
-            pass
-
-    def reload(self) -> Motion | None:
-        """Take the file's text as it is on disk (unsaved values go) and build it."""
-        return self._changed(force=True)
-
-    def _changed(self, force: bool = False) -> Motion | None:
-        """The file changed on disk: it is the truth, build it (unsaved values go). A
-        text that fails leaves the last good motion on screen, and Save refuses to write
-        it over the file."""
-        try:
-            data = self.disk.read()
-            text = self.disk.text(data)
-        except AouError as err:
-            failed = Motion(self.path, "", tuple(err.diagnostics))
-            self._say(failed)
-            return failed
-        if data == self.base_bytes and not force:
-            return None  # what the studio read or saved last
-        self.file_text, self.base_text, self.base_bytes = text, text, data
-        with self._busy:
-            m = self.engine.build(text, self.path)
-        if m.ok:
-            self._show(m)
-        else:
-            self._say(m, "The file on disk does not build; the motion shown is the last "
-                      "good one (Save will not write it over the file).")
-        return m
-
     def _told(self, text: str) -> None:
         """Say in the page what a page sent that was not taken as sent."""
         import html
@@ -415,22 +355,6 @@ class Studio:
         if notice is not None:
             notice.content = f'<div id="aou-notice"><p>{html.escape(text)}</p></div>'
 
-
-#: UTF-8's byte-order mark, as some editors save it.
-_BOM = "\ufeff".encode()
-
-    def _robot_changed(self) -> None:
-        """A file of the robot changed on disk (its description, URDF or a mesh): the
-        motion shown is built again on the robot as it is now."""
-        text = self.shown.text if self.shown is not None and self.shown.text else \
-            self.file_text
-        with self._busy:
-            m = self.engine.build(text, self.path)
-        if m.ok:
-            self._show(m)
-        else:
-            self._say(m, "The robot's files changed and this motion no longer builds on "
-                      "it; the motion shown is the last good one.")
 
 
 def _quiet():
