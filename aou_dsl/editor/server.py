@@ -24,7 +24,7 @@ from collections.abc import Callable
 from typing import Any
 
 from lsprotocol import types
-from pygls.exceptions import JsonRpcInternalError, JsonRpcInvalidParams
+from pygls.exceptions import JsonRpcException, JsonRpcInternalError, JsonRpcInvalidParams
 from pygls.io_ import StdoutWriter
 from pygls.lsp.server import LanguageServer
 from pygls.protocol import LanguageServerProtocol, lsp_method
@@ -52,6 +52,7 @@ class AouServer(LanguageServer):
 
     def __init__(self, robot: str | None = None) -> None:
         super().__init__("aouc", __version__, protocol_cls=_Protocol)
+        _strict(self.protocol._converter)
         self.docs: dict[str, Document] = {}
         self.robot = robot
         self.compile_delay = 0.8
@@ -131,6 +132,21 @@ class AouServer(LanguageServer):
             diagnostics=[to_lsp(d, doc.view, doc.path) for d in doc.diagnostics]))
 
 
+def _strict(converter: Any) -> None:
+    """Numbers, strings and booleans in a message are read as they are typed: cattrs
+    would take the string "0" for a line number, or 5 for a URI."""
+
+    def exactly(kind: type) -> Callable[[Any, Any], Any]:
+        def read(value: Any, _: Any) -> Any:
+            if type(value) is kind or (kind is float and type(value) is int):
+                return value
+            raise TypeError(f"expected {kind.__name__}, found {type(value).__name__}")
+        return read
+
+    for kind in (int, float, str, bool):
+        converter.register_structure_hook(kind, exactly(kind))
+
+
 def _path_of(uri: str) -> str:
     """The path aou gives a document: the file's, for a ``file:`` URI (relative robot
     files are found beside it), else the URI itself."""
@@ -169,6 +185,8 @@ def _guarded(fn: Callable[..., Any]) -> Callable[..., Any]:
     def run(ls: AouServer, params: Any) -> Any:
         try:
             return fn(ls, params)
+        except JsonRpcException:  # an answer already: invalid params, say
+            raise
         except Exception as exc:  # noqa: BLE001 - a bug must not stop the server
             print(f"aouc server: internal error in {fn.__name__}:\n"
                   + traceback.format_exc(), file=sys.stderr, flush=True)

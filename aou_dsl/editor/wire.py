@@ -48,7 +48,7 @@ _NEXT = re.compile(rb"content-length[ \t]*:[ \t]*\d+[ \t]*\r?\n", re.IGNORECASE)
 _FIELD = re.compile(rb"[A-Za-z][A-Za-z0-9-]*[ \t]*:[^\r\n]*")
 #: The id at the start of a body, when the body cannot be read whole.
 _ID = re.compile(rb'^\s*\{\s*(?:"jsonrpc"\s*:\s*"2\.0"\s*,\s*)?"id"\s*:\s*'
-                 rb'(-?\d{1,18}(?![\d.eE])|"(?:[^"\\\r\n]|\\.){0,200}")')
+                 rb'(-?\d{1,18}|"(?:[^"\\\r\n]|\\.){0,200}")(?=\s*[,}])')
 #: Most bytes kept of a header line or of the junk between messages.
 _MAX_LINE = 8192
 
