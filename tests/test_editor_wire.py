@@ -129,7 +129,10 @@ def test_requests_before_initialize_are_refused_and_after_shutdown_too():
         server.close()
 
 
+_BODY = json.dumps(request(9, "no/such")).encode()
 BAD_LENGTHS = [
+    b"Content-Length: %d\r\n\r\n" % (len(_BODY) + 7) + _BODY,  # ends in the next header
+    b"Content-Length: %d\r\n\r\n" % (len(_BODY) + 19) + _BODY,
     b"Content-Length: 9999\r\n\r\n" + json.dumps(request(1, "shutdown")).encode(),
     b"Content-Length: 3\r\n\r\n" + json.dumps(request(2, "shutdown")).encode(),
     b"Content-Length: abc\r\n\r\n" + json.dumps(request(3, "shutdown")).encode(),
@@ -400,4 +403,4 @@ def test_fuzz_frames(tmp_path):
 
 @pytest.mark.slow
 def test_fuzz_frames_many(tmp_path):
-    _fuzz(5000, seed=6, tmp_path=tmp_path)
+    _fuzz(20000, seed=6, tmp_path=tmp_path)

@@ -53,6 +53,22 @@ _ID = re.compile(rb'^\s*\{\s*(?:"jsonrpc"\s*:\s*"2\.0"\s*,\s*)?"id"\s*:\s*'
 _MAX_LINE = 8192
 
 
+#: What the end of a body cut inside the next message's header ends with.
+_HEADER_START = re.compile(rb"content-length[ \t]*:[ \t]*\d*\r?", re.IGNORECASE)
+
+
+def _header_at_end(body: bytes) -> int | None:
+    """Where the start of a header that runs past the end of ``body`` begins, if the
+    body ends in one (a JSON body ends in ``}`` or ``]``, so one that does cannot)."""
+    if body.rstrip()[-1:] in (b"}", b"]"):
+        return None
+    for at in range(max(0, len(body) - 40), len(body)):
+        tail = body[at:]
+        if b"content-length".startswith(tail.lower()) or _HEADER_START.fullmatch(tail):
+            return at
+    return None
+
+
 def _id_from(body: bytes) -> int | str | None:
     """The request id written at the start of ``body``, if there is one to read."""
     m = _ID.match(body[:512])
@@ -177,6 +193,13 @@ class Frames:
         if len(self.buf) < self.length:
             return False
         body = bytes(self.buf[:self.length])
+        cut = _header_at_end(body)
+        if cut is not None:  # the length ends inside the next message's header
+            del self.buf[:cut]
+            self.length = None
+            self.on_broken(_id_from(body), "its Content-Length is longer than its body: "
+                           "the next message's header starts inside it")
+            return True
         del self.buf[:self.length]
         self.length = None
         self.on_body(body)
