@@ -289,6 +289,16 @@ def test_a_line_past_the_bound_gets_v132_with_its_line():
         server.close()
 
 
+def test_the_bounds_are_the_documented_ones():
+    from aou_dsl.core.rules import RULES
+    from aou_dsl.editor.bounds import MAX_LINE, MAX_MESSAGE, max_document
+
+    docs = (ROOT / "docs" / "editors.md").read_text(encoding="utf-8")
+    assert f"lines up to {MAX_LINE:,}" in docs and f"up to {MAX_MESSAGE >> 20} MB" in docs
+    assert f"analysed up to the size `aouc lint` reads, {max_document() >> 20} MB" in docs
+    assert f"a line over {MAX_LINE:,} characters" in RULES["V132"].what
+
+
 def test_ctrl_c_ends_the_server_with_130(raw):
     _open(raw, URI, "pause 1s\n")
     raw.send(frame(hover(1, URI)))
