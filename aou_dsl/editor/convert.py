@@ -30,6 +30,8 @@ SEVERITY = {Severity.ERROR: types.DiagnosticSeverity.Error,
 #: The position encoding the client and the server agreed on (``initialize``).
 ENCODING = {"name": "utf-16"}
 
+#: The longest text whose line starts are kept in a list [characters].
+_INDEXED = 4 << 20
 #: The line ends of the protocol, the longest first.
 _EOL = re.compile(r"\r\n|\r|\n")
 
@@ -72,6 +74,35 @@ def char_col(line: str, col: int) -> int:
     return len(line)
 
 
+def _ends(text: str, a: int, b: int) -> int:
+    """How many line ends ``text[a:b]`` holds (no ``\r\n`` cut by ``b``)."""
+    return text.count("\n", a, b) + text.count("\r", a, b) - text.count("\r\n", a, b)
+
+
+def _skip_lines(text: str, start: int, lines: int | None, before: int | None = None
+                ) -> tuple[int, int]:
+    """From line start ``start``, the start of the line ``lines`` on (or of the line
+    holding offset ``before``), and how many lines were passed: counted by the string's
+    own methods a block at a time, so a text of millions of lines takes no list."""
+    n, limit = 0, len(text) if before is None else before
+    block = 1 << 16
+    while start < limit:
+        b = min(limit, start + block)
+        if text.startswith("\r\n", b - 1):  # do not cut a \r\n in two
+            b += 1
+        k = _ends(text, start, b)
+        if b > limit:  # the \r of a \r\n that holds `before`
+            k -= 1
+        if lines is not None and n + k >= lines or b >= limit:
+            break
+        n, start = n + k, b
+    for m in _EOL.finditer(text, start, limit + (1 if before is not None else 0)):
+        if (lines is not None and n == lines) or (before is not None and m.end() > before):
+            break
+        n, start = n + 1, m.end()
+    return start, n
+
+
 class Text:
     """One version of a document's text, with both line models worked out when first
     needed (each in one pass over the text)."""
@@ -98,21 +129,42 @@ class Text:
         end = starts[li + 1]
         return end - 2 if self.text.startswith("\r\n", end - 2) else end - 1
 
+    def line(self, li: int) -> tuple[int, int] | None:
+        """Where line ``li`` starts and where its text ends; None past the last line. A
+        text too large to index (one not analysed) is looked through instead: a list
+        of its line starts could take many times its own memory."""
+        if li < 0:
+            return None
+        if self._starts is not None or len(self.text) <= _INDEXED:
+            if li >= len(self.starts):
+                return None
+            return self.starts[li], self._content_end(li)
+        start, n = _skip_lines(self.text, 0, li)
+        if n < li:
+            return None
+        m = _EOL.search(self.text, start)
+        return start, m.start() if m is not None else len(self.text)
+
     def offset(self, pos: types.Position) -> int:
         """The character offset of an editor's position: a line past the last is the
         end of the text, a column past a line's end that end."""
-        starts = self.starts
         if pos.line < 0:
             return 0
-        if pos.line >= len(starts):
+        found = self.line(pos.line)
+        if found is None:
             return len(self.text)
-        start, end = starts[pos.line], self._content_end(pos.line)
+        start, end = found
         return start + char_col(self.text[start:end], pos.character)
 
     def position(self, offset: int) -> types.Position:
         """The editor's position of a character offset (one inside a line end is the
         end of that line)."""
         offset = min(max(0, offset), len(self.text))
+        if self._starts is None and len(self.text) > _INDEXED:
+            start, li = _skip_lines(self.text, 0, None, offset)
+            m = _EOL.search(self.text, start)
+            end = min(offset, m.start()) if m is not None else offset
+            return types.Position(li, units(self.text[start:end]))
         li = bisect_right(self.starts, offset) - 1
         start = self.starts[li]
         end = min(offset, self._content_end(li))
@@ -144,9 +196,14 @@ class Text:
         """The offset of aou's 1-based ``line`` and ``col``, inside that line (a line past
         the last is the end of the text). aou's columns on the first line start after a
         byte-order mark."""
-        starts = self.aou_starts
         if line < 1:
             return 0
+        if line == 1:  # without splitting the text: it may be too large to analyse
+            end = self.text.find("\n")
+            length = end if end >= 0 else len(self.text)
+            bom = int(self.text.startswith("\ufeff"))
+            return min(max(0, col - 1 + bom), length)
+        starts = self.aou_starts
         if line > len(starts):
             return len(self.text)
         text = self.lines[line - 1]
@@ -191,9 +248,10 @@ def apply_change(text: Text, rng: types.Range, new: str) -> Text:
     def offset(t: Text, pos: types.Position) -> tuple[Text, int]:
         if pos.line < 0:
             return t, 0
-        if pos.line >= len(t.starts):
+        found = t.line(pos.line)
+        if found is None:
             return t, len(t.text)
-        start, end = t.starts[pos.line], t._content_end(pos.line)
+        start, end = found
         line = t.text[start:end]
         i = char_col(line, pos.character)
         if ENCODING["name"] == "utf-16" and i < len(line) and 0 < pos.character \
