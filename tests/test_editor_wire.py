@@ -414,3 +414,35 @@ def test_fuzz_frames(tmp_path):
 @pytest.mark.slow
 def test_fuzz_frames_many(tmp_path):
     _fuzz(20000, seed=6, tmp_path=tmp_path)
+
+
+def test_frames_are_cut_the_same_however_the_bytes_arrive():
+    """The cutting (in-process): the bodies and broken messages found do not depend on
+    how the stream is split into reads, and junk without a line end is not kept."""
+    from aou_dsl.editor.wire import Frames
+
+    stream = b"".join([frame(hover(1, URI)), b"junk\r\n", frame(hover(2, URI)),
+                       b"Content-Length: 900\r\n\r\n" + json.dumps(hover(3, URI)).encode(),
+                       frame(hover(4, URI)), b"Content-Length: x\r\n\r\n",
+                       frame({"a": "\u2028"})])
+
+    def cut(sizes: random.Random | None) -> list:
+        got: list = []
+        frames = Frames(lambda b: got.append(b), lambda i, why: got.append((i, why)))
+        at = 0
+        while at < len(stream):
+            n = sizes.randint(1, 40) if sizes else len(stream)
+            frames.feed(stream[at:at + n])
+            at += n
+        return got
+
+    whole = cut(None)
+    assert [x if isinstance(x, bytes) else x[0] for x in whole] == [
+        json.dumps(hover(1, URI)).encode(), None, json.dumps(hover(2, URI)).encode(), 3,
+        json.dumps(hover(4, URI)).encode(), None, json.dumps({"a": "\u2028"}).encode()]
+    for seed in range(20):
+        assert cut(random.Random(seed)) == whole
+    got: list = []
+    frames = Frames(got.append, lambda i, why: got.append(why))
+    frames.feed(b"Content-Length: 5" + b"x" * 1_000_000)
+    assert len(frames.buf) < 10_000 and len(got) == 1

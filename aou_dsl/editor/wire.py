@@ -119,14 +119,13 @@ class Frames:
         end = self.buf.find(b"\n")
         if end < 0:
             if len(self.buf) > _MAX_LINE:  # a line too long to be a header: junk
-                m = _LENGTH.search(self.buf)
-                if m is not None and m.start() > 0:
+                m = _LENGTH.search(self.buf, 1)
+                if m is not None:
                     self._junk(self.buf[:m.start()])
                     del self.buf[:m.start()]
                     return True
-                if m is None:
-                    self._junk(self.buf[:-32])
-                    del self.buf[:-32]  # keep a tail: a header may start in it
+                self._junk(self.buf[:-32])
+                del self.buf[:-32]  # keep a tail: a header may start in it
             return False
         line = bytes(self.buf[:end]).rstrip(b"\r")
         del self.buf[:end + 1]
