@@ -93,6 +93,11 @@ class Model:
         else:
             ins = list(new)
         self.text = self._join(cells[:a] + ins + cells[b:])
+        if self.encoding != "utf-16":
+            # a high and a low surrogate side by side travel in JSON as the one character
+            # they make (code points have no halves): so does the text the editor holds
+            self.text = self.text.encode("utf-16-le", "surrogatepass").decode(
+                "utf-16-le", "surrogatepass")
         return rng_, new
 
     def lines(self) -> list[str]:
