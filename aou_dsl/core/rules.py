@@ -174,7 +174,8 @@ _RULE_LIST = [
     Rule("V132", "input-too-large", _E,
          "A `.aou` file or a robot file (URDF, robot description) is larger than aou "
          "reads (1 MB for a `.aou` file, 16 MB for a robot file), or a URDF has more "
-         "links or joints than aou loads (1000), or a longer arm (32 joints).",
+         "links or joints than aou loads (1000), or a longer arm (32 joints); in the "
+         "language server, a document over 1 MB or with a line over 10,000 characters.",
          "aou reads a whole file before checking it: a bound keeps a wrong file (a log, a "
          "disk image) from taking the machine's memory. Set AOU_MAX_INPUT_MB to read "
          "larger files.",
