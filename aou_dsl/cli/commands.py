@@ -57,10 +57,11 @@ def _read_kw(args: argparse.Namespace) -> dict:
 
 
 def _reads(args: argparse.Namespace, paths: Sequence[str]) -> list[str]:
-    """Every file the command reads (the output rule keeps its outputs off them)."""
+    """Every file the command reads (the output rule keeps its outputs off them), the
+    meshes found through ``--package-dir`` too."""
     from ..robot.files_read import files_read
 
-    return files_read(paths, getattr(args, "robot", None))
+    return files_read(paths, getattr(args, "robot", None), _package_dirs(args))
 
 
 def _count(n: int, noun: str) -> str:
@@ -136,6 +137,10 @@ def _cmd_compile(args: argparse.Namespace) -> int:
         check_format(args.output, args.format, FORMATS)  # --format csv -o x.json
         for dest in dests:  # before any work: the output rule
             guard_output(dest, reads, bag=fmt in FOLDER_FORMATS)
+        if args.write_fitted:  # the same rule, and never onto what -o writes
+            from .fitted import check_fitted_output
+
+            check_fitted_output(args.write_fitted, reads, dests)
     except AouError as err:
         return _fail(err)
     options = BuildOptions(robot=args.robot, rate=args.rate, check=not args.no_check,
@@ -170,7 +175,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
         if args.write_fitted:
             from .fitted import write_fitted
 
-            worst = max(worst, write_fitted(args.write_fitted, res, sources))
+            worst = max(worst, write_fitted(args.write_fitted, res, [*reads, *dests]))
     return worst
 
 
