@@ -166,13 +166,15 @@ _RULE_LIST = [
          "tilt 1e160deg"),
     Rule("V131", "package-escape", _E,
          "A mesh path of a robot's URDF leaves its package: a `package://NAME/...` path "
-         "with `..` steps that climb out of the package's folder.",
+         "with `..` steps that climb out of the package's folder, or one whose NAME is "
+         "no package's (`package://../etc/passwd`).",
          "A package path names a file inside that package; one that climbs out of it "
          "could make aou read any file of the machine.",
          "aouc robot escape.urdf   # <mesh filename=\"package://arm/../../../etc/passwd\"/>"),
     Rule("V132", "input-too-large", _E,
-         "A `.aou` file or a robot file (URDF, robot description) is larger than aou "
-         "reads (1 MB for a `.aou` file, 16 MB for a robot file), or a URDF has more "
+         "A `.aou` file, a robot file (URDF, robot description) or a mesh a URDF names "
+         "is larger than aou reads (1 MB for a `.aou` file, 16 MB for a robot file, 64 MB "
+         "for a mesh), or a URDF has more "
          "links or joints than aou loads (1000), or a longer arm (32 joints).",
          "aou reads a whole file before checking it: a bound keeps a wrong file (a log, a "
          "disk image) from taking the machine's memory. Set AOU_MAX_INPUT_MB to read "
