@@ -84,7 +84,8 @@ _RULE_LIST = [
          "Such a file is almost always a typo (x10000); compiling it would hang.",
          "pause 1s x5000"),
     Rule("V111", "duplicate-setting", _E,
-         "A setting (or the header) appears more than once.",
+         "A setting (or the header) appears more than once, or a statement gives one "
+         "of its arguments twice (`a=` twice, a shiver's `for` twice).",
          "Each setting has one value; the second would silently win.",
          "start 0.3m\nstart 0.4m"),
     Rule("V112", "unknown-key", _E,
