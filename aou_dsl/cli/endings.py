@@ -57,8 +57,10 @@ def extra_missing(command: str, exc: ImportError) -> str | None:
         return "media"
     if command == "studio":
         return "studio"
-    return "dmp" if exc.name.split(".")[0] in ("movement_primitives", "pytransform3d") \
-        else None
+    top = exc.name.split(".")[0]
+    if top in ("distributed", "dask"):  # compile --cluster
+        return "cluster"
+    return "dmp" if top in ("movement_primitives", "pytransform3d") else None
 
 
 def internal(exc: BaseException, debug: bool, ctrl_c: CtrlC) -> int:
