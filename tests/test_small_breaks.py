@@ -43,3 +43,46 @@ def test_plot_of_strings_that_are_not_text_is_r401(tmp_path, monkeypatch, capsys
     assert "internal error" not in err and "Traceback" not in err, err
     assert code == 1 and " R401 [error]" in err and "lone surrogate" in err, err
     assert not Path("s.png").exists()
+
+
+def test_fit_messages_say_the_quoted_line_is_the_fitted_text(tmp_path, capsys):
+    """A --fit build quotes the fitted text under its messages; where it differs from
+    the file's line it says so, with the file's own line."""
+    src = BEHAVIOURS / "fearful.aou"
+    assert main(["compile", str(src), "--robot", "ur5", "--fit", "--no-check", "-o",
+                 str(tmp_path / "f.json")]) == 0
+    err = capsys.readouterr().err
+    lines = err.splitlines()
+    quoted = [i for i, x in enumerate(lines) if x.startswith("   7 | ")]
+    assert quoted and all("a=1.437" in lines[i] for i in quoted), err
+    for i in quoted:  # each quote of the fitted line says what the file's line is
+        assert lines[i + 2] == ("     = the line as fitted, above; the file's line 7 says "
+                                "`retreat 0.06m a=2`"), err
+    assert main(["check", str(src), "--robot", "ur5", "--fit", "--no-dynamic"]) in (0, 1)
+    err = capsys.readouterr().err
+    assert "the file's line 8 says `shiver 6deg for 1.25s`" in err, err
+
+
+def test_against_places_declared_absent_failures_at_the_header(tmp_path, capsys):
+    """A descriptor the file declares absent is said at its header (the file's first
+    lines are comments), or without one at its first statement: never 1:1."""
+    traj = tmp_path / "h.json"
+    assert main(["compile", str(BEHAVIOURS / "hesitant.aou"), "--no-check", "-o",
+                 str(traj)]) == 0
+    text = (BEHAVIOURS / "hesitant.aou").read_text()
+    no_retreat = "".join(x for x in text.splitlines(True) if not x.startswith("retreat"))
+    (tmp_path / "nr.aou").write_text(no_retreat)
+    (tmp_path / "nh.aou").write_text("".join(
+        x for x in no_retreat.splitlines(True) if not x.startswith("behaviour")))
+    header = no_retreat.splitlines().index("behaviour hesitant : hesitant") + 1
+    first = [x.split()[0] if x.strip() else "" for x in
+             (tmp_path / "nh.aou").read_text().splitlines()].index("approach") + 1
+    for name, line in (("nr.aou", header), ("nh.aou", first)):
+        capsys.readouterr()
+        assert main(["measure", str(traj), "--against", str(tmp_path / name), "--format",
+                     "json"]) == 1
+        doc = json.loads(capsys.readouterr().out)
+        absent = [d for d in doc["diagnostics"] if d["code"] == "R408"
+                  and d["fields"]["descriptor"].startswith("retreat")]
+        assert len(absent) == 3, doc["diagnostics"]
+        assert {d["line"] for d in absent} == {line}, absent

@@ -156,7 +156,10 @@ def _cmd_compile(args: argparse.Namespace) -> int:
                          encode=fmt)  # the workers encode; this process writes bytes
     worst = EXIT_OK
     for k, ((src, _), dest, res) in enumerate(zip(inputs, dests, results, strict=True), 1):
-        _print_diags(res.diagnostics, sources={src: res.lint.source or ""})
+        from .fitted import original_text
+
+        _print_diags(res.diagnostics, sources={src: res.lint.source or ""},
+                     originals=original_text(res))
         if not res.ok or res.document is None:
             worst = max(worst, _exit_for(res.diagnostics))
             print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)

@@ -16,7 +16,21 @@ from ..core.diagnostics import AouError, Severity
 from .args import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, usage_error
 from .report import format_check, format_json, format_text
 
-__all__ = ["check_fitted", "check_fitted_output", "fitted_usage", "write_fitted"]
+__all__ = ["check_fitted", "check_fitted_output", "fitted_usage", "original_text",
+           "write_fitted"]
+
+
+def original_text(res) -> dict[str, str]:
+    """The file's own text, by path, when ``res`` (a build) was fitted: its messages
+    quote the fitted text, and say where it differs from the file's."""
+    from ..core.files import read_text
+
+    if getattr(res, "fitted_source", None) is None:
+        return {}
+    try:
+        return {res.path: read_text(res.path)}
+    except AouError:
+        return {}
 
 
 def check_fitted_output(path: str, reads: Sequence[str], outputs: Sequence[str] = ()) -> None:
@@ -82,8 +96,10 @@ def check_fitted(args: argparse.Namespace, read_kw: dict) -> int:
             return EXIT_USAGE
     res = build_file(args.path, BuildOptions(
         robot=read_kw["robot"], package_dirs=read_kw["package_dirs"], check=False, fit=True))
+    original = original_text(res).get(res.path)
     for d in res.diagnostics:
-        print(format_text(d, res.lint.source), file=sys.stderr)
+        print(format_text(d, res.lint.source if d.span.path == res.path else None,
+                          original), file=sys.stderr)
     if not res.ok:
         return EXIT_ERRORS
     if args.write_fitted:

@@ -120,8 +120,14 @@ def _rows(lint: FileResult, measured: Measured) -> tuple[Row, ...]:
         tol = None if w is None else d.tolerance(float(w))
         p = source_of(b, name)
         rows.append(Row(name, d.unit, w, g, tol, d.matches(w, g),
-                        p.span if p is not None else b.span))
+                        p.span if p is not None else _absent_at(b)))
     return tuple(rows)
+
+
+def _absent_at(b) -> Span:
+    """Where a descriptor the file declares absent (no statement sets it) is said: its
+    header, else its first statement; the whole file only when it has neither."""
+    return b.header_span or (b.primitives[0].span if b.primitives else b.span)
 
 
 def judge(rec: Trajectory, behaviour: str | FileResult) -> Verdict:
