@@ -86,3 +86,37 @@ def test_against_places_declared_absent_failures_at_the_header(tmp_path, capsys)
                   and d["fields"]["descriptor"].startswith("retreat")]
         assert len(absent) == 3, doc["diagnostics"]
         assert {d["line"] for d in absent} == {line}, absent
+
+
+def _setup_blocks() -> list[str]:
+    from .conftest import ROOT
+
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = text.split("## Set-up: two commands", 1)[1].split("\n## ", 1)[0]
+    return [b.strip() for b in section.split("```")[1::2]]
+
+
+def test_the_readme_set_up_makes_a_virtual_environment_first():
+    """Debian's Python refuses `pip install .` outside a virtual environment (PEP 668):
+    the set-up makes and activates one before its two commands, which stay as they
+    were."""
+    venv, install, tests = _setup_blocks()
+    assert venv == "python3 -m venv .venv && . .venv/bin/activate"
+    assert install == ("pip install . && aouc compile behaviours/hesitant.aou -o "
+                       "hesitant.json && aouc measure hesitant.json")
+    assert tests == 'pip install ".[test]" && python -m pytest -q'
+
+
+@pytest.mark.slow
+def test_the_readme_virtual_environment_command_works(tmp_path):
+    """The command, run as written by a shell: the environment's Python is the one
+    that runs afterwards, with its own pip."""
+    import subprocess
+
+    venv = _setup_blocks()[0]
+    done = subprocess.run(["bash", "-c", f"{venv} && python -c 'import sys; "
+                           "print(sys.prefix)' && pip --version"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    prefix, pip = done.stdout.splitlines()[:2]
+    assert prefix == str(tmp_path / ".venv") and str(tmp_path / ".venv") in pip
