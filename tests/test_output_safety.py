@@ -303,6 +303,7 @@ ROBOT_FORMS = {
     "a form feed before it": 'behaviour h : hesitant\n\frobot "arm.toml"\npause 1s\napproach\n',
     "a tab, CRLF line ends": 'behaviour h : hesitant\r\n\trobot "arm.toml"\r\npause 1s\r\n'
                              'approach\r\n',
+    "no blanks around it": 'behaviour h : hesitant;robot"arm.toml";pause 1s;approach\n',
     "after a comment line": 'behaviour h : hesitant # robot panda\n  robot   "arm.toml"  \n'
                             'pause 1s\napproach\n',
 }

@@ -27,7 +27,9 @@ LIMIT = 64 << 20
 
 #: A quoted name after ``robot`` anywhere in a text (comments too): the robot files of a
 #: file that does not parse, where more is kept than the command could read.
-_ROBOT_ANYWHERE = re.compile(r'\brobot\s+"([^"\n]+)"')
+#: Every robot statement naming a file matches it too (only blanks may stand between
+#: the keyword and its quoted name), so a text without a match needs no parse.
+_ROBOT_ANYWHERE = re.compile(r'\brobot\s*"([^"\n]+)"')
 
 
 def _head(path: str) -> str | None:
@@ -47,10 +49,13 @@ def _robot_names(text: str, path: str) -> list[str]:
     from ..core.diagnostics import AouError
     from ..lang.parse import SequenceBlock, Word, parse
 
+    anywhere = _ROBOT_ANYWHERE.findall(text)
+    if not anywhere:  # no robot file named (`robot panda`, or none): nothing to parse
+        return []
     try:
         tree = parse(text, path)
     except AouError:
-        return _ROBOT_ANYWHERE.findall(text)
+        return anywhere
     statements = [s for item in tree.items for s in (
         item.statements if isinstance(item, SequenceBlock) else (item,))]
     return [a.text for s in statements if s.keyword == "robot"
