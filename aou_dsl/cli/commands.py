@@ -74,10 +74,11 @@ def read_motion(path: str, args: argparse.Namespace, **kw):
 
 
 def _reads(args: argparse.Namespace, paths: Sequence[str]) -> list[str]:
-    """Every file the command reads (the output rule keeps its outputs off them)."""
+    """Every file the command reads (the output rule keeps its outputs off them), the
+    meshes found through ``--package-dir`` too."""
     from ..robot.files_read import files_read
 
-    return files_read(paths, getattr(args, "robot", None))
+    return files_read(paths, getattr(args, "robot", None), _package_dirs(args))
 
 
 # --- lint, rules, explain ---------------------------------------------------------------
@@ -100,13 +101,12 @@ def _cmd_explain(args: argparse.Namespace) -> int:
 
 def _cmd_compile(args: argparse.Namespace) -> int:
     from ..build.parallel import build_many, default_jobs
-    from ..compiler.output import FOLDER_FORMATS, FORMATS, output_paths
     from ..core.diagnostics import has_errors
-    from ..core.files import check_format, guard_output
     from ..core.options import BuildOptions, SceneOptions
     from ..lang.linter import collect_inputs
     from .ci_cmd import keep_changed, no_output_misused, write_sarif
     from .dmp_cmd import write_compiled
+    from .outputs import guard_outputs
 
     inputs, problems = collect_inputs(args.paths)
     if problems:
@@ -119,13 +119,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     sources = [src for src, _ in inputs]
     reads = _reads(args, sources)
     try:
-        dests, fmt = ([None] * len(inputs), "json") if args.no_output else \
-            output_paths(inputs, args.output, args.format)
-        check_format(args.output, args.format, FORMATS)  # --format csv -o x.json
-        for to in filter(None, dests):  # before any work: the output rule
-            guard_output(to, reads, bag=fmt in FOLDER_FORMATS)
-        if args.sarif:
-            guard_output(args.sarif, [*reads, *filter(None, dests)])
+        dests, fmt = guard_outputs(args, inputs, reads)  # before any work: the output rule
     except AouError as err:
         return _fail(err)
     options = BuildOptions(robot=args.robot, rate=args.rate, check=not args.no_check,
@@ -144,7 +138,10 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     worst = EXIT_OK
     found: list[Diagnostic] = []  # for --sarif
     for k, ((src, _), dest, res) in enumerate(zip(inputs, dests, results, strict=True), 1):
-        _print_diags(res.diagnostics, sources={src: res.lint.source or ""})
+        from .fitted import original_text
+
+        _print_diags(res.diagnostics, sources={src: res.lint.source or ""},
+                     originals=original_text(res))
         if res.ok and res.header is not None and args.track:
             from .track_cmd import compile_tracked
 
@@ -171,7 +168,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
         if args.write_fitted:
             from .fitted import write_fitted
 
-            worst = max(worst, write_fitted(args.write_fitted, res, sources))
+            worst = max(worst, write_fitted(args.write_fitted, res, [*reads, *filter(None, dests)]))
     if args.sarif:
         worst = max(worst, write_sarif(args.sarif, found, reads))
     return worst

@@ -85,7 +85,8 @@ _RULE_LIST = [
          "Such a file is almost always a typo (x10000); compiling it would hang.",
          "pause 1s x5000"),
     Rule("V111", "duplicate-setting", _E,
-         "A setting (or the header) appears more than once.",
+         "A setting (or the header) appears more than once, or a statement gives one "
+         "of its arguments twice (`a=` twice, a shiver's `for` twice).",
          "Each setting has one value; the second would silently win.",
          "start 0.3m\nstart 0.4m"),
     Rule("V112", "unknown-key", _E,
@@ -167,15 +168,17 @@ _RULE_LIST = [
          "tilt 1e160deg"),
     Rule("V131", "package-escape", _E,
          "A mesh path of a robot's URDF leaves its package: a `package://NAME/...` path "
-         "with `..` steps that climb out of the package's folder.",
+         "with `..` steps that climb out of the package's folder, or one whose NAME is "
+         "no package's (`package://../etc/passwd`).",
          "A package path names a file inside that package; one that climbs out of it "
          "could make aou read any file of the machine.",
          "aouc robot escape.urdf   # <mesh filename=\"package://arm/../../../etc/passwd\"/>"),
     Rule("V132", "input-too-large", _E,
-         "A `.aou` file or a robot file (URDF, robot description) is larger than aou "
-         "reads (1 MB for a `.aou` file, 16 MB for a robot file), or a URDF has more "
-         "links or joints than aou loads (1000), or a longer arm (32 joints); in the "
-         "language server, a document over 1 MB or with a line over 10,000 characters.",
+         "A `.aou` file, a robot file (URDF, robot description) or a mesh a URDF names "
+         "is larger than aou reads (1 MB for a `.aou` file, 16 MB for a robot file, 64 MB "
+         "for a mesh), or a URDF has more links or joints than aou loads (1000), or a "
+         "longer arm (32 joints); in the language server, a document over 1 MB or with a "
+         "line over 10,000 characters.",
          "aou reads a whole file before checking it: a bound keeps a wrong file (a log, a "
          "disk image) from taking the machine's memory. Set AOU_MAX_INPUT_MB to read "
          "larger files.",

@@ -169,6 +169,11 @@ def split_args(ctx: Ctx, st: Statement, allowed: Iterable[str], repeat: bool) ->
             if not isinstance(nxt, Quantity):
                 ctx.error(V113, "`for` must be followed by a duration, e.g. `for 1s`",
                           a.span)
+            elif out.for_ is not None:  # the second would silently win
+                ctx.error(V111, "`for` is given twice: a shiver has one duration",
+                          a.span.to(nxt.span), hint=f"keep one of `for {out.for_.text}` "
+                          f"and `for {nxt.text}`", found=nxt.text)
+                i += 1
             else:
                 out.for_ = nxt
                 i += 1

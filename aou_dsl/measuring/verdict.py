@@ -162,7 +162,7 @@ def _rows(lint: FileResult, measured: Measured) -> tuple[Row, ...]:
             lo, hi = lo or 0, hi or 0
         result = _result(d, w, g, lo, hi, stable)
         rows.append(Row(name, d.unit, w, g, tol, result == PASS,
-                        p.span if p is not None else b.span, lo, hi, result))
+                        p.span if p is not None else _absent_at(b), lo, hi, result))
     return tuple(rows)
 
 
@@ -184,6 +184,12 @@ def _result(d: Descriptor, want: float | int | None, got: float | int | None,
     if float(high) < float(want) - tol - 1e-12 or float(low) > float(want) + tol + 1e-12:
         return FAIL
     return INCONCLUSIVE
+
+
+def _absent_at(b) -> Span:
+    """Where a descriptor the file declares absent (no statement sets it) is said: its
+    header, else its first statement; the whole file only when it has neither."""
+    return b.header_span or (b.primitives[0].span if b.primitives else b.span)
 
 
 def judge(rec: Trajectory, behaviour: str | FileResult) -> Verdict:

@@ -11,8 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.codes import R405
-from ..core.diagnostics import Diagnostic, Span, diag
+from ..core.codes import R401, R405
+from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..core.trajectory import Trajectory
 from ..lang.cv import CANONICAL, CVPoint
 
@@ -125,8 +125,29 @@ def profile_data(rec: Trajectory) -> ProfileData:
             R405, "the trajectory has no goal: the plot leaves out the goal-distance "
             "panel and the line of sight",
             Span.whole_file(rec.path), hint="give it with --goal X,Y,Z, or --goal final"),)
+    for text, what in ((rec.title, "its behaviour's name"),
+                       *((e[0], "an episode's kind") for e in episodes)):
+        _check_text(text, what, rec.path)
     return ProfileData(rec.title, arm.joint_names, t, speed, distance, q, qd,
                        arm.lower, arm.upper, arm.vmax, tuple(episodes), **extra)
+
+
+def _check_text(text: object, what: str, path: str) -> None:
+    """Refuse (R401) a string of the file the figure would write that is not text: a
+    JSON string may hold a lone surrogate (``"\\ud800"``), which no font draws.
+
+    Raises:
+        AouError: R401 naming ``what`` holds it.
+    """
+    try:
+        str(text).encode("utf-8")
+    except UnicodeEncodeError as exc:
+        bad = str(text)[exc.start]
+        raise AouError(diag(R401, f"`{path}`: {what} holds a lone surrogate "
+                            f"(U+{ord(bad):04X}), which is not text: it cannot be drawn",
+                            Span.whole_file(path),
+                            hint="write the name as text (a JSON string of whole "
+                                 "characters)")) from None
 
 
 def _pyplot():
