@@ -139,4 +139,4 @@ def read_dmp(path: str) -> DmpSequence:
         doc["robot"], doc["ee_frame"], doc["joint_names"],
         tuple(float(x) for x in doc["goal"]),  # type: ignore[arg-type]
         doc["q_start"], doc["shiver_joint"], doc["rate"], doc["behaviour"], doc["state"],
-        doc["intensity"], doc["descriptors"], parts)
+        doc["intensity"], doc["descriptors"], parts, tuple(doc["files"]))

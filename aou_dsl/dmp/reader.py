@@ -38,10 +38,11 @@ import numpy as np
 
 from ..core.codes import D602, D607, D608, I501
 from ..core.diagnostics import AouError, Span, diag
+from .rollout import MIN_GOAL_DISTANCE
 
 __all__ = ["ALLOWED", "MAX_DURATION", "MAX_EXECUTION_TIME", "MAX_FOLDER_BYTES",
-           "MAX_INT_DT", "MAX_MANIFEST_BYTES", "MAX_PART_BYTES", "MAX_PARTS", "MAX_RATE",
-           "MAX_SAMPLES", "MAX_STEPS", "MAX_WEIGHTS", "MIN_GOAL_DISTANCE", "MIN_INT_DT",
+           "MAX_INT_DT", "MAX_LEAD", "MAX_MANIFEST_BYTES", "MAX_PARTS", "MAX_PART_BYTES",
+           "MAX_RATE", "MAX_SAMPLES", "MAX_STEPS", "MAX_WEIGHTS", "MIN_INT_DT", "MIN_RATE",
            "build_dmp", "check_manifest", "check_part", "read_folder"]
 
 #: Largest manifest read [bytes] (a shipped behaviour's is about 10 kB).
@@ -63,14 +64,15 @@ MIN_INT_DT, MAX_INT_DT = 1e-4, 1e-2
 MAX_STEPS = 1_000_000
 #: Most basis functions per dimension of one DMP (aou writes 400 per second).
 MAX_WEIGHTS = 100_000
-#: Highest sample rate [Hz], and most samples of the sequence at its rate.
-MAX_RATE = 1000.0
+#: Range of the sample rate [Hz], and most samples of the sequence at its rate.
+MIN_RATE, MAX_RATE = 1.0, 1000.0
 MAX_SAMPLES = 2_000_000
+#: Longest lead-in of a motion's DMP before its episode [s] (aou writes a few
+#: milliseconds: three basis functions, or one sample).
+MAX_LEAD = 10.0
 #: Largest coordinate of a position or goal [m], and largest joint value [rad].
 MAX_COORD = 10.0
 MAX_JOINT = 100.0
-#: Least distance between the start and the goal [m]: the rollout scales by their ratio.
-MIN_GOAL_DISTANCE = 1e-4
 #: Largest transformation-system gain ``alpha_y``, ``beta_y``.
 MAX_GAIN = 1e4
 #: Longest name (robot, frame, joint, behaviour, file) [characters].
@@ -110,8 +112,8 @@ class _Where:
 
     def fail(self, field: str, what: str, code: str | None = None,
              hint: str | None = None) -> AouError:
-        at = f" field `{field}`" if field else ""
-        return AouError(diag(code or self.code, f"`{self.path}`:{at} {what}",
+        at = f"field `{field}`" if field else "the file"
+        return AouError(diag(code or self.code, f"{at} {what}",
                              Span.whole_file(self.path), field=field or None,
                              hint=hint or "write the folder with `aouc compile FILE "
                              "--format dmp`"))
@@ -166,8 +168,14 @@ def _read_bounded(real: str, shown: str, limit: int, w: _Where, field: str) -> b
     try:
         kind = _special(os.stat(real).st_mode)
         if kind is not None:
-            raise w.fail(field, f"`{shown}` is a {kind}, not a regular file", code=D608)
+            raise w.fail(field, f"`{shown}` is a {kind}, not a regular file", code=D608,
+                         hint="a .dmp folder holds regular files only")
         fd = os.open(real, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0))
+    except FileNotFoundError:
+        if field:
+            raise w.fail(field, f"names `{shown}`, which is missing") from None
+        raise AouError(diag(I501, f"cannot read `{shown}`: no such file",
+                            Span.whole_file(w.path))) from None
     except OSError as exc:
         raise AouError(diag(I501, f"cannot read `{shown}`: {exc.strerror or exc}",
                             Span.whole_file(w.path))) from None
@@ -175,7 +183,8 @@ def _read_bounded(real: str, shown: str, limit: int, w: _Where, field: str) -> b
         st = os.fstat(fd)
         kind = _special(st.st_mode)
         if kind is not None:
-            raise w.fail(field, f"`{shown}` is a {kind}, not a regular file", code=D608)
+            raise w.fail(field, f"`{shown}` is a {kind}, not a regular file", code=D608,
+                         hint="a .dmp folder holds regular files only")
         if st.st_size > limit:
             raise w.fail(field, f"`{shown}` is {st.st_size} bytes, more than the "
                          f"{limit} a .dmp file may have", code=D608)
@@ -330,12 +339,13 @@ def check_manifest(doc: Any, w: _Where) -> dict[str, Any]:
     q = doc["q_start"]
     out["q_start"] = _array(q, w, "q_start", (len(names),), MAX_JOINT)
     state = doc["state"]
-    if state is not None and state not in {s.value for s in State}:
+    if state is not None and (not isinstance(state, str)
+                              or state not in {s.value for s in State}):
         raise w.fail("state", f"must be one of {', '.join(s.value for s in State)} or "
                      f"null, found {_kind(state) if not isinstance(state, str) else repr(state)}")
     out["state"] = state
     out["intensity"] = _number(doc["intensity"], w, "intensity", 0.0, 1.0)
-    out["rate"] = rate = _number(doc["rate"], w, "rate", 0.0, MAX_RATE, above=True)
+    out["rate"] = rate = _number(doc["rate"], w, "rate", MIN_RATE, MAX_RATE)
     goal = _object(doc["goal"], w, "goal", {"position"}, {"position"})
     out["goal"] = _array(goal["position"], w, "goal.position", (3,), MAX_COORD)
     if "duration" in doc:
@@ -406,8 +416,7 @@ def _entry(e: Any, w: _Where, field: str) -> dict[str, Any]:
         raise w.fail(f"{field}.kind", f"must be one of {', '.join(_KINDS)}, found {shown}")
     out = {"kind": kind,
            "duration": _number(e["duration"], w, f"{field}.duration", 0.0, MAX_DURATION),
-           "lead": _number(e.get("lead", 0.0), w, f"{field}.lead", -MAX_DURATION,
-                           MAX_DURATION),
+           "lead": _number(e.get("lead", 0.0), w, f"{field}.lead", -MAX_LEAD, MAX_LEAD),
            "start": _pose(e["start"], w, f"{field}.start"),
            "end": _pose(e["end"], w, f"{field}.end"), "file": e["file"]}
     if e["file"] is not None and kind in ("pause", "shiver"):
@@ -443,9 +452,11 @@ def _shiver(values: dict[str, float], w: _Where, field: str) -> None:
 
 def _class_of(x: dict, w: _Where, field: str, want: str) -> None:
     module, name = x.get("module"), x.get("class")
-    if ALLOWED.get((module, name)) != want:  # type: ignore[arg-type]
-        shown = f"{module!r}.{name!r}" if isinstance(module, str) and isinstance(name, str) \
-            else f"module {_kind(module)}, class {_kind(name)}"
+    named = (module, name) if isinstance(module, str) and isinstance(name, str) else None
+    if named is None or ALLOWED.get(named) != want:
+        shown = f"`{module}.{name}`" if isinstance(module, str) and isinstance(name, str) \
+            and len(module) + len(name) < 200 else \
+            f"module {_kind(module)}, class {_kind(name)}"
         at = f"{field}." if field else ""
         raise w.fail(f"{at}module", f"names {shown}: only movement_primitives' {want} is "
                      "built from a .dmp folder, and nothing named in a file is imported",
@@ -455,8 +466,11 @@ def _class_of(x: dict, w: _Where, field: str, want: str) -> None:
 
 def check_part(doc: Any, w: _Where) -> dict[str, Any]:
     """A part file's fields, each checked: the arguments :func:`build_dmp` needs."""
-    if isinstance(doc, dict):
+    if isinstance(doc, dict):  # what a file names is refused before anything else
         _class_of(doc, w, "", _CARTESIAN)
+        for key in ("forcing_term_pos", "forcing_term_rot"):
+            if isinstance(doc.get(key), dict):
+                _class_of(doc[key], w, key, _TERM)
     doc = _object(doc, w, "", _DMP_KEYS, _DMP_NEEDS)
     et = _number(doc["_execution_time"], w, "_execution_time", 1e-3, MAX_EXECUTION_TIME)
     int_dt = _number(doc["int_dt"], w, "int_dt", MIN_INT_DT, MAX_INT_DT)
@@ -533,7 +547,7 @@ def build_dmp(args: dict[str, Any]) -> Any:
 def read_folder(path: str) -> tuple[dict[str, Any], list[Any]]:
     """The checked manifest of the ``.dmp`` folder ``path`` and the DMP of each part
     (None for a hold or a shiver), its robot, frame and shiver joint checked against the
-    arm.
+    arm; the manifest's ``files`` are the files read.
 
     Raises:
         AouError: I501 when the folder or a file cannot be read; D602, D607, D608 (see the
@@ -552,7 +566,8 @@ def read_folder(path: str) -> tuple[dict[str, Any], list[Any]]:
     _check_arm(doc, w)
     budget = MAX_FOLDER_BYTES - len(data)
     dmps: list[Any] = []
-    checked = []
+    checked: list[dict[str, Any] | None] = []
+    doc["files"] = [shown]
     for i, e in enumerate(doc["parts"]):
         if e["file"] is None:
             checked.append(None)
@@ -560,6 +575,7 @@ def read_folder(path: str) -> tuple[dict[str, Any], list[Any]]:
         field = f"parts[{i}].file"
         name = _inside(folder, e["file"], w, field)
         pw = _Where(os.path.join(path, e["file"]))
+        doc["files"].append(pw.path)
         raw = _read_bounded(name, pw.path, min(MAX_PART_BYTES, budget), w, field)
         budget -= len(raw)
         checked.append(check_part(_json(raw, pw), pw))

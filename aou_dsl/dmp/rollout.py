@@ -37,11 +37,11 @@ from typing import Any
 
 import numpy as np
 
-from ..core.codes import I504
+from ..core.codes import D602, I504
 from ..core.diagnostics import AouError, Span, diag
 from .export import DmpSequence
 
-__all__ = ["Rollout", "predict", "roll", "similarity"]
+__all__ = ["DIVERGED", "MIN_GOAL_DISTANCE", "Rollout", "predict", "roll", "similarity"]
 
 _WHERE = Span.whole_file("<dmp>")
 
@@ -53,8 +53,19 @@ def _name(kind: str, key: str) -> str:
     return descriptor(kind, key).name
 
 
+#: A motion whose rolled-out position leaves this distance [m] from the base has
+#: diverged (a part file's gains or weights that make no motion): D602.
+DIVERGED = 1000.0
+
+
+class _Diverged(Exception):
+    """A motion's rollout is not finite (:data:`DIVERGED`)."""
+
+
 #: The moving kinds whose peak acceleration is a descriptor, and its name.
 _ACCEL = {kind: _name(kind, "peak_acceleration") for kind in ("approach", "retreat")}
+#: Least distance from the start to a goal [m]: the goal's similarity scales by it.
+MIN_GOAL_DISTANCE = 1e-4
 #: Step of the DMPs' rollouts [s] (the library integrates orientation every millisecond
 #: within it); the rollout is then sampled at the sequence's rate through a cubic spline.
 ROLL_DT = 0.002
@@ -175,9 +186,12 @@ def _roll_move(dmp: Any, start: np.ndarray, goal: np.ndarray, s: float, r: np.nd
     d.forcing_term_rot.weights_ = r @ wr
     d.dt_, run_t = _grid(duration)
     d.configure(start_y=start, goal_y=goal)
-    t, y = d.open_loop(run_t=run_t)
+    with np.errstate(all="ignore"):  # a diverging DMP is refused below, not warned of
+        t, y = d.open_loop(run_t=run_t)
     t = np.asarray(t) - t[0]
     y = np.asarray(y, dtype=float)
+    if len(t) < 3 or not np.isfinite(y).all() or np.abs(y[:, :3]).max() > DIVERGED:
+        raise _Diverged
     x = np.clip(t / duration, 0.0, 1.0)
     h0, h1 = _quintic(x)
     dt = float(t[-1] - t[-2])
@@ -250,6 +264,11 @@ def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
         _check(time_scale, later, pinned)
     p0 = seq.parts[0].start[:3]
     new_goal = tuple(float(x) for x in (goal if goal is not None else seq.goal))
+    if not all(math.isfinite(x) for x in new_goal) or \
+            float(np.linalg.norm(np.asarray(new_goal) - p0)) < MIN_GOAL_DISTANCE:
+        raise AouError(diag(I504, f"the goal {new_goal} must be finite and differ from "
+                            f"where the motion starts ({', '.join(f'{x:.4g}' for x in p0)})",
+                            _WHERE))
     s, r = similarity(p0, np.asarray(seq.goal), np.asarray(new_goal))
     factors = _factors(seq, intensity)
     per_part = [factors if i >= since else {} for i in range(len(seq.parts))]
@@ -327,7 +346,13 @@ def _rolled(cache: dict, i: int, p: Any, start: np.ndarray, end: np.ndarray, s: 
         return runs * k, _Stretched(spline, k)
     key = (i, s, r.tobytes(), k)
     if key not in cache:
-        tt, yy = _roll_move(p.dmp, start, end, s, r, k * p.dmp.execution_time_)
+        try:
+            tt, yy = _roll_move(p.dmp, start, end, s, r, k * p.dmp.execution_time_)
+        except _Diverged:
+            raise AouError(diag(D602, f"part {i + 1} ({p.kind}): its DMP rolls out to "
+                                f"poses that are not finite or leave {DIVERGED:g} m "
+                                "(its gains or weights do not make a motion)",
+                                _WHERE)) from None
         # At rest at both ends (a free end would leave a velocity where the pose is held).
         cache[key] = (float(tt[-1]), CubicSpline(tt, yy, axis=0, bc_type="clamped"))
     return cache[key]
