@@ -139,7 +139,7 @@ def _mutate_once(rng: random.Random, m: dict, p: dict[str, Any], canary: str,
     target = rng.random()
     if target < 0.08:  # parts listed many times
         n = rng.choice([2, 10, 1000, 5000])
-        m["parts"] = m["parts"] * n
+        m["parts"] = m["parts"] * max(1, min(n, 20_000 // max(1, len(m["parts"]))))
         what.append(f"parts x{n}")
     elif target < 0.16:  # a part file's path leaves the folder
         i = rng.choice([k for k, e in enumerate(m["parts"]) if e["file"]])

@@ -189,6 +189,20 @@ def test_a_fifo_is_refused_without_waiting(folder, which):
     assert "FIFO" in res.stderr
 
 
+def test_compiling_over_a_folder_with_a_fifo_manifest_does_not_wait(tmp_path):
+    """`aouc compile -o X.dmp` over a folder whose manifest is a FIFO: refused (I502)
+    at once; the check of whether aou wrote the folder waited on the FIFO for good."""
+    out = tmp_path / "x.dmp"
+    out.mkdir()
+    os.mkfifo(out / "manifest.json")
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    res = subprocess.run([sys.executable, "-m", "aou_dsl", "compile",
+                          str(ROOT / "behaviours" / "confident.aou"), "-o", str(out)],
+                         capture_output=True, text=True, timeout=TIMEOUT, env=env)
+    assert res.returncode == 2 and _refused(res) == "I502"
+    assert sorted(p.name for p in out.iterdir()) == ["manifest.json"]
+
+
 @pytest.mark.parametrize("field, value", [("int_dt", -0.001), ("int_dt", 0.0),
                                           ("int_dt", 1e-9), ("_execution_time", -1.0),
                                           ("n_weights_per_dim", 10 ** 9), ("dt_", 0.0)])

@@ -148,8 +148,8 @@ def _inside(folder: str, rel: Any, w: _Where, field: str) -> str:
                      "or `..`)", code=D608)
     real = os.path.realpath(os.path.join(folder, rel))
     if not real.startswith(folder + os.sep):
-        raise w.fail(field, f"`{rel}` resolves outside the .dmp folder (through a "
-                     "symbolic link)", code=D608)
+        raise w.fail(field, f"`{rel}` resolves to `{real}`, outside the .dmp folder",
+                     code=D608)
     return real
 
 
@@ -170,7 +170,9 @@ def _read_bounded(real: str, shown: str, limit: int, w: _Where, field: str) -> b
         if kind is not None:
             raise w.fail(field, f"`{shown}` is a {kind}, not a regular file", code=D608,
                          hint="a .dmp folder holds regular files only")
-        fd = os.open(real, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0))
+        # Not following a link swapped in since the path was resolved (ELOOP: I501).
+        fd = os.open(real, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0)
+                     | getattr(os, "O_NOFOLLOW", 0))
     except FileNotFoundError:
         if field:
             raise w.fail(field, f"names `{shown}`, which is missing") from None
