@@ -37,11 +37,12 @@ from typing import Any
 
 import numpy as np
 
-from ..core.codes import D602, I504
+from ..core.codes import D602
 from ..core.diagnostics import AouError, Span, diag
 from .export import DmpSequence
+from .limits import DIVERGED, Diverged, check_goal, check_options
 
-__all__ = ["DIVERGED", "MIN_GOAL_DISTANCE", "Rollout", "predict", "roll", "similarity"]
+__all__ = ["Rollout", "predict", "roll", "similarity"]
 
 _WHERE = Span.whole_file("<dmp>")
 
@@ -53,19 +54,8 @@ def _name(kind: str, key: str) -> str:
     return descriptor(kind, key).name
 
 
-#: A motion whose rolled-out position leaves this distance [m] from the base has
-#: diverged (a part file's gains or weights that make no motion): D602.
-DIVERGED = 1000.0
-
-
-class _Diverged(Exception):
-    """A motion's rollout is not finite (:data:`DIVERGED`)."""
-
-
 #: The moving kinds whose peak acceleration is a descriptor, and its name.
 _ACCEL = {kind: _name(kind, "peak_acceleration") for kind in ("approach", "retreat")}
-#: Least distance from the start to a goal [m]: the goal's similarity scales by it.
-MIN_GOAL_DISTANCE = 1e-4
 #: Step of the DMPs' rollouts [s] (the library integrates orientation every millisecond
 #: within it); the rollout is then sampled at the sequence's rate through a cubic spline.
 ROLL_DT = 0.002
@@ -191,7 +181,7 @@ def _roll_move(dmp: Any, start: np.ndarray, goal: np.ndarray, s: float, r: np.nd
     t = np.asarray(t) - t[0]
     y = np.asarray(y, dtype=float)
     if len(t) < 3 or not np.isfinite(y).all() or np.abs(y[:, :3]).max() > DIVERGED:
-        raise _Diverged
+        raise Diverged
     x = np.clip(t / duration, 0.0, 1.0)
     h0, h1 = _quintic(x)
     dt = float(t[-1] - t[-2])
@@ -259,16 +249,11 @@ def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
     Raises:
         AouError: I504 for a value out of range.
     """
-    _check(time_scale, intensity, pinned)
-    for _, later in schedule:
-        _check(time_scale, later, pinned)
+    for level in (intensity, *(later for _, later in schedule)):
+        check_options(time_scale, level, pinned, tuple(_ACCEL.values()))
     p0 = seq.parts[0].start[:3]
     new_goal = tuple(float(x) for x in (goal if goal is not None else seq.goal))
-    if not all(math.isfinite(x) for x in new_goal) or \
-            float(np.linalg.norm(np.asarray(new_goal) - p0)) < MIN_GOAL_DISTANCE:
-        raise AouError(diag(I504, f"the goal {new_goal} must be finite and differ from "
-                            f"where the motion starts ({', '.join(f'{x:.4g}' for x in p0)})",
-                            _WHERE))
+    check_goal(new_goal, p0)
     s, r = similarity(p0, np.asarray(seq.goal), np.asarray(new_goal))
     factors = _factors(seq, intensity)
     per_part = [factors if i >= since else {} for i in range(len(seq.parts))]
@@ -348,7 +333,7 @@ def _rolled(cache: dict, i: int, p: Any, start: np.ndarray, end: np.ndarray, s: 
     if key not in cache:
         try:
             tt, yy = _roll_move(p.dmp, start, end, s, r, k * p.dmp.execution_time_)
-        except _Diverged:
+        except Diverged:
             raise AouError(diag(D602, f"part {i + 1} ({p.kind}): its DMP rolls out to "
                                 f"poses that are not finite or leave {DIVERGED:g} m "
                                 "(its gains or weights do not make a motion)",
@@ -428,18 +413,3 @@ def _compose(t: np.ndarray, plans: list[_Plan], start: np.ndarray
         inv = plan.start[3:] * np.array([1.0, -1.0, -1.0, -1.0])
         quat = _qmul(_qmul(q, np.tile(inv, (len(t), 1))), quat)
     return pos, quat
-
-
-def _check(time_scale: float, intensity: float | None, pinned: tuple[str, ...]) -> None:
-    if not (isinstance(time_scale, int | float) and 0.25 <= time_scale <= 4.0):
-        raise AouError(diag(I504, f"the time scale must be a number in [0.25, 4], found "
-                            f"{time_scale!r}", _WHERE))
-    if intensity is not None and not (isinstance(intensity, int | float)
-                                      and 0.0 <= intensity <= 1.0):
-        raise AouError(diag(I504, f"the intensity must be a number in [0, 1], found "
-                            f"{intensity!r}", _WHERE))
-    bad = [p for p in pinned if p not in _ACCEL.values()]
-    if bad:
-        raise AouError(diag(I504, f"only accelerations can be pinned "
-                            f"({', '.join(_ACCEL.values())}), found {', '.join(bad)}",
-                            _WHERE))
