@@ -272,6 +272,24 @@ def test_a_written_folder_still_rolls_out(base, tmp_path):
             assert math.isclose(p.dmp.execution_time_, raw["_execution_time"])
 
 
+def test_the_rule_examples_trigger_their_own_codes(folder, capsys):
+    """`aouc rules D607` shows a part file naming `subprocess.getoutput`, `aouc rules
+    D608` a part path with `..`: put into a written folder, each is reported with that
+    very code."""
+    from aou_dsl.core.diagnostics import RULES
+
+    where, text = RULES["D607"].example.split(": ", 1)
+    (folder.parent / where).write_text(text)
+    assert main(["dmp", "roll", str(folder)]) == 1
+    assert _refused(capsys.readouterr().err) == "D607"
+    path = re.search(r'"file": "([^"]+)"', RULES["D608"].example).group(1)
+    doc = _manifest(folder)
+    next(e for e in doc["parts"] if e["file"])["file"] = path
+    _write(folder / "manifest.json", doc)
+    assert main(["dmp", "roll", str(folder)]) == 1
+    assert _refused(capsys.readouterr().err) == "D608"
+
+
 # --- the fuzz suite --------------------------------------------------------------------
 
 def _fuzz(base: Path, tmp_path: Path, seed: int, count: int, solve: bool = False) -> dict:

@@ -312,8 +312,8 @@ _RULE_LIST = [
          "bound (docs/dmp.md lists them); a part file named twice.",
          "A shared folder must not make aou read other files, wait forever or run "
          "without bound.",
-         'x.dmp/manifest.json: {"format": "aou-dmp/1", "parts": [{"file": '
-         '"../outside.json"}]}'),
+         'x.dmp/manifest.json: "parts": [{"kind": "approach", "file": "../outside.json", '
+         '...}]'),
     # --- R: reading trajectories -------------------------------------------------------
     Rule("R401", "bad-trajectory", _E,
          "A trajectory file is not valid: missing keys or columns, non-increasing time, NaN.",

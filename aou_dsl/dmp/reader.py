@@ -17,7 +17,7 @@ file names and calls it with the file's arguments: it is never used here. Instea
   ``module`` and ``class`` must name ``CartesianDMP`` (and its two ``ForcingTerm``
   fields ``ForcingTerm``); the object is constructed from the checked arguments and the
   checked weights are copied in. Nothing named in a file is imported.
-- **Every number the library loops on is bounded** (:mod:`.limits`): the execution
+- **Every number the library loops on is bounded** (:mod:`.bounds`): the execution
   time, the integration step ``int_dt``, the rollout's steps, the basis functions, the
   rate and the samples.
 
@@ -36,7 +36,7 @@ from typing import Any
 
 from ..core.codes import D608, I501
 from ..core.diagnostics import AouError, Span, diag
-from .limits import MAX_FOLDER_BYTES, MAX_MANIFEST_BYTES, MAX_NAME, MAX_PART_BYTES
+from .bounds import MAX_FOLDER_BYTES, MAX_MANIFEST_BYTES, MAX_NAME, MAX_PART_BYTES
 from .schema import Where, build_dmp, check_manifest, check_part, kind_of
 
 __all__ = ["read_folder"]

@@ -39,8 +39,8 @@ import numpy as np
 
 from ..core.codes import D602
 from ..core.diagnostics import AouError, Span, diag
+from .bounds import DIVERGED, Diverged, check_goal, check_options
 from .export import DmpSequence
-from .limits import DIVERGED, Diverged, check_goal, check_options
 
 __all__ = ["Rollout", "predict", "roll", "similarity"]
 
