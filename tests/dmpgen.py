@@ -137,18 +137,20 @@ def _mutate_once(rng: random.Random, m: dict, p: dict[str, Any], canary: str,
                  what: list[str]) -> None:
     """Break one promise of the folder ``m`` (manifest), ``p`` (parts), noting it."""
     target = rng.random()
-    if target < 0.08:  # parts listed many times
+    if target < 0.1:  # a value inside its promised range: read, then rolled out
+        _in_range(rng, m, p, what)
+    elif target < 0.16:  # parts listed many times
         n = rng.choice([2, 10, 1000, 5000])
         m["parts"] = m["parts"] * max(1, min(n, 20_000 // max(1, len(m["parts"]))))
         what.append(f"parts x{n}")
-    elif target < 0.16:  # a part file's path leaves the folder
+    elif target < 0.22:  # a part file's path leaves the folder
         i = rng.choice([k for k, e in enumerate(m["parts"]) if e["file"]])
         m["parts"][i]["file"] = rng.choice(["../outside.json", "/tmp/x.json",
                                             "parts/../../outside.json", "parts/",
                                             "parts/missing.json", "manifest.json",
                                             "parts//01-approach.json", "."])
         what.append(f"parts[{i}].file -> {m['parts'][i]['file']}")
-    elif target < 0.28:  # a part names a module and class
+    elif target < 0.32:  # a part names a module and class
         name = rng.choice(sorted(p))
         payload = rng.choice(_payloads(canary))
         if rng.random() < 0.5:
@@ -160,7 +162,7 @@ def _mutate_once(rng: random.Random, m: dict, p: dict[str, Any], canary: str,
         else:
             p[name] = payload
         what.append(f"{name} names {payload['module']}.{payload['class']}")
-    elif target < 0.64:  # a manifest field
+    elif target < 0.66:  # a manifest field
         path = rng.choice(_paths(m)[1:])
         if rng.random() < 0.15:
             _delete(m, path)
@@ -181,6 +183,27 @@ def _mutate_once(rng: random.Random, m: dict, p: dict[str, Any], canary: str,
             _set(doc, path, value)
             what.append(f"{name} {path} -> {str(value)[:60]}")
         p[name] = doc
+
+
+def _in_range(rng: random.Random, m: dict, p: dict[str, Any], what: list[str]) -> None:
+    """A field given a value the format allows (its ends included)."""
+    i = rng.randrange(len(m["parts"]))
+    name = rng.choice(sorted(p))
+    choices = [
+        (m, ("rate",), rng.choice([1, 7.5, 1000])),
+        (m, ("intensity",), rng.choice([0, 1, rng.random()])),
+        (m, ("state",), rng.choice([None, "confident", "inactive"])),
+        (m, ("parts", i, "duration"), rng.choice([0.0, rng.uniform(0, 5)])),
+        (m, ("parts", i, "lead"), rng.uniform(-1, 1)),
+        (p, (name, "int_dt"), rng.choice([1e-4, 1e-2])),
+        (p, (name, "smooth_scaling"), True),
+        (p, (name, "alpha_y", rng.randrange(6)), rng.choice([1e-3, 100.0])),
+        (p, (name, "_execution_time"), rng.uniform(0.05, 10))]
+    doc, path, value = rng.choice(choices)
+    if doc is p:
+        p[path[0]] = copy.deepcopy(p[path[0]])
+    _set(doc, path, value)
+    what.append(f"in range: {path} -> {value}")
 
 
 def _digest(folder: str) -> dict[str, str]:
