@@ -278,8 +278,10 @@ _RULE_LIST = [
          "aou_dsl.dmp.to_dmp(aou_dsl.read_trajectory('arm.csv', robot='panda'))"),
     Rule("D602", "bad-dmp-file", _E,
          "A `.dmp` folder's manifest is not an `aou-dmp/1` sequence, or a part it names is "
-         "missing.",
-         "The sequence cannot be rolled out.",
+         "missing: a field is absent, unknown, or not of its type, range or size (a "
+         "number not finite, a robot, frame or joint the arm does not have, a goal at "
+         "the start); the message names the file and the field.",
+         "The sequence cannot be rolled out, and a shared folder is untrusted input.",
          'x.dmp/manifest.json: {"format": "aou-trajectory/1"}'),
     Rule("D603", "rollout-unreachable", _E,
          "The arm cannot follow the rolled-out motion: a pose is out of reach, needs a "
@@ -302,6 +304,22 @@ _RULE_LIST = [
          "acceleration (plus 10 %) or more than the arm's limits.",
          "The blend is refused rather than sent: the arm keeps its goal.",
          "a goal moved 30 cm during a fast retreat"),
+    Rule("D607", "dmp-class-not-allowed", _E,
+         "A `.dmp` part file names a module or class other than movement_primitives' "
+         "`CartesianDMP` (and its `ForcingTerm`s).",
+         "A part file is untrusted: aou builds only the classes it allows, from checked "
+         "arguments, and imports nothing a file names (the library's `read_json` would "
+         "import and call it).",
+         'x.dmp/parts/01-approach.json: {"module": "subprocess", "class": "getoutput"}'),
+    Rule("D608", "dmp-folder-not-closed", _E,
+         "A `.dmp` folder reaches outside itself or past a bound: a part path that is "
+         "absolute, has `..` or resolves outside the folder through a symbolic link; a "
+         "FIFO, device or socket; a file, part count, duration or step count beyond its "
+         "bound (docs/dmp.md lists them); a part file named twice.",
+         "A shared folder must not make aou read other files, wait forever or run "
+         "without bound.",
+         'x.dmp/manifest.json: "parts": [{"kind": "approach", "file": "../outside.json", '
+         '...}]'),
     # --- R: reading trajectories -------------------------------------------------------
     Rule("R401", "bad-trajectory", _E,
          "A trajectory file is not valid: missing keys or columns, non-increasing time, NaN.",
