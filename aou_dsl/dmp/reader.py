@@ -36,7 +36,7 @@ from typing import Any
 
 from ..core.codes import D608, I501
 from ..core.diagnostics import AouError, Span, diag
-from .bounds import MAX_FOLDER_BYTES, MAX_MANIFEST_BYTES, MAX_NAME, MAX_PART_BYTES
+from .allowed import MAX_FOLDER_BYTES, MAX_MANIFEST_BYTES, MAX_NAME, MAX_PART_BYTES
 from .schema import Where, build_dmp, check_manifest, check_part, kind_of
 
 __all__ = ["read_folder"]

@@ -39,7 +39,7 @@ import numpy as np
 
 from ..core.codes import D602
 from ..core.diagnostics import AouError, Span, diag
-from .bounds import DIVERGED, Diverged, check_goal, check_options
+from .allowed import DIVERGED, Diverged, check_goal, check_options
 from .export import DmpSequence
 
 __all__ = ["Rollout", "predict", "roll", "similarity"]

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..core.codes import D602, D607, D608
 from ..core.diagnostics import AouError, Span, diag
-from .bounds import (
+from .allowed import (
     MAX_COORD,
     MAX_DURATION,
     MAX_EXECUTION_TIME,
