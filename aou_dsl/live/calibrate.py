@@ -101,7 +101,7 @@ def measure(points: list[tuple[str, str, float, Scene]], repeats: int = 2, seed:
                          "shake_px": f.shake_px,
                          "detected": float(np.mean([fr.detected for fr in frames])),
                          "tag": tag, "sharpness": sharp, "brightness": bright,
-                         "confidence": fuse([tag] * len(cam.window), sharp, bright)})
+                         "confidence": fuse(tag, sharp, bright)})
     finally:
         cam.close()
     return rows

@@ -7,7 +7,8 @@ Its confidence fuses (docs/live.md):
 
 - the tag's quality in each frame: 0 when it is not detected, else its decision margin
   (normalised by :data:`MARGIN_REF`) times its size in pixels (by :data:`SIZE_REF`),
-  averaged over a sliding window of :data:`WINDOW` frames (detection over the window);
+  averaged over the frames of a sliding window of the last ``WINDOW_S`` seconds
+  (detection over the window);
 - the image's quality: sharpness (variance of the Laplacian, by :data:`SHARP_REF`) times
   brightness (mean grey level, by :data:`BRIGHT_REF`), each capped at 1.
 
@@ -29,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from .geometric import BRIGHT_REF, SHARP_REF, TAG_WEIGHT
+from .geometric import BRIGHT_REF, SHARP_REF, TAG_WEIGHT, WINDOW_S
 from .perception import Estimate, Evidence
 from .scene import (
     CUBE,
@@ -46,14 +47,12 @@ from .scene import (
 )
 
 __all__ = ["BRIGHT_REF", "MARGIN_REF", "SHARP_REF", "SIZE_REF", "TAG_CODE", "TAG_WEIGHT",
-           "WINDOW", "Camera", "Frame", "fuse", "tag_image"]
+           "Camera", "Frame", "fuse", "tag_image"]
 
 #: tag36h11 id 0, its 36 bits most significant first.
 TAG_CODE = 0xD7E00984B
 #: The first quadrant of the data square, 1-based (x, y); the others turn it a quarter.
 _QUADRANT = ((1, 1), (2, 1), (3, 1), (4, 1), (5, 1), (2, 2), (3, 2), (4, 2), (3, 3))
-#: Frames the detection is averaged over.
-WINDOW = 5
 #: A decision margin this high, a tag this many pixels wide, an image this sharp
 #: (variance of the Laplacian) and this bright (mean grey level) count as fully sure.
 #: (The image's references and the tag's share of the confidence are the geometric
@@ -89,10 +88,9 @@ class Frame:
     centre: tuple[float, float] | None
 
 
-def fuse(tag_window: list[float] | deque, sharpness: float, brightness: float) -> float:
-    """The confidence from the tag's per-frame qualities over the window and the image's
-    sharpness and brightness (the module's docstring)."""
-    tag = sum(tag_window) / WINDOW
+def fuse(tag: float, sharpness: float, brightness: float) -> float:
+    """The confidence from the tag's quality over the window and the image's sharpness
+    and brightness (the module's docstring)."""
     image = min(1.0, sharpness / SHARP_REF) * min(1.0, brightness / BRIGHT_REF)
     return min(1.0, max(0.0, TAG_WEIGHT * tag + (1.0 - TAG_WEIGHT) * image))
 
@@ -109,7 +107,7 @@ class Camera:
     one scene); ``seed`` makes its sensor noise repeatable. :meth:`perceive` is a
     :class:`~.perception.Perception`; :meth:`frame` renders and detects once."""
 
-    def __init__(self, scene: Any, *, seed: int = 0, window: int = WINDOW):
+    def __init__(self, scene: Any, *, seed: int = 0, window: float = WINDOW_S):
         import pybullet as p
         from pupil_apriltags import Detector
 
@@ -118,7 +116,8 @@ class Camera:
         self.detector = Detector(families="tag36h11", nthreads=1, quad_decimate=1.0)
         self.p = p
         self.client = p.connect(p.DIRECT)
-        self.window: deque[float] = deque([0.0] * window, maxlen=window)
+        self.window_s = window
+        self._seen: deque[tuple[float, float]] = deque()
         self._boxes: dict[tuple, int] = {}
         self._build()
 
@@ -218,12 +217,15 @@ class Camera:
         scene = self._scene(t)
         fr = self.frame(scene)
         self.last = fr
-        self.window.append(tag_quality(fr))
-        conf = fuse(self.window, fr.sharpness, fr.brightness)
+        self._seen.append((t, tag_quality(fr)))
+        while self._seen and self._seen[0][0] <= t - self.window_s:
+            self._seen.popleft()
+        tag = sum(q for _, q in self._seen) / len(self._seen)
+        conf = fuse(tag, fr.sharpness, fr.brightness)
         ev = Evidence("camera", (("detected", float(fr.detected)), ("margin", fr.margin),
                                  ("size_px", fr.size_px), ("sharpness", fr.sharpness),
                                  ("brightness", fr.brightness),
-                                 ("window", sum(self.window) / len(self.window))))
+                                 ("tag", tag)))
         return Estimate(conf, scene.target if fr.detected else None, ev)
 
 

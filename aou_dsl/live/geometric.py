@@ -42,8 +42,8 @@ from .scene import Scene, blur_px, shake_px, tag_points, tag_size_px, visible_fr
 __all__ = ["FIT", "WINDOW_S", "Features", "Geometric", "Ramp", "confidence_of", "features",
            "fit_ramp"]
 
-#: The camera's sliding window, in seconds (its frames at the loop's camera rate).
-WINDOW_S = 0.25
+#: The sliding window the tag's detection is averaged over [s] (the camera's too).
+WINDOW_S = 1.0
 #: Constants of the rendered camera's fusion (:mod:`.camera`); kept here so the model
 #: needs neither PyBullet nor the detector.
 SHARP_REF, BRIGHT_REF, TAG_WEIGHT = 200.0, 100.0, 0.5
