@@ -35,7 +35,13 @@ from .regulator import Hysteresis, Regulator
 if TYPE_CHECKING:
     from ..core.trajectory import Trajectory
 
-__all__ = ["Run", "Switch", "Tick", "document", "gate", "run"]
+__all__ = ["HYSTERESIS", "Run", "Switch", "Tick", "document", "gate", "run", "segments"]
+
+#: The loop's hysteresis (unless the caller gives one): a perception's confidence wanders
+#: from tick to tick at 100 Hz, so a state changes only once the uncertainty is 0.0375
+#: past the border between two states (0.6 C-V units nearer the new state's canonical
+#: point), and an intensity level once the intensity is 0.15 past its midpoint.
+HYSTERESIS = Hysteresis(state=0.6, intensity=0.15, uncertainty=0.05)
 
 
 @dataclass(frozen=True)
@@ -63,6 +69,8 @@ class Switch:
         state, intensity: what the new motion expresses (for ``held``: what was asked).
         seconds: the re-plan's wall time, from the tick to the checked motion [s].
         reason: why a re-plan was held.
+        transition: how long the motion moves into its plan [s]; join: where it joins
+            the plan [s of the plan]; duration: the motion's length [s].
     """
 
     t: float
@@ -72,6 +80,9 @@ class Switch:
     intensity: float
     seconds: float
     reason: str = ""
+    transition: float = 0.0
+    join: float = 0.0
+    duration: float = 0.0
 
 
 @dataclass
@@ -120,10 +131,11 @@ def run(perception: Any, *, robot: str = "panda", duration: float = 10.0,
         perception: a perception, a callable of the time, or an object with
             ``perceive(t)`` (:func:`~.perception.as_perception`).
         perception_rate: how often it is asked [Hz] (default: every tick).
-        regulator: one to use (its plans kept); else one is made for ``robot``.
+        regulator: one to use (its plans kept); else one is made for ``robot`` with
+            ``hysteresis`` (default :data:`HYSTERESIS`).
     """
     p = as_perception(perception)
-    reg = regulator or Regulator(robot, goal, hysteresis=hysteresis,
+    reg = regulator or Regulator(robot, goal, hysteresis=hysteresis or HYSTERESIS,
                                  intensity_step=intensity_step)
     dt = 1.0 / rate
     every = max(1, round(rate / perception_rate)) if perception_rate else 1
@@ -172,7 +184,8 @@ def run(perception: Any, *, robot: str = "panda", duration: float = 10.0,
             if active is not None:
                 pieces.append((since, active, i))
             active, since = rep.trajectory, at
-            switches.append(Switch(t, at, kind, str(rep.state), rep.intensity, seconds))
+            switches.append(Switch(t, at, kind, str(rep.state), rep.intensity, seconds, "",
+                                   rep.transition, rep.join_time, rep.trajectory.duration))
         state, level = reg.expressed or (State.INACTIVE, 0.0)
         ticks.append(Tick(t, est.confidence, u, str(state), level, est.evidence.to_json()))
     if active is None:
@@ -254,10 +267,45 @@ def document(r: Run) -> dict[str, Any]:
                 "evidence": {k: [tk.evidence.get(k) for tk in ticks] for k in evidence_keys},
             },
             "switches": [{"t": s.t, "start": s.start, "kind": s.kind, "state": s.state,
-                          "intensity": s.intensity, "reason": s.reason} for s in r.switches],
+                          "intensity": s.intensity, "reason": s.reason,
+                          "transition": s.transition, "join": s.join,
+                          "duration": s.duration} for s in r.switches],
         },
         "t": tr.t.tolist(),
         "q": tr.q.tolist(),
         "qd": tr.qd.tolist(),
         "qdd": tr.qdd.tolist(),
     }
+
+
+def segments(r: Run, doc: dict[str, Any] | None = None) -> list[tuple[Switch, dict[str, Any]]]:
+    """Each motion the arm followed after its transition, as a trajectory document of its
+    own (time from 0 where it joined its plan): the switch that sent it, and the
+    document. ``aouc measure`` reads each; its descriptors are those of the state and
+    intensity the switch names."""
+    doc = doc or document(r)
+    t = np.asarray(doc["t"])
+    sent = [s for s in r.switches if s.kind != "held"]
+    out = []
+    for k, s in enumerate(sent):
+        begin = s.start + s.transition
+        end = sent[k + 1].start if k + 1 < len(sent) else float(t[-1]) + 1.0
+        rows = np.flatnonzero((t >= begin - 1e-9) & (t < end - 1e-9))
+        if len(rows) < 3:
+            continue
+        sub = {key: doc[key] for key in doc if key not in ("t", "q", "qd", "qdd", "live",
+                                                         "episodes")}
+        t0 = float(t[rows[0]])
+        sub |= {"behaviour": f"{s.state}_{s.intensity:g}".replace(".", "_"),
+                "state": s.state,
+                "duration": float(t[rows[-1]] - t0),
+                "episodes": [{"kind": e["kind"], "t_start": e["t_start"] - t0,
+                              "t_end": e["t_end"] - t0} for e in doc["episodes"]
+                             if e["t_start"] >= t0 - 1e-9 and e["t_end"] <= t[rows[-1]] + 1e-9],
+                "t": (t[rows] - t0).tolist(),
+                **{key: [doc[key][i] for i in rows] for key in ("q", "qd", "qdd")},
+                "live": {"switch": {"t": s.t, "kind": s.kind, "state": s.state,
+                                    "intensity": s.intensity, "join": s.join,
+                                    "complete": bool(end >= s.start + s.duration - 1e-6)}}}
+        out.append((s, sub))
+    return out
