@@ -10,7 +10,8 @@ video), ``measure`` (60 s at 1 kHz), ``compile`` (below), ``replan`` (a live re-
 ``bench_replan.py``), ``house`` (the warm session: re-lint and recompile; ``--jobs 2``
 against ``--jobs 1``, cold, ``house.py``), ``studio`` (``aouc studio``, ``bench_studio.py``),
 ``editor`` (the language server and ``aouc fmt``, ``bench_editor.py``), ``dmp``
-(behaviours as DMPs, ``bench_dmp.py``), ``track`` (``--track``, ``bench_track.py``);
+(behaviours as DMPs, ``bench_dmp.py``), ``track`` (``--track``, ``bench_track.py``),
+``live`` (the perception loop, ``bench_live.py``);
 see ``speed.py``
 for ``build`` to ``render``. Ratios
 are measured in one run, so they hold on any machine; absolute times are this
@@ -41,6 +42,7 @@ import time
 from pathlib import Path
 
 import bench_dmp
+import bench_live
 import bench_studio
 import bench_track
 import numpy as np
@@ -189,6 +191,7 @@ SECTIONS = {"build": speed.bench_build, "cold": speed.bench_cold, "lint": speed.
             "compile": bench_compile, "replan": speed.bench_replan, "house": bench_house,
             "studio": bench_studio.bench_studio, "editor": bench_editor,
             "dmp": bench_dmp.bench_dmp, "track": bench_track.bench_track}
+SECTIONS["live"] = bench_live.bench_live
 
 
 def main(argv: list[str]) -> int:
