@@ -22,7 +22,7 @@ from aou_dsl.live import calibrate
 from aou_dsl.live.geometric import FIT, Geometric, Ramp, fit_ramp
 from aou_dsl.live.perception import Estimate, Evidence, as_perception, uncertainty_of
 from aou_dsl.live.scenario import load, parse
-from aou_dsl.live.scene import Box, Scene, segments_hit_box, tag_size_px, visible_fraction
+from aou_dsl.live.world import Box, Scene, segments_hit_box, tag_size_px, visible_fraction
 
 from .conftest import ROOT, fails_with
 

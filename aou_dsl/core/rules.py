@@ -390,7 +390,7 @@ _RULE_LIST = [
          "the scene lacks.",
          "Nothing runs: a scenario read halfway would play another scene than the one "
          "written.",
-         "aouc live bad.toml   # [[event]] kind = \"slide\" with no `to`"),
+         "aouc live a.aou   # a behaviour file, not a scenario: not TOML"),
 ]
 
 RULES: dict[str, Rule] = {r.code: r for r in _RULE_LIST}

@@ -28,7 +28,7 @@ from .geometric import (
     image_quality,
     tag_quality,
 )
-from .scene import Box, Scene
+from .world import Box, Scene
 
 __all__ = ["COLUMNS", "evaluate", "fit", "measure", "read_csv", "state_of", "sweeps",
            "write_csv"]

@@ -1,5 +1,5 @@
 """A rendered camera with a real fiducial detector: PyBullet's CPU renderer draws the
-scene (:class:`~.scene.Scene`: a table, the target cube with an AprilTag 36h11 on its face,
+scene (:class:`~.world.Scene`: a table, the target cube with an AprilTag 36h11 on its face,
 box occluders; no arm), the image is dimmed, blurred and made noisy as a sensor would, and
 ``pupil-apriltags`` looks for the tag.
 
@@ -32,7 +32,7 @@ import numpy as np
 
 from .geometric import BRIGHT_REF, SHARP_REF, TAG_WEIGHT, WINDOW_S
 from .perception import Estimate, Evidence
-from .scene import (
+from .world import (
     CUBE,
     HEIGHT,
     TAG_CELLS,

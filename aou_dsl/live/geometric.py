@@ -1,7 +1,7 @@
 """A geometric model of what the camera would see: sub-millisecond and deterministic, for
 tests and the live loop.
 
-From a :class:`~.scene.Scene` it works out four things a detector depends on:
+From a :class:`~.world.Scene` it works out four things a detector depends on:
 
 - ``visible``: the fraction of the tag the camera sees: rays from the camera to the tag's
   four corners and to the centres of a 6 x 6 grid over it (its data cells), each tested
@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from .perception import Estimate, Evidence
-from .scene import Scene, blur_px, shake_px, tag_points, tag_size_px, visible_fraction
+from .world import Scene, blur_px, shake_px, tag_points, tag_size_px, visible_fraction
 
 __all__ = ["FIT", "WINDOW_S", "Features", "Geometric", "Ramp", "confidence_of", "features",
            "fit_ramp"]

@@ -40,7 +40,7 @@ from typing import Any
 
 from ..core.codes import I507
 from ..core.diagnostics import AouError, Span, diag
-from .scene import Box, Scene
+from .world import Box, Scene
 
 __all__ = ["EVENT_KINDS", "Event", "Scenario", "load", "parse"]
 

@@ -9,11 +9,12 @@ world frame [m] (the table's top at z = 0); angles in radians.
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from ..core.memo import cached
 
 __all__ = ["CUBE", "HEIGHT", "TAG_CELLS", "WIDTH", "Box", "Scene", "focal_px", "shake_px",
            "tag_points", "visible_fraction"]
@@ -102,7 +103,7 @@ def tag_points(scene: Scene, cells: int = 0) -> np.ndarray:
     return centre + uv[:, :1] * right + uv[:, 1:] * up
 
 
-@functools.cache
+@cached(maxsize=4)
 def _grid(cells: int) -> np.ndarray:
     """The tag's corners and grid centres in face coordinates, in [-1, 1]."""
     uv = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
