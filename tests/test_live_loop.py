@@ -329,3 +329,15 @@ def test_aouc_live_renders_the_camera_the_confidence_and_the_arm(tmp_path):
     assert len(frames) == 15 and frames[0].shape == (240, 960, 3)
     # the camera's panel shows the scene dimmed: darker than the plot's white panel
     assert frames[5][40:, :320].mean() < frames[5][40:, 320:640].mean() - 50
+
+
+def test_observe_takes_a_perceptions_estimate(reg):
+    """Regulator.observe is update with uncertainty = 1 - confidence; what is not an
+    Estimate is refused."""
+    from .conftest import fails_with
+
+    r = _fresh(reg)
+    q0 = r.plan(State.CONFIDENT, 1.0).q[0]
+    rep = r.observe(q0, None, None, Estimate(0.5), restart=True)
+    assert rep is not None and rep.state is State.HESITANT
+    fails_with("I504", r.observe, q0, None, None, 0.5)

@@ -32,9 +32,13 @@ def cmd_live(args: argparse.Namespace) -> int:
     if args.render:
         check_output(args.render, ("mp4", "gif"), reads=reads, force=args.force)
     sc = scenarios.load(args.path)
-    perception = _perception(args.perception, sc)
-    if perception is None:
+    missing = _missing(args.perception == "camera" or bool(args.render), bool(args.render))
+    if missing:
+        print(f"aouc: this needs the {missing[0]} extra ({missing[1]} is missing): "
+              f"pip install '.[{missing[0]}]' in aou's folder (the one with pyproject.toml)",
+              file=sys.stderr)
         return EXIT_USAGE
+    perception = _perception(args.perception, sc)
     try:
         r = run(perception, robot=args.robot or "panda", duration=sc.duration, rate=sc.rate,
                 goal=sc.goal, title=sc.title or args.path,
@@ -56,19 +60,26 @@ def cmd_live(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _missing(camera: bool, media: bool) -> tuple[str, str] | None:
+    """The extra and the module missing for what was asked, before any long work."""
+    import importlib.util
+
+    wanted = ([("perception", "pupil_apriltags"), ("perception", "pybullet")] if camera
+              else []) + ([("media", "imageio"), ("media", "PIL")] if media else [])
+    for extra, module in wanted:  # fixed names, never from the input
+        if importlib.util.find_spec(module) is None:
+            return extra, module
+    return None
+
+
 def _perception(kind: str, sc):
     if kind == "geometric":
         from ..live.geometric import Geometric
 
         return Geometric(sc.scene_at)
-    try:
-        from ..live.camera import Camera
+    from ..live.camera import Camera
 
-        return Camera(sc.scene_at)
-    except ImportError as exc:
-        print(f"aouc: --perception camera needs the perception extra ({exc.name} is "
-              "missing): pip install '.[perception]' in aou's folder", file=sys.stderr)
-        return None
+    return Camera(sc.scene_at)
 
 
 def summary(r) -> str:
