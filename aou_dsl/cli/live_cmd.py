@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import time
 from collections import Counter
 
 from .args import EXIT_OK, EXIT_USAGE
@@ -24,7 +25,8 @@ def cmd_live(args: argparse.Namespace) -> int:
     """Run the scenario; write the recording (``-o``) and the video (``--render``)."""
     from ..core.files import check_output, write_atomic
     from ..live import scenario as scenarios
-    from ..live.loop import document, run
+    from ..live.loop import HYSTERESIS, document, run
+    from ..live.regulator import Regulator
 
     reads = [args.path]
     if args.output:
@@ -38,10 +40,17 @@ def cmd_live(args: argparse.Namespace) -> int:
               f"pip install '.[{missing[0]}]' in aou's folder (the one with pyproject.toml)",
               file=sys.stderr)
         return EXIT_USAGE
+    # every plan made before the loop starts, as a robot would: a re-plan is then warm
+    clock = time.perf_counter()
+    reg = Regulator(args.robot or "panda", sc.goal, hysteresis=HYSTERESIS)
+    made = reg.prepare()
+    if not args.quiet:
+        print(f"{made} plans made for {reg.robot} in {time.perf_counter() - clock:.1f} s",
+              file=sys.stderr)
     perception = _perception(args.perception, sc)
     try:
-        r = run(perception, robot=args.robot or "panda", duration=sc.duration, rate=sc.rate,
-                goal=sc.goal, title=sc.title or args.path,
+        r = run(perception, duration=sc.duration, rate=sc.rate, regulator=reg,
+                title=sc.title or args.path,
                 perception_rate=CAMERA_RATE if args.perception == "camera" else None)
     finally:
         close = getattr(perception, "close", None)
