@@ -4,16 +4,22 @@
     python benchmarks/bench.py build cold   # some sections
     python benchmarks/bench.py --json       # the figures as JSON on stdout (text on stderr)
 
-Sections: ``build`` (the warm checked build), ``cold`` (cold starts against their import
-floors), ``lint`` (long files, many files), ``jobs`` (``--jobs N``), ``render`` (a 640x480
-video), ``measure`` (60 s at 1 kHz), ``compile`` (below), ``replan`` (a live re-plan,
-``bench_replan.py``), ``house`` (the warm session: re-lint and recompile; ``--jobs 2``
-against ``--jobs 1``, cold, ``house.py``), ``studio`` (``aouc studio``, ``bench_studio.py``),
-``editor`` (the language server and ``aouc fmt``, ``bench_editor.py``), ``dmp``
-(behaviours as DMPs, ``bench_dmp.py``), ``track`` (``--track``, ``bench_track.py``),
-``live`` (the perception loop, ``bench_live.py``);
-see ``speed.py``
-for ``build`` to ``render``. Ratios
+Every time figure is printed with its kind: ``[cold]`` (a new process), ``[warm]`` (the
+libraries and the arm loaded, the motion new: values changed in every primitive) or
+``[cached]`` (the same input again, or one only partly new); see ``speed.py``. The goals
+are judged on warm figures (cold ones for the start).
+
+Sections: ``build`` (the checked build of a new motion, in-process and through ``aouc
+compile``), ``cold`` (cold starts against their import floors), ``lint`` (long files, many
+files), ``jobs`` (``--jobs N``'s warm pool), ``sweep`` (``--jobs 2`` against ``--jobs 1``
+on 40 different motions), ``render`` (a 640x480 video), ``measure`` (60 s at 1 kHz),
+``compile`` (below), ``replan`` (a live re-plan, ``bench_replan.py``), ``house`` (the
+warm session: re-lint and rebuild; ``--jobs 2`` against ``--jobs 1``, cold,
+``house.py``), ``studio`` (``aouc studio``, ``bench_studio.py``), ``editor`` (the language
+server and ``aouc fmt``, ``bench_editor.py``), ``dmp`` (behaviours as DMPs,
+``bench_dmp.py``), ``track`` (``--track``, ``bench_track.py``), ``live`` (the perception
+loop, ``bench_live.py``); see ``speed.py`` for
+``build`` to ``render``. Ratios
 are measured in one run, so they hold on any machine; absolute times are this
 machine's (its cores and load are in the JSON). The JSON lists every figure with its
 goal (null for a figure that only says where the time goes) and whether it is met, and
@@ -22,9 +28,9 @@ a summary of the goals.
 compile, per shipped behaviour:
 - cold: a fresh Python process that imports aou and compiles the file (imports, robot
   model loading and all), as `aouc compile` does once;
-- warm: the median of repeated `compile_behaviour` calls in one process (the case of a
-  robot that recompiles as its uncertainty changes), garbage collector paused as timeit
-  does;
+- warm: the median of `compile_behaviour` calls in one process, each of a motion it has
+  not seen (the behaviour with every primitive's values varied: the case of a robot
+  that recompiles as its uncertainty changes), garbage collector paused as timeit does;
 - the real-time factor: trajectory duration / warm compile time;
 - by hand: the same Cartesian path, sampled at the same rate with linear timing, solved
   with `pybullet.calculateInverseKinematics` per sample, as a user would without aou;
@@ -49,7 +55,7 @@ import numpy as np
 import speed
 from bench_editor import bench_editor
 from house import bench_house
-from speed import figure, say
+from speed import figure, load, say, variant
 
 ROOT = Path(__file__).resolve().parent.parent
 BEHAVIOURS = ["confident", "curious", "hesitant", "fearful", "inactive"]
@@ -119,10 +125,10 @@ def _quat(r: np.ndarray) -> list[float]:
 
 def bench_compile(repeat: int = 15) -> None:
     from aou_dsl.compiler.pipeline import compile_behaviour, target_path
-    from aou_dsl.lang.linter import lint_file
+    from aou_dsl.lang.linter import lint_file, lint_source
     from aou_dsl.robot.load import load_arm
 
-    say("compile (panda, 250 Hz)")
+    say(f"compile (panda, 250 Hz); warm: {repeat} new motions of each behaviour; {load()}")
     say(f"{'behaviour':<10}{'cold s':>8}{'warm ms':>9}{'motion s':>9}{'RTF':>7}"
           f"{'by-hand ms':>11}{'speed-up':>9}  {'pos err mm aou/hand':>20}"
           f"  {'gaze err deg aou/hand':>22}")
@@ -131,15 +137,17 @@ def bench_compile(repeat: int = 15) -> None:
         cold = _cold(path)
         b = lint_file(str(path)).behaviour
         compile_behaviour(b)
+        text = path.read_text()
+        lints = [lint_source(variant(text, k), f"{name}_{k}.aou") for k in range(1, repeat + 1)]
         # As timeit does: collect, then keep the garbage collector out of the timed runs,
         # so that garbage left by the previous behaviour's by-hand run is not charged here.
         gc.collect()
         gc.disable()
         times = []
         try:
-            for _ in range(repeat):
+            for lint in lints:  # each a motion this process has not compiled
                 t = time.perf_counter()
-                res = compile_behaviour(b)
+                res = compile_behaviour(lint.behaviour, timeline=lint.timeline)
                 times.append(time.perf_counter() - t)
         finally:
             gc.enable()
@@ -157,11 +165,11 @@ def bench_compile(repeat: int = 15) -> None:
               f"{tr.duration / warm:>7.0f}{hand_t * 1000:>11.1f}{hand_t / warm:>9.1f}"
               f"  {aou_p:>9.4f} / {hand_p:<8.4f}  {aou_g:>10.4f} / {hand_g:<9.4f}")
     warm, rtf, speedup = hesitant
-    figure("compile_warm_hesitant_ms", "warm compile of hesitant", warm * 1000, "ms",
-           at_most=100.0)
-    figure("compile_rtf", "compile real-time factor (hesitant)", rtf, "", at_least=250.0,
-           fmt="{:.0f}")
-    figure("compile_vs_by_hand", "faster than by hand (hesitant)", speedup, "x",
+    figure("compile_warm_hesitant_ms", "compile of a new hesitant motion", warm * 1000, "ms",
+           kind="warm", at_most=100.0)
+    figure("compile_rtf", "compile real-time factor (hesitant)", rtf, "", kind="warm",
+           at_least=250.0, fmt="{:.0f}")
+    figure("compile_vs_by_hand", "faster than by hand (hesitant)", speedup, "x", kind="warm",
            at_least=10.0)
 
 
@@ -176,19 +184,65 @@ def bench_measure() -> None:
     rec = res.trajectory
     measure(rec)  # load the robot model once
     times = []
-    for _ in range(5):
+    for k in range(1, 6):  # every sample moved by a nanoradian more: new to every memo
+        new = rec.with_(q=rec.q + 1e-9 * k)
         t = time.perf_counter()
-        m = measure(rec)
+        m = measure(new)
         times.append(time.perf_counter() - t)
     say(f"measure: {res.trajectory.duration:.1f} s of motion at 1 kHz ({len(rec.t)} samples), "
         f"{len(m.episodes)} episodes found")
-    figure("measure_60s_1khz_s", "measure of 60 s at 1 kHz", statistics.median(times), "s",
-           at_most=1.0, fmt="{:.3f}")
+    figure("measure_60s_1khz_s", "measure of 60 s at 1 kHz, new samples", statistics.median(times),
+           "s", kind="warm", at_most=1.0, fmt="{:.3f}")
+
+
+_NOISY = (
+    "import time\n"
+    "import numpy as np\n"
+    "from aou_dsl.compiler.pipeline import CompileOptions, compile_behaviour\n"
+    "from aou_dsl.lang.linter import load\n"
+    "text = 'approach a=0.05\\npause 2s x14\\nretreat 0.05m a=0.1 x8\\n"
+    "gaze horizontal 15deg x4\\n'\n"
+    "b, _ = load(text, 'long.aou')\n"
+    "rec = compile_behaviour(b, CompileOptions(rate=1000.0)).trajectory\n"
+    "q = np.asarray(rec.q) + np.random.default_rng(0).normal(0, 3e-4, np.shape(rec.q))\n"
+    "rec = rec.with_(q=q, qd=None, qdd=None)\n"
+)
+
+
+def bench_measure_noisy() -> None:
+    """Measuring a 60 s recording at 1 kHz with uncertainties (3e-4 rad of noise on every
+    joint): cold, a fresh process's first measurement (imports, robot model, the
+    re-noised copies); warm, the median of three in one process."""
+    cold = ("t = time.perf_counter()\n"
+            "from aou_dsl.measuring.measured import measure\n"
+            "m = measure(rec)\n"
+            "print(time.perf_counter() - t, len(m.uncertainty))")
+    out = subprocess.run([sys.executable, "-c", _NOISY + cold], capture_output=True,
+                         text=True, check=True)
+    cold_s, spreads = out.stdout.split()
+    warm = ("from aou_dsl.measuring.measured import measure\n"
+            "measure(rec)\n"
+            "ts = []\n"
+            "for _ in range(3):\n"
+            "    t = time.perf_counter(); measure(rec); ts.append(time.perf_counter() - t)\n"
+            "print(sorted(ts)[1])")
+    out = subprocess.run([sys.executable, "-c", _NOISY + warm], capture_output=True,
+                         text=True, check=True)
+    say(f"measure with uncertainties: 60 s at 1 kHz, 3e-4 rad of noise, {spreads} "
+        "descriptors with an interval")
+    figure("measure_noisy_60s_1khz_cold_s", "measure of a noisy 60 s at 1 kHz with "
+           "uncertainties", float(cold_s), "s", kind="cold", fmt="{:.2f}")
+    figure("measure_noisy_60s_1khz_warm_s", "measure of a noisy 60 s at 1 kHz with "
+           "uncertainties", float(out.stdout.strip()), "s", kind="warm", at_most=1.0,
+           fmt="{:.2f}")
 
 
 SECTIONS = {"build": speed.bench_build, "cold": speed.bench_cold, "lint": speed.bench_lint,
-            "jobs": speed.bench_jobs, "render": speed.bench_render, "measure": bench_measure,
-            "compile": bench_compile, "replan": speed.bench_replan, "house": bench_house,
+            "jobs": speed.bench_jobs, "sweep": speed.bench_sweep, "render": speed.bench_render,
+            "measure": bench_measure,
+            "measure_noisy": bench_measure_noisy, "compile": bench_compile,
+            "replan": speed.bench_replan,
+            "house": bench_house,
             "studio": bench_studio.bench_studio, "editor": bench_editor,
             "dmp": bench_dmp.bench_dmp, "track": bench_track.bench_track}
 SECTIONS["live"] = bench_live.bench_live

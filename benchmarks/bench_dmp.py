@@ -2,7 +2,8 @@
 
 - rollout: the hesitant behaviour's DMPs rolled out (the library's integration, every
   2 ms, then sampled at 250 Hz), and rolled out and solved for the Panda (inverse
-  kinematics at every sample), each per second of motion: the median of 3;
+  kinematics at every sample), each per second of motion: the median of 3 of the same
+  sequence (cached);
 - intensity: hesitant raised from 0.5 to 1 in its first pause. Through the DMPs, three
   ways: whole (the motions whose time scale changes integrated again, the whole
   behaviour solved by inverse kinematics: how it was first done), live (those motions'
@@ -13,7 +14,8 @@
   plan, warm, joined by a jerk-limited transition). Wall and CPU time of each (the CPU
   time is steadier on a shared machine), and smoothness over the second after the
   change: the largest joint jerk (third differences at the sample rate) and the largest
-  step of a joint acceleration between two samples.
+  step of a joint acceleration between two samples. The changes are warm: a new
+  intensity, from the rollouts the running behaviour keeps (as a live robot has them).
 """
 
 from __future__ import annotations
@@ -58,9 +60,9 @@ def bench_dmp() -> None:
     motion = float(ro.t[-1])
     say(f"dmp: hesitant ({motion:.1f} s of motion, {len(seq.parts)} parts) on the Panda")
     figure("dmp_rollout_s_per_s", "DMP rollout per second of motion",
-           statistics.median(rolls) / motion, "s", at_most=0.5, fmt="{:.3f}")
+           statistics.median(rolls) / motion, "s", kind="cached", at_most=0.5, fmt="{:.3f}")
     figure("dmp_rollout_solved_s_per_s", "DMP rollout and IK per second of motion",
-           statistics.median(solves) / motion, "s", at_most=1.0, fmt="{:.3f}")
+           statistics.median(solves) / motion, "s", kind="cached", at_most=1.0, fmt="{:.3f}")
 
     pause = next((a, b) for k, a, b in ro.parts if k == "pause")
     at = 0.5 * sum(pause)
@@ -110,12 +112,12 @@ def bench_dmp() -> None:
         f"{np.abs(ways['live'][2].q - ways['whole'][2].q).max() * 1000:.3f} mrad apart)")
     dmp_s = ways["live"][0]
     figure("dmp_intensity_whole_ms", "intensity change through the DMPs, whole (roll, IK)",
-           ways["whole"][0] * 1000, "ms")
+           ways["whole"][0] * 1000, "ms", kind="warm")
     figure("dmp_intensity_ms", "intensity change through the DMPs, live (retimed, the "
-           "remainder's IK)", dmp_s * 1000, "ms")
+           "remainder's IK)", dmp_s * 1000, "ms", kind="warm")
     figure("dmp_intensity_regulator_ms", "the regulator's change through the DMPs (checked)",
-           ways["regulator"][0] * 1000, "ms")
+           ways["regulator"][0] * 1000, "ms", kind="warm")
     figure("dmp_intensity_vs_replan", "the live way's time over a warm re-plan's",
-           dmp_s / rep.seconds, "x")
+           dmp_s / rep.seconds, "x", kind=None)
     figure("dmp_intensity_jerk", "its largest joint jerk over the re-plan's",
-           dmp_jerk / max(re_jerk, 1e-12), "x", at_most=1.0, fmt="{:.2f}")
+           dmp_jerk / max(re_jerk, 1e-12), "x", kind=None, at_most=1.0, fmt="{:.2f}")

@@ -54,8 +54,8 @@ def bench_live() -> None:
     clock = time.perf_counter()
     reg = Regulator("panda", hysteresis=loop.HYSTERESIS)
     made = reg.prepare()
-    say(f"  every plan made beforehand: {made} plans in {time.perf_counter() - clock:.1f} s "
-        "(cold)")
+    figure("live_prepare_s", f"every plan made beforehand ({made} plans)",
+           time.perf_counter() - clock, "s", kind="cold")
     ticks: list[float] = []
     replans: list[float] = []
     perceive: list[float] = []
@@ -91,14 +91,16 @@ def bench_live() -> None:
             replans.append(s.seconds)
         if s.kind != "held":
             last = s.state
-    figure("live_geometric_ms", "geometric model, one answer (warm, median)",
-           1000 * statistics.median(perceive), "ms", at_most=1.0, fmt="{:.2f}")
-    figure("live_tick_p99_ms", "loop tick at 100 Hz, geometric model (warm, p99)",
-           1000 * float(np.percentile(ticks, 99)), "ms", at_most=10.0, fmt="{:.2f}")
+    figure("live_geometric_ms", "geometric model, one answer (median)",
+           1000 * statistics.median(perceive), "ms", kind="warm", at_most=1.0, fmt="{:.2f}")
+    figure("live_tick_p99_ms", "loop tick at 100 Hz, geometric model (p99)",
+           1000 * float(np.percentile(ticks, 99)), "ms", kind="warm", at_most=10.0,
+           fmt="{:.2f}")
     say(f"  loop ticks: median {1000 * statistics.median(ticks):.2f} ms, max "
         f"{1000 * max(ticks):.1f} ms over {len(ticks)} ticks")
-    figure("live_replan_p95_ms", "re-plan after a change of state to the arm (warm, p95)",
-           1000 * float(np.percentile(replans, 95)), "ms", at_most=100.0, fmt="{:.0f}")
+    figure("live_replan_p95_ms", "re-plan after a change of state, to the arm (p95)",
+           1000 * float(np.percentile(replans, 95)), "ms", kind="warm", at_most=100.0,
+           fmt="{:.0f}")
     say(f"  over {len(replans)} changes of state; median {1000 * statistics.median(replans):.0f}"
         " ms")
     _camera(load(str(SCENARIOS[0])))
@@ -120,8 +122,8 @@ def _camera(sc) -> None:
             times.append(time.perf_counter() - clock)
     finally:
         cam.close()
-    figure("live_camera_hz", "rendered camera + AprilTag detection at 320x240 (warm, median)",
-           1.0 / statistics.median(times), "Hz", at_least=15.0, fmt="{:.1f}")
+    figure("live_camera_hz", "rendered camera + AprilTag detection at 320x240 (median)",
+           1.0 / statistics.median(times), "Hz", kind="warm", at_least=15.0, fmt="{:.1f}")
 
 
 if __name__ == "__main__":

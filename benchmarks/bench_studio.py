@@ -2,12 +2,14 @@
 
     python benchmarks/bench.py studio
 
-- **slider release to the new motion playing** (hesitant on the Panda, warm): a studio
+- **slider release to the new motion playing** (hesitant on the Panda; cached): a studio
   runs in this process; REPEATS times a new ``pause_duration`` reaches it as the page
   sends a released slider, and the time until the new motion is on its way to the page
   (compiled, the arm's track, path and timeline sent: it plays) is taken, and beside it
   the time until its safety checks and measurement are done and its numbers sent. Each
-  value is new, so nothing is cached. Goal: p95 <= 200 ms to the motion playing.
+  value is new, but only the pauses change: what the other primitives make is answered
+  by what the process kept, so the figure is of the cached kind. Goal: p95 <= 200 ms to
+  the motion playing.
 - **cold start to the first frame of motion**: ``aouc studio FILE`` is started in a
   fresh process, Chromium (already running) opens its address, and the time from the
   start until the page's timeline marks a time past zero (the motion is playing in the
@@ -74,10 +76,11 @@ def _release(repeats: int) -> None:
     say(f"studio: slider release, hesitant on the panda, {repeats} values: the new motion "
         f"plays after {1000 * float(np.median(playing)):.0f} ms (median), checked and "
         f"measured after {1000 * float(np.median(checked)):.0f} ms")
-    figure("studio_release_p95_ms", "slider release to new motion playing (p95, warm)",
-           1000 * float(np.percentile(playing, 95)), "ms", at_most=200.0, fmt="{:.0f}")
-    figure("studio_checked_p95_ms", "slider release to its checks and numbers (p95, warm)",
-           1000 * float(np.percentile(checked, 95)), "ms", fmt="{:.0f}")
+    figure("studio_release_p95_ms", "slider release to new motion playing (p95; one value "
+           "new, the other primitives reused)", 1000 * float(np.percentile(playing, 95)), "ms",
+           kind="cached", at_most=200.0, fmt="{:.0f}")
+    figure("studio_checked_p95_ms", "slider release to its checks and numbers (p95, the same)",
+           1000 * float(np.percentile(checked, 95)), "ms", kind="cached", fmt="{:.0f}")
 
 
 def _cold_compile() -> float:
@@ -145,4 +148,4 @@ def bench_studio(repeats: int = 20, release: bool = True) -> None:
     say(f"studio: cold `aouc compile` of hesitant {compile_s:.2f} s; cold `aouc studio` to "
         f"the first frame of motion in the browser {studio_s:.2f} s")
     figure("studio_cold_vs_compile", "cold studio to first frame / cold compile",
-           studio_s / compile_s, "x", at_most=3.0)
+           studio_s / compile_s, "x", kind=None, at_most=3.0)

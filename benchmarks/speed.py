@@ -1,15 +1,29 @@
 """The speed goals of aou, measured: each figure printed beside its goal (see bench.py).
 
+Every time figure says its kind:
+
+- **cold**: a new process (imports, robot loading and all);
+- **warm**: the libraries and the arm loaded, the input new: motions this process has
+  not seen, values changed in every primitive (:func:`variants`), so that no memo of
+  an earlier build can answer;
+- **cached**: the same input again, or one only partly new (one value moved, a comment
+  added), where what did not change is answered by what the process kept.
+
+Goals are judged on warm figures (and on cold ones where the goal is the start).
+
 Sections (each a function of this module):
 
-- ``build``: the warm checked build of hesitant.aou (lint, compile, safety replay,
-  measure) in one process, as a robot re-planning would run it; its real-time factor
-  and its ratio to the compile alone, with where the time goes.
+- ``build``: the checked build of hesitant (lint, compile, safety replay, measure) in
+  one process, as a robot re-planning would run it: warm through ``aou_dsl.compile``
+  and end to end through ``aouc compile FILE -o out.json`` (the JSON written), and the
+  same input again (cached); the real-time factor and where the warm time goes.
 - ``cold``: ``aouc compile`` and ``aouc lint`` started fresh, against the time Python
   takes to import what they depend on (ratios measured in the same run, interleaved).
 - ``lint``: time and memory of linting ever longer files (linear? bounded?), and a
   folder of 1000 generated files.
-- ``jobs``: ``aouc compile --jobs N``'s pool against one process.
+- ``jobs``: ``aouc compile --jobs N``'s pool against one process, on new motions.
+- ``sweep``: ``aouc compile --jobs 2`` against ``--jobs 1`` (each a new process) on 40
+  different motions (hesitant with its values varied, each file new).
 - ``render``: a 640x480 video of hesitant.aou against its duration.
 - ``replan``: a live re-plan in the middle of a motion (``bench_replan.py``, whose
   printout is passed on), its median against its goal.
@@ -24,7 +38,6 @@ import json
 import os
 import random
 import re
-import shutil
 import statistics
 import subprocess
 import sys
@@ -38,12 +51,18 @@ HESITANT = ROOT / "behaviours" / "hesitant.aou"
 AOUC = [sys.executable, "-m", "aou_dsl"]
 
 
+#: The kinds of a figure (module docstring); None: not a time (a size, a count, a ratio
+#: of two kinds' times says its kinds in its label).
+KINDS = ("cold", "warm", "cached")
+
+
 @dataclass
 class Figure:
     key: str
     label: str
     value: float
     unit: str
+    kind: str | None
     goal: str | None = None
     met: bool | None = None
 
@@ -56,18 +75,23 @@ def say(text: str) -> None:
     print(text, file=OUT, flush=True)
 
 
-def figure(key: str, label: str, value: float, unit: str = "", *, at_most: float | None = None,
-           at_least: float | None = None, fmt: str = "{:.1f}") -> Figure:
-    """Record and print one figure, beside its goal when it has one."""
+def figure(key: str, label: str, value: float, unit: str = "", *, kind: str | None,
+           at_most: float | None = None, at_least: float | None = None,
+           fmt: str = "{:.1f}") -> Figure:
+    """Record and print one figure, its kind (:data:`KINDS`) first, beside its goal
+    when it has one."""
+    if kind is not None and kind not in KINDS:
+        raise ValueError(f"kind must be one of {KINDS} or None, not {kind!r}")
     goal, met = None, None
     if at_most is not None:
         goal, met = f"<= {fmt.format(at_most)} {unit}".rstrip(), value <= at_most
     elif at_least is not None:
         goal, met = f">= {fmt.format(at_least)} {unit}".rstrip(), value >= at_least
-    f = Figure(key, label, float(value), unit, goal, met)
+    f = Figure(key, label, float(value), unit, kind, goal, met)
     FIGURES.append(f)
     tail = "" if goal is None else f"   goal {goal}: {'met' if met else 'NOT MET'}"
-    say(f"  {label}: {fmt.format(value)} {unit}{tail}".replace(" :", ":"))
+    tag = "" if kind is None else f"[{kind}] "
+    say(f"  {tag}{label}: {fmt.format(value)} {unit}{tail}".replace(" :", ":"))
     return f
 
 
@@ -108,45 +132,127 @@ def _median_ms(fn, repeat: int, cpu: list[float] | None = None) -> tuple[float, 
     return statistics.median(times) * 1000, out
 
 
+# --- new motions -----------------------------------------------------------------------
+
+#: The statements that make motion; every number in them is varied by :func:`variant`.
+PRIMITIVES = ("approach", "pause", "retreat", "gaze", "shiver", "tilt")
+_NUMBER = re.compile(r"(?<![\w.])(\d+(?:\.\d+)?)")
+
+
+def variant(text: str, k: int) -> str:
+    """``text`` with every value of its primitives (not a repeat count ``xN``) scaled by
+    ``1 - 0.003 k`` (k >= 1): the same behaviour, a motion no process has built (every
+    primitive changes, so no memo of another build can answer)."""
+    factor = 1.0 - 0.003 * k
+    lines = []
+    for line in text.splitlines():
+        code, mark, comment = line.partition("#")
+        words = code.split()
+        if words and words[0] in PRIMITIVES:
+            code = _NUMBER.sub(lambda m: f"{float(m.group(1)) * factor:.6g}", code)
+        lines.append(code + mark + comment)
+    return "\n".join(lines) + "\n"
+
+
+def write_variants(folder: str, source: Path, ks: range, stem: str | None = None
+                   ) -> list[str]:
+    """:func:`variant` ``k`` of ``source`` for each k, each a file in ``folder``."""
+    text = source.read_text()
+    out = []
+    for k in ks:
+        path = Path(folder, f"{stem or source.stem}_{k:03d}.aou")
+        path.write_text(variant(text, k))
+        out.append(str(path))
+    return out
+
+
+def load() -> str:
+    """The machine's load averages (1, 5, 15 min): a figure on a shared machine is only
+    as good as the cores were free."""
+    try:
+        return "load average " + ", ".join(f"{x:.2f}" for x in os.getloadavg())
+    except OSError:  # not reported here
+        return "load average unknown"
+
+
+def _each_ms(fn, items: list, cpu: list[float] | None = None) -> tuple[float, object]:
+    """Median wall time [ms] of ``fn(item)`` over ``items`` (each timed once: a warm
+    figure times each new input once), garbage collector paused as timeit does; the
+    median CPU time [ms] appended to ``cpu`` when given."""
+    it = iter(items)
+    return _median_ms(lambda: fn(next(it)), len(items), cpu)
+
+
 # --- build ------------------------------------------------------------------------------
 
 
+def _aouc_compile(path: str, out: str) -> None:
+    """``aouc compile PATH -o OUT`` in this process (quietly)."""
+    from aou_dsl.cli.commands import main
+
+    with contextlib.redirect_stderr(io.StringIO()), contextlib.redirect_stdout(io.StringIO()):
+        code = main(["compile", path, "-o", out])
+    if code != 0:
+        raise RuntimeError(f"aouc compile {path} exited {code}")
+
+
 def bench_build(repeat: int = 15) -> None:
-    from aou_dsl.build.builder import CHECK_RATE, build_file
+    import aou_dsl
+    from aou_dsl.build.builder import CHECK_RATE
     from aou_dsl.compiler.pipeline import DEFAULT_RATE, compile_behaviour, sample
     from aou_dsl.lang.linter import lint_file
     from aou_dsl.measuring.measured import measure
     from aou_dsl.safety.replay import replay
 
-    say("warm checked build of behaviours/hesitant.aou (lint, compile, safety replay, "
-        "measure), one process")
-    path = str(HESITANT)
-    for _ in range(3):
-        res = build_file(path)
-    assert res.ok, res.diagnostics
-    cpu: list[float] = []
-    build_ms, res = _median_ms(lambda: build_file(path), repeat, cpu)
-    lint = lint_file(path)
-    lint_ms, _ = _median_ms(lambda: lint_file(path), repeat)
-    compile_ms, comp = _median_ms(
-        lambda: compile_behaviour(lint.behaviour, timeline=lint.timeline), repeat)
-    tr = comp.trajectory
-    dense = tr if DEFAULT_RATE >= CHECK_RATE else sample(comp, CHECK_RATE)  # as the build
-    replay_ms, _ = _median_ms(lambda: replay(dense), repeat)
-    measure_ms, _ = _median_ms(lambda: measure(tr), repeat)
-    duration = tr.duration
-    figure("build_ms", "checked build", build_ms, "ms", at_most=100.0)
-    figure("build_cpu_ms", "checked build, CPU time of this process", cpu[0], "ms")
-    figure("build_rtf", "real-time factor (motion / checked build)", duration / build_ms * 1000,
-           "", at_least=200.0, fmt="{:.0f}")
-    figure("build_over_compile", "checked build / compile alone", build_ms / compile_ms, "x",
-           fmt="{:.2f}")
-    say(f"  where the time goes: lint {lint_ms:.1f} ms, compile {compile_ms:.1f} ms, "
-        f"safety replay {replay_ms:.1f} ms ({len(dense.t)} samples), measure "
-        f"{measure_ms:.1f} ms; motion {duration:.2f} s")
-    figure("compile_ms", "compile alone", compile_ms, "ms")
-    figure("replay_ms", "safety replay", replay_ms, "ms")
-    figure("measure_ms", "measure", measure_ms, "ms")
+    say("checked build of hesitant (lint, compile, safety replay, measure), one process; "
+        f"warm: {repeat} motions each new (hesitant's values varied), {load()}")
+    with tempfile.TemporaryDirectory() as tmp:
+        # distinct motions for each figure, none built before it is timed
+        primer, api, cli, stages = (write_variants(tmp, HESITANT, range(a, a + n), f"v{a}")
+                                    for a, n in ((1, 3), (10, repeat), (40, repeat),
+                                                 (70, repeat)))
+        for path in primer:  # the libraries, the arm and the command line loaded
+            assert aou_dsl.compile(path).ok
+            _aouc_compile(path, path + ".json")
+        cpu: list[float] = []
+        api_ms, res = _each_ms(lambda p: aou_dsl.compile(p), api, cpu)
+        assert res.ok, res.diagnostics
+        cli_cpu: list[float] = []
+        cli_ms, _ = _each_ms(lambda p: _aouc_compile(p, p + ".json"), cli, cli_cpu)
+        lints: list = []
+        lint_ms, _ = _each_ms(lambda p: lints.append(lint_file(p)), stages)
+        comps: list = []
+        compile_ms, _ = _each_ms(lambda lint: comps.append(
+            compile_behaviour(lint.behaviour, timeline=lint.timeline)), lints)
+        trs = [c.trajectory for c in comps]
+        dense = [tr if DEFAULT_RATE >= CHECK_RATE else sample(c, CHECK_RATE)
+                 for c, tr in zip(comps, trs, strict=True)]  # as the build samples it
+        replay_ms, _ = _each_ms(replay, dense)
+        measure_ms, _ = _each_ms(measure, trs)
+        cached_ms, _ = _median_ms(lambda: aou_dsl.compile(api[0]), repeat)
+    duration = res.trajectory.duration
+    figure("build_api_ms", "checked build of a new motion, aou_dsl.compile (no output)",
+           api_ms, "ms", kind="warm", at_most=60.0)
+    figure("build_api_cpu_ms", "the same, CPU time of this process", cpu[0], "ms",
+           kind="warm")
+    figure("build_cli_ms", "checked build of a new motion end to end, `aouc compile FILE -o "
+           "out.json` in a process that ran it before (JSON written)", cli_ms, "ms",
+           kind="warm", at_most=80.0)
+    figure("build_cli_cpu_ms", "the same, CPU time of this process", cli_cpu[0], "ms",
+           kind="warm")
+    figure("build_rtf", "real-time factor (motion / end-to-end checked build)",
+           duration / cli_ms * 1000, "", kind="warm", at_least=270.0, fmt="{:.0f}")
+    figure("build_cached_ms", "aou_dsl.compile of the same file again", cached_ms, "ms",
+           kind="cached")
+    say(f"  where the warm time goes: lint {lint_ms:.1f} ms, compile {compile_ms:.1f} ms, "
+        f"safety replay {replay_ms:.1f} ms ({len(dense[-1].t)} samples), measure "
+        f"{measure_ms:.1f} ms; the rest of aouc compile (arguments, the document, writing) "
+        f"{cli_ms - api_ms:.1f} ms; motion {duration:.2f} s")
+    figure("compile_ms", "compile alone, a new motion", compile_ms, "ms", kind="warm")
+    figure("replay_ms", "safety replay, a new motion", replay_ms, "ms", kind="warm")
+    figure("measure_ms", "measure, a new motion", measure_ms, "ms", kind="warm")
+    figure("build_over_compile", "checked build / compile alone (both warm)",
+           api_ms / compile_ms, "x", kind=None, fmt="{:.2f}")
 
 
 # --- cold starts ------------------------------------------------------------------------
@@ -217,14 +323,19 @@ def bench_cold(repeat: int = 7) -> None:
             for k, args in runs.items():
                 times[k].append(_run(args, cwd=tmp))
     med = {k: statistics.median(v) * 1000 for k, v in times.items()}
-    figure("cold_compile_ms", "cold `aouc compile hesitant.aou`", med["aouc compile"], "ms")
-    figure("cold_compile_floor_ms", "importing its dependencies", med["compile floor"], "ms")
-    figure("cold_compile_ratio", "cold compile / import floor",
-           med["aouc compile"] / med["compile floor"], "x", at_most=1.3, fmt="{:.2f}")
-    figure("cold_lint_ms", "cold `aouc lint behaviours/`", med["aouc lint"], "ms")
-    figure("cold_lint_floor_ms", "`import lark, pydantic`", med["lint floor"], "ms")
-    figure("cold_lint_ratio", "cold lint / import floor", med["aouc lint"] / med["lint floor"],
-           "x", at_most=2.0, fmt="{:.2f}")
+    say(f"  {load()}")
+    figure("cold_compile_ms", "`aouc compile behaviours/hesitant.aou -o h.json`",
+           med["aouc compile"], "ms", kind="cold")
+    figure("cold_compile_floor_ms", "importing its dependencies", med["compile floor"], "ms",
+           kind="cold")
+    figure("cold_compile_ratio", "cold compile / import floor (both cold)",
+           med["aouc compile"] / med["compile floor"], "x", kind=None, at_most=1.2,
+           fmt="{:.2f}")
+    figure("cold_lint_ms", "`aouc lint behaviours/`", med["aouc lint"], "ms", kind="cold")
+    figure("cold_lint_floor_ms", "`import lark, pydantic`", med["lint floor"], "ms",
+           kind="cold")
+    figure("cold_lint_ratio", "cold lint / import floor (both cold)",
+           med["aouc lint"] / med["lint floor"], "x", kind=None, at_most=2.0, fmt="{:.2f}")
 
 
 # --- lint -------------------------------------------------------------------------------
@@ -274,17 +385,18 @@ def bench_lint() -> None:
             say(f"  {n:>6} lines ({os.path.getsize(path) / 1e6:.2f} MB): {float(secs):.2f} s, "
                 f"peak memory {float(rss):.0f} MB, {printed} lines printed")
             last_rss = float(rss)
-        figure("lint_time_per_line_growth", "time per line, 64k lines / 8k lines",
-               per_line[64000] / per_line[8000], "x", at_most=1.5, fmt="{:.2f}")
-        figure("lint_peak_mb_64k", "peak memory linting 64k lines", last_rss, "MB")
+        figure("lint_time_per_line_growth", "time per line, 64k lines / 8k lines (each cold)",
+               per_line[64000] / per_line[8000], "x", kind=None, at_most=1.5, fmt="{:.2f}")
+        figure("lint_peak_mb_64k", "peak memory linting 64k lines", last_rss, "MB",
+               kind=None)
         folder = os.path.join(tmp, "generated")
         os.makedirs(folder)
         rng = random.Random(14)
         for i in range(1000):
             Path(folder, f"g{i:04d}.aou").write_text(_generated(rng))
         secs = statistics.median(_run([*AOUC, "lint", folder]) for _ in range(3))
-    figure("lint_files_per_s", "`aouc lint` of 1000 generated files (cold, startup included)",
-           1000 / secs, "files/s", at_least=500.0, fmt="{:.0f}")
+    figure("lint_files_per_s", "`aouc lint` of 1000 generated files (startup included)",
+           1000 / secs, "files/s", kind="cold", at_least=500.0, fmt="{:.0f}")
 
 
 # --- jobs -------------------------------------------------------------------------------
@@ -327,26 +439,28 @@ def _ceiling(cores: int) -> float:
     return one / (time.perf_counter() - t)
 
 
-def bench_jobs(copies: int = 3, rounds: int = 5) -> None:
+def bench_jobs(per: int = 3, rounds: int = 5) -> None:
     from aou_dsl.build.parallel import BuildPool, build_many, default_jobs
     from aou_dsl.compiler.output import encode
 
     cores = default_jobs()
-    say(f"`aouc compile --jobs {cores}`: a warm pool against one process "
-        f"({copies} copies of each shipped behaviour, {rounds} rounds, medians)")
+    shipped = sorted((ROOT / "behaviours").glob("*.aou"))
+    say(f"`aouc compile --jobs {cores}`'s warm pool against one process, {per} new motions "
+        f"of each shipped behaviour a round, the same for both and new each round, "
+        f"{rounds} rounds (medians); {load()}")
     with tempfile.TemporaryDirectory() as tmp:
-        paths = []
-        for i in range(copies):
-            for src in sorted((ROOT / "behaviours").glob("*.aou")):
-                dst = Path(tmp, f"{src.stem}{i}.aou")
-                shutil.copy(src, dst)
-                paths.append(str(dst))
-        list(build_many(paths[:5], None, 1))  # this process warm too
+
+        def batch(r: int) -> list[str]:
+            ks = range(1 + r * per, 1 + (r + 1) * per)
+            return [p for src in shipped for p in write_variants(tmp, src, ks, f"{src.stem}")]
+
+        list(build_many(batch(rounds), None, 1))  # this process warm too (other motions)
         t = time.perf_counter()
         with BuildPool(cores) as pool:
             start = time.perf_counter() - t
-            walls, cpus, ceilings = [], [], []
-            for _ in range(rounds):  # interleaved: the machine's load changes
+            walls, cpus, ceilings, same = [], [], [], True
+            for r in range(rounds):  # interleaved: the machine's load changes
+                paths = batch(r)
                 c, t = time.process_time(), time.perf_counter()
                 one = list(build_many(paths, None, 1))
                 t1, c1 = time.perf_counter() - t, time.process_time() - c
@@ -357,19 +471,93 @@ def bench_jobs(copies: int = 3, rounds: int = 5) -> None:
                 walls.append(t1 / tn)
                 cpus.append(c1 / max(max(used), 1e-9))
                 ceilings.append(_ceiling(cores))
-    same = all((a.document is None and b.document is None)
-               or encode(a.document, "json") == encode(b.document, "json")
-               for a, b in zip(one, many, strict=True))
+                same = same and all(
+                    (a.document is None and b.document is None)
+                    or encode(a.document, "json") == encode(b.document, "json")
+                    for a, b in zip(one, many, strict=True))
     ceiling = statistics.median(ceilings)
-    say(f"  {len(paths)} files; the pool started in {start:.2f} s, once; documents "
-        f"identical to --jobs 1: {same}; load {os.getloadavg()[0]:.2f}; what {cores} "
-        f"processes can gain on this machine now (pure-Python loops): {ceiling:.2f}x")
-    figure("jobs_speedup", f"speed-up on {cores} cores", statistics.median(walls), "x",
-           at_least=0.8 * min(cores, ceiling), fmt="{:.2f}")
+    say(f"  {len(paths)} files a round; the pool started in {start:.2f} s, once; documents "
+        f"identical to --jobs 1: {same}; {load()}; what {cores} processes can gain on this "
+        f"machine now (pure-Python loops): {ceiling:.2f}x")
+    figure("jobs_speedup", f"speed-up of a warm pool on {cores} cores", statistics.median(walls),
+           "x", kind="warm", at_least=0.8 * min(cores, ceiling), fmt="{:.2f}")
     figure("jobs_cpu_speedup", "one process's CPU time / the busiest worker's",
-           statistics.median(cpus), "x", at_least=0.8 * cores, fmt="{:.2f}")
-    figure("jobs_identical", "outputs identical to --jobs 1", float(same), "",
+           statistics.median(cpus), "x", kind="warm", at_least=0.8 * cores, fmt="{:.2f}")
+    figure("jobs_identical", "outputs identical to --jobs 1", float(same), "", kind=None,
            at_least=1.0, fmt="{:.0f}")
+
+
+# --- sweep ------------------------------------------------------------------------------
+
+
+#: ``aouc`` (its ``main``, as ``python -m aou_dsl`` runs it) that says, last on its
+#: standard error, the CPU time of its own process and of its workers [s].
+_AOUC_CPU = ("import resource, sys\n"
+             "from aou_dsl.cli.commands import main\n"
+             "code = main(sys.argv[1:])\n"
+             "me, kids = (resource.getrusage(w) for w in (resource.RUSAGE_SELF, "
+             "resource.RUSAGE_CHILDREN))\n"
+             "print(me.ru_utime + me.ru_stime, kids.ru_utime + kids.ru_stime, file=sys.stderr)\n"
+             "sys.exit(code)\n")
+
+
+def _aouc_run(args: list[str]) -> tuple[float, float, float]:
+    """Wall time of one ``aouc`` process, and the CPU time of the process itself and of
+    its workers [s]."""
+    t = time.perf_counter()
+    proc = subprocess.run([sys.executable, "-c", _AOUC_CPU, *args], cwd=ROOT,
+                          capture_output=True, check=False)
+    wall = time.perf_counter() - t
+    if proc.returncode != 0:
+        raise RuntimeError(proc.stderr.decode()[-2000:])
+    own, workers = (float(x) for x in proc.stderr.decode().splitlines()[-1].split())
+    return wall, own, workers
+
+
+def _same_bytes(a: str, b: str) -> bool:
+    names = sorted(os.listdir(a))
+    return names == sorted(os.listdir(b)) and all(
+        Path(a, n).read_bytes() == Path(b, n).read_bytes() for n in names)
+
+
+def bench_sweep(files: int = 40, rounds: int = 3) -> None:
+    """``aouc compile FOLDER --jobs 2`` against ``--jobs 1``, each a new process, on
+    ``files`` different motions (hesitant with its values varied): the cold start of the
+    command, then every file a motion the process has not seen."""
+    say(f"`aouc compile --jobs 2` against `--jobs 1` on {files} different motions (hesitant "
+        f"varied, each file new), each a new process, {rounds} rounds interleaved "
+        f"(medians); {load()} at the start")
+    with tempfile.TemporaryDirectory() as tmp:
+        src = os.path.join(tmp, "sweep")
+        os.mkdir(src)
+        write_variants(src, HESITANT, range(1, files + 1))
+        _aouc_run(["lint", src])  # the parser's cache written, as any user's is
+        ratios, cpu_ratios, paths, ceilings = [], [], [], []
+        walls: dict[int, list[float]] = {1: [], 2: []}
+        same = True
+        for r in range(rounds):
+            out = {j: os.path.join(tmp, f"out{r}_{j}") for j in (1, 2)}
+            w1, c1, _ = _aouc_run(["compile", src, "-o", out[1] + "/", "--jobs", "1"])
+            w2, own, workers = _aouc_run(["compile", src, "-o", out[2] + "/", "--jobs", "2"])
+            ratios.append(w1 / w2)
+            cpu_ratios.append((own + workers) / c1)
+            # what the wall ratio is on two free cores: the busier process sets the pace
+            paths.append(c1 / max(own, workers))
+            walls[1].append(w1)
+            walls[2].append(w2)
+            ceilings.append(_ceiling(2))
+            same = same and _same_bytes(out[1], out[2])
+    say(f"  --jobs 1 {statistics.median(walls[1]):.2f} s, --jobs 2 "
+        f"{statistics.median(walls[2]):.2f} s (medians); CPU time of --jobs 2 over --jobs "
+        f"1's {statistics.median(cpu_ratios):.2f}; {load()} at the end; what 2 processes "
+        f"can gain on this machine now (pure-Python loops): {statistics.median(ceilings):.2f}x")
+    figure("sweep_jobs2_cpu_path", "--jobs 1 CPU time / the busier process's of --jobs 2 "
+           "(the speed-up on two free cores)", statistics.median(paths), "x", kind="cold",
+           fmt="{:.2f}")
+    figure("sweep_jobs2_speedup", f"--jobs 1 time / --jobs 2 time, {files} different motions",
+           statistics.median(ratios), "x", kind="cold", at_least=1.5, fmt="{:.2f}")
+    figure("sweep_identical", "outputs of --jobs 2 byte-identical to --jobs 1", float(same), "",
+           kind=None, at_least=1.0, fmt="{:.0f}")
 
 
 # --- render -----------------------------------------------------------------------------
@@ -398,10 +586,11 @@ def bench_render() -> None:
     say(f"  {info['frames']} frames, {info['duration']:.2f} s of video in {secs:.1f} s, "
         f"{used:.1f} s of CPU time in all; load {os.getloadavg()[0]:.2f}; what {cores} "
         f"processes can gain on this machine now (pure-Python loops): {ceiling:.2f}x")
-    figure("render_realtime_factor", "video duration / rendering time",
-           info["duration"] / secs, "", at_least=1.0, fmt="{:.2f}")
+    figure("render_realtime_factor", "video duration / rendering time (motion compiled "
+           "before)", info["duration"] / secs, "", kind="warm", at_least=1.0, fmt="{:.2f}")
     figure("render_cpu_realtime_factor", f"video duration / (CPU time / {cores} cores)",
-           info["duration"] / (used / (cores or 1)), "", at_least=1.0, fmt="{:.2f}")
+           info["duration"] / (used / (cores or 1)), "", kind="warm", at_least=1.0,
+           fmt="{:.2f}")
 
 
 # --- replan -----------------------------------------------------------------------------
@@ -419,5 +608,5 @@ def bench_replan() -> None:
     found = re.search(r"warm re-plan: median ([0-9.]+) ms", text)
     if found is None:
         raise RuntimeError("bench_replan.py no longer prints its median re-plan time")
-    figure("replan_ms", "warm mid-motion re-plan (median)", float(found.group(1)), "ms",
-           at_most=100.0)
+    figure("replan_ms", "mid-motion re-plan from a new state, the plans made before "
+           "(median)", float(found.group(1)), "ms", kind="warm", at_most=100.0)

@@ -36,9 +36,11 @@ import numpy as np
 __all__ = [
     "PRESETS",
     "URDF_PATHS",
+    "NOISE_LEVELS",
     "Logger",
     "UrdfJoint",
     "dynamic_replay",
+    "noisy",
     "record",
     "to_csv_text",
     "to_json_doc",
@@ -326,6 +328,17 @@ PRESETS: dict[str, Logger] = {
     "teleop_guided": Logger(rate=100.0, jitter=0.1, gap_probability=5e-3, max_gap=0.05,
                             drop=0.005, noise=2e-4, decimals=5, start=0.3, seed=5),
 }
+
+
+#: Encoder noise levels [rad] that measuring is tested under: from a good encoder read
+#: over a fieldbus to a cheap one over a noisy bus.
+NOISE_LEVELS = (1e-4, 3e-4, 6e-4, 1e-3)
+
+
+def noisy(noise: float, rate: float, seed: int = 0) -> Logger:
+    """A logger at ``rate`` [Hz] with ``noise`` [rad] of encoder noise, a 5 % jittered
+    clock, 0.5 % dropped samples and a 24-bit encoder's resolution (2.6e-7 rad)."""
+    return Logger(rate=rate, jitter=0.05, drop=0.005, noise=noise, quantum=2.6e-7, seed=seed)
 
 
 def _timestamps(logger: Logger, duration: float, rng: np.random.Generator) -> np.ndarray:

@@ -99,3 +99,32 @@ def test_copies_split_across_a_worker_give_what_each_build_alone_gives(tmp_path)
     got = list(build_many(paths, OPTIONS, jobs=2))
     assert [r.path for r in got] == paths
     assert _documents(got) == _documents(build_file(p, OPTIONS) for p in paths)
+
+
+@forking
+def test_a_batch_is_written_without_making_the_documents_lists(tmp_path, monkeypatch):
+    """``aouc compile --jobs 2`` writes each file from the bytes its builder encoded
+    from the trajectory's arrays: the document's lists of samples (a float object per
+    sample, made in this process for every file it went through) are never made, here
+    or in a worker (a copy of this process, the refusal included), and the files are
+    those ``--jobs 1`` writes."""
+    from aou_dsl.cli.commands import main
+    from aou_dsl.compiler import output
+
+    if _ran_alone("test_a_batch_is_written_without_making_the_documents_lists"):
+        return
+    paths = [str(BEHAVIOURS / f"{n}.aou") for n in ("curious", "confident", "hesitant")]
+    for jobs in (1, 2):
+        assert main(["compile", *paths, "-o", f"{tmp_path / str(jobs)}/", "--jobs", str(jobs),
+                     "--rate", "100"]) == 0
+    one = {p.name: p.read_bytes() for p in (tmp_path / "1").iterdir()}
+    two = {p.name: p.read_bytes() for p in (tmp_path / "2").iterdir()}
+    assert sorted(one) == ["confident.json", "curious.json", "hesitant.json"] and one == two
+
+    def refused(*args, **kwargs):
+        raise AssertionError("the document's lists were made")
+
+    monkeypatch.setattr(output, "with_samples", refused)
+    out = tmp_path / "2again"
+    assert main(["compile", *paths, "-o", f"{out}/", "--jobs", "2", "--rate", "100"]) == 0
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == one

@@ -12,19 +12,20 @@ import pytest
 pytest.importorskip("lsprotocol", reason="the lsp extra is not installed")
 from aou_dsl.editor import lsp_engine as engine
 from aou_dsl.editor.compiling import Compiles
+from aou_dsl.editor.convert import Text
 from aou_dsl.editor.state import Document
 
 ROOT = Path(__file__).resolve().parent.parent
 
 
 def _doc(text: str) -> Document:
-    doc = Document("file:///x.aou", "x.aou", text)
+    doc = Document("file:///x.aou", "x.aou", Text(text))
     doc.lint = engine.lint(text, "x.aou")
     return doc
 
 
 def _edit(doc: Document, text: str) -> None:
-    doc.text = text
+    doc.view = Text(text)
     doc.generation += 1
     doc.lint = engine.lint(text, "x.aou")
 

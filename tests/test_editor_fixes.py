@@ -13,7 +13,7 @@ from aou_dsl.lang.linter import lint_source
 
 pytest.importorskip("lsprotocol", reason="the lsp extra is not installed")
 from aou_dsl.editor.actions import resolve
-from aou_dsl.editor.convert import lines_of
+from aou_dsl.editor.convert import Text
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -37,7 +37,7 @@ SLIPS = [
 
 
 def _apply(text: str, d) -> str:
-    span, new = resolve(d.fix, lines_of(text))
+    span, new = resolve(d.fix, text.split("\n"))
     lines = text.split("\n")
     start = sum(len(ln) + 1 for ln in lines[:span.line - 1]) + span.col - 1
     end = sum(len(ln) + 1 for ln in lines[:span.end_line - 1]) + span.end_col - 1
@@ -89,12 +89,12 @@ def test_ranges_count_utf16_and_skip_a_byte_order_mark():
 
     text = "\ufeffpause 3m\n"
     (d,) = [d for d in lint_source(text, "x.aou").diagnostics if d.code == "V102"]
-    rng = to_lsp(d, lines_of(text), "x.aou").range
+    rng = to_lsp(d, Text(text), "x.aou").range
     assert (rng.start, rng.end) == (types.Position(0, 7), types.Position(0, 9))
     text = 'robot "😀x"; pause 3m\n'  # the emoji is two UTF-16 code units
     (d,) = [d for d in lint_source(text, "x.aou").diagnostics if d.code == "V102"]
-    assert to_lsp(d, lines_of(text), "x.aou").range.start == types.Position(0, 19)
+    assert to_lsp(d, Text(text), "x.aou").range.start == types.Position(0, 19)
     other = diag("V102", "in the robot file", Span("arm.toml", 7, 3, 7, 9))
-    shown = to_lsp(other, lines_of(text), "x.aou")
+    shown = to_lsp(other, Text(text), "x.aou")
     assert shown.range.start == shown.range.end == types.Position(0, 0)
     assert shown.message.startswith("arm.toml:7:3: ")

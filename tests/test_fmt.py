@@ -4,6 +4,7 @@ timeline, byte-identical compile), and any blanks a person adds come out the sam
 
 from __future__ import annotations
 
+import os
 import random
 import re
 import subprocess
@@ -201,3 +202,23 @@ def test_server_without_the_extra_says_which_to_install() -> None:
                          stdin=subprocess.DEVNULL, timeout=60)
     assert out.returncode == 2
     assert "lsp extra" in out.stderr and "pip install '.[lsp]'" in out.stderr
+
+
+@pytest.mark.skipif(not hasattr(os, "geteuid") or os.geteuid() != 0,
+                    reason="giving a file to another user needs root")
+def test_fmt_keeps_the_owner_group_and_mode_of_what_it_rewrites(tmp_path):
+    """A file of nobody's, rewritten by root, stays nobody's: same owner, group, mode."""
+    import pwd
+
+    nobody = pwd.getpwnam("nobody")
+    messy = tmp_path / "messy.aou"
+    messy.write_text("pause   1s  x2 # two\n")
+    os.chown(messy, nobody.pw_uid, nobody.pw_gid)
+    messy.chmod(0o640)
+    from aou_dsl.cli import main
+
+    assert main(["fmt", str(messy)]) == 0
+    st = messy.stat()
+    assert messy.read_text() == "pause 1s x2  # two\n"
+    assert (st.st_uid, st.st_gid, st.st_mode & 0o7777) == (nobody.pw_uid, nobody.pw_gid,
+                                                           0o640)

@@ -69,6 +69,16 @@ def _workspace(root: Path) -> dict[str, str]:
     n = 20
     t = [i * 0.05 for i in range(n)]
     q = [[0.0, -0.3, 0.0, -2.0, 0.0, 1.8, 0.8] for _ in t]
+    # the robot line in the other forms the grammar accepts
+    (root / "z.aou").write_text('behaviour z : confident; robot "arm/arm.toml"; approach\n')
+    (root / "f.aou").write_text('behaviour f : confident\n\frobot "arm/arm.toml"\n'
+                                'approach\n')
+    # a URDF whose package mesh is found only through --package-dir
+    (root / "arm" / "pkgs" / "otherpkg" / "meshes").mkdir(parents=True)
+    (root / "arm" / "pkgs" / "otherpkg" / "meshes" / "m.stl").write_bytes(b"solid m\n")
+    (root / "arm" / "arm2.urdf").write_text(ARM_URDF.replace(
+        "package://armpkg/meshes/l2.stl", "package://otherpkg/meshes/m.stl"))
+    (root / "prev.json").write_text('{"generator": "aouc 0.2.0"}\n')  # an earlier output
     (root / "t.json").write_text(json.dumps(
         {"format": "aou-trajectory/1", "robot": "panda", "joint_names": [
             f"panda_joint{k}" for k in range(1, 8)], "t": t, "q": q}))
@@ -77,7 +87,9 @@ def _workspace(root: Path) -> dict[str, str]:
                                                    for x in t))
     return {"aou": "y.aou", "robot": "arm/arm.toml", "urdf": "arm/arm.urdf",
             "mesh": "arm/meshes/l1.stl", "package mesh": "arm/armpkg/meshes/l2.stl",
-            "plain aou": "a.aou", "trajectory": "t.json", "recording": "rec.csv"}
+            "plain aou": "a.aou", "trajectory": "t.json", "recording": "rec.csv",
+            "one-line aou": "z.aou", "form-feed aou": "f.aou", "urdf2": "arm/arm2.urdf",
+            "package-dir mesh": "arm/pkgs/otherpkg/meshes/m.stl", "-o output": "prev.json"}
 
 
 #: Each writing command: (name, argv with OUT for the output, the inputs it reads by role,
@@ -105,6 +117,20 @@ COMMANDS = [
     ("plot --cv", ["plot", "--cv", "y.aou", "a.aou", "-o", "OUT"],
      ("aou", "plain aou", "robot", "urdf", "mesh"), "pdf"),
     ("render", ["render", "t.json", "-o", "OUT"], ("trajectory",), "gif"),
+    ("compile a one-line .aou", ["compile", "z.aou", "--format", "json", "-o", "OUT"],
+     ("one-line aou", "robot", "urdf", "mesh", "package mesh"), "json"),
+    ("compile a form-feed .aou", ["compile", "f.aou", "--format", "json", "-o", "OUT"],
+     ("form-feed aou", "robot", "urdf", "mesh", "package mesh"), "json"),
+    ("compile --write-fitted", ["compile", "y.aou", "--fit", "--no-check", "--write-fitted",
+                                "OUT", "-o", "prev.json"],
+     ("aou", "robot", "urdf", "mesh", "package mesh", "-o output"), "aou"),
+    ("check --write-fitted", ["check", "z.aou", "--fit", "--no-dynamic", "--write-fitted",
+                              "OUT"], ("one-line aou", "robot", "urdf", "mesh"), "aou"),
+    ("robot --package-dir -o", ["robot", "arm/arm2.urdf", "--package-dir", "arm/pkgs",
+                                "--format", "json", "-o", "OUT", "--force"],
+     ("urdf2", "package-dir mesh", "mesh"), "json"),
+    ("plot --package-dir", ["plot", "t.json", "--robot", "arm/arm2.urdf", "--package-dir",
+                            "arm/pkgs", "-o", "OUT"], ("urdf2", "package-dir mesh"), "png"),
     ("render a side-by-side", ["render", "--side-by-side", "t.json", "rec.csv", "--robot",
                                "panda", "-o", "OUT"], ("trajectory", "recording"), "mp4"),
 ]
@@ -332,6 +358,41 @@ def test_an_existing_file_aou_did_not_write_needs_force(command, argv, existing,
     (root / out).write_text(text)
     err = refused(root, [out if a == "OUT" else a for a in argv], capsys, fresh_tmp)
     assert "I506" in err and "--force" in err
+
+
+VARIANT_ROLES = ("variant base", "robot", "urdf", "mesh", "package mesh", "trajectory")
+
+
+@pytest.mark.parametrize("role", VARIANT_ROLES)
+@pytest.mark.parametrize("way", ["a symbolic link", "a relative link", "a hard link",
+                                 "a link to the folder"])
+def test_variants_never_write_onto_an_input(role, way, tmp_path, capsys, fresh_tmp):
+    """`variants -o DIR` writes DIR/STEM-NAME-low.aou and -high.aou: where either name
+    is, or links to, a file the command reads, it is refused and nothing is written."""
+    root = tmp_path / "ws"
+    root.mkdir()
+    roles = _workspace(root)
+    (root / "v.aou").write_text(f'behaviour v : confident\nrobot "{root}/arm/arm.toml"\n'
+                                'approach a=0.5\n')  # absolute: the variants lint in vd/
+    roles["variant base"] = "v.aou"
+    target = roles[role]
+    name = "v-approach_acceleration-high.aou"
+    out = "vd"
+    if way == "a symbolic link":
+        steps = [("symlink", f"vd/{name}", str(root / target))]
+    elif way == "a relative link":
+        steps = [("symlink", f"vd/{name}", f"../{target}")]
+    elif way == "a hard link":
+        steps = [("hardlink", f"vd/{name}", target)]
+    else:  # the output folder links to the input's folder, named as the variant
+        folder, base = os.path.split(target)
+        steps = [("symlink", "lnk", folder or ".")]
+        out = "lnk"
+        if base != name:
+            steps.append(("symlink", f"{folder or '.'}/{name}", base))
+    _make(root, steps)
+    refused(root, ["variants", "v.aou", "--vary", "approach_acceleration=0.2,0.8", "-o",
+                   out], capsys, fresh_tmp)
 
 
 # --- the slow run: random chains and spellings -------------------------------------------

@@ -507,7 +507,7 @@ def test_an_acceleration_the_joints_cannot_produce_is_an_error(synths):
     from aou_dsl.measuring import episodes as E
     from aou_dsl.measuring import measured as D
 
-    ctx, bounds, _, _ = D._context(synths["hesitant"].recording())
+    ctx, bounds, _ = D._context(synths["hesitant"].recording())
     piece = next(p for p in E.pieces(ctx, bounds) if isinstance(p, E.Piece))
     u = (piece.p1 - piece.p0) / np.linalg.norm(piece.p1 - piece.p0)
     peak, _ = E.peak_acceleration(ctx, piece, u)  # consistent: no error

@@ -181,6 +181,52 @@ def test_variant_counts_and_angles(tmp_path):
     assert hi.first("gaze", "horizontal").angle == pytest.approx(np.radians(30))
 
 
+@pytest.mark.parametrize("descriptor,low,high", [
+    ("retreat_count", 1, 3), ("pause_count", 4, 6), ("retreat_count", 2, 1),
+    ("retreat_count", 0, 2), ("pause_duration", 1.25, 2.5),
+    ("retreat_acceleration", 0.05, 0.3)])
+def test_each_variant_declares_the_value_it_reports(tmp_path, capsys, descriptor, low,
+                                                    high):
+    """Read back, each file declares the value its name and the report give: the
+    formatter leaves out a count of 1, and the low file kept the base's x3."""
+    from aou_dsl.lang.declared import written
+
+    assert main(["variants", str(BEHAVIOURS / "hesitant.aou"), "--vary",
+                 f"{descriptor}={low},{high}", "-o", str(tmp_path)]) == EXIT_OK
+    err = capsys.readouterr().err
+    texts = []
+    for label, value in (("low", low), ("high", high)):
+        path = tmp_path / f"hesitant-{descriptor}-{label}.aou"
+        assert f"({descriptor}={value:g})" in err
+        r = lint_file(str(path))
+        assert r.ok and written(r.behaviour)[descriptor] == pytest.approx(value)
+        texts.append(path.read_text().split("\n", 1)[1])
+    assert texts[0] != texts[1]
+
+
+def test_a_variant_that_does_not_say_what_it_reports_is_refused():
+    """The read-back check fails on a file whose text declares another value."""
+    from aou_dsl.core.diagnostics import AouError
+    from aou_dsl.lang.linter import lint_source
+    from aou_dsl.media.variants import Variant, _check_says
+
+    text = (BEHAVIOURS / "hesitant.aou").read_text()
+    b = lint_source(text, "v.aou").behaviour
+    with pytest.raises(AouError) as err:
+        _check_says(Variant("low", 1.0, text, "v-low.aou"), b, "retreat_count", b.span)
+    (d,) = err.value.diagnostics
+    assert d.code == "I504" and "retreat_count=3" in d.message and "not the 1" in d.message
+    _check_says(Variant("high", 3.0, text, "v-high.aou"), b, "retreat_count", b.span)
+    with pytest.raises(AouError):
+        _check_says(Variant("low", 1.6, text, "v-low.aou"), b, "pause_duration", b.span)
+
+
+def test_variants_that_would_be_one_file_are_refused(tmp_path):
+    assert main(["variants", str(BEHAVIOURS / "hesitant.aou"), "--vary",
+                 "pause_duration=1.0000001,1.0000002", "-o", str(tmp_path)]) == EXIT_USAGE
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("vary,code", [
     ("shiver_amplitude=2,8", EXIT_USAGE),     # hesitant has no shiver to vary
     ("no_such=1,2", EXIT_USAGE),

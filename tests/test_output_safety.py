@@ -292,3 +292,93 @@ def test_the_files_a_command_reads_follow_the_chain_and_never_block(ws):
                                                       robot="arm/arm.urdf")]
     assert got[:3] == ["f.aou", "gone.aou", "arm/arm.urdf"]
     assert "arm/fifo.toml" in got and "arm/meshes/l1.stl" in got
+
+
+# --- every robot line the grammar accepts; --write-fitted ---------------------------------
+
+#: A behaviour naming its robot file in the forms the grammar accepts besides one
+#: statement a line at the left margin.
+ROBOT_FORMS = {
+    "one line of statements": 'behaviour h : hesitant; robot "arm.toml"; pause 1s; approach\n',
+    "a form feed before it": 'behaviour h : hesitant\n\frobot "arm.toml"\npause 1s\napproach\n',
+    "a tab, CRLF line ends": 'behaviour h : hesitant\r\n\trobot "arm.toml"\r\npause 1s\r\n'
+                             'approach\r\n',
+    "no blanks around it": 'behaviour h : hesitant;robot"arm.toml";pause 1s;approach\n',
+    "after a comment line": 'behaviour h : hesitant # robot panda\n  robot   "arm.toml"  \n'
+                            'pause 1s\napproach\n',
+}
+
+
+@pytest.mark.parametrize("form", list(ROBOT_FORMS))
+def test_the_robot_file_of_every_form_of_robot_line_is_an_input(form, tmp_path,
+                                                                monkeypatch, capsys):
+    """The robot file is the parsed file's: the one-line form and a form feed before
+    the line hid it from a scan of the text, and -o wrote the trajectory over it."""
+    monkeypatch.chdir(tmp_path)
+    Path("arm.toml").write_text('robot = "panda"\n')  # a description that compiles
+    Path("b.aou").write_text(ROBOT_FORMS[form])
+    from aou_dsl.lang.linter import lint_file
+
+    lint = lint_file("b.aou")
+    assert lint.behaviour is not None and lint.behaviour.settings.robot.endswith("arm.toml")
+    before = _hashes(tmp_path)
+    assert main(["compile", "b.aou", "--format", "json", "--no-check", "-o",
+                 "arm.toml"]) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert " I502 [error]" in err and "arm.toml" in err, err
+    assert _hashes(tmp_path) == before
+
+
+@pytest.fixture
+def fit_ws(tmp_path, monkeypatch):
+    """A behaviour that needs fitting, naming a description of a built-in arm whose URDF
+    is a file of the folder, with a mesh; and a trajectory compiled from it."""
+    monkeypatch.chdir(tmp_path)
+    _workspace(tmp_path)
+    Path("arm.toml").write_text('robot = "ur5"\n')
+    Path("b.aou").write_text((BEHAVIOURS / "fearful.aou").read_text().replace(
+        "behaviour fearful : fearful", 'behaviour fearful : fearful\nrobot "arm.toml"'))
+    return tmp_path
+
+
+@pytest.mark.parametrize("argv", [
+    ["compile", "b.aou", "--fit", "--no-check", "--write-fitted", "arm.toml", "-o",
+     "out.json"],
+    ["compile", "b.aou", "--fit", "--no-check", "--write-fitted", "out.json", "-o",
+     "out.json"],
+    ["compile", "b.aou", "--fit", "--no-check", "--write-fitted", "./out.json", "-o",
+     "out.json"],
+    ["compile", "b.aou", "--fit", "--no-check", "--write-fitted", "b.aou", "-o", "o.json"],
+    ["compile", "a.aou", "--robot", "arm/arm.toml", "--fit", "--no-check",
+     "--write-fitted", "arm/arm.urdf", "-o", "o.json"],
+    ["compile", "a.aou", "--robot", "arm/arm.toml", "--fit", "--no-check",
+     "--write-fitted", "arm/meshes/l1.stl", "-o", "o.json"],
+    ["compile", "a.aou", "--robot", "arm/arm.toml", "--fit", "--no-check",
+     "--write-fitted", "arm/armpkg/meshes/l2.stl", "-o", "o.json"],
+    ["check", "b.aou", "--fit", "--no-dynamic", "--write-fitted", "arm.toml"],
+    ["check", "b.aou", "--fit", "--no-dynamic", "--write-fitted", "link.aou"],
+])
+def test_write_fitted_obeys_the_output_rule_before_any_work(fit_ws, argv, capsys,
+                                                            monkeypatch):
+    """--write-fitted onto an input, a link to one or the -o output: I502 before the
+    build starts, every file as it was."""
+    os.symlink("b.aou", "link.aou")
+    Path("out.json").write_text('{"generator": "aouc 0.2.0"}\n')  # an earlier output
+    import aou_dsl.build.builder as builder
+
+    def no_build(*a, **k):
+        raise AssertionError("built before the output rule was checked")
+
+    monkeypatch.setattr(builder, "build_file", no_build)
+    before = _hashes(fit_ws)
+    assert main(argv) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert " I502 [error]" in err and "Traceback" not in err, err
+    assert _hashes(fit_ws) == before
+
+
+def test_write_fitted_beside_its_inputs_still_writes(fit_ws, capsys):
+    """The rule refuses only what it must: a new path is written, the -o output too."""
+    assert main(["compile", "b.aou", "--fit", "--no-check", "--write-fitted",
+                 "fitted.aou", "-o", "out.json"]) == EXIT_OK, capsys.readouterr().err
+    assert "f=" in Path("fitted.aou").read_text() and Path("out.json").exists()

@@ -386,3 +386,64 @@ def test_fit_lists_the_fitted_values_in_the_page_and_fits_each_move(tmp_path, op
         assert "retreat 0.06m a=3\n" in studio.shown.text and studio.shown.ok
     finally:
         studio.close()
+
+
+#: A page of another site that tries to drive the studio: it opens the studio's websocket
+#: (even knowing the token) and loads its page, and says what came of each.
+FOREIGN = """<!doctype html><html><body><script>
+window.result = {ws: "pending", page: "pending"};
+const ws = new WebSocket("ws://127.0.0.1:PORT/?token=TOKEN", ["PROTOCOL"]);
+ws.onopen = () => { window.result.ws = "open"; };
+ws.onerror = () => { if (window.result.ws === "pending") window.result.ws = "refused"; };
+ws.onclose = (e) => { if (window.result.ws === "pending") window.result.ws = "refused"; };
+fetch("http://127.0.0.1:PORT/?token=TOKEN", {mode: "no-cors"})
+  .then(() => { window.result.page = "answered"; })
+  .catch(() => { window.result.page = "failed"; });
+</script></body></html>"""
+
+
+def test_a_page_of_another_origin_cannot_open_the_studios_websocket(tmp_path, browser):
+    """A page served from another origin on this machine (another local server's port:
+    Chromium's own local-network check stops a public site, not this) opens the studio's
+    websocket knowing even its token, and is refused; the studio's own page connects."""
+    import functools
+    import http.server
+    import threading
+
+    import viser
+
+    from aou_dsl.studio.app import Studio
+
+    path = tmp_path / "h.aou"
+    shutil.copy(os.path.join(ROOT, "behaviours", "hesitant.aou"), path)
+    before = path.read_bytes()
+    studio = Studio(str(path), port=0).start()
+    site = tmp_path.parent / f"{tmp_path.name}-site"
+    site.mkdir()
+    (site / "index.html").write_text(
+        FOREIGN.replace("PORT", str(studio.port)).replace("TOKEN", studio.gate.token)
+        .replace("PROTOCOL", f"viser-v{viser.__version__}"))
+    other = http.server.ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(
+        http.server.SimpleHTTPRequestHandler, directory=str(site)))
+    threading.Thread(target=other.serve_forever, daemon=True).start()
+    page = browser.new_page()
+    try:
+        connected = []
+        studio.server.on_client_connect(lambda client: connected.append(client))
+        page.goto(f"http://127.0.0.1:{other.server_address[1]}/")
+        result = wait_for(lambda: (r := page.evaluate("window.result"))["ws"] != "pending"
+                          and r["page"] != "pending" and r)
+        assert result["ws"] == "refused"
+        time.sleep(1.0)
+        assert connected == []  # the studio never saw a page from there
+        assert studio.inbox.refused == 0
+        # the studio's own page, in the same browser, still connects
+        page.goto(studio.url)
+        page.locator("#aou-descriptors").wait_for(timeout=60_000)
+        assert len(connected) == 1
+    finally:
+        page.close()
+        other.shutdown()
+        other.server_close()
+        studio.close()
+    assert path.read_bytes() == before and os.listdir(tmp_path) == ["h.aou"]

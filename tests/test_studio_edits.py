@@ -121,3 +121,34 @@ def test_a_file_synth_wrote_for_a_state_says_its_intensity():
     assert synth_origin(HESITANT) is None
     blend = synthesize(C=-0.5, V=0.2, intensity=0.8, verify=False)  # a C-V point
     assert synth_origin(blend) == Origin("hesitant", 0.8, (-0.5, 0.2))
+
+
+#: Characters Python's ``str.splitlines`` ends a line at, that the language does not.
+LINE_LIKE = ["\f", "\v", "\x1c", "\x1d", "\x1e", "\x85", "\u2028", "\u2029"]
+PEEK_SEQUENCE = """\
+# a sequence
+behaviour peek : curious
+sequence {
+  approach 0.08m a=0.09
+  pause 1.25s   # first
+  gaze horizontal 20deg
+  pause 1.25s
+  approach a=0.09
+}
+"""
+
+
+@pytest.mark.parametrize("mark", LINE_LIKE)
+@pytest.mark.parametrize("text, changes", [
+    (HESITANT, {"retreat_acceleration": 0.2, "pause_count": 4}),
+    (PEEK_SEQUENCE, {"horizontal_gaze": 26.0}),
+])
+def test_line_like_characters_in_comments_move_no_edit(mark, text, changes):
+    """A character that is not a line end in the language, in comments before the
+    statements edited, leaves each edit on its own statement: the edit is the one made
+    without it, the character kept where it was."""
+    plain = apply(text, changes)
+    marked = text.replace("# a", f"# a{mark}", 1).replace("# first", f"# fi{mark}rst")
+    assert marked != text
+    want = plain.replace("# a", f"# a{mark}", 1).replace("# first", f"# fi{mark}rst")
+    assert apply(marked, changes) == want

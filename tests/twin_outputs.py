@@ -8,6 +8,12 @@ preset, the arm's dynamic replay for the behaviours, the document's own motion f
 generated files) with ``aouc measure --format json``. Files and measurements must be the
 same bytes, exit codes the same.
 
+With ``--decoded``, a change of how numbers are written (not of what they are) passes:
+files that differ in bytes are compared as what a reader gets from them (a JSON
+document parsed; a CSV's cells as numbers, its comment lines' numbers too; an NPZ's
+arrays and header), and only a difference there fails; those that differ only in bytes
+are counted.
+
     python -m tests.twin_outputs --baseline /work/main --candidate . --cases 40 --out /tmp/twin
 
 Each checkout runs in its own interpreter with ``PYTHONPATH`` at its root, so the same
@@ -20,10 +26,13 @@ import argparse
 import contextlib
 import io
 import json
+import math
 import os
+import re
 import shutil
 import subprocess
 import sys
+import zipfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -120,6 +129,60 @@ def differences(a: Path, b: Path) -> tuple[int, list[str]]:
     return len(names), bad
 
 
+def _same_value(a, b) -> bool:
+    """Equal as decoded values: floats to the bit (a NaN equals a NaN), containers
+    element by element."""
+    if isinstance(a, float) and isinstance(b, float):
+        return (math.isnan(a) and math.isnan(b)) or (a == b and math.copysign(1, a)
+                                                      == math.copysign(1, b))
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(_same_value(a[k], b[k]) for k in a)
+    if isinstance(a, list) and isinstance(b, list):
+        return len(a) == len(b) and all(_same_value(x, y) for x, y in zip(a, b, strict=True))
+    return type(a) is type(b) and a == b
+
+
+_NUMBER = re.compile(r"-?(?:\d+\.?\d*(?:[eE][-+]?\d+)?|nan|inf)")
+
+
+def _cells(text: str) -> list:
+    """A CSV (or any text) as a reader gets it: each line's tokens, numbers as floats."""
+    return [[float(t) if _NUMBER.fullmatch(t) else t for t in re.split(r"([,:\[\]{} ])", line)]
+            for line in text.splitlines()]
+
+
+def _npz(data: bytes) -> dict:
+    import numpy as np
+
+    out = {}
+    with zipfile.ZipFile(io.BytesIO(data)) as zf:
+        for name in zf.namelist():
+            raw = zf.read(name)
+            out[name] = (np.load(io.BytesIO(raw), allow_pickle=False).tolist()
+                         if name.endswith(".npy") else json.loads(raw))
+    return out
+
+
+def decoded_equal(a: Path, b: Path) -> bool:
+    """Whether two files read as the same values (by their extension: JSON, CSV, NPZ;
+    a measurement: its exit code line and its JSON)."""
+    x, y = a.read_bytes(), b.read_bytes()
+    try:
+        if a.suffix == ".npz":
+            return _same_value(_npz(x), _npz(y))
+        if a.suffix == ".csv":
+            return _same_value(_cells(x.decode()), _cells(y.decode()))
+        if a.suffix == ".json":
+            if a.parent.name == "measured":  # exit code, then the printed JSON
+                (cx, jx), (cy, jy) = (t.decode().split("\n", 1) for t in (x, y))
+                return cx == cy and _same_value(json.loads(jx or "null"),
+                                                json.loads(jy or "null"))
+            return _same_value(json.loads(x), json.loads(y))
+    except (ValueError, zipfile.BadZipFile):
+        return False
+    return x == y
+
+
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--baseline", type=Path, required=True)
@@ -127,6 +190,8 @@ def main() -> int:
     p.add_argument("--cases", type=int, default=40)
     p.add_argument("--seed", type=int, default=7)
     p.add_argument("--out", type=Path, required=True)
+    p.add_argument("--decoded", action="store_true",
+                   help="files that differ in bytes pass when they read as the same values")
     p.add_argument("--measure-jobs", type=Path, help=argparse.SUPPRESS)
     args = p.parse_args()
     if args.measure_jobs:  # the child: measure in this checkout
@@ -146,7 +211,14 @@ def main() -> int:
                        env=dict(os.environ, PYTHONPATH=str(tree)), cwd=tree, check=True)
     count, bad = differences(args.out / "baseline", args.out / "candidate")
     print(f"exit codes: {codes}")
-    print(f"{count} files compared ({len(jobs)} measurements), {len(bad)} differ")
+    print(f"{count} files compared ({len(jobs)} measurements), {len(bad)} differ in bytes")
+    if args.decoded:
+        base, cand = args.out / "baseline", args.out / "candidate"
+        values = [n for n in bad if not ((base / n).is_file() and (cand / n).is_file()
+                                         and decoded_equal(base / n, cand / n))]
+        print(f"{len(bad) - len(values)} of them read as the same values, {len(values)} "
+              "differ when decoded")
+        bad = values
     for name in bad:
         print(f"  differs: {name}")
     return 1 if bad or codes["baseline"] != codes["candidate"] else 0

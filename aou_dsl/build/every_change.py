@@ -22,13 +22,18 @@ from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
-from ..core.diagnostics import Diagnostic, Severity, Span, has_errors
+from ..core.codes import C308, C309
+from ..core.diagnostics import Diagnostic, Fix, Severity, Span, has_errors
 from ..lang.linter import FileResult, lint_source
 
 __all__ = ["statement_edits", "with_every_change"]
 
 #: The start distance a start pose refusal's hint gives.
 _START = re.compile(r"`(start \d+cm)`")
+#: A hint that is an edit of keyed values (``write `f=1.3Hz for 2.31s```).
+_SAID = re.compile(r"write `([^`]+)`")
+#: The refusals whose edit sets keyed values of their statement.
+_KEYED = frozenset({C308, C309})
 
 
 def with_every_change(res: Any, build: Callable[[FileResult], Any]) -> Any:
@@ -53,7 +58,13 @@ def with_every_change(res: Any, build: Callable[[FileResult], Any]) -> Any:
     if left is not None:
         hint = f"{hint}; not every refusal is answered: then {left}"
     fields = {**d.fields, "edits": edits, "edits_complete": left is None}
-    res.diagnostics = [replace(x, hint=hint, fields=fields) if x is d else x
+    fix = d.fix
+    mine = [e for e in edits if (e["line"], e["col"]) == (d.span.line, d.span.col)]
+    if fix is None and d.code in _KEYED and mine:  # the refused statement, whole
+        e = mine[0]
+        fix = Fix(Span(d.span.path, e["line"], e["col"], e["end_line"], e["end_col"]),
+                  e["text"])
+    res.diagnostics = [replace(x, hint=hint, fields=fields, fix=fix) if x is d else x
                        for x in res.diagnostics]
     return res
 
@@ -68,6 +79,9 @@ def _own(lint: FileResult, d: Diagnostic) -> str | None:
         return None
     if d.fix is not None and d.fix.key is not None and (d.hint or "").startswith("write `"):
         return apply_edit(text, d.fix.span, d.fix.text)
+    said = _SAID.match(d.hint or "")
+    if d.fix is None and said and d.code in _KEYED:  # `f=1.3Hz for 2.31s`: two keys
+        return apply_edit(text, d.span, said[1])
     if d.fields.get("reach"):
         return apply(text, [Change(Span(d.span.path, r["line"], r["col"], r["line"],
                                         r["end_col"]), r["key"], r["declared"], r["fitted"],
@@ -187,7 +201,7 @@ def _said(d: Diagnostic, edits: list[dict[str, Any]]) -> str:
     5``)."""
     mine = [e for e in edits if (e["line"], e["col"]) == (d.span.line, d.span.col)]
     keyed = {id(e): _key_edit(e) for e in edits}
-    if mine and d.fix is not None and all(keyed.values()):
+    if mine and (d.fix is not None or d.code in _KEYED) and all(keyed.values()):
         others = [e for e in edits if e is not mine[0]]
         more = "; ".join(f"`{keyed[id(e)]}` in the {e['text'].split()[0]} at line "
                          f"{e['line']}" for e in others)

@@ -117,7 +117,7 @@ def _on_cluster(paths: list[str], options: BuildOptions, cluster: Any,
     except ImportError:  # pragma: no cover - the extra is installed with the tests
         raise ImportError("building on a cluster needs Dask distributed: "
                           "pip install '.[cluster]' in aou's folder (the one with "
-                          "pyproject.toml)") from None
+                          "pyproject.toml)", name="distributed") from None
     from ..lang.linter import FileResult, read_source
     from .builder import build_lint
 

@@ -119,16 +119,18 @@ def build_group(lints: list[FileResult], options: BuildOptions, encode: str | No
 _ENCODED = "_encoded"
 def _pack(res: BuildResult, encode: str | None) -> BuildResult:
     """In the worker: the result ready to go back; its document also encoded in
-    ``encode`` when asked (a byte format), so that the parent only writes bytes. The
+    ``encode`` when asked (a byte format, from the trajectory's arrays), so that the
+    parent only writes bytes. The
     document's lists of samples stay behind: the parent makes them again from the
     trajectory's arrays when it needs them, which travel as raw bytes (lists pickle
     float by float, which made reading the results back most of the parent's work)."""
-    if encode is not None and res.document is not None:
+    if encode is not None:
         from ..compiler.output import FOLDER_FORMATS
         from ..compiler.output import encode as encode_doc
 
-        if encode not in FOLDER_FORMATS:
-            setattr(res, _ENCODED, (encode, encode_doc(res.document, encode)))
+        doc = _encodable(res) if encode not in FOLDER_FORMATS else None
+        if doc is not None:
+            setattr(res, _ENCODED, (encode, encode_doc(doc, encode)))
     res.drop_samples()
     return res
 
@@ -141,9 +143,21 @@ def encoded(res: BuildResult, fmt: str) -> bytes:
     done = getattr(res, _ENCODED, None)
     if done is not None and done[0] == fmt:
         return done[1]
-    if res.document is None:
+    doc = _encodable(res)
+    if doc is None:
         raise ValueError(f"{res.path}: the build failed, there is no document")
-    return encode(res.document, fmt)
+    return encode(doc, fmt)
+
+
+def _encodable(res: BuildResult) -> dict | None:
+    """A build's document to encode, its samples as the trajectory's arrays (the same
+    bytes as its lists, written without making them); None when the build failed."""
+    from ..compiler.output import array_document
+
+    tr = res.compiled.trajectory if res.compiled is not None else None
+    if res.header is None or tr is None:
+        return res.document
+    return array_document(res.header, tr)
 
 
 

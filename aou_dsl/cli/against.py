@@ -1,6 +1,7 @@
 """``aouc measure REC --against FILE.aou``: a recording judged against the behaviour it
 should show (:mod:`aou_dsl.measuring.verdict`), as a table, JSON or GitHub annotations;
-exit 1 when a descriptor is outside its tolerance."""
+exit 1 when a descriptor is outside its tolerance, 3 when none is but the recording's noise
+leaves one undecided (inconclusive), 0 when all pass."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ import argparse
 import sys
 
 from ..core.diagnostics import Diagnostic
-from .args import EXIT_ERRORS, EXIT_OK
+from .args import EXIT_ERRORS, EXIT_INCONCLUSIVE, EXIT_OK
 from .report import format_github, format_json, format_text
 
 __all__ = ["cmd_measure_against", "format_verdict"]
@@ -18,35 +19,61 @@ def _v(v: float | int | None) -> str:
     return "absent" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
 
 
+def _pm(r) -> str:
+    """The measured value's 95 % interval as +- its larger half (a count's as lo..hi)."""
+    if r.measured is None or r.low is None or r.high is None:
+        return "" if r.high is None else f"or {_v(r.high)}"  # copies that found it
+    if isinstance(r.measured, int) and not isinstance(r.measured, bool):
+        return "" if r.low == r.high else f"{r.low}..{r.high}"
+    half = max(r.measured - r.low, r.high - r.measured)
+    return f"+-{half:.2g}" if half > 0 else ""
+
+
+_SHOWN = {"pass": "pass", "fail": "FAIL", "inconclusive": "INCONCLUSIVE"}
+
+
 def format_verdict(verdict) -> str:
-    """The table: each descriptor declared and measured, its tolerance, pass or FAIL; the
-    C-V point of each; how many pass."""
+    """The table: each descriptor declared and measured with its 95 % interval, its
+    tolerance, pass, FAIL or INCONCLUSIVE; the C-V point of each; how many pass."""
     lines = [f"{verdict.path} against {verdict.against} (robot {verdict.robot})"]
     if verdict.goal_from_file:
         lines.append("  (the recording has no goal: measured at the behaviour's)")
-    lines.append(f"  {'descriptor':24s} {'declared':>10s} {'measured':>10s} "
+    lines.append(f"  {'descriptor':24s} {'declared':>10s} {'measured':>10s} {'95 %':>10s} "
                  f"{'tolerance':>11s}  {'unit':6s} result")
     for r in verdict.rows:
         tol = "-" if r.tolerance is None else (
             "exact" if r.tolerance == 0 else f"+-{r.tolerance:.3g}")
         lines.append(f"  {r.name:24s} {_v(r.declared):>10s} {_v(r.measured):>10s} "
-                     f"{tol:>11s}  {r.unit:6s} {'pass' if r.ok else 'FAIL'}")
+                     f"{_pm(r):>10s} {tol:>11s}  {r.unit:6s} {_SHOWN[r.result]}")
     for side, cv in (("declared", verdict.declared_cv), ("measured", verdict.measured_cv)):
         lines.append(f"  C-V {side}: C={cv.C:+.2f} V={cv.V:+.2f} -> {cv.state.value}")
     n = sum(r.ok for r in verdict.rows)
-    lines.append(f"  {n} of {len(verdict.rows)} descriptors within tolerance")
+    undecided = len(verdict.inconclusive)
+    lines.append(f"  {n} of {len(verdict.rows)} descriptors within tolerance"
+                 + (f", {undecided} inconclusive" if undecided else ""))
     return "\n".join(lines)
 
 
-def cmd_measure_against(args: argparse.Namespace, read_kw: dict) -> int:
-    """Run ``aouc measure PATH --against FILE.aou`` (``read_kw``: how to read PATH)."""
-    from ..api import read_trajectory
+def cmd_measure_against(args: argparse.Namespace, read) -> int:
+    """Run ``aouc measure PATH --against FILE.aou`` (``read(path, args, **kw)`` reads
+    PATH). A recording that names no robot (a bare CSV without ``--robot``) is read
+    with the behaviour's."""
+    from ..core.codes import I501
+    from ..core.diagnostics import AouError
     from ..lang.linter import lint_file
     from ..measuring.verdict import judge
 
     lint = lint_file(args.against)
-    verdict = judge(read_trajectory(args.path, **read_kw), lint)
-    outside: list[Diagnostic] = verdict.outside()
+    try:
+        rec = read(args.path, args)
+    except AouError as e:
+        b = lint.behaviour
+        if args.robot or b is None or not any(
+                d.code == I501 and "without its robot" in d.message for d in e.diagnostics):
+            raise
+        rec = read(args.path, args, robot=b.settings.robot)
+    verdict = judge(rec, lint)
+    outside: list[Diagnostic] = verdict.outside() + verdict.undecided()
     sources = {lint.path: lint.source or ""}
     if args.format == "json":
         print(format_json(verdict.to_json() | {
@@ -58,4 +85,6 @@ def cmd_measure_against(args: argparse.Namespace, read_kw: dict) -> int:
         print(format_verdict(verdict))
         for d in verdict.diagnostics + outside:
             print(format_text(d, sources.get(d.span.path)), file=sys.stderr)
-    return EXIT_ERRORS if outside else EXIT_OK
+    if verdict.failed:
+        return EXIT_ERRORS
+    return EXIT_INCONCLUSIVE if verdict.inconclusive else EXIT_OK

@@ -13,12 +13,14 @@ from collections.abc import Callable
 
 from ..version import __version__
 
-__all__ = ["EXIT_ERRORS", "EXIT_INTERRUPTED", "EXIT_OK", "EXIT_USAGE", "build_parser", "number",
-           "usage_error"]
+__all__ = ["EXIT_ERRORS", "EXIT_INCONCLUSIVE", "EXIT_INTERRUPTED", "EXIT_OK", "EXIT_USAGE",
+           "build_parser", "number", "usage_error"]
 
 EXIT_OK = 0
 EXIT_ERRORS = 1
 EXIT_USAGE = 2
+#: ``measure --against``: nothing failed, but the noise leaves a descriptor undecided.
+EXIT_INCONCLUSIVE = 3
 #: Interrupted (Ctrl-C): 128 + SIGINT, as shells report it.
 EXIT_INTERRUPTED = 130
 
@@ -151,6 +153,12 @@ def _recording(p: argparse.ArgumentParser) -> None:
                    "position (for a recording without a goal)")
 
 
+def _column_map(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--map", metavar="COL=JOINT,...|FILE",
+                   help="a recording's columns named otherwise than the robot's joints: "
+                   "column=joint pairs, or a file of them (one per line)")
+
+
 def _fit(p: argparse.ArgumentParser) -> None:
     p.add_argument("--fit", action="store_true",
                    help="change what the arm cannot give (accelerations, shiver frequency, "
@@ -269,6 +277,7 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     _collision(chk)
     _controller(chk)
     _recording(chk)
+    _column_map(chk)
     _scene(chk)
     _track(chk)
     c["plot"] = plot = sub.add_parser(
@@ -278,6 +287,7 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     plot.add_argument("--cv", action="store_true",
                       help="plot the C-V plane with each behaviour's inferred point")
     _recording(plot)
+    _column_map(plot)
     c["render"] = render = sub.add_parser("render", help="render a video of a behaviour")
     render.add_argument("path", nargs="?", metavar="FILE")
     render.add_argument("-o", "--output", required=True, metavar="X.mp4|X.gif")
@@ -300,9 +310,12 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
         "measure", help="measure the eleven descriptors of a trajectory")
     meas.add_argument("path", metavar="FILE", help="a trajectory .json/.npz, or a .csv")
     _recording(meas)
+    _column_map(meas)
     meas.add_argument("--against", metavar="FILE.aou",
                       help="judge the motion against this behaviour: each descriptor "
-                      "declared vs measured with its tolerance; exit 1 when one is outside")
+                      "declared vs measured with its tolerance and the measured value's "
+                      "95 %% interval; exit 1 when one is outside, 3 when none is but one "
+                      "is inconclusive. A recording without a robot takes the file's")
     meas.add_argument("--format", choices=("table", "json", "github"), default="table",
                       help="github: annotations (with --against)")
     c["robot"] = rob = sub.add_parser(
@@ -379,12 +392,10 @@ def _dmp(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def _live(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    """The ``aouc live`` parser."""
     live = sub.add_parser("live", help="run the perception loop on a scenario headless: "
                           "perception, regulator, re-planned motion, checks (docs/live.md)")
     live.add_argument("path", metavar="SCENARIO.toml", help="a scenario file")
-    live.add_argument("--robot", metavar="NAME", default="panda",
-                      help="the arm (default panda)")
+    live.add_argument("--robot", metavar="NAME", default="panda", help="the arm (panda)")
     live.add_argument("--perception", choices=("geometric", "camera"), default="geometric",
                       help="geometric: the fitted model (fast, deterministic); camera: a "
                       "rendered camera and an AprilTag detector (the perception extra)")

@@ -59,11 +59,27 @@ def _read_kw(args: argparse.Namespace) -> dict:
             "package_dirs": _package_dirs(args)}
 
 
+def read_motion(path: str, args: argparse.Namespace, **kw):
+    """``path`` read with the command's options (``kw`` overrides them) and ``--map``."""
+    from ..api import read_trajectory
+
+    options, spec = _read_kw(args) | kw, getattr(args, "map", None)
+    if not spec or path.endswith(".aou"):
+        return read_trajectory(path, **options)
+    from ..core.options import package_dirs as absolute
+    from ..measuring.columns import column_map
+    from ..measuring.recording import read_recording
+
+    dirs = {"package_dirs": absolute(options["package_dirs"])}
+    return read_recording(path, columns=column_map(spec), **(options | dirs))
+
+
 def _reads(args: argparse.Namespace, paths: Sequence[str]) -> list[str]:
-    """Every file the command reads (the output rule keeps its outputs off them)."""
+    """Every file the command reads (the output rule keeps its outputs off them), the
+    meshes found through ``--package-dir`` too."""
     from ..robot.files_read import files_read
 
-    return files_read(paths, getattr(args, "robot", None))
+    return files_read(paths, getattr(args, "robot", None), _package_dirs(args))
 
 
 # --- lint, rules, explain ---------------------------------------------------------------
@@ -86,13 +102,12 @@ def _cmd_explain(args: argparse.Namespace) -> int:
 
 def _cmd_compile(args: argparse.Namespace) -> int:
     from ..build.parallel import build_many, default_jobs
-    from ..compiler.output import FOLDER_FORMATS, FORMATS, output_paths
     from ..core.diagnostics import has_errors
-    from ..core.files import check_format, guard_output
     from ..core.options import BuildOptions, SceneOptions
     from ..lang.linter import collect_inputs
     from .ci_cmd import keep_changed, no_output_misused, write_sarif
     from .dmp_cmd import write_compiled
+    from .outputs import guard_outputs
 
     inputs, problems = collect_inputs(args.paths)
     if problems:
@@ -105,13 +120,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     sources = [src for src, _ in inputs]
     reads = _reads(args, sources)
     try:
-        dests, fmt = ([None] * len(inputs), "json") if args.no_output else \
-            output_paths(inputs, args.output, args.format)
-        check_format(args.output, args.format, FORMATS)  # --format csv -o x.json
-        for to in filter(None, dests):  # before any work: the output rule
-            guard_output(to, reads, bag=fmt in FOLDER_FORMATS)
-        if args.sarif:
-            guard_output(args.sarif, [*reads, *filter(None, dests)])
+        dests, fmt = guard_outputs(args, inputs, reads)  # before any work: the output rule
     except AouError as err:
         return _fail(err)
     options = BuildOptions(robot=args.robot, rate=args.rate, check=not args.no_check,
@@ -130,13 +139,17 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     worst = EXIT_OK
     found: list[Diagnostic] = []  # for --sarif
     for k, ((src, _), dest, res) in enumerate(zip(inputs, dests, results, strict=True), 1):
-        _print_diags(res.diagnostics, sources={src: res.lint.source or ""})
-        if res.ok and res.document is not None and args.track:
+        from .fitted import original_text
+
+        _print_diags(res.diagnostics, sources={src: res.lint.source or ""},
+                     originals=original_text(res))
+        if res.ok and res.header is not None and args.track:
             from .track_cmd import compile_tracked
 
             res = compile_tracked(args, res, reads)
         found += res.diagnostics
-        if not res.ok or res.document is None:
+        # the header, not res.document: that makes the samples' lists, in this process
+        if not res.ok or res.header is None:
             worst = max(worst, _exit_for(res.diagnostics))
             print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)
             continue
@@ -156,7 +169,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
         if args.write_fitted:
             from .fitted import write_fitted
 
-            worst = max(worst, write_fitted(args.write_fitted, res, sources))
+            worst = max(worst, write_fitted(args.write_fitted, res, [*reads, *filter(None, dests)]))
     if args.sarif:
         worst = max(worst, write_sarif(args.sarif, found, reads))
     return worst
@@ -167,7 +180,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
-    from ..api import check, read_trajectory
+    from ..api import check
     from .ci_cmd import robot_refusals
     from .report import format_check
     from .track_cmd import check_tracking, nothing_to_track
@@ -181,7 +194,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
 
         return check_fitted(args, _read_kw(args))
     with nothing_to_track(args):  # the arm refuses the file: --track says what to do
-        tr = read_trajectory(args.path, **_read_kw(args))
+        tr = read_motion(args.path, args)
     refused = robot_refusals(args, tr)
     _print_diags(refused)
     if any(d.severity == Severity.ERROR for d in refused):
@@ -219,15 +232,15 @@ def _check_diagnostics(path: str, report) -> list[Diagnostic]:
 
 
 def _cmd_measure(args: argparse.Namespace) -> int:
-    from ..api import measure, read_trajectory
+    from ..api import measure
     from ..lang.cv import missing_descriptors
     from .report import format_measured
 
     if args.against:
         from .against import cmd_measure_against
 
-        return cmd_measure_against(args, _read_kw(args))
-    tr = read_trajectory(args.path, **_read_kw(args))
+        return cmd_measure_against(args, read_motion)
+    tr = read_motion(args.path, args)
     m = measure(tr)
     missing = missing_descriptors(tr.goal)  # what the C-V point could not use
     if args.format == "json":
@@ -247,12 +260,13 @@ def _cmd_measure(args: argparse.Namespace) -> int:
 
 
 def _cmd_plot(args: argparse.Namespace) -> int:
-    from ..api import read_trajectory
     from ..core.files import check_output
     from ..lang.linter import lint_paths
     from ..media.plot import FORMATS, cv_figure, profile_data, profile_figure, save
 
     reads = _reads(args, args.paths)
+    if args.map and "=" not in args.map:  # a mapping file is an input too
+        reads.append(args.map)
     check_output(args.output, FORMATS, reads=reads)
     if args.cv:
         results, problems = lint_paths(args.paths)
@@ -265,7 +279,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
         print("aouc: plot takes one file (or --cv with several)", file=sys.stderr)
         return EXIT_USAGE
     else:
-        tr = read_trajectory(args.paths[0], **_read_kw(args))
+        tr = read_motion(args.paths[0], args)
         data = profile_data(tr)
         _print_diags(list(data.diagnostics))  # R405: no goal, no goal-distance panel
         fig = profile_figure(data)

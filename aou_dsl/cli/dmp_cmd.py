@@ -63,7 +63,7 @@ def cmd_dmp(args: argparse.Namespace) -> int:
     import os
 
     from ..compiler.output import encode
-    from ..core.files import write_atomic
+    from ..core.files import check_output, write_atomic
     from ..dmp.manifest import read_dmp
     from ..dmp.solve import solve
     from ..synth.recipe import descriptor
@@ -75,7 +75,12 @@ def cmd_dmp(args: argparse.Namespace) -> int:
         print(f"aouc: error: cannot write `{args.output}`: expected .json, .csv or .npz",
               file=sys.stderr)
         return 2
+    reads = _reads(args.path)
+    if args.output:  # before any work: the output rule, against the folder read
+        check_output(args.output, reads=reads)
+        _outside(args.output, args.path)
     seq = read_dmp(args.path)
+    reads = _reads(args.path, seq)
     out = solve(seq, path=args.path, check=not args.no_check, goal=args.goal,
                 time_scale=args.time_scale, intensity=args.intensity,
                 pinned=tuple(descriptor(kind, "peak_acceleration").name for kind in args.pin))
@@ -89,10 +94,32 @@ def cmd_dmp(args: argparse.Namespace) -> int:
     for name, want in out.rollout.predicted.items():
         print(f"{name:<24}{_num(want):>16}{_num(m[name]):>16}")
     if args.output:
-        write_atomic(args.output, encode(rolled_document(seq, out), fmt), inputs=[args.path])
+        write_atomic(args.output, encode(rolled_document(seq, out), fmt), inputs=reads)
         print(f"wrote {args.output}: {out.trajectory.duration:.2f} s of motion",
               file=sys.stderr)
     return EXIT_OK
+
+
+def _reads(path: str, seq: Any = None) -> list[str]:
+    """The files ``aouc dmp roll`` reads from the folder ``path``: the folder and its
+    manifest, and (once read) every part file."""
+    import os
+
+    return [path, os.path.join(path, "manifest.json"), *(seq.files if seq else ())]
+
+
+def _outside(output: str, folder: str) -> None:
+    """The output rule for a folder read: nothing is written inside it (I502)."""
+    import os
+
+    from ..core.codes import I502
+    from ..core.diagnostics import AouError, Span, diag
+
+    real = os.path.realpath(folder)
+    if os.path.realpath(output).startswith(real + os.sep):
+        raise AouError(diag(I502, f"refusing to write `{output}`: it is inside `{folder}`, "
+                            "the .dmp folder this command reads", Span.whole_file(output),
+                            hint="choose another output with -o", input=folder))
 
 
 def _num(v: Any) -> str:

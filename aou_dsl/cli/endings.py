@@ -60,6 +60,8 @@ def extra_missing(command: str, exc: ImportError) -> str | None:
     top = exc.name.split(".")[0]
     if top == "mujoco":  # --track
         return "track"
+    if top in ("distributed", "dask"):  # compile --cluster
+        return "cluster"
     return "dmp" if top in ("movement_primitives", "pytransform3d") else None
 
 

@@ -1,16 +1,57 @@
 """``--fit`` and ``--write-fitted`` of ``aouc compile`` and ``aouc check``: the fitted
-file written (atomically, never over an input), and ``check`` of a fitted behaviour."""
+file written (atomically, never over an input), and ``check`` of a fitted behaviour.
+
+``--write-fitted PATH`` obeys the output rule of ``-o``
+(:func:`aou_dsl.core.files.guard_output`), checked before any work: never one of the
+files the command reads (the ``.aou`` file, its robot file, the URDF, the meshes), a
+link to one, a special file, nor the file ``-o`` writes."""
 
 from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Sequence
 
 from ..core.diagnostics import AouError, Severity
 from .args import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, usage_error
 from .report import format_check, format_json, format_text
 
-__all__ = ["check_fitted", "fitted_usage", "write_fitted"]
+__all__ = ["check_fitted", "check_fitted_output", "fitted_usage", "original_text",
+           "write_fitted"]
+
+
+def original_text(res) -> dict[str, str]:
+    """The file's own text, by path, when ``res`` (a build) was fitted: its messages
+    quote the fitted text, and say where it differs from the file's."""
+    from ..core.files import read_text
+
+    if getattr(res, "fitted_source", None) is None:
+        return {}
+    try:
+        return {res.path: read_text(res.path)}
+    except AouError:
+        return {}
+
+
+def check_fitted_output(path: str, reads: Sequence[str], outputs: Sequence[str] = ()) -> None:
+    """Refuse, before any work, a ``--write-fitted`` path that breaks the output rule
+    against ``reads``, or that is (or links to) one of the command's ``outputs``.
+
+    Raises:
+        AouError: I502 naming the clash (the codes of
+            :func:`aou_dsl.core.files.check_output`).
+    """
+    from ..core.codes import I502
+    from ..core.diagnostics import Span, diag
+    from ..core.files import check_output, same_file
+
+    check_output(path, reads=reads)
+    for out in outputs:
+        if same_file(path, out):
+            raise AouError(diag(I502, f"refusing to write the fitted text into `{path}`: "
+                                f"-o writes the output there (`{out}`)",
+                                Span.whole_file(path),
+                                hint="give --write-fitted a path of its own"))
 
 
 def fitted_usage(command: str) -> int:
@@ -41,17 +82,28 @@ def check_fitted(args: argparse.Namespace, read_kw: dict) -> int:
     from ..api import check
     from ..build.builder import build_file
     from ..core.options import BuildOptions
+    from ..robot.files_read import files_read
 
     if not args.path.endswith(".aou") or (args.write_fitted and not args.fit):
         return fitted_usage("check")
+    reads = files_read([args.path], read_kw["robot"], read_kw["package_dirs"])
+    if args.write_fitted:
+        try:
+            check_fitted_output(args.write_fitted, reads)
+        except AouError as err:
+            for d in err.diagnostics:
+                print(format_text(d), file=sys.stderr)
+            return EXIT_USAGE
     res = build_file(args.path, BuildOptions(
         robot=read_kw["robot"], package_dirs=read_kw["package_dirs"], check=False, fit=True))
+    original = original_text(res).get(res.path)
     for d in res.diagnostics:
-        print(format_text(d, res.lint.source), file=sys.stderr)
+        print(format_text(d, res.lint.source if d.span.path == res.path else None,
+                          original), file=sys.stderr)
     if not res.ok:
         return EXIT_ERRORS
     if args.write_fitted:
-        code = write_fitted(args.write_fitted, res, [args.path])
+        code = write_fitted(args.write_fitted, res, reads)
         if code != EXIT_OK:
             return code
     tr = res.trajectory.with_(path=args.path)

@@ -29,12 +29,23 @@ def _lines(source: str) -> list[str]:
     return source.splitlines()
 
 
-def _source_excerpt(d: Diagnostic, source: str | None) -> list[str]:
+def _source_excerpt(d: Diagnostic, source: str | None, original: str | None = None
+                    ) -> list[str]:
+    """The line of ``source`` at ``d`` with a caret. When ``source`` is a fitted text
+    and ``original`` the file's, a line the fit changed is said to be the fitted text,
+    with the file's own line beside it: it is not what the file says."""
     if not source or d.span.line < 1:
         return []
     lines = _lines(source)
     if d.span.line > len(lines):
         return []
+    note = []
+    if original is not None:
+        was = _lines(original)
+        was_line = was[d.span.line - 1] if d.span.line <= len(was) else ""
+        if was_line != lines[d.span.line - 1]:
+            note = [f"     = the line as fitted, above; the file's line {d.span.line} says "
+                    f"`{was_line.strip()[:EXCERPT]}`"]
     text = lines[d.span.line - 1].expandtabs(1)
     width = (d.span.end_col - d.span.col) if d.span.end_line == d.span.line else len(text)
     width = max(1, min(width, len(text) - d.span.col + 2, EXCERPT))
@@ -45,13 +56,16 @@ def _source_excerpt(d: Diagnostic, source: str | None) -> list[str]:
             "..." if start + EXCERPT < len(text) else "")
         col -= start - (3 if start else 0)
     gutter = f"{d.span.line:>4} | "
-    return [gutter + text, " " * (len(gutter) - 2) + "| " + " " * (col - 1) + "^" * width]
+    return [gutter + text, " " * (len(gutter) - 2) + "| " + " " * (col - 1) + "^" * width,
+            *note]
 
 
-def format_text(d: Diagnostic, source: str | None = None) -> str:
-    """``path:line:col: CODE [severity] message``, the source line with a caret, the hint."""
+def format_text(d: Diagnostic, source: str | None = None, original: str | None = None
+                ) -> str:
+    """``path:line:col: CODE [severity] message``, the source line with a caret, the hint.
+    ``original``: the file's text when ``source`` is its fitted text (``--fit``)."""
     out = [f"{d.span}: {d.code} [{d.severity}] {d.message}"]
-    out += _source_excerpt(d, source)
+    out += _source_excerpt(d, source, original)
     if d.hint:
         out.append(f"     = hint: {d.hint}")
     return "\n".join(out)
@@ -139,6 +153,32 @@ def format_check(path: str, robot: str, t, report) -> str:
     return "\n".join(lines)
 
 
+def _interval(value, spread) -> str:
+    """A descriptor's 95 % interval beside its value: ``+- x`` around a value (``+0.1
+    -0.02`` when lopsided), ``4..6`` for a count or a presence the noise can flip,
+    ``exact`` for a value read without noise."""
+    if spread is None:
+        return ""
+    lo, hi = spread.low, spread.high
+    if value is None and spread.stable:
+        return ""
+    if value is None or isinstance(value, int) and not isinstance(value, bool):
+        if lo == hi and spread.stable:
+            return "exact"
+
+        def v(x) -> str:
+            return "absent" if x is None else (f"{x:.4g}" if isinstance(x, float) else str(x))
+        return f"({v(lo)}..{v(hi)})"
+    if lo is None or hi is None:
+        return "(unstable)"
+    up, down = hi - value, value - lo
+    if up <= 0 and down <= 0:
+        return "exact"
+    if abs(up - down) <= 0.1 * max(up, down):
+        return f"+- {max(up, down):.2g}"
+    return f"+{up:.2g} -{down:.2g}"
+
+
 def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = ()) -> str:
     """``aouc measure``: the eleven descriptors as a table, and the C-V point; ``missing``:
     the descriptors the point could not use (:func:`aou_dsl.lang.cv.missing_descriptors`)."""
@@ -149,7 +189,8 @@ def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = 
 
     for k, v in m.descriptors.items():
         val = "null" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
-        lines.append(f"  {k:<22} {val:>10} {REGISTRY[k].unit}".rstrip())
+        lines.append(f"  {k:<22} {val:>10} {_interval(v, m.uncertainty.get(k)):<14} "
+                     f"{REGISTRY[k].unit}".rstrip())
     los = m.line_of_sight
     if los is not None and len(los.angle):
         # The model assumes the hand looks at the goal throughout: how far it did not.
@@ -166,11 +207,13 @@ def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = 
 
 
 def print_diagnostics(diags: list[Diagnostic], fmt: str = "text",
-                 sources: dict[str, str] | None = None, stream=None) -> None:
+                 sources: dict[str, str] | None = None, stream=None,
+                 originals: dict[str, str] | None = None) -> None:
     """Each diagnostic on ``stream`` (standard error), as text with its source line, or
-    as a GitHub annotation."""
+    as a GitHub annotation. ``originals``: the files' own texts, where ``sources`` holds
+    their fitted texts."""
     stream = stream or sys.stderr
     for d in diags:
         text = format_github(d) if fmt == "github" else format_text(
-            d, (sources or {}).get(d.span.path))
+            d, (sources or {}).get(d.span.path), (originals or {}).get(d.span.path))
         print(text, file=stream)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import functools
 import math
+import re
 import time
 from dataclasses import dataclass, field
 
@@ -192,9 +193,10 @@ def _too_fast(code: str, fail: TimingFailure, ep: Episode, edit: str | None,
               **fields) -> Diagnostic:
     """C308 or C309: the limit a shiver or a tilt exceeds; the hint is the edit that
     fits (the value the message gives), when there is one."""
+    one_key = edit is not None and len(re.findall(r"\w+=|\bfor\s", edit)) == 1
     return diag(code, fail.reason, ep.span, hint=f"write `{edit}`" if edit else None,
-                joint=fail.joint, limit=fail.limit, **fields,
-                fix=Fix(ep.span, edit, edit.split("=")[0]) if edit else None)
+                joint=fail.joint, limit=fail.limit, **fields,  # a fix sets one key:
+                fix=Fix(ep.span, edit, edit.split("=")[0]) if edit and one_key else None)
 
 
 def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),

@@ -33,7 +33,7 @@ from .diagnostics import AouError, Span, diag
 from .output_folders import is_aou_bag, is_aou_dmp
 
 __all__ = ["atomic", "check_format", "check_output", "decode", "guard_output", "is_own_output",
-           "make_folders", "read_bytes", "read_text", "sweep_stale", "temp_prefix",
+           "make_folders", "read_bytes", "read_text", "same_file", "sweep_stale", "temp_prefix",
            "write_atomic"]
 
 
@@ -83,6 +83,12 @@ def check_format(path: str | None, fmt: str | None, known: Sequence[str]) -> Non
             I502, f"refusing to write {fmt} into `{path}`, whose extension names {ext}",
             Span.whole_file(path), hint=f"name it `{stem}.{fmt}`, or leave out --format "
             f"to write {ext}"))
+
+
+def same_file(path: str, other: str) -> bool:
+    """Whether writing ``path`` would write ``other``: the same path, a link to it (or
+    through a linked folder), or a hard link of it."""
+    return _clash(path, other) is not None
 
 
 def _clash(path: str, read: str) -> str | None:

@@ -8,6 +8,7 @@ and the environment variable that raises it:
 
 - a ``.aou`` file: 1 MB (V132);
 - a robot file (URDF, robot description): 16 MB (V132);
+- a mesh a URDF names: 64 MB (V132; PyBullet reads it, after :func:`check_size`);
 - a trajectory or recording: 256 MB, and 2,000,000 samples (R410).
 
 ``AOU_MAX_INPUT_MB`` raises (or lowers) the size bound of every kind;
@@ -22,7 +23,7 @@ import stat
 from .codes import I501, I504, R410, V132
 from .diagnostics import AouError, Span, diag
 
-__all__ = ["ENV_BYTES", "ENV_SAMPLES", "LIMITS", "check_regular", "input_limit",
+__all__ = ["ENV_BYTES", "ENV_SAMPLES", "LIMITS", "check_regular", "check_size", "input_limit",
            "max_samples", "read_input", "read_input_text", "size_text", "too_many_samples"]
 
 _MB = 1 << 20
@@ -30,6 +31,7 @@ _MB = 1 << 20
 LIMITS: dict[str, tuple[int, str, str]] = {
     "behaviour": (1 * _MB, V132, "a .aou file"),
     "robot": (16 * _MB, V132, "a robot file"),
+    "mesh": (64 * _MB, V132, "a mesh file"),
     "recording": (256 * _MB, R410, "a trajectory or recording"),
 }
 #: Most samples of a recording read by default.
@@ -121,6 +123,23 @@ def _too_large(path: str, kind: str, size: int | None) -> AouError:
                          hint=f"if the file is right, raise the bound: set {ENV_BYTES} "
                               f"(in MB, e.g. {ENV_BYTES}={max(2 * bound // _MB, 1)})",
                          limit=bound, default=limit, variable=ENV_BYTES))
+
+
+def check_size(path: str, kind: str, what: str = "") -> None:
+    """Refuse a file another library is to read (a mesh PyBullet loads) when it is not a
+    regular file, or larger than the bound of ``kind``.
+
+    Raises:
+        AouError: I501 when it is missing or not a regular file; the code of ``kind``
+            (V132, R410) when it is larger than the bound.
+    """
+    check_regular(path, what)
+    try:
+        size = os.stat(path).st_size
+    except OSError as exc:
+        raise _cannot(path, what, exc) from None
+    if size > input_limit(kind):
+        raise _too_large(path, kind, size)
 
 
 def read_input(path: str, kind: str, what: str = "") -> bytes:

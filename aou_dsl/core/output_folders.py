@@ -28,7 +28,8 @@ def is_aou_bag(folder: str) -> bool:
 def is_aou_dmp(folder: str) -> bool:
     """Whether ``folder`` holds DMPs aou wrote and nothing else: ``manifest.json`` (an
     ``aou-dmp/1`` sequence) and its ``parts`` folder."""
-    if not set(os.listdir(folder)) <= {"manifest.json", "parts"}:
+    if not set(os.listdir(folder)) <= {"manifest.json", "parts"} or \
+            not os.path.isfile(os.path.join(folder, "manifest.json")):  # not a FIFO's wait
         return False
     try:
         with open(os.path.join(folder, "manifest.json"), "rb") as fh:

@@ -85,7 +85,8 @@ _RULE_LIST = [
          "Such a file is almost always a typo (x10000); compiling it would hang.",
          "pause 1s x5000"),
     Rule("V111", "duplicate-setting", _E,
-         "A setting (or the header) appears more than once.",
+         "A setting (or the header) appears more than once, or a statement gives one "
+         "of its arguments twice (`a=` twice, a shiver's `for` twice).",
          "Each setting has one value; the second would silently win.",
          "start 0.3m\nstart 0.4m"),
     Rule("V112", "unknown-key", _E,
@@ -167,14 +168,17 @@ _RULE_LIST = [
          "tilt 1e160deg"),
     Rule("V131", "package-escape", _E,
          "A mesh path of a robot's URDF leaves its package: a `package://NAME/...` path "
-         "with `..` steps that climb out of the package's folder.",
+         "with `..` steps that climb out of the package's folder, or one whose NAME is "
+         "no package's (`package://../etc/passwd`).",
          "A package path names a file inside that package; one that climbs out of it "
          "could make aou read any file of the machine.",
          "aouc robot escape.urdf   # <mesh filename=\"package://arm/../../../etc/passwd\"/>"),
     Rule("V132", "input-too-large", _E,
-         "A `.aou` file or a robot file (URDF, robot description) is larger than aou "
-         "reads (1 MB for a `.aou` file, 16 MB for a robot file), or a URDF has more "
-         "links or joints than aou loads (1000), or a longer arm (32 joints).",
+         "A `.aou` file, a robot file (URDF, robot description) or a mesh a URDF names "
+         "is larger than aou reads (1 MB for a `.aou` file, 16 MB for a robot file, 64 MB "
+         "for a mesh), or a URDF has more links or joints than aou loads (1000), or a "
+         "longer arm (32 joints); in the language server, a document over 1 MB or with a "
+         "line over 10,000 characters.",
          "aou reads a whole file before checking it: a bound keeps a wrong file (a log, a "
          "disk image) from taking the machine's memory. Set AOU_MAX_INPUT_MB to read "
          "larger files.",
@@ -274,8 +278,10 @@ _RULE_LIST = [
          "aou_dsl.dmp.to_dmp(aou_dsl.read_trajectory('arm.csv', robot='panda'))"),
     Rule("D602", "bad-dmp-file", _E,
          "A `.dmp` folder's manifest is not an `aou-dmp/1` sequence, or a part it names is "
-         "missing.",
-         "The sequence cannot be rolled out.",
+         "missing: a field is absent, unknown, or not of its type, range or size (a "
+         "number not finite, a robot, frame or joint the arm does not have, a goal at "
+         "the start); the message names the file and the field.",
+         "The sequence cannot be rolled out, and a shared folder is untrusted input.",
          'x.dmp/manifest.json: {"format": "aou-trajectory/1"}'),
     Rule("D603", "rollout-unreachable", _E,
          "The arm cannot follow the rolled-out motion: a pose is out of reach, needs a "
@@ -298,6 +304,22 @@ _RULE_LIST = [
          "acceleration (plus 10 %) or more than the arm's limits.",
          "The blend is refused rather than sent: the arm keeps its goal.",
          "a goal moved 30 cm during a fast retreat"),
+    Rule("D607", "dmp-class-not-allowed", _E,
+         "A `.dmp` part file names a module or class other than movement_primitives' "
+         "`CartesianDMP` (and its `ForcingTerm`s).",
+         "A part file is untrusted: aou builds only the classes it allows, from checked "
+         "arguments, and imports nothing a file names (the library's `read_json` would "
+         "import and call it).",
+         'x.dmp/parts/01-approach.json: {"module": "subprocess", "class": "getoutput"}'),
+    Rule("D608", "dmp-folder-not-closed", _E,
+         "A `.dmp` folder reaches outside itself or past a bound: a part path that is "
+         "absolute, has `..` or resolves outside the folder through a symbolic link; a "
+         "FIFO, device or socket; a file, part count, duration or step count beyond its "
+         "bound (docs/dmp.md lists them); a part file named twice.",
+         "A shared folder must not make aou read other files, wait forever or run "
+         "without bound.",
+         'x.dmp/manifest.json: "parts": [{"kind": "approach", "file": "../outside.json", '
+         '...}]'),
     # --- R: reading trajectories -------------------------------------------------------
     Rule("R401", "bad-trajectory", _E,
          "A trajectory file is not valid: missing keys or columns, non-increasing time, NaN.",
@@ -351,6 +373,24 @@ _RULE_LIST = [
          "image, a stream) from taking the machine's memory. Set AOU_MAX_INPUT_MB or "
          "AOU_MAX_SAMPLES to read larger ones.",
          "aouc measure huge.npz   # its q.npy claims 1,000,000,000 samples"),
+    Rule("R411", "noise-beyond-segmentation", _W,
+         "A recording's joint noise is more than its segmentation bears: copies of it "
+         "re-noised at the noise level aou estimated read a different count, or find a "
+         "descriptor present that the recording reads absent (or the reverse).",
+         "A count or a presence that the noise can flip is a guess, not a measurement; the "
+         "warning names the noise level and the descriptors it affects, and a judgement "
+         "against a behaviour file reads them as inconclusive.",
+         "a 250 Hz recording of the hesitant behaviour with 1e-3 rad of joint noise"),
+    Rule("R412", "inconclusive", _W,
+         "A recording measured against a behaviour file shows a descriptor whose 95 % "
+         "interval straddles its tolerance's edge, or a count or presence its noise can "
+         "flip: neither a pass nor a fail.",
+         "Its noise leaves the descriptor undecided: passing it would claim what the "
+         "recording does not show, failing it would blame the motion for the logger's "
+         "noise. `aouc measure --against` exits 3 when nothing fails but something is "
+         "inconclusive.",
+         "a retreat's peak acceleration measured 0.1205 +- 0.009 m/s^2 against a declared "
+         "0.12 +- 0.0036"),
     Rule("I501", "cannot-read", _E,
          "An input file or folder cannot be read (missing, a directory, permissions, encoding).",
          "Nothing can be checked or compiled.",

@@ -4,8 +4,8 @@ check that the motion still means what it meant.
 A compiled trajectory becomes a sequence of parts (:func:`to_dmp`): one
 ``movement_primitives`` ``CartesianDMP`` of the hand's pose per rest-to-rest motion
 episode, a hold per pause, and a shiver as an oscillation of the roll. :func:`write_dmp`
-writes the sequence as a folder that ``movement_primitives.io.read_json`` reads part by
-part, beside a manifest; :func:`read_dmp` reads it back; :func:`roll` rolls it out to a
+writes the sequence as a folder of the library's part files beside a manifest;
+:func:`read_dmp` reads it back as untrusted input (:mod:`.reader`); :func:`roll` rolls it out to a
 new goal, time scale and intensity and :func:`solve` makes joint motion of it, checked
 and measured like a compile (docs/dmp.md). Needs the ``dmp`` extra.
 """

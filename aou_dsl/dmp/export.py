@@ -72,6 +72,8 @@ class DmpSequence:
         intensity: the intensity the behaviour expresses (0.5: the study's stimulus).
         descriptors: the eleven descriptors measured on the source trajectory.
         parts: the parts, in time order.
+        files: the files it was read from (:func:`aou_dsl.dmp.read_dmp`: the manifest and
+            every part file), none when made in memory.
     """
 
     robot: str
@@ -86,6 +88,7 @@ class DmpSequence:
     intensity: float
     descriptors: dict[str, Any]
     parts: list[DmpPart]
+    files: tuple[str, ...] = ()
 
     @property
     def duration(self) -> float:

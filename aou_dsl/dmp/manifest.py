@@ -1,12 +1,13 @@
-"""The ``.dmp`` format: a folder that ``movement_primitives`` reads part by part.
+"""The ``.dmp`` format: a folder of ``movement_primitives`` DMPs, one file per part.
 
 ``x.dmp/`` holds ``manifest.json`` (``"format": "aou-dmp/1"``: the robot, the goal, the
 start configuration, the descriptors, and one entry per part with its kind, duration,
 end poses and values) and one file per motion, ``parts/NN-KIND.json``, written by
-``movement_primitives.io.write_json``, so that ``movement_primitives.io.read_json``
-loads it as a ``CartesianDMP``. The folder is made beside its target under a temporary
-name and renamed onto it when complete; an existing ``.dmp`` folder there is replaced,
-anything else is refused (I502).
+``movement_primitives.io.write_json``. aou reads it back with its own checked reader
+(:mod:`.reader`), never with the library's ``read_json``, which imports and calls
+whatever module and class a file names. The folder is made beside its target under a
+temporary name and renamed onto it when complete; an existing ``.dmp`` folder there is
+replaced, anything else is refused (I502).
 """
 
 from __future__ import annotations
@@ -17,11 +18,9 @@ import shutil
 import tempfile
 from typing import Any
 
-import numpy as np
-
-from ..core.codes import D602, I502
+from ..core.codes import I502
 from ..core.diagnostics import AouError, Span, diag
-from .export import MOVES, DmpPart, DmpSequence
+from .export import DmpPart, DmpSequence
 
 __all__ = ["FORMAT", "PARAMETERS", "manifest", "read_dmp", "write_dmp"]
 
@@ -121,49 +120,23 @@ def write_dmp(path: str, seq: DmpSequence, *, inputs: Any = ()) -> None:
             shutil.rmtree(tmp, ignore_errors=True)
 
 
-def _bad(path: str, what: str) -> AouError:
-    return AouError(diag(D602, f"`{path}` is not a readable .dmp folder: {what}",
-                         _where(path), hint="write one with `aouc compile FILE --format dmp`"))
-
-
 def read_dmp(path: str) -> DmpSequence:
-    """The sequence written at ``path``.
+    """The sequence written at ``path``, read as untrusted input by aou's own
+    schema-checked reader (:mod:`.reader`: the folder closed, every field checked, only
+    ``CartesianDMP`` built; ``movement_primitives.io.read_json`` is never called).
 
     Raises:
-        AouError: I501 when the folder or its manifest cannot be read; D602 when they are
-            not an ``aou-dmp/1`` sequence.
+        AouError: I501 when the folder or a file cannot be read; D602 when they are not
+            an ``aou-dmp/1`` sequence (naming the field), D607 for a part naming a class
+            outside the allow-list, D608 for a folder that is not closed.
     """
-    from ..core.files import read_text
+    from .reader import read_folder
 
-    text = read_text(os.path.join(path, "manifest.json"), "the .dmp manifest")
-    try:
-        doc = json.loads(text)
-        if doc.get("format") != FORMAT:
-            raise _bad(path, f"its format is {doc.get('format')!r}, expected {FORMAT!r}")
-        parts = [_part(path, e) for e in doc["parts"]]
-        return DmpSequence(
-            doc["robot"], doc["ee_frame"], tuple(doc["joint_names"]),
-            tuple(float(x) for x in doc["goal"]["position"]),  # type: ignore[arg-type]
-            np.asarray(doc["q_start"], dtype=float), doc["shiver_joint"], float(doc["rate"]),
-            doc["behaviour"], doc["state"], float(doc["intensity"]), doc["descriptors"],
-            parts)
-    except AouError:
-        raise
-    except (ValueError, KeyError, TypeError, IndexError) as exc:
-        raise _bad(path, f"{type(exc).__name__}: {exc}") from None
-
-
-def _part(path: str, e: dict) -> DmpPart:
-    from movement_primitives.io import read_json
-
-    def pose(x: dict) -> np.ndarray:
-        return np.asarray([*x["position"], *x["quaternion"]], dtype=float)
-
-    dmp = None
-    if e["kind"] in MOVES and e["file"] is not None:
-        name = os.path.join(path, e["file"])
-        if not os.path.isfile(name):
-            raise _bad(path, f"its part `{e['file']}` is missing")
-        dmp = read_json(name)
-    return DmpPart(e["kind"], float(e["duration"]), pose(e["start"]), pose(e["end"]), dmp,
-                   {k: float(v) for k, v in e["values"].items()}, float(e.get("lead", 0.0)))
+    doc, dmps = read_folder(path)
+    parts = [DmpPart(e["kind"], e["duration"], e["start"], e["end"], dmp, e["values"],
+                     e["lead"]) for e, dmp in zip(doc["parts"], dmps, strict=True)]
+    return DmpSequence(
+        doc["robot"], doc["ee_frame"], doc["joint_names"],
+        tuple(float(x) for x in doc["goal"]),  # type: ignore[arg-type]
+        doc["q_start"], doc["shiver_joint"], doc["rate"], doc["behaviour"], doc["state"],
+        doc["intensity"], doc["descriptors"], parts, tuple(doc["files"]))

@@ -37,8 +37,9 @@ from typing import Any
 
 import numpy as np
 
-from ..core.codes import I504
+from ..core.codes import D602
 from ..core.diagnostics import AouError, Span, diag
+from .bounds import DIVERGED, Diverged, check_goal, check_options
 from .export import DmpSequence
 
 __all__ = ["Rollout", "predict", "roll", "similarity"]
@@ -175,9 +176,12 @@ def _roll_move(dmp: Any, start: np.ndarray, goal: np.ndarray, s: float, r: np.nd
     d.forcing_term_rot.weights_ = r @ wr
     d.dt_, run_t = _grid(duration)
     d.configure(start_y=start, goal_y=goal)
-    t, y = d.open_loop(run_t=run_t)
+    with np.errstate(all="ignore"):  # a diverging DMP is refused below, not warned of
+        t, y = d.open_loop(run_t=run_t)
     t = np.asarray(t) - t[0]
     y = np.asarray(y, dtype=float)
+    if len(t) < 3 or not np.isfinite(y).all() or np.abs(y[:, :3]).max() > DIVERGED:
+        raise Diverged
     x = np.clip(t / duration, 0.0, 1.0)
     h0, h1 = _quintic(x)
     dt = float(t[-1] - t[-2])
@@ -245,11 +249,11 @@ def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
     Raises:
         AouError: I504 for a value out of range.
     """
-    _check(time_scale, intensity, pinned)
-    for _, later in schedule:
-        _check(time_scale, later, pinned)
+    for level in (intensity, *(later for _, later in schedule)):
+        check_options(time_scale, level, pinned, tuple(_ACCEL.values()))
     p0 = seq.parts[0].start[:3]
     new_goal = tuple(float(x) for x in (goal if goal is not None else seq.goal))
+    check_goal(new_goal, p0)
     s, r = similarity(p0, np.asarray(seq.goal), np.asarray(new_goal))
     factors = _factors(seq, intensity)
     per_part = [factors if i >= since else {} for i in range(len(seq.parts))]
@@ -327,7 +331,13 @@ def _rolled(cache: dict, i: int, p: Any, start: np.ndarray, end: np.ndarray, s: 
         return runs * k, _Stretched(spline, k)
     key = (i, s, r.tobytes(), k)
     if key not in cache:
-        tt, yy = _roll_move(p.dmp, start, end, s, r, k * p.dmp.execution_time_)
+        try:
+            tt, yy = _roll_move(p.dmp, start, end, s, r, k * p.dmp.execution_time_)
+        except Diverged:
+            raise AouError(diag(D602, f"part {i + 1} ({p.kind}): its DMP rolls out to "
+                                f"poses that are not finite or leave {DIVERGED:g} m "
+                                "(its gains or weights do not make a motion)",
+                                _WHERE)) from None
         # At rest at both ends (a free end would leave a velocity where the pose is held).
         cache[key] = (float(tt[-1]), CubicSpline(tt, yy, axis=0, bc_type="clamped"))
     return cache[key]
@@ -403,18 +413,3 @@ def _compose(t: np.ndarray, plans: list[_Plan], start: np.ndarray
         inv = plan.start[3:] * np.array([1.0, -1.0, -1.0, -1.0])
         quat = _qmul(_qmul(q, np.tile(inv, (len(t), 1))), quat)
     return pos, quat
-
-
-def _check(time_scale: float, intensity: float | None, pinned: tuple[str, ...]) -> None:
-    if not (isinstance(time_scale, int | float) and 0.25 <= time_scale <= 4.0):
-        raise AouError(diag(I504, f"the time scale must be a number in [0.25, 4], found "
-                            f"{time_scale!r}", _WHERE))
-    if intensity is not None and not (isinstance(intensity, int | float)
-                                      and 0.0 <= intensity <= 1.0):
-        raise AouError(diag(I504, f"the intensity must be a number in [0, 1], found "
-                            f"{intensity!r}", _WHERE))
-    bad = [p for p in pinned if p not in _ACCEL.values()]
-    if bad:
-        raise AouError(diag(I504, f"only accelerations can be pinned "
-                            f"({', '.join(_ACCEL.values())}), found {', '.join(bad)}",
-                            _WHERE))

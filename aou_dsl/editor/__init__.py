@@ -19,7 +19,7 @@ __all__ = ["cmd_server"]
 
 def cmd_server(args: argparse.Namespace) -> int:
     """``aouc server``: serve the Language Server Protocol on stdin and stdout until
-    the editor says exit. 2 when the ``lsp`` extra is missing."""
+    the editor says exit. 2 when the ``lsp`` extra is missing, 130 on Ctrl-C."""
     try:
         import lsprotocol  # noqa: F401
         import pygls  # noqa: F401
@@ -30,5 +30,4 @@ def cmd_server(args: argparse.Namespace) -> int:
         return 2
     from .server import serve
 
-    serve(robot=getattr(args, "robot", None))
-    return 0
+    return serve(robot=getattr(args, "robot", None))

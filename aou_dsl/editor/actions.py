@@ -6,7 +6,7 @@ from lsprotocol import types
 
 from ..core.diagnostics import Diagnostic, Fix, Span
 from . import lsp_engine as engine
-from .convert import lines_of, to_lsp, to_range, utf16_col
+from .convert import to_lsp, to_range
 from .state import Document
 from .text import tokens_of
 
@@ -42,7 +42,7 @@ def _action(doc: Document, d: Diagnostic) -> types.CodeAction:
     if every:
         edits = [types.TextEdit(range=to_range(Span(doc.path, e["line"], e["col"],
                                                      e["end_line"], e["end_col"]),
-                                               doc.lines), new_text=e["text"])
+                                               doc.view), new_text=e["text"])
                  for e in every]
         said = "; ".join(f"`{e['text']}`" for e in every)
         title = f"{d.code}: write {said}"
@@ -50,10 +50,10 @@ def _action(doc: Document, d: Diagnostic) -> types.CodeAction:
         assert d.fix is not None
         span, text = resolve(d.fix, doc.lines)
         title = f"{d.code}: write `{text.strip()}`"
-        edits = [types.TextEdit(range=to_range(span, doc.lines), new_text=text)]
+        edits = [types.TextEdit(range=to_range(span, doc.view), new_text=text)]
     return types.CodeAction(
         title=title, kind=types.CodeActionKind.QuickFix, is_preferred=preferred,
-        diagnostics=[to_lsp(d, doc.lines)],
+        diagnostics=[to_lsp(d, doc.view)],
         edit=types.WorkspaceEdit(changes={doc.uri: edits}))
 
 
@@ -67,7 +67,7 @@ def _fixable(doc: Document, d: Diagnostic) -> bool:
 def code_actions(doc: Document, rng: types.Range) -> list[types.CodeAction]:
     """A quick fix for each diagnostic at ``rng`` whose hint is an edit."""
     return [_action(doc, d) for d in doc.diagnostics
-            if _fixable(doc, d) and _overlaps(to_range(d.span, doc.lines), rng)]
+            if _fixable(doc, d) and _overlaps(to_range(d.span, doc.view), rng)]
 
 
 def format_edits(doc: Document) -> list[types.TextEdit] | None:
@@ -78,6 +78,5 @@ def format_edits(doc: Document) -> list[types.TextEdit] | None:
         return None
     if formatted == doc.text:
         return []
-    lines = lines_of(doc.text)
-    end = types.Position(len(lines) - 1, utf16_col(lines[-1], len(lines[-1])))
-    return [types.TextEdit(range=types.Range(types.Position(0, 0), end), new_text=formatted)]
+    return [types.TextEdit(range=types.Range(types.Position(0, 0), doc.view.end()),
+                           new_text=formatted)]

@@ -13,7 +13,6 @@ from ..core.units import UNITS, Dim, units_for
 from ..lang.ir import State
 from ..lang.primitives import KINDS
 from ..lang.validate import KEYWORDS
-from .convert import offset_of
 from .state import Document
 from .text import statement_at, tokens_of
 
@@ -66,7 +65,7 @@ def _units(keyword: str, key: str | None, number: str) -> list[types.CompletionI
 
 
 def complete(doc: Document, pos: types.Position) -> types.CompletionList:
-    li, col = offset_of(doc.lines, pos)
+    li, col = doc.view.aou_at(pos)
     line = doc.lines[li]
     toks = tokens_of(line[:col])
     stmt = statement_at(toks, col)

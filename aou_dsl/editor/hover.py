@@ -8,12 +8,10 @@ import re
 
 from lsprotocol import types
 
-from ..core.diagnostics import Span
 from ..lang.descriptors import DEFINITIONS, REGISTRY, Descriptor
 from ..lang.ir import State
 from ..lang.primitives import KINDS
 from . import lsp_engine as engine
-from .convert import offset_of, to_range
 from .state import Document
 from .text import Tok, at, statement_at, tokens_of
 
@@ -158,7 +156,7 @@ def _planned(ep) -> str:
 
 
 def hover(doc: Document, pos: types.Position) -> types.Hover | None:
-    li, col = offset_of(doc.lines, pos)
+    li, col = doc.view.aou_at(pos)
     line = doc.lines[li]
     codes = [d.code for d in doc.diagnostics if d.span.path == doc.path
              and (d.span.line, d.span.col - 1) <= (li + 1, col) <= (d.span.end_line,
@@ -171,7 +169,9 @@ def hover(doc: Document, pos: types.Position) -> types.Hover | None:
     stmt = statement_at(toks, col)
     rng = None
     if tok is not None and stmt and tok in stmt:
-        rng = to_range(Span("", li + 1, tok.start + 1, li + 1, tok.end + 1), doc.lines)
+        start = doc.view.aou_starts[li]
+        rng = types.Range(doc.view.position(start + tok.start),
+                          doc.view.position(start + tok.end))
         if stmt[0].text == "behaviour":
             texts.insert(0, _header(doc))
         elif (text := _episodes(doc, li + 1, stmt) if tok is stmt[0]

@@ -28,7 +28,7 @@ def _symbol(st: Statement, doc: Document) -> types.DocumentSymbol:
         kind = types.SymbolKind.Event
     return types.DocumentSymbol(
         name=written.strip() or st.keyword, kind=kind, detail=st.keyword,
-        range=to_range(st.span, doc.lines), selection_range=to_range(st.keyword_span, doc.lines))
+        range=to_range(st.span, doc.view), selection_range=to_range(st.keyword_span, doc.view))
 
 
 def document_symbols(doc: Document) -> list[types.DocumentSymbol]:
@@ -44,7 +44,7 @@ def document_symbols(doc: Document) -> list[types.DocumentSymbol]:
                         item.span.col + len("sequence"))
             out.append(types.DocumentSymbol(
                 name="sequence", kind=types.SymbolKind.Namespace,
-                range=to_range(item.span, doc.lines), selection_range=to_range(head, doc.lines),
+                range=to_range(item.span, doc.view), selection_range=to_range(head, doc.view),
                 children=[_symbol(st, doc) for st in item.statements]))
         else:
             out.append(_symbol(item, doc))

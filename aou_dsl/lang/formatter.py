@@ -211,10 +211,11 @@ def format_file(path: str) -> FormatResult:
 
 def write_in_place(path: str, text: str) -> None:
     """Replace ``path``'s text whole or not at all (a temporary file renamed over it),
-    keeping its permissions.
+    keeping its permissions, its owner and its group.
 
     Raises:
-        AouError: I502 when it cannot be written.
+        AouError: I502 when it cannot be written, or when its owner or group cannot be
+            kept (a file of another user's, rewritten without the right to give it back).
     """
     folder = os.path.dirname(os.path.realpath(path))
     try:
@@ -225,7 +226,10 @@ def write_in_place(path: str, text: str) -> None:
     try:
         with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
             f.write(text)
-        os.chmod(tmp, os.stat(path).st_mode & 0o7777)
+        was, now = os.stat(path), os.stat(tmp)
+        if (was.st_uid, was.st_gid) != (now.st_uid, now.st_gid):
+            os.chown(tmp, was.st_uid, was.st_gid)
+        os.chmod(tmp, was.st_mode & 0o7777)  # after chown, which clears set-id bits
         os.replace(tmp, os.path.realpath(path))
     except OSError as exc:
         raise AouError(diag(I502, f"cannot write `{path}`: {exc.strerror}",

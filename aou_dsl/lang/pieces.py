@@ -57,22 +57,24 @@ def _field_names(cls: type) -> tuple[str, ...]:
     return tuple(f.name for f in dataclasses.fields(cls))
 
 
-def shifted(obj: Any, lines: int) -> Any:
-    """``obj`` with every :class:`Span` in it moved down by ``lines``: syntax nodes, IR
-    nodes, diagnostics and their fixes are rebuilt field by field (an IR node's checks
-    are not run again: its values are those already checked)."""
-    if lines == 0:
+def shifted(obj: Any, lines: int, cols: int = 0) -> Any:
+    """``obj`` with every :class:`Span` in it moved down by ``lines`` and right by
+    ``cols``: syntax nodes, IR nodes, diagnostics and their fixes are rebuilt field by
+    field (an IR node's checks are not run again: its values are those already checked).
+    A shift right is for a statement parsed alone, whose spans all lie on its one line."""
+    if lines == 0 and cols == 0:
         return obj
     if isinstance(obj, Span):
-        return Span(obj.path, obj.line + lines, obj.col, obj.end_line + lines, obj.end_col)
+        return Span(obj.path, obj.line + lines, obj.col + cols, obj.end_line + lines,
+                    obj.end_col + cols)
     if isinstance(obj, tuple | list):
-        return type(obj)(shifted(x, lines) for x in obj)
+        return type(obj)(shifted(x, lines, cols) for x in obj)
     if isinstance(obj, dict):
-        return {k: shifted(v, lines) for k, v in obj.items()}
+        return {k: shifted(v, lines, cols) for k, v in obj.items()}
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         new = object.__new__(type(obj))
         for name in _field_names(type(obj)):
-            object.__setattr__(new, name, shifted(getattr(obj, name), lines))
+            object.__setattr__(new, name, shifted(getattr(obj, name), lines, cols))
         return new
     return obj
 
@@ -261,11 +263,13 @@ class Pieces:
             if q is not None:
                 p = q.moved(line)
             else:
-                st = parse_statement(" " * (col - 1) + piece, self.path)
+                # parsed at column 1 and moved to its own: padding it with spaces to
+                # its column would make each piece of a long line cost the line so far
+                st = parse_statement(piece, self.path)
                 if st is None:
                     return None
                 self.parsed += 1
-                p = Piece(1, st).moved(line)
+                p = Piece(1, shifted(st, 0, col - 1)).moved(line)
         self._new_at[piece, line, col] = p
         self._new_anywhere.setdefault((piece, col), p)
         self._by_statement[id(p.statement)] = p

@@ -169,6 +169,11 @@ def split_args(ctx: Ctx, st: Statement, allowed: Iterable[str], repeat: bool) ->
             if not isinstance(nxt, Quantity):
                 ctx.error(V113, "`for` must be followed by a duration, e.g. `for 1s`",
                           a.span)
+            elif out.for_ is not None:  # the second would silently win
+                ctx.error(V111, "`for` is given twice: a shiver has one duration",
+                          a.span.to(nxt.span), hint=f"keep one of `for {out.for_.text}` "
+                          f"and `for {nxt.text}`", found=nxt.text)
+                i += 1
             else:
                 out.for_ = nxt
                 i += 1
@@ -258,6 +263,15 @@ class Reader:
         self.args = split_args(ctx, st, keys, repeat=True)
         self.pos = self.args.positional
         self.count = 1 if self.args.count is None else self.args.count
+        self._index: dict[int, int] | None = None
+
+    def _where(self, a: object, missing: int) -> int:
+        """The place of ``a`` among the statement's arguments (``missing`` when it is not
+        one): looked up, not searched, so a statement of many arguments reads in linear
+        time."""
+        if self._index is None:
+            self._index = {id(b): k for k, b in enumerate(self.st.args)}
+        return self._index.get(id(a), missing)
 
     def error(self, code: str, message: str, span: Span, hint: str | None = None,
               fix: Fix | None = None) -> None:
@@ -303,7 +317,7 @@ class Reader:
     def _after(self, a: object) -> object | None:
         """The argument written after ``a`` in the statement."""
         args = self.st.args
-        i = next((k for k, b in enumerate(args) if b is a), len(args))
+        i = self._where(a, len(args))
         return args[i + 1] if i + 1 < len(args) else None
 
     def si(self, q: Quantity | None, dim: Dim, what: str) -> float | None:
@@ -356,14 +370,14 @@ class Reader:
 
     def done(self) -> bool:
         """Report arguments left over; True when this statement added no diagnostic."""
-        skip: list[object] = []
+        skip: set[int] = set()
         for a in self.pos:
-            if any(a is b for b in skip):
+            if id(a) in skip:
                 continue
             text = getattr(a, "text", None) or ":"
             hint = self._slip(a)
             if hint and "repeat count" in hint:  # `x 3`: one slip, one diagnostic
-                skip.append(self._after(a))
+                skip.add(id(self._after(a)))
             self.error(V113, f"unexpected argument `{text}` to `{self.st.keyword}`; "
                        f"usage: {self.kind.usage}", a.span, hint=hint, fix=self._slip_fix(a))
         return len(self.ctx.diags) == self.n_before
@@ -374,8 +388,8 @@ class Reader:
                      self._slip(a) or "")
         if m is None:
             return None
-        args = list(self.st.args)
-        i = next((k for k, b in enumerate(args) if b is a), 0)
+        args = self.st.args
+        i = self._where(a, 0)
         first, last = (a, self._after(a)) if m.group(1) else (args[i - 1] if i else None, a)
         if first is None or last is None:
             return None
@@ -384,8 +398,8 @@ class Reader:
     def _slip(self, a: object) -> str | None:
         """What a left-over argument most likely meant: a unit written apart from its
         number (`f=3 Hz`), a repeat count apart from its x (`x 3`)."""
-        args = list(self.st.args)
-        i = next((k for k, b in enumerate(args) if b is a), 0)
+        args = self.st.args
+        i = self._where(a, 0)
         before, after = args[i - 1] if i else None, self._after(a)
         key = f"{before.key}=" if isinstance(before, KeyVal) else ""
         if isinstance(before, KeyVal):

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -42,7 +43,7 @@ from .episodes import (
 )
 from .holds import MIN_PAUSE, REST_SPEED, Boundary, Rest, boundaries, rest_at_end, rest_signals
 from .roll import MIN_TILT, SHAPED_CYCLE, Lobe, lobe, roll_angle, rotations
-from .signal import Grid, joint_noise, short_window, smooth, to_grid, unwrap
+from .signal import Grid, JointNoise, joint_noise, short_window, smooth, to_grid, unwrap
 
 __all__ = ["MIN_PAUSE", "MIN_TILT", "STILL_TRANSLATION", "LineOfSight", "Measured",
            "measure"]
@@ -81,7 +82,8 @@ class Measured:
     ``resolution`` the grid rounded positions lie on, 0 for none); ``gaze_error`` the
     largest line-of-sight angle [deg] (NaN without a goal);
     episode times are from the first sample, which is at ``t_origin`` on the
-    recording's own clock.
+    recording's own clock; ``uncertainty`` each descriptor's 95 % interval
+    (:mod:`.uncertainty`).
     """
 
     descriptors: Descriptors
@@ -95,6 +97,8 @@ class Measured:
     line_of_sight: LineOfSight | None = None
     t_origin: float = 0.0
     resolution: tuple[float, ...] = field(default=())
+    #: Per descriptor, its :class:`.uncertainty.Spread` (empty when not computed).
+    uncertainty: dict[str, Any] = field(default_factory=dict)
 
     def to_json(self) -> dict:
         eps = [{"kind": e.kind, "start": round(e.t_start + self.t_origin, 4),
@@ -113,6 +117,8 @@ class Measured:
                                else None),
             "duration": round(self.duration, 6),
             "diagnostics": [d.to_json() for d in self.diagnostics],
+            "uncertainty": {k: s.to_json() for k, s in self.uncertainty.items()},
+            "uncertainty_level": 0.95,
         }
 
 
@@ -137,14 +143,16 @@ def _checked(rec: Trajectory, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     return t, q
 
 
-def _context(rec: Trajectory) -> tuple[Context, list[Boundary], np.ndarray, np.ndarray]:
+def _context(rec: Trajectory, pinned: JointNoise | None = None
+             ) -> tuple[Context, list[Boundary], JointNoise]:
     """The per-sample signals of a trajectory and its boundaries; also the joints'
-    noise and resolution."""
+    noise and resolution (``pinned``: that noise, not the one the samples show: the
+    re-noised copies of :mod:`.uncertainty` are read with the recording's filters)."""
     arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
     cols = rec.columns(arm.joint_names)
     t, q = _checked(rec, cols)
     q, _ = unwrap(q)
-    jn = joint_noise(t, q)
+    jn = joint_noise(t, q) if pinned is None else pinned
     noise = jn.effective
     h0 = float(np.median(np.diff(t)))
     window = short_window(float(noise.max()), h0)
@@ -161,7 +169,7 @@ def _context(rec: Trajectory) -> tuple[Context, list[Boundary], np.ndarray, np.n
     ctx = Context(arm, rec.path, rest, grid.q, noise, pos, pos_s, rot, roll_angle(rot),
                   goal, rot[0][:, 1].copy(), rot[0][:, 0].copy(), _edge_rest(rec, rest),
                   raw, _computed(noise, grid, carried))
-    return ctx, boundaries(rest), jn.sigma, jn.quantum
+    return ctx, boundaries(rest), jn
 
 
 def _carried(rec: Trajectory, cols: np.ndarray, grid: Grid
@@ -274,18 +282,32 @@ def _unequal(name: str, vals: list[float]) -> bool:
     return max(vals) - min(vals) > REGISTRY[name].tolerance(float(np.median(vals)))
 
 
-def measure(rec: Trajectory) -> Measured:
+def measure(rec: Trajectory, *, uncertainty: bool = True) -> Measured:
     """Measure the eleven descriptors of a trajectory.
 
     Without a goal (``rec.goal`` None) the gaze descriptors and the line of sight are
     unknown (None), approach and retreat are told by the hand's forward axis, and R405
-    says so.
+    says so. A recording that carries noise gets an uncertainty on every descriptor
+    (:mod:`.uncertainty`, unless ``uncertainty`` is False), and R411 when its noise is
+    more than a count or a presence bears.
 
     Raises:
         AouError: R401/R402 when the trajectory cannot be measured; R406 when a
             measured value contradicts the joint motion it came from.
     """
-    ctx, bounds, sigma, quantum = _context(rec)
+    m, jn = _measure(rec)
+    if uncertainty:
+        from .uncertainty import attach
+
+        attach(m, rec, jn, _measure)
+    return m
+
+
+def _measure(rec: Trajectory, pinned: JointNoise | None = None
+             ) -> tuple[Measured, JointNoise]:
+    """One measurement, without an uncertainty; with the joints' noise it used."""
+    ctx, bounds, jn = _context(rec, pinned)
+    quantum = jn.quantum
     coarse: list[tuple[float, float, float]] = []
     episodes = _episodes(ctx, pieces(ctx, bounds), coarse)
     descriptors = derive(episodes)
@@ -307,4 +329,4 @@ def measure(rec: Trajectory) -> Measured:
     return Measured(descriptors, episodes, point, diags, float(ctx.noise.max()),
                     los.max if los is not None and len(los.angle) else math.nan,
                     float(ctx.rest.t_last), tuple(float(x) for x in ctx.noise), los,
-                    float(rec.t[0]), tuple(float(x) for x in quantum))
+                    float(rec.t[0]), tuple(float(x) for x in quantum)), jn

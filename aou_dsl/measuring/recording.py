@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import json
 import os
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -337,7 +338,8 @@ def read_recording(path: str, *, robot: str | None = None,
                    goal: tuple[float, float, float] | str | None = None,
                    ee_frame: str | None = None, angle_unit: str | None = None,
                    time_unit: str | None = None,
-                   package_dirs: tuple[str, ...] = ()) -> Trajectory:
+                   package_dirs: tuple[str, ...] = (),
+                   columns: Mapping[str, str] | None = None) -> Trajectory:
     """Read a ``.json`` or ``.npz`` trajectory or a ``.csv`` recording (a file of another
     extension by its content: a JSON object, a zip, or a CSV whose header starts with
     ``t``).
@@ -356,6 +358,8 @@ def read_recording(path: str, *, robot: str | None = None,
             is refused too, and so are times on which the joints move more than ten times
             faster than their velocity limits (seconds read as milliseconds).
         package_dirs: folders of the robot's ``package://`` meshes, kept with the motion.
+        columns: the file's columns renamed to the robot's joints (``--map``,
+            :mod:`.columns`), before anything is judged.
 
     Raises:
         AouError: I501 when the file cannot be read or is in a format aou does not read
@@ -373,6 +377,10 @@ def read_recording(path: str, *, robot: str | None = None,
                        else _json(path, text, goal is None))
         trusted = header.generator.startswith("aouc")
         where = Where(path, text=text if fmt == "json" else None)
+    if columns:
+        from .columns import renamed
+
+        rec = renamed(rec, columns)
     changes: dict[str, Any] = {k: v for k, v in (("robot", robot), ("ee_frame", ee_frame),
                                                  ("package_dirs", tuple(package_dirs))) if v}
     if robot and robot != rec.robot and not ee_frame and _other_arm(rec, robot, package_dirs):

@@ -1,6 +1,7 @@
 """A recording (or a trajectory) judged against the behaviour it should show: each
 descriptor declared by the ``.aou`` file beside the one measured, with its tolerance and
-a pass or a fail, and the C-V point of each (``aouc measure REC --against FILE.aou``).
+a pass, a fail or an inconclusive (the measured value's interval straddles the
+tolerance's edge), and the C-V point of each (``aouc measure REC --against FILE.aou``).
 
 The declared values are the file's own (:func:`aou_dsl.lang.declared.declared`, the same
 the compiler checks its output against), the tolerances those of the descriptor table
@@ -12,24 +13,31 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..core.codes import R408
+from ..core.codes import R408, R412
 from ..core.diagnostics import AouError, Diagnostic, Severity, Span, diag
 from ..core.trajectory import Trajectory
 from ..lang.cv import CVPoint
 from ..lang.declared import declared, source_of
-from ..lang.descriptors import REGISTRY
+from ..lang.descriptors import REGISTRY, Descriptor
 from ..lang.linter import FileResult, lint_file
 from .measured import Measured, measure
 
-__all__ = ["Row", "Verdict", "judge"]
+__all__ = ["FAIL", "INCONCLUSIVE", "PASS", "Row", "Verdict", "judge"]
+
+
+PASS, FAIL, INCONCLUSIVE = "pass", "fail", "inconclusive"
 
 
 @dataclass(frozen=True)
 class Row:
     """One descriptor: ``declared`` and ``measured`` in its unit (None: absent; a count
     absent is 0), the ``tolerance`` a measured value may be off by (None where the
-    descriptor is declared absent: it must be measured absent), ``ok`` whether it is
-    within, and ``span`` the statement that declares it."""
+    descriptor is declared absent: it must be measured absent), ``ok`` whether it
+    passes, and ``span`` the statement that declares it. ``low`` and ``high`` are the
+    measured value's 95 % interval (a noisy recording's; the value itself for a
+    trajectory without noise), ``result`` pass, fail or inconclusive: inconclusive
+    when the interval straddles the tolerance's edge (or the noise can flip a count or
+    a presence), so that the noise alone could make it pass or fail."""
 
     name: str
     unit: str
@@ -38,11 +46,15 @@ class Row:
     tolerance: float | None
     ok: bool
     span: Span
+    low: float | int | None = None
+    high: float | int | None = None
+    result: str = PASS
 
     def to_json(self) -> dict:
         return {"descriptor": self.name, "unit": self.unit, "declared": _round(self.declared),
                 "measured": _round(self.measured), "tolerance": _round(self.tolerance),
-                "ok": self.ok}
+                "ok": self.ok, "result": self.result, "low": _round(self.low),
+                "high": _round(self.high)}
 
 
 @dataclass(frozen=True)
@@ -71,12 +83,35 @@ class Verdict:
 
     @property
     def ok(self) -> bool:
-        """Whether every descriptor is within its tolerance."""
+        """Whether every descriptor passes (within its tolerance, interval and all)."""
         return all(r.ok for r in self.rows)
 
     @property
     def failed(self) -> tuple[Row, ...]:
-        return tuple(r for r in self.rows if not r.ok)
+        return tuple(r for r in self.rows if r.result == FAIL)
+
+    @property
+    def inconclusive(self) -> tuple[Row, ...]:
+        return tuple(r for r in self.rows if r.result == INCONCLUSIVE)
+
+    @property
+    def result(self) -> str:
+        """fail when a descriptor fails, else inconclusive when one is, else pass."""
+        return FAIL if self.failed else (INCONCLUSIVE if self.inconclusive else PASS)
+
+    def undecided(self) -> list[Diagnostic]:
+        """R412 for each descriptor whose interval straddles its tolerance's edge."""
+        out = []
+        for r in self.inconclusive:
+            tol = "" if r.tolerance is None else f", tolerance +-{_text(r.tolerance)}"
+            out.append(diag(R412, f"{r.name}: declared {_text(r.declared, r.unit)}, "
+                            f"measured {_text(r.measured, r.unit)} on `{self.path}`, "
+                            f"95 % interval {_text(r.low)} to {_text(r.high)}{tol}: the "
+                            "recording's noise leaves it undecided",
+                            r.span, descriptor=r.name, declared=r.declared,
+                            measured=r.measured, tolerance=r.tolerance, low=r.low,
+                            high=r.high))
+        return out
 
     def outside(self) -> list[Diagnostic]:
         """R408 for each descriptor outside its tolerance, at the statement declaring it."""
@@ -91,7 +126,8 @@ class Verdict:
 
     def to_json(self) -> dict:
         return {"path": self.path, "against": self.against, "robot": self.robot,
-                "ok": self.ok, "descriptors": [r.to_json() for r in self.rows],
+                "ok": self.ok, "result": self.result,
+                "descriptors": [r.to_json() for r in self.rows],
                 "cv": {"declared": self.declared_cv.to_json(),
                        "measured": self.measured_cv.to_json()},
                 "goal_from_behaviour": self.goal_from_file}
@@ -119,9 +155,41 @@ def _rows(lint: FileResult, measured: Measured) -> tuple[Row, ...]:
             w, g = w or 0, g or 0
         tol = None if w is None else d.tolerance(float(w))
         p = source_of(b, name)
-        rows.append(Row(name, d.unit, w, g, tol, d.matches(w, g),
-                        p.span if p is not None else b.span))
+        spread = measured.uncertainty.get(name)
+        lo, hi, stable = (g, g, True) if spread is None else (
+            spread.low, spread.high, spread.stable)
+        if d.is_count:
+            lo, hi = lo or 0, hi or 0
+        result = _result(d, w, g, lo, hi, stable)
+        rows.append(Row(name, d.unit, w, g, tol, result == PASS,
+                        p.span if p is not None else _absent_at(b), lo, hi, result))
     return tuple(rows)
+
+
+def _result(d: Descriptor, want: float | int | None, got: float | int | None,
+            low: float | int | None, high: float | int | None, stable: bool) -> str:
+    """pass when the whole interval ``low..high`` of the measured ``got`` matches the
+    declared ``want``, fail when none of it does, else inconclusive. A presence the
+    noise can flip (``stable`` False) is inconclusive unless the values the copies read
+    all miss the tolerance."""
+    if want is None or got is None:
+        if stable:
+            return PASS if d.matches(want, got) else FAIL
+        return INCONCLUSIVE
+    if low is None or high is None:
+        return PASS if d.matches(want, got) else FAIL
+    tol = d.tolerance(float(want))
+    if d.matches(want, low) and d.matches(want, high) and stable:
+        return PASS
+    if float(high) < float(want) - tol - 1e-12 or float(low) > float(want) + tol + 1e-12:
+        return FAIL
+    return INCONCLUSIVE
+
+
+def _absent_at(b) -> Span:
+    """Where a descriptor the file declares absent (no statement sets it) is said: its
+    header, else its first statement; the whole file only when it has neither."""
+    return b.header_span or (b.primitives[0].span if b.primitives else b.span)
 
 
 def judge(rec: Trajectory, behaviour: str | FileResult) -> Verdict:

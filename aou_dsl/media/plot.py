@@ -11,8 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.codes import R405
-from ..core.diagnostics import Diagnostic, Span, diag
+from ..core.codes import R401, R405
+from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..core.trajectory import Trajectory
 from ..lang.cv import CANONICAL, CVPoint
 
@@ -38,6 +38,10 @@ class ProfileData:
         sight: for a recording with a goal, the line-of-sight angle [deg] over time
             (``sight_t`` [s]), else empty.
         diagnostics: what the figure cannot show (R405: no goal, so no goal distance).
+        raw_t, raw_speed: for a recording with noise, its speed by plain differences
+            at its own samples (drawn faint behind ``speed``, which is then filtered
+            as ``aouc measure`` and ``aouc check`` filter it), else empty.
+        noise: the recording's largest joint noise [rad] (0: none).
     """
 
     title: str
@@ -55,6 +59,9 @@ class ProfileData:
     sight_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
     sight: np.ndarray = field(default_factory=lambda: np.zeros(0))
     diagnostics: tuple[Diagnostic, ...] = ()
+    raw_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    raw_speed: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    noise: float = 0.0
 
     @property
     def has_goal(self) -> bool:
@@ -88,6 +95,20 @@ def profile_data(rec: Trajectory) -> ProfileData:
     qd = np.gradient(q, t, axis=0)
     episodes = rec.episodes
     extra: dict = {}
+    if not episodes and len(t) >= 8:
+        # A recording's noise: its speed is drawn filtered, as measure and check read it.
+        from ..measuring.episodes import COMPUTED_NOISE
+        from ..measuring.signal import joint_noise, short_window, smooth, to_grid
+
+        sigma = float(joint_noise(t, q).effective.max(initial=0.0))
+        if sigma > COMPUTED_NOISE:
+            w = short_window(sigma, float(np.median(np.diff(t))))
+            grid = to_grid(t, q, w * float(np.median(np.diff(t))))
+            extra.update(raw_t=t, raw_speed=speed, noise=sigma)
+            t, q = grid.t + t[0], grid.q
+            pos, _ = batch_fk(arm, q)
+            speed = np.linalg.norm(smooth(pos, w, 1, grid.h, order=2), axis=1)
+            qd = smooth(q, w, 1, grid.h, order=2)
     if not episodes:
         from ..measuring.measured import measure
 
@@ -104,8 +125,29 @@ def profile_data(rec: Trajectory) -> ProfileData:
             R405, "the trajectory has no goal: the plot leaves out the goal-distance "
             "panel and the line of sight",
             Span.whole_file(rec.path), hint="give it with --goal X,Y,Z, or --goal final"),)
+    for text, what in ((rec.title, "its behaviour's name"),
+                       *((e[0], "an episode's kind") for e in episodes)):
+        _check_text(text, what, rec.path)
     return ProfileData(rec.title, arm.joint_names, t, speed, distance, q, qd,
                        arm.lower, arm.upper, arm.vmax, tuple(episodes), **extra)
+
+
+def _check_text(text: object, what: str, path: str) -> None:
+    """Refuse (R401) a string of the file the figure would write that is not text: a
+    JSON string may hold a lone surrogate (``"\\ud800"``), which no font draws.
+
+    Raises:
+        AouError: R401 naming ``what`` holds it.
+    """
+    try:
+        str(text).encode("utf-8")
+    except UnicodeEncodeError as exc:
+        bad = str(text)[exc.start]
+        raise AouError(diag(R401, f"`{path}`: {what} holds a lone surrogate "
+                            f"(U+{ord(bad):04X}), which is not text: it cannot be drawn",
+                            Span.whole_file(path),
+                            hint="write the name as text (a JSON string of whole "
+                                 "characters)")) from None
 
 
 def _pyplot():
@@ -134,7 +176,15 @@ def profile_figure(d: ProfileData):
                              gridspec_kw={"height_ratios": list(panels.values())})
     panel = dict(zip(panels, axes, strict=True))
     ax_v, ax_q, ax_qd = panel["v"], panel["q"], panel["qd"]
-    ax_v.plot(d.t, d.speed, color="black", lw=1.2, label="end-effector speed")
+    if len(d.raw_speed):
+        ax_v.plot(d.raw_t, d.raw_speed, color="black", lw=0.6, alpha=0.2,
+                  label="raw (differences)")
+        ax_v.plot(d.t, d.speed, color="black", lw=1.2,
+                  label=f"filtered (noise {d.noise:.2g} rad)")
+        ax_v.legend(fontsize=7, loc="upper right")
+    else:
+        ax_v.plot(d.t, d.speed, color="black", lw=1.2, label="end-effector speed")
+    # The filtered speed sets the scale: the raw one's noise may reach far above it.
     top = max(float(d.speed.max()), 1e-3) * 1.25
     for kind, a, b in d.episodes[:MAX_SHADED]:
         for ax in axes:

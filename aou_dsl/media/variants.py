@@ -8,8 +8,9 @@ statement stay byte for byte, so the pair differs in that descriptor only. A fir
 ``# written by `aouc variants` ...`` marks each file as aou's (it may be replaced
 again without ``--force``); varying a variant replaces that line and keeps the base's
 name (``a-pause_duration-low.aou`` varied again gives ``a-NAME-low.aou``). Values are in the
-descriptor's unit (m, s, m/s^2, deg, deg/s; counts are whole numbers). Both files must
-lint without errors, or neither is returned.
+descriptor's unit (m, s, m/s^2, deg, deg/s; counts are whole numbers, a count of 1 is
+written ``x1``). Both files must lint without errors and, read back, declare the value
+they are named for, and the two must differ; or neither is returned.
 """
 
 from __future__ import annotations
@@ -155,7 +156,10 @@ def make_variants(b: Behaviour, text: str, descriptor: str, low: float, high: fl
             raise AouError(diag(I504, f"{descriptor} is a count: expected a whole number, "
                                 f"found {value:g}", where))
         new = prim.replace(**{d.ir_field: int(value) if d.is_count else value * d.scale})
-        body = _rewrite(text, prim.span, KINDS[d.kind].format(prim), KINDS[d.kind].format(new))
+        formatted = KINDS[d.kind].format(new)
+        if d.is_count and new.count == 1:  # the formatter leaves out a count of 1
+            formatted += " x1"
+        body = _rewrite(text, prim.span, KINDS[d.kind].format(prim), formatted)
         variant = Variant(label, value, _marked(body, os.path.basename(b.span.path), label,
                                                 descriptor, value), f"{prefix}-{label}.aou")
         lint = lint_source(variant.text, variant.path)
@@ -165,5 +169,34 @@ def make_variants(b: Behaviour, text: str, descriptor: str, low: float, high: fl
                 replace(e, message=f"the {label} variant (`{statement}`, for "
                         f"{variant.path}) would not lint: {e.message}", span=prim.span)
                 for e in lint.diagnostics if e.severity == "error"])
+        _check_says(variant, lint.behaviour, descriptor, where)
         out.append(variant)
+    if out[0].text.split("\n", 1)[1] == out[1].text.split("\n", 1)[1]:
+        raise AouError(diag(I504, f"the low and high variants of {descriptor} would be the "
+                            f"same file ({low:g} and {high:g} write the same text)", where,
+                            hint="give two values that differ in the file's precision "
+                                 "(six significant digits)"))
     return out
+
+
+def _check_says(v: Variant, b: Behaviour | None, descriptor: str, where: Span) -> None:
+    """Refuse a variant whose text, read back, does not declare ``descriptor`` as the
+    value it reports (to the six digits it is reported with).
+
+    Raises:
+        AouError: I504 naming both values.
+    """
+    import math
+
+    from ..lang.declared import written
+
+    got = None if b is None else written(b)[descriptor]
+    want = abs(v.value)
+    if got is not None and (got == want if REGISTRY[descriptor].is_count else
+                            math.isclose(abs(got), want, rel_tol=5e-6, abs_tol=1e-12)):
+        return
+    raise AouError(diag(I504, f"the {v.label} variant ({v.path}) would declare "
+                        f"{descriptor}={'absent' if got is None else f'{got:g}'}, not the "
+                        f"{v.value:g} asked for: nothing is written", where,
+                        hint="vary a descriptor the file sets with one statement, to a "
+                             "value the statement can take"))

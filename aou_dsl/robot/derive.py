@@ -100,7 +100,8 @@ def _local(model: Any, q: np.ndarray, frame_id: int) -> tuple[Any, np.ndarray]:
     data = model.createData()
     pin.framesForwardKinematics(model, data, q)
     jac = pin.computeFrameJacobian(model, data, q, frame_id, pin.LOCAL)
-    return data.oMf[frame_id].copy(), jac
+    # one joint: Pinocchio's binding gives a vector of 6, not a (6, 1) matrix
+    return data.oMf[frame_id].copy(), np.asarray(jac).reshape(6, model.nv)
 
 
 def _signed_axis(v: np.ndarray) -> str:

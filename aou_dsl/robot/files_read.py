@@ -4,9 +4,14 @@ A command that writes must not write over anything it reads. What it reads is mo
 the files on its command line: a ``.aou`` file names its robot file (``robot "arm.toml"``,
 unless ``--robot`` overrides it), a robot description names its URDF (``urdf = ...``),
 and a URDF names its meshes. :func:`files_read` follows that chain. It reads only what
-it must to follow it (the ``robot`` lines, the description's ``urdf``, the URDF's mesh
+it must to follow it (the ``robot`` settings, the description's ``urdf``, the URDF's mesh
 names), only regular files, and at most :data:`LIMIT` bytes of each: a file it cannot
 follow is left to the command, which says what is wrong with it.
+
+A ``.aou`` file's robot files are those of its parsed statements, as the linter reads
+them: a ``robot`` setting anywhere the grammar accepts one (after a ``;`` on one line,
+after a form feed) is seen. A file that does not parse loads no robot; its text is
+then searched for every quoted name after ``robot`` all the same.
 """
 
 from __future__ import annotations
@@ -20,7 +25,11 @@ __all__ = ["LIMIT", "files_read", "robot_files"]
 #: The most bytes read of one file to follow the chain (larger files are not followed).
 LIMIT = 64 << 20
 
-_ROBOT_LINE = re.compile(r'^[ \t]*robot[ \t]+"([^"\n]+)"', re.M)
+#: A quoted name after ``robot`` anywhere in a text (comments too): the robot files of a
+#: file that does not parse, where more is kept than the command could read.
+#: Every robot statement naming a file matches it too (only blanks may stand between
+#: the keyword and its quoted name), so a text without a match needs no parse.
+_ROBOT_ANYWHERE = re.compile(r'\brobot\s*"([^"\n]+)"')
 
 
 def _head(path: str) -> str | None:
@@ -34,6 +43,25 @@ def _head(path: str) -> str | None:
         return None
 
 
+def _robot_names(text: str, path: str) -> list[str]:
+    """The quoted robot names of the ``robot`` statements of ``text``, parsed as the
+    linter parses it (every name after ``robot`` when it does not parse)."""
+    from ..core.diagnostics import AouError
+    from ..lang.parse import SequenceBlock, Word, parse
+
+    anywhere = _ROBOT_ANYWHERE.findall(text)
+    if not anywhere:  # no robot file named (`robot panda`, or none): nothing to parse
+        return []
+    try:
+        tree = parse(text, path)
+    except AouError:
+        return anywhere
+    statements = [s for item in tree.items for s in (
+        item.statements if isinstance(item, SequenceBlock) else (item,))]
+    return [a.text for s in statements if s.keyword == "robot"
+            for a in s.args if isinstance(a, Word) and a.quoted]
+
+
 def _aou_robots(path: str) -> list[str]:
     """The robot files a ``.aou`` file names, joined to its folder as the linter does."""
     text = _head(path)
@@ -41,7 +69,7 @@ def _aou_robots(path: str) -> list[str]:
         return []
     folder = os.path.dirname(path)
     return [r if os.path.isabs(r) else os.path.normpath(os.path.join(folder, r))
-            for r in _ROBOT_LINE.findall(text)]
+            for r in _robot_names(text, path)]
 
 
 def _urdf_of(robot: str) -> tuple[str | None, tuple[str, ...]]:

@@ -8,7 +8,9 @@ zero or below, a lower limit above the upper, effort limits below zero (zero on 
 joint), a zero or enormous joint axis, and numbers that are not finite. A file with
 more than :data:`MAX_LINKS` links or joints, or a chain deeper than :data:`MAX_DEPTH`, is
 V132: the work of loading an arm grows with its joints. A package path that climbs out of
-its package (``package://arm/../../etc/passwd``) is V131.
+its package (``package://arm/../../etc/passwd``), or names no package
+(``package://../etc/passwd``), is V131; one that does not resolve inside a package that
+exists (:func:`aou_dsl.robot.urdf.resolve_uri`) is a mesh not found.
 """
 
 from __future__ import annotations
@@ -25,7 +27,8 @@ from ..core.diagnostics import AouError, Span, diag
 from .chain import MAX_ARM_JOINTS
 from .urdf_model import Joint, Urdf
 
-__all__ = ["MAX_ARM_JOINTS", "MAX_DEPTH", "MAX_LINKS", "check_mesh_paths", "check_urdf"]
+__all__ = ["MAX_ARM_JOINTS", "MAX_DEPTH", "MAX_LINKS", "check_mesh_paths", "check_urdf",
+           "package_parts"]
 
 #: Most links (and most joints) of a URDF aou loads.
 MAX_LINKS = 1000
@@ -128,23 +131,36 @@ def _joint(urdf: Urdf, j: Joint) -> str | None:
     return None
 
 
+def package_parts(uri: str) -> tuple[str, str] | None:
+    """The package and the path inside it of a ``package://`` ``uri`` (vendors write
+    ``package:///NAME/...`` for ``package://NAME/...``); None when it names no package
+    (``package://../x``, ``package://./x``) or climbs out of it (``..`` steps, an
+    absolute path, a drive or a backslash)."""
+    body = uri[len("package://"):]
+    body = body[1:] if body.startswith("/") else body
+    package, _, rest = body.partition("/")
+    clean = posixpath.normpath(rest) if rest else ""
+    if package in ("", ".", "..") or "\\" in package or ":" in package or not rest or \
+            rest.startswith("/") or clean == ".." or clean.startswith("../") or \
+            "\\" in rest or ":" in rest:
+        return None
+    return package, rest
+
+
 def check_mesh_paths(urdf: Urdf) -> None:
-    """Refuse (V131) a ``package://`` mesh path that climbs out of its package."""
+    """Refuse (V131) a ``package://`` mesh path that climbs out of its package or
+    names none (:func:`package_parts`)."""
     try:
         root = ET.fromstring(urdf.text)
     except ET.ParseError:
         return
     for mesh in root.iter("mesh"):
         uri = mesh.get("filename", "")
-        if not uri.startswith("package://"):
-            continue
-        _, _, rest = uri[len("package://"):].partition("/")
-        clean = posixpath.normpath(rest) if rest else ""
-        if rest.startswith("/") or clean == ".." or clean.startswith("../") or \
-                "\\" in rest or ":" in rest:
+        if uri.startswith("package://") and package_parts(uri) is None:
             raise _bad(urdf, f"the mesh path `{uri}` leaves its package", code=V131,
-                       hint="a package:// path names a file inside the package, without "
-                            "`..` steps that climb out of it", found=uri)
+                       hint="a package:// path names a file inside a package: "
+                            "package://NAME/..., without `..` steps that climb out of it",
+                       found=uri)
 
 
 def check_urdf(urdf: Urdf) -> None:

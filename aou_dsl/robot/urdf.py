@@ -5,7 +5,8 @@ copies aou loads.
 - :func:`resolve_uri` finds a ``package://pkg/...`` mesh: in the folders given, in the
   URDF's folder and its parents (a folder named ``pkg``, or holding one), in
   ``ROS_PACKAGE_PATH``; a package copied out of its install is found by the longest tail
-  of the path that exists under one of the URDF's parents.
+  of the path under a folder given, the URDF's folder or one of its two parents. Never
+  outside the package, links resolved.
 - :func:`kinematic_xml` is the copy Pinocchio builds the kinematics from: continuous
   joints become revolute joints of :data:`CONTINUOUS_RANGE` (one angle each), missing
   velocity limits are filled in, and no mesh is read.
@@ -25,8 +26,8 @@ from collections.abc import Sequence
 
 from ..core.codes import V109
 from ..core.diagnostics import AouError, Span, diag
-from ..core.inputs import read_input_text
-from .sanity import check_urdf
+from ..core.inputs import check_size, read_input_text
+from .sanity import check_urdf, package_parts
 from .urdf_model import CONTINUOUS_RANGE, GAZE_FRAME, MOVING, Gaze, Joint, Urdf
 
 __all__ = ["CONTINUOUS_RANGE", "GAZE_FRAME", "MOVING", "Gaze", "Joint", "Urdf", "gaze_rpy",
@@ -98,12 +99,9 @@ def _package_dirs(package: str, folder: str, extra: Sequence[str]) -> list[str]:
     out: list[str] = []
     ancestors = []
     d = os.path.abspath(folder)
-    while True:
+    while os.path.dirname(d) != d:  # never the file system's root: /etc is no package
         ancestors.append(d)
-        up = os.path.dirname(d)
-        if up == d:
-            break
-        d = up
+        d = os.path.dirname(d)
     ros = [p for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
     for base in [*extra, *ancestors, *ros]:
         base = os.path.abspath(base)
@@ -113,26 +111,58 @@ def _package_dirs(package: str, folder: str, extra: Sequence[str]) -> list[str]:
     return out
 
 
+def _inside(path: str, folder: str) -> bool:
+    """Whether ``path`` is inside ``folder``, both with their links resolved."""
+    real, top = os.path.realpath(path), os.path.realpath(folder)
+    return real == top or real.startswith(top.rstrip(os.sep) + os.sep)
+
+
 def resolve_uri(uri: str, folder: str, package_dirs: Sequence[str] = ()) -> str | None:
     """The absolute path of a mesh ``uri`` written in a URDF that lives in ``folder``;
     None when no regular file is found (a folder or a FIFO is none; see the module's
-    docstring for the search)."""
+    docstring for the search).
+
+    A ``package://`` path resolves only inside a package that exists: a folder named as
+    the package on the search path, or, for a package copied out of its install, a
+    folder given in ``package_dirs`` or the folder holding the URDF (or one of its
+    :data:`COPIED_DEPTH` parents) holding the longest tail of the path. The file, its
+    links resolved, must lie inside that folder (its links resolved too):
+    ``package://../x``, a package that does not exist and a link out of the package
+    resolve to nothing.
+    """
     if uri.startswith("file://"):
         uri = uri[len("file://"):]
     if not uri.startswith("package://"):
         path = uri if os.path.isabs(uri) else os.path.join(folder, uri)
         return os.path.normpath(path) if os.path.isfile(path) else None
-    package, _, rest = uri[len("package://"):].partition("/")
+    parts = package_parts(uri)
+    if parts is None:
+        return None
+    package, rest = parts
     for d in _package_dirs(package, folder, package_dirs):
-        if os.path.isfile(os.path.join(d, rest)):
-            return os.path.normpath(os.path.join(d, rest))
-    parts = [package, *rest.split("/")]
-    for base in [*package_dirs, folder, *_parents(folder)]:
-        for k in range(len(parts) - 1):
-            path = os.path.join(base, *parts[k:])
-            if os.path.isfile(path):
+        path = os.path.join(d, rest)
+        if os.path.isdir(d) and os.path.isfile(path) and _inside(path, d):
+            return os.path.normpath(path)
+    tail = rest.split("/")
+    roots = [*package_dirs, *_copied_roots(folder)]
+    for k in range(len(tail) - 1):  # the longest tail first
+        for root in roots:
+            path = os.path.join(root, *tail[k:])
+            if os.path.isfile(path) and _inside(path, root):
                 return os.path.normpath(os.path.abspath(path))
     return None
+
+
+#: How many parents of a URDF's folder may be the root of the package holding it, copied
+#: out of its install under another name (``pkg/urdf/sub/arm.urdf``: ``pkg``).
+COPIED_DEPTH = 2
+
+
+def _copied_roots(folder: str) -> list[str]:
+    """The folders that may be the package holding a URDF in ``folder``: it and its
+    :data:`COPIED_DEPTH` parents, never the file system's root."""
+    out = [os.path.abspath(folder), *_parents(folder)][:COPIED_DEPTH + 1]
+    return [d for d in out if os.path.dirname(d) != d]
 
 
 def _parents(folder: str) -> list[str]:
@@ -243,6 +273,10 @@ def scene_xml(urdf: Urdf, package_dirs: Sequence[str], gaze: Gaze | None, *,
 
     Every mesh filename is made absolute; visual shapes are dropped unless ``visuals``
     (the checks need collision shapes only, and visual meshes are the slow part).
+
+    Raises:
+        AouError: V132 for a mesh larger than the bound of a mesh file (``AOU_MAX_INPUT_MB``
+            raises it; :mod:`aou_dsl.core.inputs`).
     """
     root = ET.fromstring(urdf.text)
     folder = os.path.dirname(urdf.path)
@@ -257,6 +291,7 @@ def scene_xml(urdf: Urdf, package_dirs: Sequence[str], gaze: Gaze | None, *,
             if path is None:
                 missing.append(uri)
             else:
+                check_size(path, "mesh", "the mesh")  # PyBullet reads it all
                 mesh.set("filename", path)
     if gaze is not None:
         _add_gaze(root, *gaze)

@@ -5,6 +5,14 @@ compiler plans at ``velocity_scale`` of them, the check allows the full limit), 
 acceleration limits from :mod:`aou_dsl.core.robot_specs` (planned at ``accel_scale``, checked in
 full). Each check reports its worst sample.
 
+A recording carries encoder noise, which differences turn into velocities and
+accelerations far beyond any limit (1e-4 rad at 1 kHz is about 100 rad/s^2). Its limits
+are judged on the filtered signal (:func:`filtered`): the noise estimated as
+``aouc measure`` estimates it, the velocity through the measurement's own filter, the
+acceleration through a Savitzky-Golay filter just long enough that its noise stays
+under 2 % of the smallest acceleration limit. Noise alone then never reaches a limit,
+while a violation that lasts as long as the filter still does.
+
 :func:`check_rates` checks what a motion generator computes from the positions it is
 sent at its rate: velocity, acceleration and jerk by backward differences (the jerk
 limits come from :mod:`aou_dsl.core.robot_specs`, or a controller's, see
@@ -19,10 +27,75 @@ import numpy as np
 
 from ..robot.kinematics import ArmModel
 
-__all__ = ["Check", "check_limits", "check_rates"]
+__all__ = ["Check", "Filtered", "check_limits", "check_rates", "filtered"]
 
 #: Relative slack on velocity and acceleration limits (numerical differentiation).
 SLACK = 1e-3
+#: The acceleration filter's noise (NOISE_SIGMAS of its std) stays under this fraction
+#: of the smallest acceleration limit.
+ACCEL_RESOLUTION = 0.02
+#: Longest acceleration filter [s].
+MAX_ACCEL_WINDOW = 0.25
+
+
+@dataclass(frozen=True)
+class Filtered:
+    """A noisy recording's joint signals on one clock, filtered as its limits are judged.
+
+    Attributes:
+        t: times [s], (N,); q, qd, qdd: positions, filtered velocities and
+            accelerations, (N, n).
+        noise: the largest joint noise [rad].
+        velocity_window, accel_window: the filters' spans [s].
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    noise: float
+    velocity_window: float
+    accel_window: float
+
+    @property
+    def note(self) -> str:
+        return (f"on the filtered signal (noise {self.noise:.2g} rad; velocity over "
+                f"{self.velocity_window * 1e3:.0f} ms, acceleration over "
+                f"{self.accel_window * 1e3:.0f} ms)")
+
+
+def filtered(t: np.ndarray, q: np.ndarray, amax: np.ndarray) -> Filtered | None:
+    """The joint signals as a noisy recording's limits are judged; None for a
+    trajectory without noise (compiled, or computed by a planner), whose own
+    derivatives are judged. ``amax``: the acceleration limits [rad/s^2], (n,)."""
+    from ..measuring.episodes import COMPUTED_NOISE
+    from ..measuring.signal import (
+        NOISE_SIGMAS,
+        curvature_gain,
+        joint_noise,
+        odd,
+        short_window,
+        smooth,
+        to_grid,
+    )
+
+    if len(t) < 8:
+        return None
+    noise = joint_noise(t, q).effective
+    sigma = float(noise.max(initial=0.0))
+    if sigma <= COMPUTED_NOISE:
+        return None
+    h = float(np.median(np.diff(t)))
+    wv = short_window(sigma, h)
+    grid = to_grid(t, q, wv * h)
+    longest = odd(MAX_ACCEL_WINDOW / grid.h, 5)
+    resolution = ACCEL_RESOLUTION * float(np.min(amax))
+    wa = 5
+    while wa < longest and NOISE_SIGMAS * sigma * curvature_gain(wa, grid.h) > resolution:
+        wa += 2
+    qd = smooth(grid.q, wv, 1, grid.h, order=2)
+    qdd = smooth(grid.q, wa, 2, grid.h, order=3)
+    return Filtered(grid.t + t[0], grid.q, qd, qdd, sigma, wv * grid.h, wa * grid.h)
 
 
 @dataclass(frozen=True)
@@ -59,17 +132,26 @@ def check_limits(arm: ArmModel, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
 
     Shapes: ``t`` (N,), ``q``, ``qd``, ``qdd`` (N, n) in the arm's joint order. Position
     is checked as the distance from the middle of the range against the half range.
+    A trajectory whose positions carry noise (a recording) is judged on its filtered
+    signal instead (:func:`filtered`; ``qd`` and ``qdd`` are then not used), and each
+    check's detail says so.
     """
     names = arm.joint_names
+    judged = filtered(np.asarray(t, float), np.asarray(q, float), arm.amax)
+    note = ""
+    if judged is not None:
+        t, q, qd, qdd = judged.t, judged.q, judged.qd, judged.qdd
+        note = " " + judged.note
     mid = (arm.upper + arm.lower) / 2.0
     pos = _worst("joint-position", t, q - mid, np.where(q >= mid, arm.upper, arm.lower) - mid,
-                 names, "against the URDF position limits")
+                 names, "against the URDF position limits" + note)
     pos = Check(pos.name, pos.ok, pos.time, pos.joint,
                 pos.value + mid[names.index(pos.joint)], pos.limit + mid[names.index(pos.joint)],
                 pos.detail)
-    vel = _worst("joint-velocity", t, qd, arm.vmax, names, "against the URDF velocity limits")
+    vel = _worst("joint-velocity", t, qd, arm.vmax, names,
+                 "against the URDF velocity limits" + note)
     acc = _worst("joint-acceleration", t, qdd, arm.amax, names,
-                 "against the robot table's acceleration limits")
+                 "against the robot table's acceleration limits" + note)
     return [pos, vel, acc]
 
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..robot.kinematics import ArmModel
-from .limits import Check
+from .limits import Check, filtered
 
 __all__ = ["TRACKING_LIMIT", "check_torque", "check_tracking", "inverse_dynamics"]
 
@@ -46,12 +46,18 @@ def inverse_dynamics(arm: ArmModel, q: np.ndarray, qd: np.ndarray, qdd: np.ndarr
 def check_torque(arm: ArmModel, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
                  qdd: np.ndarray) -> tuple[Check, float]:
     """The ``joint-torque`` check: the sample and joint whose torque comes nearest (or
-    furthest past) its effort limit, and that ratio.
+    furthest past) its effort limit, and that ratio. A noisy recording's torques come
+    from its filtered signal (:func:`~.limits.filtered`, as its limits are judged): a
+    second derivative of raw noise asks for torques no motion does.
 
     Returns:
         the check (value: the torque [N m], limit: the effort limit) and the worst
         ratio of torque to effort limit (0 when no joint has a limit).
     """
+    note = ""
+    judged = filtered(np.asarray(t, float), np.asarray(q, float), arm.amax)
+    if judged is not None:  # a noisy recording: judged on its filtered signal, as limits are
+        t, q, qd, qdd, note = judged.t, judged.q, judged.qd, judged.qdd, " " + judged.note
     tau = inverse_dynamics(arm, q, qd, qdd)
     effort = np.where(np.isfinite(arm.effort) & (arm.effort > 0), arm.effort, np.inf)
     ratio = np.abs(tau) / effort
@@ -64,7 +70,7 @@ def check_torque(arm: ArmModel, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
     check = Check("joint-torque", worst <= 1.0, float(t[i]), arm.joint_names[j],
                   float(tau[i, j]), float(arm.effort[j]),
                   f"inverse dynamics (gravity included) against the URDF effort limits: "
-                  f"{worst:.0%} of {arm.joint_names[j]}'s")
+                  f"{worst:.0%} of {arm.joint_names[j]}'s" + note)
     return check, worst
 
 

@@ -24,13 +24,13 @@ not read as motion.
 
 from __future__ import annotations
 
-import functools
 import re
 import time
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.memo import cached
 from ..core.servo_specs import MODES, ServoTable, generic_table, servo_table
 from ..core.trajectory import Trajectory
 
@@ -121,10 +121,17 @@ def _own_table(path: str, servo: dict, n: int) -> ServoTable:
                       source=servo.get("source", f"the robot description `{path}`"))
 
 
-@functools.lru_cache(maxsize=8)
 def _model(robot: str, package_dirs: tuple[str, ...], servo: ServoTable):
     """The MuJoCo model of ``robot``'s arm with ``servo``'s actuators, and the qpos
-    addresses of the arm joints (shape (n,)); kept per robot, folders and table."""
+    addresses of the arm joints (shape (n,)); kept per robot, folders and table, and the
+    bytes of the robot's files (an edited URDF is a new model)."""
+    from ..robot.load import robot_key
+
+    return _built(robot_key(robot, package_dirs, meshes=False), robot, package_dirs, servo)
+
+
+@cached(maxsize=8)
+def _built(key: tuple, robot: str, package_dirs: tuple[str, ...], servo: ServoTable):
     import mujoco
 
     from ..core.codes import V109

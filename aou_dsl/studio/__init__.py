@@ -4,7 +4,10 @@ shape it live (the ``studio`` extra: viser, yourdfpy, watchfiles).
 - :mod:`.engine`: the one door to the pipeline (build, measure, keep the last good);
 - :mod:`.app`: the wiring; :mod:`.view3d`: the 3D scene; :mod:`.controls`: the player
   and the sliders; :mod:`.plots`: the numbers; :mod:`.edits`: Save's rewrite of the
-  text; :mod:`.watch`: reloading when the file changes on disk.
+  text; :mod:`.disk`: reading the file and Save's checks; :mod:`.watch`: reloading when
+  the file changes on disk;
+- :mod:`.gate`: only the printed address's page is answered (token, Host, Origin);
+  :mod:`.serving`: viser's server behind it, and the check of what a page sends.
 
 docs/studio.md says how to use it.
 """
@@ -20,8 +23,10 @@ __all__ = ["serve"]
 def serve(path: str, *, robot: str | None = None, host: str = "127.0.0.1", port: int = 8080,
           compare: str | None = None, stop: threading.Event | None = None,
           package_dirs: tuple[str, ...] = (), fit: bool = False) -> int:
-    """Run the studio of ``path`` until interrupted (or ``stop`` is set); the exit status.
-    ``fit``: build as ``aouc compile --fit`` does.
+    """Run the studio of ``path`` until interrupted (or ``stop`` is set); the exit status
+    (130 after Ctrl-C, as every aouc command). ``fit``: build as ``aouc compile --fit``
+    does. The address printed carries the per-run token without which the studio
+    answers nothing.
 
     Raises:
         AouError: the file (or ``compare``) does not build, or the robot cannot be drawn.
@@ -46,6 +51,7 @@ def serve(path: str, *, robot: str | None = None, host: str = "127.0.0.1", port:
         (stop or threading.Event()).wait()
     except KeyboardInterrupt:  # the way to stop it
         print("aouc studio: stopped", file=sys.stderr)
+        return 130
     finally:
         studio.close()
     return 0

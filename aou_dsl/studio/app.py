@@ -7,7 +7,12 @@ shown (:mod:`.plots`), Save writes (:mod:`.edits`), the file is watched (:mod:`.
 The file is the truth: the sliders edit its text (:func:`.edits.apply`), the engine
 builds that text, and Save writes the text of the motion shown, so the saved file
 compiles to exactly that motion. A text that fails shows its diagnostics and leaves the
-last good motion on screen. Nothing is written but the file given, and only on Save.
+last good motion on screen. Nothing is written but the file given, and only on Save
+(:mod:`.disk`: never over an edit made on disk since, nor through a link swapped in).
+
+Only the page the command printed drives it: the server answers requests that carry
+its address and its per-run token (:mod:`.gate`), and every value a page sends is
+checked before it reaches viser or the compiler (:mod:`.serving`).
 """
 
 from __future__ import annotations
@@ -18,7 +23,10 @@ import time
 from typing import TYPE_CHECKING, Any
 
 from ..core.diagnostics import AouError, Severity
+from .disk import Disk
 from .engine import Engine, Motion
+from .filing import Filing
+from .gate import Gate
 
 if TYPE_CHECKING:
     from ..core.trajectory import Trajectory
@@ -30,7 +38,7 @@ __all__ = ["LOCAL", "Studio"]
 LOCAL = "127.0.0.1"
 
 
-class Studio:
+class Studio(Filing):
     """The studio of one file (a ``.aou`` file, or a recording to play).
 
     Args:
@@ -66,24 +74,25 @@ class Studio:
         self.drawn: Trajectory | None = None  # the motion playing
         self.previewed = 0  # counts the motions played before their checks
         self._busy = threading.Lock()
+        self.gate = Gate(host)  # the per-run token and the check of who asks
+        self.disk = Disk(path)
+        self.base_bytes = b""  # the file's bytes the sliders' text comes from
+        self.shown_base = b""  # ... and those the motion shown comes from (Save's check)
 
     # --- start and stop -------------------------------------------------------------
 
     def start(self) -> Studio:
         """Build the file, start serving, draw. Raises AouError when the first build of
         the file fails (there is nothing to show) or a robot cannot be drawn."""
-        from ..core.files import read_text
-
-        first = self._first_motion(read_text)
-        import viser
-
+        first = self._first_motion()
         from . import view3d as scene
         from .controls import Player, Sliders
+        from .serving import Inbox, open_server
 
         with _quiet():  # viser prints its own banner: `aouc studio:` says the address
-            self.server = viser.ViserServer(
-                host=self.host, port=self.asked_port, verbose=False,
-                label=f"aou studio: {os.path.basename(self.path)}")
+            self.server = open_server(self.gate, self.host, self.asked_port,
+                                      f"aou studio: {os.path.basename(self.path)}")
+        self.inbox = Inbox(self.server, self._told)
         self.server.scene.set_up_direction("+z")
         # Plain lights, no shadows nor environment map: a laptop without a GPU (or a
         # browser rendering WebGL in software) keeps a smooth frame rate.
@@ -118,11 +127,12 @@ class Studio:
             self.watcher = None
         return self
 
-    def _first_motion(self, read_text) -> Motion:
+    def _first_motion(self) -> Motion:
         if self.recording:
             first = self.engine.read(self.path)
         else:
-            self.file_text = self.base_text = read_text(self.path)
+            self.base_bytes = self.disk.read()
+            self.file_text = self.base_text = self.disk.text(self.base_bytes)
             first = self.engine.build(self.file_text, self.path)
         if not first.ok or first.trajectory is None:
             raise AouError([d for d in first.diagnostics if d.severity == Severity.ERROR])
@@ -147,8 +157,8 @@ class Studio:
 
     @property
     def url(self) -> str:
-        host = "localhost" if self.host in (LOCAL, "localhost") else self.host
-        return f"http://{host}:{self.port}"
+        """The page's address, with the token without which the studio answers nothing."""
+        return self.gate.url(self.port)
 
     def close(self) -> None:
         self._closed = True
@@ -166,7 +176,12 @@ class Studio:
         gui = self.server.gui
         if not self.recording:
             self.save_button = gui.add_button("Save", hint=f"write the values into {self.path}")
-            self.save_button.on_click(lambda _: self.save())
+            self.save_button.on_click(lambda _: self._guarded(self._save_clicked))
+            self.reload_button = gui.add_button(
+                "Reload", hint=f"take the text of {self.path} as it is on disk (the values "
+                "set here go)")
+            self.reload_button.on_click(lambda _: self._guarded(self.reload))
+        self.notice = gui.add_html("")  # what the page sent that was not taken as sent
         self.diags = gui.add_html("")
         if self.ghost is not None and self.compare_path:
             self.ghost_box = gui.add_checkbox(
@@ -216,6 +231,7 @@ class Studio:
 
         assert m.trajectory is not None
         self.shown = m
+        self.shown_base = self.base_bytes
         if not drawn:
             self._draw(m.trajectory)
         data = profile_data(m.trajectory)
@@ -331,51 +347,14 @@ class Studio:
         return synthesize(origin.state, intensity=intensity, robot=robot, goal=goal,
                           verify=False)
 
-    def save(self) -> str:
-        """Write the text of the motion shown into the file (atomic); the path."""
-        from ..core.files import write_atomic
+    def _told(self, text: str) -> None:
+        """Say in the page what a page sent that was not taken as sent."""
+        import html
 
-        with self._busy:  # a build under way finishes first: Save writes what it shows
-            m = self.shown
-        if m is None or self.recording or m.text == self.file_text:
-            return self.path
-        write_atomic(self.path, m.text.encode())
-        self.file_text = m.text
-        self.status.content += " · saved"
-        return self.path
+        notice = getattr(self, "notice", None)
+        if notice is not None:
+            notice.content = f'<div id="aou-notice"><p>{html.escape(text)}</p></div>'
 
-    def _changed(self) -> None:
-        """The file changed on disk: it is the truth, build it (unsaved values go)."""
-        from ..core.files import read_text
-
-        try:
-            text = read_text(self.path)
-        except AouError as err:
-            self._say(Motion(self.path, "", tuple(err.diagnostics)))
-            return
-        if text == self.file_text:
-            return
-        self.file_text = self.base_text = text
-        with self._busy:
-            m = self.engine.build(text, self.path)
-        if m.ok:
-            self._show(m)
-        else:
-            self._say(m, "The file on disk does not build; the motion shown is the last "
-                      "good one.")
-
-    def _robot_changed(self) -> None:
-        """A file of the robot changed on disk (its description, URDF or a mesh): the
-        motion shown is built again on the robot as it is now."""
-        text = self.shown.text if self.shown is not None and self.shown.text else \
-            self.file_text
-        with self._busy:
-            m = self.engine.build(text, self.path)
-        if m.ok:
-            self._show(m)
-        else:
-            self._say(m, "The robot's files changed and this motion no longer builds on "
-                      "it; the motion shown is the last good one.")
 
 
 def _quiet():

@@ -230,9 +230,15 @@ def _insert_at(st: Statement, field: str) -> Span:
 
 
 def _offset(text: str, span: Span, end: bool) -> int:
+    """The offset in ``text`` of ``span``'s start (or end). Lines are counted as the
+    parser counts them, at ``\n`` only: a form feed, a vertical tab or U+2028 in a
+    comment is within its line (``str.splitlines`` would count a line there, and an
+    edit would land on the statement before)."""
     line, col = (span.end_line, span.end_col) if end else (span.line, span.col)
-    lines = text.splitlines(keepends=True)
-    return sum(len(x) for x in lines[:line - 1]) + col - 1
+    start = 0
+    for _ in range(line - 1):
+        start = text.index("\n", start) + 1
+    return start + col - 1
 
 
 def _splice(text: str, edits: list[Edit]) -> str:

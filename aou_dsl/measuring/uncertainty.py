@@ -1,0 +1,227 @@
+"""How much each measured descriptor can be trusted: a parametric bootstrap of the noise.
+
+A recording's joints carry noise whose level :func:`.signal.joint_noise` estimates joint
+by joint. The measurement is a chain of filters, thresholds, episode boundaries, fits and
+medians: no closed formula carries that noise through all of it. So it is carried by
+doing it again. The recording is smoothed (the measurement's own velocity filter, as a
+position filter), fresh noise at each joint's estimated level is added, and the copy is
+measured with the recording's own filters and thresholds (its noise pinned, not
+re-estimated). :data:`REPLICATES` copies give each descriptor a std; its 95 % interval is
+the value +- Student's t of that many copies times the std, widened to take in the value
+less what the noise adds on average (the copies' mean beside the smoothed recording's
+own reading: the larger of noisy readings is biased up), and for a duration a sampling
+step at each edge and the edges' own placement error (:data:`EDGES`). docs/measure.md
+gives the coverage measured over simulated recordings.
+
+A count or a presence that differs between the copies is a segmentation the noise can
+flip: its interval spans what the copies read, and R411 names it with the noise level;
+so does a value whose interval reaches more than 20 % of itself from it.
+A trajectory without noise (compiled, or computed by a planner) is measured exactly:
+every interval is the value itself.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..core.codes import R411
+from ..core.diagnostics import AouError, Span, diag
+from ..core.trajectory import Trajectory
+from ..lang.descriptors import REGISTRY
+from .episodes import COMPUTED_NOISE
+from .signal import JointNoise, short_window, smooth, to_grid, unwrap
+
+__all__ = ["REPLICATES", "Spread", "attach"]
+
+#: Re-noised copies measured per recording.
+REPLICATES = 10
+#: Two-sided 95 % quantile of Student's t with ``REPLICATES - 1`` degrees of freedom.
+T95 = 2.262
+#: The seed of the copies' noise: the same file gives the same intervals.
+SEED = 20240
+#: The error of placing a pause's edges where the motion beside it stops, as a fraction
+#: of a duration or of a speed over one (the refinement's own error on noisy recordings,
+#: about 1 % of the duration over the generated recordings of the tests, whatever the
+#: noise: not something re-noised copies show).
+EDGES = 0.01
+
+
+@dataclass(frozen=True)
+class Spread:
+    """A descriptor's uncertainty.
+
+    Attributes:
+        sd: the std the noise gives it (0 for a count the copies agree on; None when
+            absent or when the copies disagree on its presence).
+        low, high: its 95 % interval (a count's: the least and most the copies read;
+            None where it is absent in the recording and in every copy).
+        stable: whether every copy reads the same count and the same presence, and
+            the interval reaches no further than 20 % of the value from it: whether
+            the value can be trusted.
+        absent_in: how many copies read it absent.
+    """
+
+    sd: float | None
+    low: float | int | None
+    high: float | int | None
+    stable: bool
+    absent_in: int = 0
+
+    def to_json(self) -> dict:
+        def r(v: float | int | None) -> float | int | None:
+            return round(v, 6) if isinstance(v, float) else v
+
+        return {"sd": r(self.sd), "low": r(self.low), "high": r(self.high),
+                "stable": self.stable, "absent_in_copies": self.absent_in}
+
+
+def exact(value: float | int | None) -> Spread:
+    """The spread of a value read without noise."""
+    return Spread(None if value is None else 0.0, value, value, True)
+
+
+def _copies(rec: Trajectory, cols: np.ndarray, jn: JointNoise, rng: np.random.Generator
+            ) -> list[Trajectory]:
+    """``rec`` with its arm joints smoothed (the base), then :data:`REPLICATES` copies
+    of the base with fresh noise at each moving joint's level; other columns as they
+    are."""
+    t = np.asarray(rec.t, float)
+    q_all = np.asarray(rec.q, float)
+    q, _ = unwrap(q_all[:, cols])
+    level = jn.effective
+    h0 = float(np.median(np.diff(t)))
+    window = short_window(float(level.max()), h0)
+    grid = to_grid(t, q, window * h0)
+    base = smooth(grid.q, window, 0, grid.h, order=3) if window > 3 else grid.q
+    tt = t - t[0]
+    smooth_q = np.column_stack([np.interp(tt, grid.t, base[:, j]) for j in range(q.shape[1])])
+    moving = level > 0
+    smooth_q[:, ~moving] = q[:, ~moving]
+    base_q = q_all.copy()
+    base_q[:, cols] = smooth_q
+    out = [rec.with_(q=base_q)]
+    for _ in range(REPLICATES):
+        qc = q_all.copy()
+        qc[:, cols] = smooth_q + rng.standard_normal(q.shape) * level
+        out.append(rec.with_(q=qc))
+    return out
+
+
+def _spread(name: str, value: float | int | None, base: float | int | None,
+            reads: list[float | int | None], step: float) -> Spread:
+    """The spread of descriptor ``name`` read ``value`` in the recording, ``base`` in
+    its smoothed base and ``reads`` in the re-noised copies; ``step`` the sampling
+    step [s]."""
+    d = REGISTRY[name]
+    if d.is_count:
+        counts = [int(c or 0) for c in reads]
+        n, b = int(value or 0), int(base or 0)
+        lo, hi = min([n, b, *counts]), max([n, b, *counts])
+        sd = float(np.std(counts, ddof=1)) if len(counts) > 1 else 0.0
+        return Spread(sd, lo, hi, lo == hi)
+    present = [float(r) for r in reads if r is not None]
+    absent = len(reads) - len(present)
+    if value is None:
+        if not present and base is None:
+            return Spread(None, None, None, True, absent)
+        seen = present + ([] if base is None else [float(base)])
+        return Spread(None, min(seen), max(seen), False, absent)
+    v = float(value)
+    if len(present) < 2 or base is None:
+        return Spread(None, v, v, False, absent)
+    sd = float(np.std(present, ddof=1))
+    # What the noise adds on average (the larger of noisy readings is biased up, a
+    # peak-to-peak range grows with the noise): the copies' mean beside the base's.
+    corrected = v - (float(np.mean(present)) - float(base))
+    # Each of a duration's two edges falls on a sample (known to a step at best), and
+    # is placed by following the motion beside it back to rest (its own error).
+    timed = d.unit == "s" or d.unit.endswith("/s")  # a duration, or a speed over one
+    half = T95 * sd + (2 * step if d.unit == "s" else 0.0) + (EDGES * abs(v) if timed else 0.0)
+    return Spread(sd, min(v, corrected) - half, max(v, corrected) + half, absent == 0,
+                  absent)
+
+
+def attach(m, rec: Trajectory, jn: JointNoise,
+           measure_once: Callable[[Trajectory, JointNoise | None], tuple]) -> None:
+    """Give ``m`` (a :class:`.measured.Measured` of ``rec``, whose joints' noise is
+    ``jn``) its uncertainty, and R411 when a count or a presence is not stable."""
+    value = m.descriptors
+    if float(jn.effective.max(initial=0.0)) <= COMPUTED_NOISE:
+        m.uncertainty = {k: exact(value[k]) for k in REGISTRY}
+        return
+    from ..robot.load import load_arm
+
+    arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
+    cols = rec.columns(arm.joint_names)
+    rng = np.random.default_rng(SEED)
+    base, *copies = _copies(rec, cols, jn, rng)
+    reads = []
+    for copy in copies:
+        try:
+            reads.append(measure_once(copy, jn)[0].descriptors)
+        except AouError:  # a copy the noise made unreadable adds nothing
+            continue
+    try:
+        smooth_read = measure_once(base, jn)[0].descriptors
+    except AouError:
+        smooth_read = None
+    if len(reads) < 2 or smooth_read is None:
+        m.uncertainty = {k: Spread(None, value[k], value[k], False) for k in REGISTRY}
+    else:
+        step = float(np.median(np.diff(np.asarray(rec.t, float))))
+        m.uncertainty = {k: _spread(k, value[k], smooth_read[k], [r[k] for r in reads],
+                                    step) for k in REGISTRY}
+    vague = [k for k, s in m.uncertainty.items() if _vague(k, value[k], s)]
+    for k in vague:  # not to be trusted: a verdict on it is inconclusive
+        m.uncertainty[k] = replace(m.uncertainty[k], stable=False)
+    shaky = [k for k, s in m.uncertainty.items() if not s.stable]
+    if shaky:
+        noise = float(jn.effective.max())
+        what = "; ".join(_shaky_text(k, value[k], m.uncertainty[k], len(reads))
+                         for k in shaky)
+        m.diagnostics.append(diag(
+            R411, f"the joints' noise ({noise:.2g} rad) is more than this recording's "
+            f"segmentation bears: {what}. These descriptors are not to be trusted",
+            Span.whole_file(rec.path),
+            hint="log at a higher rate or with less noise; a longer pause or a slower "
+            "motion stands out of the noise better",
+            noise=noise, descriptors=shaky))
+
+
+#: A value whose 95 % interval reaches further than this fraction of itself from it is
+#: too vague to report without a warning (near zero: :data:`VAGUE_TOLERANCES` times the
+#: descriptor's absolute tolerance).
+VAGUE = 0.2
+VAGUE_TOLERANCES = 3.0
+
+
+def _vague(name: str, value: float | int | None, s: Spread) -> bool:
+    half = half_width(s, value)
+    if half is None or REGISTRY[name].is_count or value is None:
+        return False
+    return half > max(VAGUE * abs(float(value)), VAGUE_TOLERANCES * REGISTRY[name].abs_tol)
+
+
+def _shaky_text(name: str, value, s: Spread, n: int) -> str:
+    def v(x) -> str:
+        return "absent" if x is None else (f"{x:.4g}" if isinstance(x, float) else str(x))
+
+    if not s.absent_in and value is not None and not REGISTRY[name].is_count:
+        return f"{name} reads {v(value)}, 95 % interval {v(s.low)} to {v(s.high)}"
+
+    if REGISTRY[name].is_count:
+        return f"{name} reads {v(value)}, from {s.low} to {s.high} in {n} re-noised copies"
+    if value is None:
+        return f"{name} reads absent, present in {n - s.absent_in} of {n} re-noised copies"
+    return f"{name} reads {v(value)}, absent in {s.absent_in} of {n} re-noised copies"
+
+
+def half_width(s: Spread, value: float | int | None) -> float | None:
+    """The interval's larger distance from the value (None when absent)."""
+    if value is None or s.low is None or s.high is None:
+        return None
+    return max(float(value) - float(s.low), float(s.high) - float(value))
+
