@@ -341,3 +341,21 @@ def test_observe_takes_a_perceptions_estimate(reg):
     rep = r.observe(q0, None, None, Estimate(0.5), restart=True)
     assert rep is not None and rep.state is State.HESITANT
     fails_with("I504", r.observe, q0, None, None, 0.5)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("name", "states"), [
+    ("occluder", ["confident", "curious", "hesitant", "curious", "confident"]),
+    ("dimming", ["confident", "curious", "hesitant", "fearful", "inactive"]),
+])
+def test_aouc_live_runs_the_shipped_scenarios(tmp_path, name, states):
+    """The longer variant of the known scenes, through the command on the files that
+    ship: the states the recording logs, in order."""
+    out = tmp_path / "run.json"
+    p = subprocess.run([sys.executable, "-m", "aou_dsl", "live",
+                        str(SCENARIOS / f"{name}.toml"), "-o", str(out), "-q"],
+                       capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stderr
+    logged = json.loads(out.read_text())["live"]["ticks"]["state"]
+    seen = [s for k, s in enumerate(logged) if k == 0 or logged[k - 1] != s]
+    assert seen == states
