@@ -17,7 +17,8 @@ on 40 different motions), ``render`` (a 640x480 video), ``measure`` (60 s at 1 k
 warm session: re-lint and rebuild; ``--jobs 2`` against ``--jobs 1``, cold,
 ``house.py``), ``studio`` (``aouc studio``, ``bench_studio.py``), ``editor`` (the language
 server and ``aouc fmt``, ``bench_editor.py``), ``dmp`` (behaviours as DMPs,
-``bench_dmp.py``), ``track`` (``--track``, ``bench_track.py``); see ``speed.py`` for
+``bench_dmp.py``), ``track`` (``--track``, ``bench_track.py``), ``live`` (the perception
+loop, ``bench_live.py``); see ``speed.py`` for
 ``build`` to ``render``. Ratios
 are measured in one run, so they hold on any machine; absolute times are this
 machine's (its cores and load are in the JSON). The JSON lists every figure with its
@@ -47,6 +48,7 @@ import time
 from pathlib import Path
 
 import bench_dmp
+import bench_live
 import bench_studio
 import bench_track
 import numpy as np
@@ -243,6 +245,7 @@ SECTIONS = {"build": speed.bench_build, "cold": speed.bench_cold, "lint": speed.
             "house": bench_house,
             "studio": bench_studio.bench_studio, "editor": bench_editor,
             "dmp": bench_dmp.bench_dmp, "track": bench_track.bench_track}
+SECTIONS["live"] = bench_live.bench_live
 
 
 def main(argv: list[str]) -> int:

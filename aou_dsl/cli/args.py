@@ -362,6 +362,7 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     _robot(stu)
     _editor(sub, c)
     c["dmp"] = _dmp(sub)
+    c["live"] = _live(sub)
     c["rules"] = rules = sub.add_parser("rules", help="list the diagnostic codes, or explain some")
     rules.add_argument("codes", nargs="*", metavar="CODE")
     rules.add_argument("--format", choices=("text", "json"), default="text")
@@ -388,6 +389,24 @@ def _dmp(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                      help="write the solved trajectory (.json, .csv, .npz)")
     dmp.add_argument("--no-check", action="store_true", help="skip the safety replay")
     return dmp
+
+
+def _live(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    live = sub.add_parser("live", help="run the perception loop on a scenario headless: "
+                          "perception, regulator, re-planned motion, checks (docs/live.md)")
+    live.add_argument("path", metavar="SCENARIO.toml", help="a scenario file")
+    live.add_argument("--robot", metavar="NAME", default="panda", help="the arm (panda)")
+    live.add_argument("--perception", choices=("geometric", "camera"), default="geometric",
+                      help="geometric: the fitted model (fast, deterministic); camera: a "
+                      "rendered camera and an AprilTag detector (the perception extra)")
+    live.add_argument("-o", "--output", metavar="RUN.json",
+                      help="write the recording: the executed trajectory (aouc measure "
+                      "reads it) and, per tick, confidence, uncertainty, state, intensity")
+    live.add_argument("--render", metavar="RUN.mp4",
+                      help="write a video: the camera's view, the confidence and the arm")
+    live.add_argument("-q", "--quiet", action="store_true", help="print no summary")
+    _force(live)
+    return live
 
 
 def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:

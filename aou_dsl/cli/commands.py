@@ -23,6 +23,7 @@ from .endings import CtrlC, extra_missing, internal
 from .fmt import cmd_fmt
 from .lint_cmd import cmd_lint
 from .lint_cmd import count as _count
+from .live_cmd import cmd_live
 from .report import format_json
 from .report import print_diagnostics as _print_diags
 from .tools import cmd_robot, cmd_rules, cmd_synth
@@ -372,7 +373,7 @@ _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "compile": _cmd_compile, "check": _cmd_check, "measure": _cmd_measure,
     "plot": _cmd_plot, "render": _cmd_render, "variants": _cmd_variants,
     "robot": cmd_robot, "synth": cmd_synth, "studio": _cmd_studio,
-    "fmt": cmd_fmt, "server": cmd_server, "dmp": _cmd_dmp,
+    "fmt": cmd_fmt, "server": cmd_server, "dmp": _cmd_dmp, "live": cmd_live,
 }
 
 

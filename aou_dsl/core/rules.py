@@ -376,6 +376,13 @@ _RULE_LIST = [
          "A hand-written behaviour or robot file is not lost to a command that makes "
          "one; `--force` replaces it.",
          "aouc synth --state confident --no-verify -o a.aou"),
+    Rule("I507", "bad-scenario", _E,
+         "A scenario file for `aouc live` is not one: not TOML, a key it does not know, a "
+         "value of the wrong kind or out of its range, an event that names an occluder "
+         "the scene lacks.",
+         "Nothing runs: a scenario read halfway would play another scene than the one "
+         "written.",
+         "aouc live a.aou   # a behaviour file, not a scenario: not TOML"),
 ]
 
 RULES: dict[str, Rule] = {r.code: r for r in _RULE_LIST}

@@ -42,6 +42,7 @@ if TYPE_CHECKING:
 
     from ..core.trajectory import Trajectory
     from .dmp_follow import DmpRun
+    from .perception import Estimate
 
 __all__ = ["PATH", "Hysteresis", "Regulator", "Replan", "from_uncertainty"]
 
@@ -208,6 +209,24 @@ class Regulator:
                 raise AouError(diag(I504, f"{name} must be a number in [{lo:g}, 1], found "
                                     f"{x!r}", _WHERE))
         return float(C), float(V), float(i)
+
+    def observe(self, q, qd=None, qdd=None, estimate: Estimate | None = None,
+                **kwargs) -> Replan | None:
+        """:meth:`update` from a perception's :class:`~.perception.Estimate`: the
+        uncertainty is ``1 - confidence`` (other keywords as :meth:`update`'s)."""
+        from .perception import Estimate, uncertainty_of
+
+        if not isinstance(estimate, Estimate):
+            raise AouError(diag(I504, "observe() needs a perception's Estimate", _WHERE))
+        return self.update(q, qd, qdd, uncertainty=uncertainty_of(estimate), **kwargs)
+
+    def checkpoint(self) -> tuple:
+        """What the regulator expresses and follows now, for :meth:`rollback`."""
+        return (self.expressed, self._last, self._dmp)
+
+    def rollback(self, kept: tuple) -> None:
+        """Forget a re-plan the arm did not get: back to a :meth:`checkpoint`."""
+        self.expressed, self._last, self._dmp = kept
 
     # --- plans ----------------------------------------------------------------------------
 
