@@ -79,7 +79,7 @@ def test_save_onto_a_folder_or_a_fifo_swapped_in_refuses(studio_of, tmp_path, sw
     with pytest.raises(AouError) as err:
         studio.save()
     assert time.monotonic() - start < 10  # a FIFO is not opened for reading
-    assert ("a folder" if swap == "folder" else "a special file") in str(err.value)
+    assert ("a folder" if swap == "folder" else "a FIFO (a named pipe)") in str(err.value)
     if swap == "folder":
         assert (path / "inside").read_text() == "kept\n"
     else:

@@ -24,7 +24,8 @@ from .codes import I501, I504, R410, V132
 from .diagnostics import AouError, Span, diag
 
 __all__ = ["ENV_BYTES", "ENV_SAMPLES", "LIMITS", "check_regular", "check_size", "input_limit",
-           "max_samples", "read_input", "read_input_text", "size_text", "too_many_samples"]
+           "max_samples", "read_input", "read_input_text", "size_text", "too_many_samples",
+           "what_it_is"]
 
 _MB = 1 << 20
 #: kind -> (bound [bytes], the code of a file over it, what a file of the kind is).
@@ -71,7 +72,8 @@ def max_samples() -> int:
     return int(_env_number(ENV_SAMPLES, MAX_SAMPLES))
 
 
-def _what_it_is(mode: int) -> str:
+def what_it_is(mode: int) -> str:
+    """What a file that is not a regular one is, in words (``a FIFO (a named pipe)``)."""
     if stat.S_ISDIR(mode):
         return "a folder"
     if stat.S_ISFIFO(mode):
@@ -87,7 +89,7 @@ def _what_it_is(mode: int) -> str:
 
 def _not_regular(path: str, what: str, mode: int) -> AouError:
     name = f"{what + ' ' if what else ''}`{path}`"
-    return AouError(diag(I501, f"cannot read {name}: it is {_what_it_is(mode)}, not a "
+    return AouError(diag(I501, f"cannot read {name}: it is {what_it_is(mode)}, not a "
                          "regular file", Span.whole_file(path),
                          hint="aou reads inputs from regular files only: save the data "
                               "to a file first"))

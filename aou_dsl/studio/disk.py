@@ -24,6 +24,7 @@ import stat
 from ..core.codes import I501, I502
 from ..core.diagnostics import AouError, Span, diag
 from ..core.files import decode, temp_prefix
+from ..core.inputs import what_it_is
 
 __all__ = ["MAX_BYTES", "Disk"]
 
@@ -152,8 +153,6 @@ class Disk:
 def _kind(mode: int) -> str:
     if stat.S_ISLNK(mode):
         return "a symbolic link"
-    if stat.S_ISDIR(mode):
-        return "a folder"
     if stat.S_ISREG(mode):
         return "a file"
-    return "a special file (a FIFO, a socket or a device)"
+    return what_it_is(mode)
