@@ -319,10 +319,33 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     _robot(stu)
     _editor(sub, c)
     c["dmp"] = _dmp(sub)
+    c["study"] = _study(sub)
     c["rules"] = rules = sub.add_parser("rules", help="list the diagnostic codes, or explain some")
     rules.add_argument("codes", nargs="*", metavar="CODE")
     rules.add_argument("--format", choices=("text", "json"), default="text")
     return c
+
+
+def _study(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """The ``aouc study`` parser (``init``, ``simulate``, ``analyze``; docs/study.md)."""
+    study = sub.add_parser("study", help="a perception study of behaviours: its file, "
+                           "simulated participants, the analysis (needs the `study` extra)")
+    acts = study.add_subparsers(dest="action", metavar="ACTION", required=True)
+    init = acts.add_parser("init", help="write a study file of the paper's design in DIR")
+    init.add_argument("folder", metavar="DIR")
+    init.add_argument("--force", action="store_true", help="replace files already there")
+    sim = acts.add_parser("simulate", help="answers of simulated participants")
+    sim.add_argument("study", metavar="STUDY.toml")
+    sim.add_argument("--participants", type=int_in(1, 100_000), default=55, metavar="N")
+    sim.add_argument("--policy", metavar="FILE.toml",
+                     help="the probability of each answer per question (docs/study.md)")
+    sim.add_argument("-o", "--output", required=True, metavar="RESULTS.json")
+    ana = acts.add_parser("analyze", help="the study's statistics, as a report")
+    ana.add_argument("results", nargs="+", metavar="RESULTS",
+                     help="answers: JSON or CSV of jsPsych rows, or the SQLite store")
+    ana.add_argument("--study", required=True, metavar="STUDY.toml")
+    ana.add_argument("-o", "--output", required=True, metavar="REPORT_DIR")
+    return study
 
 
 def _dmp(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:

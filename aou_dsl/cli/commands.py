@@ -356,12 +356,18 @@ def _cmd_dmp(args: argparse.Namespace) -> int:
     return cmd_dmp(args)
 
 
+def _cmd_study(args: argparse.Namespace) -> int:
+    from .study_cmd import cmd_study
+
+    return cmd_study(args)
+
+
 _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "lint": _cmd_lint, "rules": cmd_rules, "explain": _cmd_explain,
     "compile": _cmd_compile, "check": _cmd_check, "measure": _cmd_measure,
     "plot": _cmd_plot, "render": _cmd_render, "variants": _cmd_variants,
     "robot": cmd_robot, "synth": cmd_synth, "studio": _cmd_studio,
-    "fmt": cmd_fmt, "server": cmd_server, "dmp": _cmd_dmp,
+    "fmt": cmd_fmt, "server": cmd_server, "dmp": _cmd_dmp, "study": _cmd_study,
 }
 
 

@@ -57,6 +57,8 @@ def extra_missing(command: str, exc: ImportError) -> str | None:
         return "media"
     if command == "studio":
         return "studio"
+    if command == "study" and exc.name.split(".")[0] in ("scipy", "statsmodels"):
+        return "study"
     return "dmp" if exc.name.split(".")[0] in ("movement_primitives", "pytransform3d") \
         else None
 

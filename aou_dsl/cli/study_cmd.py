@@ -1,0 +1,64 @@
+"""``aouc study``: a perception study's file, simulated participants and analysis."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+
+from .args import EXIT_OK
+
+__all__ = ["cmd_study"]
+
+
+def cmd_study(args: argparse.Namespace) -> int:
+    if args.action == "init":
+        import os
+
+        from ..core.files import guard_output
+        from ..study.init import init_study
+        for name in ("study.toml", *(f"behaviours/{n}.aou" for n in
+                                     ("confident", "curious", "hesitant", "fearful"))):
+            guard_output(os.path.join(args.folder, name), force=args.force)
+        for path in init_study(args.folder):
+            print(f"wrote {path}", file=sys.stderr)
+        return EXIT_OK
+    from ..study.spec import read_study
+
+    study = read_study(args.study)
+    if args.action == "simulate":
+        return _simulate(args, study)
+    return _analyze(args, study)
+
+
+def _simulate(args: argparse.Namespace, study) -> int:
+    from ..core.files import write_atomic
+    from ..study.simulate import read_policy, simulate
+
+    policy = read_policy(args.policy, study) if args.policy else None
+    reads = [args.study, *(p.path for p in study.part_a), *(p.path for p in study.pairs)]
+    if args.policy:
+        reads.append(args.policy)
+    rows = simulate(study, args.participants, policy)
+    write_atomic(args.output, (json.dumps(rows, indent=0) + "\n").encode(), inputs=reads)
+    print(f"wrote {args.output}: {args.participants} simulated participants, "
+          f"{len(rows)} rows", file=sys.stderr)
+    return EXIT_OK
+
+
+def _analyze(args: argparse.Namespace, study) -> int:
+    from ..study.analyze import analyze
+    from ..study.answers import read_answers
+    from ..study.report import write_report
+
+    rows = read_answers(args.results, study)
+    res = analyze(rows, study)
+    reads = [args.study, *args.results]
+    for path in write_report(args.output, res, rows, reads):
+        print(f"wrote {path}", file=sys.stderr)
+    p = res["participants"]
+    print(f"{p['kept']} of {p['answered']} participants analysed "
+          f"({len(p['excluded'])} excluded)", file=sys.stderr)
+    return EXIT_OK
+
