@@ -14,12 +14,10 @@ __all__ = ["cmd_study"]
 
 def cmd_study(args: argparse.Namespace) -> int:
     if args.action == "init":
-        import os
-
         from ..core.files import guard_output
-        from ..study.init import init_study
-        for name in ("study.toml", *(f"behaviours/{n}.aou" for n in
-                                     ("confident", "curious", "hesitant", "fearful"))):
+        from ..study.init import BASES, init_study
+
+        for name in ("study.toml", *(f"behaviours/{n}.aou" for n in BASES)):
             guard_output(os.path.join(args.folder, name), force=args.force)
         for path in init_study(args.folder):
             print(f"wrote {path}", file=sys.stderr)
