@@ -327,13 +327,32 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
 
 
 def _study(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    """The ``aouc study`` parser (``init``, ``simulate``, ``analyze``; docs/study.md)."""
+    """The ``aouc study`` parser (``init``, ``build``, ``serve``, ``simulate``,
+    ``analyze``; docs/study.md)."""
     study = sub.add_parser("study", help="a perception study of behaviours: its file, "
                            "simulated participants, the analysis (needs the `study` extra)")
     acts = study.add_subparsers(dest="action", metavar="ACTION", required=True)
     init = acts.add_parser("init", help="write a study file of the paper's design in DIR")
     init.add_argument("folder", metavar="DIR")
     init.add_argument("--force", action="store_true", help="replace files already there")
+    bld = acts.add_parser("build", help="the study as a static jsPsych experiment in DIR "
+                          "(videos, page; the manifest beside it as DIR.manifest.json)")
+    bld.add_argument("study", metavar="STUDY.toml")
+    bld.add_argument("-o", "--output", required=True, metavar="DIR")
+    bld.add_argument("-j", "--jobs", type=int_in(0, 64), default=1, metavar="N",
+                     help="videos drawn at once (0: one per core; default 1)")
+    bld.add_argument("--jspsych", metavar="DIR",
+                     help="copy jsPsych from this npm install (node_modules) into the study, "
+                     "so that it runs offline (default: a pinned CDN version)")
+    bld.add_argument("--jatos", action="store_true",
+                     help="also write a JATOS study archive, DIR.jzip")
+    srv = acts.add_parser("serve", help="serve a built study and store the answers in "
+                          "DIR/answers.sqlite")
+    srv.add_argument("folder", metavar="DIR")
+    srv.add_argument("--port", type=int_in(0, 65535), default=8000, metavar="P",
+                     help="port to serve on (default 8000; 0: any free one)")
+    srv.add_argument("--host", default="127.0.0.1", metavar="H",
+                     help="address to bind (default 127.0.0.1: this machine only)")
     sim = acts.add_parser("simulate", help="answers of simulated participants")
     sim.add_argument("study", metavar="STUDY.toml")
     sim.add_argument("--participants", type=int_in(1, 100_000), default=55, metavar="N")

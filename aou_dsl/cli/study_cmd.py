@@ -22,11 +22,15 @@ def cmd_study(args: argparse.Namespace) -> int:
         for path in init_study(args.folder):
             print(f"wrote {path}", file=sys.stderr)
         return EXIT_OK
+    if args.action == "serve":
+        return _serve(args)
     from ..study.spec import read_study
 
     study = read_study(args.study)
     if args.action == "simulate":
         return _simulate(args, study)
+    if args.action == "build":
+        return _build(args, study)
     return _analyze(args, study)
 
 
@@ -60,3 +64,33 @@ def _analyze(args: argparse.Namespace, study) -> int:
           f"({len(p['excluded'])} excluded)", file=sys.stderr)
     return EXIT_OK
 
+
+
+def _build(args: argparse.Namespace, study) -> int:
+    import time
+
+    from ..build.parallel import default_jobs
+    from ..study.build import build_study, manifest_path
+
+    start = time.perf_counter()
+    got = build_study(study, args.output, jobs=args.jobs or default_jobs(),
+                      jspsych=args.jspsych, jatos=args.jatos)
+    print(f"wrote {args.output}: {got['videos']} videos ({got['drawn']} drawn, "
+          f"{got['reused']} up to date) in {time.perf_counter() - start:.1f} s; "
+          f"the manifest is {manifest_path(args.output)}"
+          + (f", the JATOS archive {os.path.normpath(args.output)}.jzip" if args.jatos else ""),
+          file=sys.stderr)
+    return EXIT_OK
+
+
+def _serve(args: argparse.Namespace) -> int:
+    from ..core.codes import I501
+    from ..core.diagnostics import AouError, Span, diag
+    from ..core.files import is_own_output
+    from ..study.serve import serve
+
+    if not is_own_output(os.path.join(args.folder, "timeline.json")):
+        raise AouError(diag(I501, f"`{args.folder}` is not a study `aouc study build` wrote "
+                            "(it has no timeline.json of its own)",
+                            Span.whole_file(args.folder)))
+    return serve(args.folder, host=args.host, port=args.port)

@@ -77,7 +77,7 @@ def _participants(rows: list[Row], study: Study) -> tuple[dict[str, list[Row]], 
     return kept, excluded
 
 
-def _fit_json(fit: Fit, options: tuple[str, ...], holm_p: float) -> dict:
+def _fit_json(fit: Fit, options: tuple[str, ...], holm_p: float | None) -> dict:
     n = fit.n
     return {
         "n": n, "chi2": fit.chi2, "df": fit.df, "p": fit.p, "p_holm": holm_p,

@@ -152,6 +152,26 @@ def _behaviour(path: str, base: str, where: Span) -> tuple[str, str | None]:
     return full, r.behaviour.state if r.behaviour else None
 
 
+def _attention(rd: _Reader, table: dict, checks: list) -> tuple[dict, ...]:
+    """``[attention] checks``: each a table of ``question``, ``options`` (2 to 10 texts)
+    and ``answer`` (one of them)."""
+    if set(table) - {"checks"}:
+        raise rd.fail("attention", "expected only `checks`")
+    out = []
+    for i, c in enumerate(checks, 1):
+        if not isinstance(c, dict) or set(c) != {"question", "options", "answer"}:
+            raise rd.fail("attention.checks", f"check {i}: expected a table of question, "
+                          "options and answer")
+        q = rd.get(c, "attention.checks.question", str)
+        opts = rd.strings(c, "attention.checks.options", most=10)
+        a = rd.get(c, "attention.checks.answer", str)
+        if len(opts) < 2 or a not in opts:
+            raise rd.fail("attention.checks", f"check {i}: expected two options or more, "
+                          "the answer one of them")
+        out.append({"question": q, "options": list(opts), "answer": a})
+    return tuple(out)
+
+
 def read_study(path: str) -> Study:
     """The study file at ``path``, checked (E701, E702; I501 when it cannot be read)."""
     text = read_input_text(path, "study")
@@ -210,7 +230,7 @@ def read_study(path: str) -> Study:
         intensity=rd.get(a, "part_a.intensity", int, 5, lo=2, hi=11), pairs=tuple(pairs),
         texts={k: rd.get(texts, f"texts.{k}", str) for k in texts if k != "demographics"},
         demographics=rd.strings(texts, "texts.demographics"),
-        attention=tuple(c for c in checks if isinstance(c, dict)),
+        attention=_attention(rd, attention, checks),
         completion={k: rd.get(completion, f"completion.{k}", str) for k in completion},
         render={k: rd.get(render, f"render.{k}", (int, float), lo=1, hi=4096)
                 for k in render})
