@@ -105,8 +105,7 @@ class _Handler(BaseHTTPRequestHandler):
         self.send_header("Content-Type", kind)
         self.send_header("Content-Length", str(len(body)))
         self.send_header("X-Content-Type-Options", "nosniff")
-        self.send_header("Cache-Control", "no-store")
-        for k, v in (headers or {}).items():
+        for k, v in ({"Cache-Control": "no-store"} | (headers or {})).items():
             self.send_header(k, v)
         self.end_headers()
         if self.command != "HEAD":
@@ -152,9 +151,13 @@ class _Handler(BaseHTTPRequestHandler):
                 self._reply(416, b"", headers={"Content-Range": f"bytes */{size}"})
                 return
             self._reply(206, data[start:end + 1], kind, {
-                "Content-Range": f"bytes {start}-{end}/{size}", "Accept-Ranges": "bytes"})
+                "Content-Range": f"bytes {start}-{end}/{size}", "Accept-Ranges": "bytes",
+                "Cache-Control": "max-age=31536000, immutable"})
             return
-        self._reply(200, data, kind, {"Accept-Ranges": "bytes"})
+        # A video is named by its hash: it never changes, so the browser may keep it.
+        keep = {"Cache-Control": "max-age=31536000, immutable"} if name.startswith(
+            "stimuli/") else {}
+        self._reply(200, data, kind, {"Accept-Ranges": "bytes", **keep})
 
     do_HEAD = do_GET
 
