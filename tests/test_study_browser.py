@@ -21,7 +21,6 @@ import signal
 import sqlite3
 import subprocess
 import sys
-import time
 
 import pytest
 
@@ -43,6 +42,8 @@ if shutil.which("npm") is None:
     pytest.skip("npm is missing (apt-get install -y npm): the study's tests install jsPsych "
                 "with it", allow_module_level=True)
 
+#: ``aouc`` run by this Python, on this worktree's code.
+AOUC = [sys.executable, "-c", "from aou_dsl.cli import main; main()"]
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
         "--disable-background-networking", "--disable-component-update", "--disable-sync",
         "--autoplay-policy=no-user-gesture-required"]
@@ -71,8 +72,10 @@ end = "Thank you."
 behaviours = ["b/zeta.aou", "b/omega.aou"]
 [part_b]
 pairs = [{ behaviour = "b/omega.aou", descriptor = "pause_duration", low = 0.2, high = 0.5 }]
-[attention]
-checks = [{ question = "Choose the colour of the sky.", options = ["red", "blue"], answer = "blue" }]
+[[attention.checks]]
+question = "Choose the colour of the sky."
+options = ["red", "blue"]
+answer = "blue"
 [completion]
 code = "XK42QZ"
 """
@@ -120,7 +123,7 @@ class Server:
     def __init__(self, site: str, port: int = 0):
         env = dict(os.environ, PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""))
         self.proc = subprocess.Popen(
-            [sys.executable, "-c", "from aou_dsl.cli import main; main()", "study", "serve", site, "--port", str(port)],
+            [*AOUC, "study", "serve", site, "--port", str(port)],
             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
         line = self.proc.stdout.readline()  # type: ignore[union-attr]
         m = re.search(r"http://127\.0\.0\.1:(\d+)/", line)
@@ -253,44 +256,73 @@ def _check_rows(rows: list, pid: str) -> None:
     assert next(r for r in mine if r["aou_part"] == "attention")["passed"] is True
 
 
+#: Participants taking the study at once (each group in a thread, with its own browser).
+GROUPS = 3
+
+
+def _crowd(url: str, pids: list[str]) -> dict[str, tuple[list, str]]:
+    """``pids`` take the study, :data:`GROUPS` at a time; each one's pages and end status.
+    The first of them also waits for every video to loop."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from playwright.sync_api import sync_playwright
+
+    def group(mine: list[str]) -> dict:
+        out = {}
+        with sync_playwright() as pw:
+            b = pw.chromium.launch(executable_path=CHROMIUM, args=ARGS, headless=True)
+            try:
+                for pid in mine:
+                    seen, page = take(b, url, pid, loops=pid == pids[0])
+                    out[pid] = (seen, _finish(page))
+                    page.context.close()
+            finally:
+                b.close()
+        return out
+
+    with ThreadPoolExecutor(GROUPS) as pool:
+        done = list(pool.map(group, [pids[i::GROUPS] for i in range(GROUPS)]))
+    return {k: v for d in done for k, v in d.items()}
+
+
 def _run(browser, built, n: int, tmp_path):
     path, site = built
-    if os.path.exists(os.path.join(site, "answers.sqlite")):
-        for suffix in ("", "-wal", "-shm"):
-            if os.path.exists(os.path.join(site, "answers.sqlite" + suffix)):
-                os.remove(os.path.join(site, "answers.sqlite" + suffix))
+    for suffix in ("", "-wal", "-shm"):
+        if os.path.exists(os.path.join(site, "answers.sqlite" + suffix)):
+            os.remove(os.path.join(site, "answers.sqlite" + suffix))
     server = Server(site)
     expected = ["consent", "instructions", "A", "A", "instructions"]
+    pids = [f"P{i:03d}" for i in range(n)]
+    half = n // 2
     try:
-        half = n // 2
-        for i in range(n):
-            pid = f"P{i:03d}"
-            if i != half:
-                seen, page = take(browser, server.url, pid, loops=i == 0)
-                assert "received" in _finish(page)
-                page.context.close()
-            else:  # the server is killed before this participant's last page
-                seen, page = take(browser, server.url, pid, until="demographics")
-                before = stored(site)
-                server.kill()
-                assert len(stored(site)) == len(before) == half  # nothing lost
-                more, page = take(browser, None, pid, page=page)  # type: ignore[arg-type]
-                seen += more
-                page.wait_for_selector("#aou-download", timeout=15_000)  # offered
-                offered = page.evaluate("async () => (await fetch(document.querySelector("
-                                        "'#aou-download').href)).text()")
-                assert any(r.get("aou_part") == "end" for r in json.loads(offered))
-                server = Server(site, server.port)  # restarted: the page tries again
-                assert "received" in _finish(page)
-                page.context.close()
-            assert seen[:5] == expected and seen[-2:] == ["demographics", "end"], seen
-            assert sorted(seen[5:-2]) == ["B", "attention"], seen
+        results = _crowd(server.url, pids[:half])
+        # The server is killed before this participant's last page: nothing stored is
+        # lost, the page keeps the answers and offers them, and sends them once the
+        # server is back.
+        pid = pids[half]
+        seen, page = take(browser, server.url, pid, until="demographics")
+        before = stored(site)
+        server.kill()
+        assert sorted(stored(site)) == sorted(before) == sorted(pids[:half])
+        more, page = take(browser, None, pid, page=page)  # type: ignore[arg-type]
+        page.wait_for_selector("#aou-download", timeout=15_000)
+        offered = page.evaluate("async () => (await fetch(document.querySelector("
+                                "'#aou-download').href)).text()")
+        assert any(r.get("aou_part") == "end" for r in json.loads(offered))
+        server = Server(site, server.port)
+        results[pid] = (seen + more, _finish(page))
+        page.context.close()
+        results.update(_crowd(server.url, pids[half + 1:]))
         # A participant who already submitted is refused, and nothing is stored twice.
-        _, page = take(browser, server.url, "P000")
+        _, page = take(browser, server.url, pids[0])
         assert "already" in _finish(page)
         page.context.close()
     finally:
         server.kill()
+    for pid, (seen, status) in results.items():
+        assert "received" in status and "already" not in status, (pid, status)
+        assert seen[:5] == expected and seen[-2:] == ["demographics", "end"], seen
+        assert sorted(seen[5:-2]) == ["B", "attention"], seen
     got = stored(site)
     assert sorted(got) == [f"P{i:03d}" for i in range(n)]
     for pid, rows in got.items():
@@ -301,7 +333,7 @@ def _run(browser, built, n: int, tmp_path):
     seeds = {e["aou_seed"] for e in ends}
     assert len(orders) > 1 and sides == {"low", "high"} and len(seeds) == n
     report = tmp_path / "report"
-    done = subprocess.run([sys.executable, "-c", "from aou_dsl.cli import main; main()", "study", "analyze",
+    done = subprocess.run([*AOUC, "study", "analyze",
                            os.path.join(site, "answers.sqlite"), "--study", path,
                            "-o", str(report)], capture_output=True, text=True,
                           env=dict(os.environ, PYTHONPATH=ROOT))
@@ -338,7 +370,7 @@ def _leaks(site: str, served: list[str]) -> list[str]:
     names = set(REGISTRY) | {b for b, _, _ in BEHAVIOURS.values()} | set(BEHAVIOURS) | \
         {os.path.splitext(n)[0] for n in BEHAVIOURS} | {"study.toml", "manifest"}
     found = []
-    for root, dirs, files in os.walk(site):
+    for _root, dirs, files in os.walk(site):
         for f in dirs + files:
             found += [f"file name {f}: {n}" for n in names if n in f]
     for rel in served:
