@@ -31,6 +31,8 @@ from aou_dsl.study.build import build_study
 from aou_dsl.study.jspsych import PACKAGES
 from aou_dsl.study.spec import read_study
 
+from .test_study_build import BEHAVIOURS, write_study
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CHROMIUM = next((p for p in (os.environ.get("AOU_CHROMIUM"), shutil.which("chromium"),
                              "/usr/bin/chromium") if p and os.path.exists(p)), None)
@@ -47,50 +49,6 @@ AOUC = [sys.executable, "-c", "from aou_dsl.cli import main; main()"]
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
         "--disable-background-networking", "--disable-component-update", "--disable-sync",
         "--autoplay-policy=no-user-gesture-required"]
-
-#: Names that must appear nowhere a participant can load.
-BEHAVIOURS = {"zeta.aou": ("zephyr_walk", "confident",
-                           "approach a=0.3\npause 0.3s\n"),
-              "omega.aou": ("quill_drift", "hesitant",
-                            "approach a=0.3\npause 0.2s x2\nretreat 0.03m a=0.5\n")}
-
-STUDY = """[study]
-title = "How does it move?"
-robot = "panda"
-seed = 7
-[render]
-width = 64
-height = 48
-fps = 4
-[texts]
-consent = "You are asked to watch videos."
-instructions_a = "Watch the videos."
-instructions_b = "Compare two videos."
-demographics = ["Age"]
-end = "Thank you."
-[part_a]
-behaviours = ["b/zeta.aou", "b/omega.aou"]
-[part_b]
-pairs = [{ behaviour = "b/omega.aou", descriptor = "pause_duration", low = 0.2, high = 0.5 }]
-[[attention.checks]]
-question = "Choose the colour of the sky."
-options = ["red", "blue"]
-answer = "blue"
-[completion]
-code = "XK42QZ"
-"""
-
-
-def write_study(folder: str) -> str:
-    os.makedirs(os.path.join(folder, "b"), exist_ok=True)
-    for name, (behaviour, state, body) in BEHAVIOURS.items():
-        with open(os.path.join(folder, "b", name), "w") as fh:
-            fh.write(f"behaviour {behaviour} : {state}\n\n{body}")
-    path = os.path.join(folder, "study.toml")
-    with open(path, "w") as fh:
-        fh.write(STUDY)
-    return path
-
 
 @pytest.fixture(scope="module")
 def node_modules(tmp_path_factory):
@@ -426,3 +384,18 @@ def test_nothing_served_says_which_stimulus_is_which(built, tmp_path):
         server.kill()
     assert not os.path.abspath(os.path.join(site, "..", "site.manifest.json")).startswith(
         os.path.abspath(site) + os.sep)
+
+
+def test_the_pinned_hashes_are_the_npm_packages_files(node_modules):
+    """The hashes the page's CDN tags carry are those of the files npm installs."""
+    import base64
+    import hashlib
+
+    from aou_dsl.study.jspsych import FILES
+
+    for pkg, path, pinned in FILES:
+        with open(os.path.join(node_modules, *pkg.split("/"), *path.split("/")), "rb") as fh:
+            digest = hashlib.sha384(fh.read()).digest()
+        assert pinned == "sha384-" + base64.b64encode(digest).decode(), (pkg, path)
+        with open(os.path.join(node_modules, *pkg.split("/"), "package.json")) as fh:
+            assert json.load(fh)["version"] == PACKAGES[pkg]
