@@ -321,3 +321,22 @@ def test_a_bad_attention_check_is_E701(tmp_path, check):
         read_study(path)
     assert err.value.diagnostics[0].code == "E701"
     assert "attention" in err.value.diagnostics[0].message
+
+
+def test_the_papers_design_makes_every_pair(tmp_path):
+    """Every pair of `aouc study init`'s design has its two variants (the tilts and the
+    vertical gaze the paper varied are added to a copy of their base first)."""
+    from aou_dsl.lang.linter import lint_source
+    from aou_dsl.study.build import plan_stimuli
+    from aou_dsl.study.init import PAIRS, init_study
+
+    init_study(str(tmp_path))
+    study = read_study(str(tmp_path / "study.toml"))
+    stims = plan_stimuli(study)
+    assert len(stims) == 4 + 2 * len(PAIRS) == 44
+    for s in stims:
+        assert lint_source(s.text, s.path).ok, (s.item, s.role)
+    for p, (base, d, lo, hi) in zip(study.pairs, PAIRS, strict=True):
+        assert p.state == base and p.descriptor == d
+        low, high = (s for s in stims if s.item == p.id)
+        assert (low.value, high.value) == (lo, hi) and low.text != high.text

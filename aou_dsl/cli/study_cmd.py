@@ -15,9 +15,9 @@ __all__ = ["cmd_study"]
 def cmd_study(args: argparse.Namespace) -> int:
     if args.action == "init":
         from ..core.files import guard_output
-        from ..study.init import BASES, init_study
+        from ..study.init import init_study, written_names
 
-        for name in ("study.toml", *(f"behaviours/{n}.aou" for n in BASES)):
+        for name in written_names():
             guard_output(os.path.join(args.folder, name), force=args.force)
         for path in init_study(args.folder):
             print(f"wrote {path}", file=sys.stderr)

@@ -12,7 +12,7 @@ import os
 
 from ..core.files import write_atomic
 
-__all__ = ["BASES", "PAIRS", "init_study"]
+__all__ = ["BASES", "PAIRS", "PART_B_BASES", "init_study", "written_names"]
 
 #: The four base behaviours, as the study's files say them.
 BASES = {
@@ -39,6 +39,27 @@ PAIRS = [
     ("fearful", "pause_count", 2, 4), ("fearful", "retreat_count", 1, 3),
     ("fearful", "approach_acceleration", 0.05, 0.1), ("fearful", "retreat_acceleration", 1, 2),
 ]
+
+#: (base, descriptor) -> (file, statement): the paper varied a tilt and a vertical gaze
+#: that its base stimuli did not have. A variant changes one value of a statement the
+#: file holds, so these pairs vary a base with that statement added, written beside it.
+PART_B_BASES = {
+    ("curious", "tilt_angle"): ("curious_tilt", "tilt 20deg v=30deg/s"),
+    ("curious", "tilt_velocity"): ("curious_tilt", "tilt 20deg v=30deg/s"),
+    ("curious", "vertical_gaze"): ("curious_vertical", "gaze vertical 15deg"),
+    ("hesitant", "tilt_angle"): ("hesitant_tilt", "tilt 20deg v=30deg/s"),
+}
+
+
+def _pair_file(base: str, descriptor: str) -> str:
+    return PART_B_BASES.get((base, descriptor), (base, ""))[0]
+
+
+def written_names() -> list[str]:
+    """The files ``init_study`` writes, relative to its folder."""
+    stems = list(BASES) + sorted({f for f, _ in PART_B_BASES.values()})
+    return ["study.toml", *(f"behaviours/{n}.aou" for n in stems)]
+
 
 STUDY = '''# study.toml: written by `aouc study init`; a perception study (docs/study.md).
 # It reproduces the design of the study behind aou: Part A shows the four base behaviours
@@ -94,8 +115,19 @@ def init_study(folder: str) -> list[str]:
         path = os.path.join(folder, "behaviours", f"{name}.aou")
         write_atomic(path, text.encode())
         written.append(path)
+    for (name, _), (stem, statement) in sorted(PART_B_BASES.items(), key=lambda kv: kv[1]):
+        path = os.path.join(folder, "behaviours", f"{stem}.aou")
+        if path in written:
+            continue
+        what, body = BASES[name]
+        text = (f"# {stem}.aou: the study's {name} stimulus with `{statement}` added, the "
+                f"base of Part B's pairs\n# that vary it.\nbehaviour {stem} : {name}\n\n"
+                f"{body}{statement}\n")
+        write_atomic(path, text.encode())
+        written.append(path)
     a = ", ".join(f'"behaviours/{n}.aou"' for n in BASES)
-    b = ",\n".join(f'  {{ behaviour = "behaviours/{base}.aou", descriptor = "{d}", '
+    b = ",\n".join(f'  {{ behaviour = "behaviours/{_pair_file(base, d)}.aou", '
+                    f'descriptor = "{d}", '
                    f"low = {lo}, high = {hi} }}" for base, d, lo, hi in PAIRS)
     path = os.path.join(folder, "study.toml")
     write_atomic(path, STUDY.format(a=a, b=b).encode())
