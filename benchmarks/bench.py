@@ -41,6 +41,7 @@ from pathlib import Path
 
 import bench_dmp
 import bench_studio
+import bench_study
 import numpy as np
 import speed
 from bench_editor import bench_editor
@@ -186,7 +187,7 @@ SECTIONS = {"build": speed.bench_build, "cold": speed.bench_cold, "lint": speed.
             "jobs": speed.bench_jobs, "render": speed.bench_render, "measure": bench_measure,
             "compile": bench_compile, "replan": speed.bench_replan, "house": bench_house,
             "studio": bench_studio.bench_studio, "editor": bench_editor,
-            "dmp": bench_dmp.bench_dmp}
+            "dmp": bench_dmp.bench_dmp, "study": bench_study.bench_study}
 
 
 def main(argv: list[str]) -> int:
