@@ -27,7 +27,7 @@ def bench_study() -> None:
     from aou_dsl.study.answers import read_answers
     from aou_dsl.study.build import build_study
     from aou_dsl.study.init import init_study
-    from aou_dsl.study.report import write_report
+    from aou_dsl.study.report_files import write_report
     from aou_dsl.study.simulate import simulate
     from aou_dsl.study.spec import read_study
 

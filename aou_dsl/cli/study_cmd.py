@@ -52,7 +52,7 @@ def _simulate(args: argparse.Namespace, study) -> int:
 def _analyze(args: argparse.Namespace, study) -> int:
     from ..study.analyze import analyze
     from ..study.answers import read_answers
-    from ..study.report import write_report
+    from ..study.report_files import write_report
 
     rows = read_answers(args.results, study)
     res = analyze(rows, study)
