@@ -340,3 +340,22 @@ def test_the_papers_design_makes_every_pair(tmp_path):
         assert p.state == base and p.descriptor == d
         low, high = (s for s in stims if s.item == p.id)
         assert (low.value, high.value) == (lo, hi) and low.text != high.text
+
+
+def test_a_build_stopped_early_resumes_where_it_stopped(copy):
+    """The cache is written as each video is drawn, and a folder a stopped build left is
+    one a build may write into: a second build draws only what the first did not."""
+    study = os.path.join(copy, "study.toml")
+    site = os.path.join(copy, "site")
+    shutil.rmtree(site)
+    os.remove(manifest_path(site))
+
+    def stop(msg: str) -> None:
+        if "[2/" in msg:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        build_study(read_study(study), site, log=stop)
+    assert not os.path.exists(os.path.join(site, "timeline.json"))
+    got = build_study(read_study(study), site, **QUIET)
+    assert (got["drawn"], got["reused"]) == (2, 2)

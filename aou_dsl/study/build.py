@@ -192,8 +192,9 @@ def _guard_site(site: str, reads: list[str]) -> None:
         if os.path.realpath(read).startswith(real + os.sep):
             raise AouError(diag(I502, f"refusing to build into `{site}`: it holds `{read}`, "
                                 "which this command reads", where, input=read))
-    if os.path.isdir(site) and os.listdir(site) and not is_own_output(
-            os.path.join(site, "timeline.json")):
+    own = {"stimuli", CACHE, WORK, "timeline.json", "index.html", "experiment.js", "jspsych"}
+    if os.path.isdir(site) and not is_own_output(os.path.join(site, "timeline.json")) and \
+            set(os.listdir(site)) - own:  # (a build stopped early left only its own files)
         raise AouError(diag(I502, f"refusing to build into `{site}`: the folder holds files "
                             "other than a study aou built", where,
                             hint="build into a new or empty folder"))
@@ -243,8 +244,11 @@ def build_study(study: Study, site: str, *, jobs: int = 1, jspsych: str | None =
             todo[key] = s
     log(f"study build: {len(stims)} videos, {len(stims) - sum(1 for k in keys if k in todo)} "
         f"up to date, {len(todo)} to draw ({jobs} at a time)")
-    drawn = _draw_all(todo, site, robot, render, jobs, log)
-    videos.update(drawn)
+    def keep(key: str, sha: str) -> None:  # the cache is written as each video is drawn
+        videos[key] = sha
+        _save_cache(site, videos, reads)
+
+    drawn = _draw_all(todo, site, robot, render, jobs, log, keep)
     jspsych_files = []
     if jspsych:
         from .jspsych import copy_local
@@ -270,16 +274,20 @@ def build_study(study: Study, site: str, *, jobs: int = 1, jspsych: str | None =
                    bool(jspsych))
     write_atomic(manifest_path(site), (json.dumps(man, indent=1) + "\n").encode(),
                  inputs=reads)
-    write_atomic(os.path.join(site, CACHE), (json.dumps(
-        {"generator": GENERATOR, "videos": {k: videos[k] for k in sorted(set(keys))}},
-        indent=1) + "\n").encode(), inputs=reads)
+    _save_cache(site, {k: videos[k] for k in set(keys)}, reads)
     if jatos:
         write_jzip(study, site, jspsych_files)
     return {"videos": len(set(keys)), "drawn": len(drawn), "reused": len(set(keys)) - len(drawn)}
 
 
+def _save_cache(site: str, videos: dict[str, str], reads: list[str]) -> None:
+    write_atomic(os.path.join(site, CACHE), (json.dumps(
+        {"generator": GENERATOR, "videos": dict(sorted(videos.items()))}, indent=1)
+        + "\n").encode(), inputs=reads)
+
+
 def _draw_all(todo: dict[str, Stim], site: str, robot: str, render: dict, jobs: int,
-              log) -> dict[str, str]:
+              log, keep) -> dict[str, str]:
     """Draw each video of ``todo`` (key -> stimulus), ``jobs`` at once; key -> sha."""
     if not todo:
         return {}
@@ -299,6 +307,7 @@ def _draw_all(todo: dict[str, Stim], site: str, robot: str, render: dict, jobs: 
         assert sha is not None
         os.replace(tmp, os.path.join(site, "stimuli", f"{sha}.mp4"))
         out[key] = sha
+        keep(key, sha)
         log(f"study build: [{len(out)}/{len(todo)}] drew {s.label} "
             f"({os.path.basename(s.path)}) at {time.perf_counter() - t0:.1f} s")
 
