@@ -399,3 +399,45 @@ def test_the_pinned_hashes_are_the_npm_packages_files(node_modules):
         assert pinned == "sha384-" + base64.b64encode(digest).decode(), (pkg, path)
         with open(os.path.join(node_modules, *pkg.split("/"), "package.json")) as fh:
             assert json.load(fh)["version"] == PACKAGES[pkg]
+
+
+#: A stand-in for the ``jatos.js`` a JATOS server serves: it keeps what the study sends.
+JATOS_STUB = """window.jatos = {workerId: "77", onLoad: function (f) { setTimeout(f, 0); },
+  endStudy: function (data) { window.aouResult = data; },
+  endStudyAndRedirect: function (url, data) { window.aouResult = data; }};"""
+
+
+def test_in_jatos_the_answers_go_to_jatos(browser, built, tmp_path):
+    """The JATOS archive's page loads jatos.js and ends the study with the rows as the
+    result data, the participant's id JATOS's worker id."""
+    import http.server
+    import threading
+    import zipfile
+    from functools import partial
+
+    from aou_dsl.study.build import write_jzip
+
+    path, site = built
+    files = [os.path.join(r, f) for r, _, fs in os.walk(os.path.join(site, "jspsych"))
+             for f in fs]
+    archive = write_jzip(read_study(path), site, files)
+    with zipfile.ZipFile(archive) as z:
+        z.extractall(tmp_path / "jatos")
+    folder = tmp_path / "jatos" / "site"
+    (folder / "jatos.js").write_text(JATOS_STUB)
+    handler = partial(http.server.SimpleHTTPRequestHandler, directory=str(folder))
+    httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    threading.Thread(target=httpd.serve_forever, daemon=True).start()
+    try:
+        page = browser.new_context().new_page()
+        page.goto(f"http://127.0.0.1:{httpd.server_address[1]}/index.html")
+        take(browser, None, "jatos", page=page, play=False)  # type: ignore[arg-type]
+        page.wait_for_function("() => window.aouResult !== undefined", timeout=15_000)
+        rows = json.loads(page.evaluate("() => window.aouResult"))
+        page.context.close()
+    finally:
+        httpd.shutdown()
+        httpd.server_close()
+    assert {r["participant"] for r in rows} == {"jatos-77"}
+    assert sorted(r["aou_part"] for r in rows if r.get("aou_part")) == [
+        "A", "A", "B", "attention", "end"]
