@@ -191,7 +191,7 @@ def read_study(path: str) -> Study:
     b = rd.table(data, "part_b", {"pairs"})
     texts = rd.table(data, "texts", {"consent", "instructions_a", "instructions_b",
                                      "demographics", "end"})
-    render = rd.table(data, "render", {"width", "height", "fps", "seconds"})
+    render = rd.table(data, "render", {"width", "height", "fps"})
     base = os.path.dirname(os.path.abspath(path))
     states = rd.strings(a, "part_a.states", ("confident", "curious", "hesitant", "fearful"))
     bad = [x for x in states if x not in STATES]
