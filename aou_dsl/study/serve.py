@@ -18,6 +18,7 @@ text)``; a participant id that already submitted is refused (409).
 from __future__ import annotations
 
 import datetime
+import errno
 import json
 import mimetypes
 import os
@@ -26,6 +27,9 @@ import sqlite3
 import sys
 import threading
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+
+from ..core.codes import I504
+from ..core.diagnostics import AouError, Span, diag
 
 __all__ = ["MAX_BODY", "STORE", "StudyServer", "open_store", "serve"]
 
@@ -199,7 +203,21 @@ def serve(folder: str, *, host: str = LOCAL, port: int = 8000) -> int:
     if host not in (LOCAL, "localhost"):
         print(f"aouc: warning: the study's server binds {host}: anyone who can reach this "
               "machine can take the study and submit answers", file=sys.stderr)
-    server = StudyServer(folder, host, port)
+    server = None
+    for p in [port] if port == 0 else range(port, min(port + 20, 65536)):
+        try:
+            server = StudyServer(folder, host, p)
+            break
+        except OSError as exc:
+            if exc.errno != errno.EADDRINUSE:
+                raise AouError(diag(I504, f"cannot serve on {host}:{p}: {exc.strerror}",
+                                    Span.whole_file("--host"))) from None
+    if server is None:
+        raise AouError(diag(I504, f"ports {port} to {port + 19} are all taken: choose "
+                            "another with --port", Span.whole_file("--port")))
+    if server.port != port and port != 0:
+        print(f"aouc: port {port} is taken: serving on {server.port} (--port chooses)",
+              file=sys.stderr)
     print(f"aouc study: serving {folder} at {server.url} (Ctrl-C stops); answers go to "
           f"{os.path.join(folder, STORE)}", flush=True)
     try:
