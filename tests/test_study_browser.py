@@ -441,3 +441,19 @@ def test_in_jatos_the_answers_go_to_jatos(browser, built, tmp_path):
     assert {r["participant"] for r in rows} == {"jatos-77"}
     assert sorted(r["aou_part"] for r in rows if r.get("aou_part")) == [
         "A", "A", "B", "attention", "end"]
+
+
+def test_a_participant_who_declines_sends_nothing(browser, built):
+    path, site = built
+    server = Server(site)
+    try:
+        page = browser.new_context().new_page()
+        page.goto(f"{server.url}?PROLIFIC_PID=NOPE")
+        page.get_by_role("button", name="I do not agree", exact=True).click()
+        page.wait_for_function("() => /did not agree/.test(document.body.innerText)")
+        page.wait_for_timeout(500)  # a request the page would send has time to arrive
+        assert page.query_selector("#aou-end") is None
+        page.context.close()
+    finally:
+        server.kill()
+    assert "NOPE" not in stored(site)

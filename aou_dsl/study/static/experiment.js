@@ -90,6 +90,7 @@
                                 STUDY_ID: platform.study_id, SESSION_ID: platform.session_id});
 
     var order = 0;
+    var declined = false;  // no consent: nothing is recorded or sent
     var orderOf = [];
     var sides = {};
     var timeline = [];
@@ -101,6 +102,7 @@
       data: {aou_page: "consent"},
       on_finish: function (data) {
         if (data.response !== 0) {
+          declined = true;
           jsPsych.abortExperiment("<p>You did not agree to take part. You may close this " +
                                   "page.</p>");
         }
@@ -226,6 +228,7 @@
     }
 
     function finish() {
+      if (declined) return;
       var rows = jsPsych.data.get().values();
       rows.push({participant: participant, aou_part: "end", aou_item: "", aou_seed: seed,
                  aou_order: orderOf, aou_sides: sides, PROLIFIC_PID: platform.prolific_pid,
