@@ -45,7 +45,7 @@ if shutil.which("npm") is None:
                 "with it", allow_module_level=True)
 
 #: ``aouc`` run by this Python, on this worktree's code.
-AOUC = [sys.executable, "-c", "from aou_dsl.cli import main; main()"]
+AOUC = [sys.executable, "-m", "aou_dsl"]
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
         "--disable-background-networking", "--disable-component-update", "--disable-sync",
         "--autoplay-policy=no-user-gesture-required"]

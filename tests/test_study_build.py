@@ -359,3 +359,31 @@ def test_a_build_stopped_early_resumes_where_it_stopped(copy):
     assert not os.path.exists(os.path.join(site, "timeline.json"))
     got = build_study(read_study(study), site, **QUIET)
     assert (got["drawn"], got["reused"]) == (2, 2)
+
+
+def test_the_command_line_builds_and_refuses(copy, tmp_path):
+    """``aouc study build`` over a built study draws nothing and says so; ``serve`` on a
+    folder that is not a built study, and a build whose pair cannot be made, are coded
+    errors, not tracebacks."""
+    import subprocess
+    import sys
+
+    aouc = [sys.executable, "-m", "aou_dsl"]
+    env = dict(os.environ, PYTHONPATH=ROOT)
+    study = os.path.join(copy, "study.toml")
+    site = os.path.join(copy, "site")
+    got = subprocess.run([*aouc, "study", "build", study, "-o", site, "--jobs", "2"],
+                         capture_output=True, text=True, env=env, timeout=300)
+    assert got.returncode == 0, got.stderr
+    assert "4 videos (0 drawn, 4 up to date)" in got.stderr
+    assert "site.manifest.json" in got.stderr
+    got = subprocess.run([*aouc, "study", "serve", str(tmp_path)], capture_output=True,
+                         text=True, env=env, timeout=60)
+    assert got.returncode == 2 and "I501" in got.stderr and "Traceback" not in got.stderr
+    text = open(study).read().replace("low = 0.2", "low = 0.1")  # a pause too short
+    with open(study, "w") as fh:
+        fh.write(text)
+    got = subprocess.run([*aouc, "study", "build", study, "-o", site], capture_output=True,
+                         text=True, env=env, timeout=300)
+    assert got.returncode in (1, 2) and "E702" in got.stderr and "pair B1" in got.stderr
+    assert "Traceback" not in got.stderr
