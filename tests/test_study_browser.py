@@ -150,6 +150,7 @@ def take(browser, url: str, pid: str, *, loops: bool = False, play: bool = True,
                                "#jspsych-survey-html-form, #aou-end", timeout=15_000)
         if page.query_selector("#aou-end"):
             seen.append("end")
+            assert page.inner_text("#aou-code") == "XK42QZ"  # the completion code
             return seen, page
         text = page.inner_text(".jspsych-content")
         if page.query_selector("textarea[name=description]"):
