@@ -458,3 +458,36 @@ def test_a_participant_who_declines_sends_nothing(browser, built):
     finally:
         server.kill()
     assert "NOPE" not in stored(site)
+
+
+def test_the_page_sends_the_participant_back_to_the_platform(browser, built, tmp_path,
+                                                              node_modules):
+    """With ``[completion] redirect``, the page goes to the platform's completion address
+    once the answers are stored (not before)."""
+    path, site = built
+    folder = tmp_path / "copy"
+    shutil.copytree(os.path.dirname(path), folder, ignore=shutil.ignore_patterns("answers*"))
+    study = folder / "study.toml"
+    back = "https://app.prolific.com/submissions/complete?cc=XK42QZ"
+    study.write_text(study.read_text().replace('code = "XK42QZ"', f'redirect = "{back}"'))
+    got = build_study(read_study(str(study)), str(folder / "site"), jspsych=node_modules,
+                      log=lambda m: None)
+    assert got["drawn"] == 0  # the videos are the built study's
+    server = Server(str(folder / "site"))
+    try:
+        ctx = browser.new_context()
+        ctx.route("https://app.prolific.com/**",
+                  lambda route: route.fulfill(body="<p id=back>completed</p>",
+                                              content_type="text/html"))
+        page = ctx.new_page()
+        page.goto(f"{server.url}?PROLIFIC_PID=R1&STUDY_ID=S1&SESSION_ID=X1")
+        seen, page = take(browser, None, "R1", page=page, play=False, until="demographics")
+        assert seen[-1] in ("B", "attention")
+        page.fill("input[name=d0]", "40")
+        with page.expect_navigation(url=back, timeout=30_000):
+            page.click("#jspsych-survey-html-form-next")
+        assert page.inner_text("#back") == "completed"
+        ctx.close()
+    finally:
+        server.kill()
+    assert "R1" in stored(str(folder / "site"))
