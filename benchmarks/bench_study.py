@@ -1,7 +1,8 @@
 """Benchmark of ``aouc study`` (docs/study.md), each figure beside its goal.
 
-- build, cold: the paper's design (``aouc study init``: 4 Part A videos and 20 pairs, 44
-  videos at 640x480 and 30 frames a second) built from nothing with ``--jobs 2``;
+- build, cold: the paper's design (``aouc study init``: 4 Part A stimuli and 20 pairs, 44
+  stimuli in 27 distinct videos at 640x480 and 30 frames a second) built from nothing
+  with ``--jobs 2``;
 - rebuild, warm: the same study after one behaviour changed (the confident stimulus's
   approach), as a share of the cold build: only that behaviour's videos are drawn again;
 - rebuild, cached: nothing changed, nothing drawn;

@@ -20,9 +20,12 @@ robot's description, and of the video. ``--jatos`` writes ``SITE.jzip`` beside i
 Rendering reuses ``aouc render``'s code (one video per stimulus, no caption) and Part B's
 variants are ``aouc variants``'s. A video is keyed by the sha256 of everything it depends
 on (aou's version, the text compiled, the robot's name and file contents, width, height
-and frame rate); ``SITE/.aou-cache.json`` maps keys to videos, and a video whose key is
-there and whose file still has its hash is not drawn again. Videos are drawn ``jobs`` at a
-time, each in a process of its own, with progress on standard error.
+and frame rate); a text not seen before is compiled, and keyed again by its motion (the
+samples, joints and goal), so that texts differing only where the motion does not (a
+comment, a variant whose value is its base's) share one video. ``SITE/.aou-cache.json``
+maps both keys to videos, and a video whose key is there and whose file still has its
+hash is not drawn again. Videos are drawn ``jobs`` at a time, each in a process of its
+own, with progress on standard error.
 """
 
 from __future__ import annotations
@@ -142,6 +145,33 @@ def video_key(stim: Stim, robot: str, robot_sha: str, render: dict) -> str:
     return _sha(json.dumps(doc, sort_keys=True).encode())
 
 
+def motion_key(stim: Stim, robot: str, robot_sha: str, render: dict) -> str:
+    """The sha256 of the motion a stimulus's text compiles to (its samples, joints and
+    goal) with the robot and render settings: two texts that differ only where the motion
+    does not (a comment, a variant's value equal to its base's) share a video."""
+    import numpy as np
+
+    from ..build.builder import build_source
+    from ..core.options import BuildOptions
+    from ..version import __version__
+
+    res = build_source(stim.text, stim.path, BuildOptions(robot=robot, check=False))
+    if not res.ok:
+        first = next(d for d in res.diagnostics if d.severity == "error")
+        raise AouError(diag(E702, f"{stim.label} ({os.path.basename(stim.path)}"
+                            f"{f', {stim.descriptor}={stim.value:g}' if stim.descriptor else ''}"
+                            f") does not compile: {first.code} {first.message}",
+                            Span.whole_file(stim.path)))
+    tr = res.trajectory
+    h = hashlib.sha256(json.dumps({"aou": __version__, "robot": os.path.basename(robot),
+                                   "robot_sha256": robot_sha, "render": render,
+                                   "joints": list(tr.joint_names), "goal": tr.goal},
+                                  sort_keys=True).encode())
+    h.update(np.ascontiguousarray(tr.t, dtype="<f8").tobytes())
+    h.update(np.ascontiguousarray(tr.q, dtype="<f8").tobytes())
+    return h.hexdigest()
+
+
 def _render_one(text: str, label: str, robot: str, out: str, render: dict) -> list[str]:
     """Compile ``text`` and draw its video into ``out`` (in a process of its own); the
     error messages, none when it worked."""
@@ -168,14 +198,15 @@ def _file_sha(path: str) -> str | None:
         return None
 
 
-def _load_cache(site: str) -> dict[str, str]:
-    """The cache's key -> video hash entries (an unreadable cache is an empty one)."""
+def _load_cache(site: str, part: str = "videos") -> dict[str, str]:
+    """The cache's key -> video hash entries of ``part`` (``videos``: by text,
+    ``motions``: by motion); an unreadable cache is an empty one."""
     try:
         with open(os.path.join(site, CACHE), "rb") as fh:
             doc = json.loads(fh.read(10_000_000))
     except (OSError, ValueError):
         return {}
-    videos = doc.get("videos") if isinstance(doc, dict) else None
+    videos = doc.get(part) if isinstance(doc, dict) else None
     if not isinstance(videos, dict):
         return {}
     return {k: v for k, v in videos.items() if isinstance(k, str) and isinstance(v, str)
@@ -232,21 +263,36 @@ def build_study(study: Study, site: str, *, jobs: int = 1, jspsych: str | None =
     keys = [video_key(s, robot, robot_sha, render) for s in stims]
     stimuli = os.path.join(site, "stimuli")
     os.makedirs(stimuli, exist_ok=True)
-    cache = _load_cache(site)
-    videos: dict[str, str] = {}  # key -> video sha
-    for key in set(keys):  # a cached video is used only while its file has its hash
-        sha = cache.get(key)
-        if sha and _file_sha(os.path.join(stimuli, f"{sha}.mp4")) == sha:
-            videos[key] = sha
-    todo = {}
+    cache, by_motion = _load_cache(site), _load_cache(site, "motions")
+    videos: dict[str, str] = {}  # text key -> video sha
+    motions: dict[str, str] = {}  # motion key -> video sha
+
+    def ok(sha: str | None) -> bool:  # a cached video counts only while it has its hash
+        return bool(sha) and _file_sha(os.path.join(stimuli, f"{sha}.mp4")) == sha
+
+    for key in set(keys):
+        if ok(cache.get(key)):
+            videos[key] = cache[key]
+    # A text not seen before is compiled: a motion already drawn is not drawn again.
+    todo: dict[str, Stim] = {}  # motion key -> the stimulus to draw
+    waiting: dict[str, list[str]] = {}  # motion key -> text keys showing it
     for s, key in zip(stims, keys, strict=True):
-        if key not in videos and key not in todo:
-            todo[key] = s
-    log(f"study build: {len(stims)} videos, {len(stims) - sum(1 for k in keys if k in todo)} "
-        f"up to date, {len(todo)} to draw ({jobs} at a time)")
-    def keep(key: str, sha: str) -> None:  # the cache is written as each video is drawn
-        videos[key] = sha
-        _save_cache(site, videos, reads)
+        if key in videos or any(key in ks for ks in waiting.values()):
+            continue
+        mkey = motion_key(s, robot, robot_sha, render)
+        if ok(by_motion.get(mkey)):
+            videos[key] = motions[mkey] = by_motion[mkey]
+            continue
+        todo.setdefault(mkey, s)
+        waiting.setdefault(mkey, []).append(key)
+    log(f"study build: {len(stims)} videos, {len(stims) - sum(1 for k in keys if k not in videos)}"
+        f" up to date, {len(todo)} to draw ({jobs} at a time)")
+
+    def keep(mkey: str, sha: str) -> None:  # the cache is written as each video is drawn
+        motions[mkey] = sha
+        for key in waiting[mkey]:
+            videos[key] = sha
+        _save_cache(site, videos, motions, reads)
 
     drawn = _draw_all(todo, site, robot, render, jobs, log, keep)
     jspsych_files = []
@@ -274,16 +320,20 @@ def build_study(study: Study, site: str, *, jobs: int = 1, jspsych: str | None =
                    bool(jspsych))
     write_atomic(manifest_path(site), (json.dumps(man, indent=1) + "\n").encode(),
                  inputs=reads)
-    _save_cache(site, {k: videos[k] for k in set(keys)}, reads)
+    used_shas = {videos[k] for k in keys}
+    _save_cache(site, {k: videos[k] for k in set(keys)},
+                {m: v for m, v in {**by_motion, **motions}.items() if v in used_shas}, reads)
     if jatos:
         write_jzip(study, site, jspsych_files)
-    return {"videos": len(set(keys)), "drawn": len(drawn), "reused": len(set(keys)) - len(drawn)}
+    distinct = len({videos[k] for k in keys})
+    return {"videos": distinct, "drawn": len(drawn), "reused": distinct - len(drawn)}
 
 
-def _save_cache(site: str, videos: dict[str, str], reads: list[str]) -> None:
+def _save_cache(site: str, videos: dict[str, str], motions: dict[str, str],
+                reads: list[str]) -> None:
     write_atomic(os.path.join(site, CACHE), (json.dumps(
-        {"generator": GENERATOR, "videos": dict(sorted(videos.items()))}, indent=1)
-        + "\n").encode(), inputs=reads)
+        {"generator": GENERATOR, "videos": dict(sorted(videos.items())),
+         "motions": dict(sorted(motions.items()))}, indent=1) + "\n").encode(), inputs=reads)
 
 
 def _draw_all(todo: dict[str, Stim], site: str, robot: str, render: dict, jobs: int,
