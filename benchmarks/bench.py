@@ -50,6 +50,7 @@ from pathlib import Path
 import bench_dmp
 import bench_live
 import bench_studio
+import bench_study
 import bench_track
 import numpy as np
 import speed
@@ -244,7 +245,8 @@ SECTIONS = {"build": speed.bench_build, "cold": speed.bench_cold, "lint": speed.
             "replan": speed.bench_replan,
             "house": bench_house,
             "studio": bench_studio.bench_studio, "editor": bench_editor,
-            "dmp": bench_dmp.bench_dmp, "track": bench_track.bench_track}
+            "dmp": bench_dmp.bench_dmp, "track": bench_track.bench_track,
+            "study": bench_study.bench_study}
 SECTIONS["live"] = bench_live.bench_live
 
 

@@ -34,6 +34,7 @@ LAYERS = [
     ("live",),
     ("media", "editor"),
     ("studio",),
+    ("study",),
     ("api",),
     ("cli",),
     ("__main__", ""),

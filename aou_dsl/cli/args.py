@@ -7,11 +7,21 @@ number in its range is a usage error (exit 2) with a message that names the rang
 from __future__ import annotations
 
 import argparse
-import math
 import sys
-from collections.abc import Callable
 
 from ..version import __version__
+from .actions_args import dmp_parser, live_parser, study_parser
+from .argtypes import (
+    HEIGHT,
+    LENGTH,
+    RATE,
+    UNIT_RANGE,
+    force_option,
+    frame_size,
+    int_in,
+    number,
+    point,
+)
 
 __all__ = ["EXIT_ERRORS", "EXIT_INCONCLUSIVE", "EXIT_INTERRUPTED", "EXIT_OK", "EXIT_USAGE",
            "build_parser", "number", "usage_error"]
@@ -43,65 +53,6 @@ def usage_error(command: str, message: str) -> int:
     return EXIT_USAGE
 
 
-def number(lo: float, hi: float, *, lo_open: bool = False, what: str = "a number"
-           ) -> Callable[[str], float]:
-    """An argparse type: a finite float in [lo, hi] (or (lo, hi] with ``lo_open``)."""
-    def parse(text: str) -> float:
-        try:
-            x = float(text)
-        except ValueError:
-            x = math.nan
-        ok = math.isfinite(x) and (x > lo if lo_open else x >= lo) and x <= hi
-        if not ok:
-            bracket = "(" if lo_open else "["
-            raise argparse.ArgumentTypeError(
-                f"expected {what} in {bracket}{lo:g}, {hi:g}], found `{text}`")
-        return x
-    return parse
-
-
-def int_in(lo: int, hi: int) -> Callable[[str], int]:
-    """An argparse type: a whole number in [lo, hi]."""
-    def parse(text: str) -> int:
-        try:
-            x = int(text)
-        except ValueError:
-            x = lo - 1
-        if not lo <= x <= hi:
-            raise argparse.ArgumentTypeError(f"expected a whole number in [{lo}, {hi}], "
-                                             f"found `{text}`")
-        return x
-    return parse
-
-
-def point(text: str) -> tuple[float, float, float]:
-    """argparse type of X,Y,Z options (metres, finite, within 10 m)."""
-    parts = text.strip("()").split(",")
-    coord = number(-10.0, 10.0, what="a coordinate in metres")
-    if len(parts) != 3:
-        raise argparse.ArgumentTypeError(f"expected X,Y,Z in metres, found `{text}`")
-    x, y, z = (coord(p) for p in parts)
-    return (x, y, z)
-
-
-def frame_size(text: str) -> tuple[int, int]:
-    """argparse type of --size WxH (pixels, 16 to 4096 each)."""
-    try:
-        w, h = (int(x) for x in text.lower().split("x"))
-    except ValueError:
-        w = h = -1
-    if not (16 <= w <= 4096 and 16 <= h <= 4096):
-        raise argparse.ArgumentTypeError(f"expected WxH in pixels, each from 16 to 4096, "
-                                         f"e.g. 640x480, found `{text}`")
-    return (w, h)
-
-
-RATE = number(1.0, 10000.0, what="a sample rate in Hz")
-LENGTH = number(0.0, 2.0, what="a length in metres")
-HEIGHT = number(-2.0, 2.0, what="a height in metres")
-UNIT_RANGE = number(-1.0, 1.0, what="a coordinate of the C-V plane")
-
-
 ROBOT_HELP = ("robot: a built-in name (panda, ur5, xarm7, ...; `aouc robot --list`) or a "
               "path to a .urdf or a .toml robot description; overrides the file's `robot`")
 
@@ -115,12 +66,6 @@ def _package_dir(p: argparse.ArgumentParser) -> None:
     p.add_argument("--package-dir", action="append", default=[], metavar="DIR",
                    help="a folder holding ROS packages, searched first for the URDF's "
                    "package:// meshes (repeatable)")
-
-
-def _force(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--force", action="store_true",
-                   help="replace an existing output file aou did not write (without it, "
-                   "only aou's own outputs are replaced)")
 
 
 def _controller(p: argparse.ArgumentParser) -> None:
@@ -303,7 +248,7 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
                      help="descriptor and its two values, in the descriptor's unit")
     var.add_argument("-o", "--output", metavar="DIR", help="folder (default: here)")
     var.add_argument("--render", metavar="X.mp4|X.gif", help="also render the pair")
-    _force(var)
+    force_option(var)
     _render(var)
     _scene(var)
     c["measure"] = meas = sub.add_parser(
@@ -327,7 +272,7 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
                      help="toml: a robot description pinning every value")
     rob.add_argument("-o", "--output", metavar="FILE",
                      help="write to FILE instead of standard output (e.g. -o arm.toml)")
-    _force(rob)
+    force_option(rob)
     _package_dir(rob)
     c["synth"] = syn = sub.add_parser(
         "synth", help="write a .aou file for a state, or a point of the C-V plane, at an "
@@ -346,7 +291,7 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
                      help="skip the compile that fits the values to the arm")
     syn.add_argument("-o", "--output", metavar="FILE.aou",
                      help="output file (default: standard output)")
-    _force(syn)
+    force_option(syn)
     c["studio"] = stu = sub.add_parser(
         "studio", help="see a behaviour in 3D in the browser and shape it live (`studio` extra)")
     stu.add_argument("path", metavar="FILE", help="a .aou file, or a recording with --robot")
@@ -361,52 +306,13 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
                      "page; Save writes the sliders' values)")
     _robot(stu)
     _editor(sub, c)
-    c["dmp"] = _dmp(sub)
-    c["live"] = _live(sub)
+    c["dmp"] = dmp_parser(sub)
+    c["live"] = live_parser(sub)
+    c["study"] = study_parser(sub)
     c["rules"] = rules = sub.add_parser("rules", help="list the diagnostic codes, or explain some")
     rules.add_argument("codes", nargs="*", metavar="CODE")
     rules.add_argument("--format", choices=("text", "json"), default="text")
     return c
-
-
-def _dmp(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    """The ``aouc dmp`` parser (``roll``)."""
-    dmp = sub.add_parser("dmp", help="roll a behaviour's DMPs (--format dmp) out to a new "
-                         "goal and tempo (needs the `dmp` extra; docs/dmp.md)")
-    dmp.add_argument("action", choices=("roll",))
-    dmp.add_argument("path", metavar="FILE.dmp", help="a folder `aouc compile --format dmp` "
-                     "wrote")
-    dmp.add_argument("--goal", type=point, metavar="X,Y,Z",
-                     help="the new goal in metres (default: the one it was compiled for)")
-    dmp.add_argument("--time-scale", type=number(0.25, 4.0, what="a time scale"), default=1.0,
-                     metavar="K", help="durations times K, accelerations over K^2 (default 1)")
-    dmp.add_argument("--intensity", type=number(0.0, 1.0, what="an intensity"),
-                     metavar="I", help="in [0, 1] (default: the behaviour's own)")
-    dmp.add_argument("--pin", action="append", default=[], choices=("approach", "retreat"),
-                     help="keep the peak acceleration of these motions whatever the goal "
-                     "(repeatable)")
-    dmp.add_argument("-o", "--output", metavar="FILE",
-                     help="write the solved trajectory (.json, .csv, .npz)")
-    dmp.add_argument("--no-check", action="store_true", help="skip the safety replay")
-    return dmp
-
-
-def _live(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    live = sub.add_parser("live", help="run the perception loop on a scenario headless: "
-                          "perception, regulator, re-planned motion, checks (docs/live.md)")
-    live.add_argument("path", metavar="SCENARIO.toml", help="a scenario file")
-    live.add_argument("--robot", metavar="NAME", default="panda", help="the arm (panda)")
-    live.add_argument("--perception", choices=("geometric", "camera"), default="geometric",
-                      help="geometric: the fitted model (fast, deterministic); camera: a "
-                      "rendered camera and an AprilTag detector (the perception extra)")
-    live.add_argument("-o", "--output", metavar="RUN.json",
-                      help="write the recording: the executed trajectory (aouc measure "
-                      "reads it) and, per tick, confidence, uncertainty, state, intensity")
-    live.add_argument("--render", metavar="RUN.mp4",
-                      help="write a video: the camera's view, the confidence and the arm")
-    live.add_argument("-q", "--quiet", action="store_true", help="print no summary")
-    _force(live)
-    return live
 
 
 def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:

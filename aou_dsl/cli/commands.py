@@ -19,6 +19,7 @@ from ..core.diagnostics import AouError, Diagnostic, Severity, Span
 from ..core.rules import category
 from ..editor import cmd_server
 from .args import EXIT_ERRORS, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, build_parser, usage_error
+from .dmp_cmd import cmd_dmp
 from .endings import CtrlC, extra_missing, internal
 from .fmt import cmd_fmt
 from .lint_cmd import cmd_lint
@@ -26,6 +27,7 @@ from .lint_cmd import count as _count
 from .live_cmd import cmd_live
 from .report import format_json
 from .report import print_diagnostics as _print_diags
+from .study_cmd import cmd_study
 from .tools import cmd_robot, cmd_rules, cmd_synth
 
 __all__ = ["EXIT_ERRORS", "EXIT_OK", "EXIT_USAGE", "main"]
@@ -362,18 +364,13 @@ def _cmd_studio(args: argparse.Namespace) -> int:
     return cmd_studio(args)
 
 
-def _cmd_dmp(args: argparse.Namespace) -> int:
-    from .dmp_cmd import cmd_dmp
-
-    return cmd_dmp(args)
-
-
 _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
     "lint": cmd_lint, "rules": cmd_rules, "explain": _cmd_explain,
     "compile": _cmd_compile, "check": _cmd_check, "measure": _cmd_measure,
     "plot": _cmd_plot, "render": _cmd_render, "variants": _cmd_variants,
     "robot": cmd_robot, "synth": cmd_synth, "studio": _cmd_studio,
-    "fmt": cmd_fmt, "server": cmd_server, "dmp": _cmd_dmp, "live": cmd_live,
+    "fmt": cmd_fmt, "server": cmd_server, "dmp": cmd_dmp, "live": cmd_live,
+    "study": cmd_study,
 }
 
 

@@ -62,6 +62,8 @@ def extra_missing(command: str, exc: ImportError) -> str | None:
         return "track"
     if top in ("distributed", "dask"):  # compile --cluster
         return "cluster"
+    if command == "study" and top in ("scipy", "statsmodels"):
+        return "study"
     return "dmp" if top in ("movement_primitives", "pytransform3d") else None
 
 

@@ -9,7 +9,8 @@ and the environment variable that raises it:
 - a ``.aou`` file: 1 MB (V132);
 - a robot file (URDF, robot description): 16 MB (V132);
 - a mesh a URDF names: 64 MB (V132; PyBullet reads it, after :func:`check_size`);
-- a trajectory or recording: 256 MB, and 2,000,000 samples (R410).
+- a trajectory or recording: 256 MB, and 2,000,000 samples (R410);
+- a study file: 1 MB (E701); a study's results: 256 MB (E703).
 
 ``AOU_MAX_INPUT_MB`` raises (or lowers) the size bound of every kind;
 ``AOU_MAX_SAMPLES`` the samples of a recording.
@@ -20,7 +21,7 @@ from __future__ import annotations
 import os
 import stat
 
-from .codes import I501, I504, R410, V132
+from .codes import E701, E703, I501, I504, R410, V132
 from .diagnostics import AouError, Span, diag
 
 __all__ = ["ENV_BYTES", "ENV_SAMPLES", "LIMITS", "check_regular", "check_size", "input_limit",
@@ -34,6 +35,8 @@ LIMITS: dict[str, tuple[int, str, str]] = {
     "robot": (16 * _MB, V132, "a robot file"),
     "mesh": (64 * _MB, V132, "a mesh file"),
     "recording": (256 * _MB, R410, "a trajectory or recording"),
+    "study": (1 * _MB, E701, "a study file"),
+    "results": (256 * _MB, E703, "a study's results"),
 }
 #: Most samples of a recording read by default.
 MAX_SAMPLES = 2_000_000

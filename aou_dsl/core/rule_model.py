@@ -28,6 +28,7 @@ class Category(enum.Enum):
     READING = "R"
     USAGE = "I"
     DMP = "D"
+    STUDY = "E"
 
     @property
     def is_usage(self) -> bool:

@@ -19,6 +19,7 @@ from __future__ import annotations
 from .rule_model import Category, Rule, Severity
 from .rules_check import CHECK_RULES
 from .rules_dmp import DMP_RULES
+from .rules_study import STUDY_RULES
 
 __all__ = ["RULES", "Category", "Rule", "Severity", "category"]
 
@@ -343,6 +344,7 @@ _RULE_LIST = [
          "inconclusive.",
          "a retreat's peak acceleration measured 0.1205 +- 0.009 m/s^2 against a declared "
          "0.12 +- 0.0036"),
+    *STUDY_RULES,  # perception studies' files (rules_study.py)
     Rule("I501", "cannot-read", _E,
          "An input file or folder cannot be read (missing, a directory, permissions, encoding).",
          "Nothing can be checked or compiled.",
