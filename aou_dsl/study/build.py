@@ -30,7 +30,6 @@ own, with progress on standard error.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import random
@@ -39,179 +38,31 @@ import sys
 import time
 import uuid
 import zipfile
-from dataclasses import dataclass
 from importlib import resources
 
 from ..core.codes import E702, I502, I506
 from ..core.diagnostics import AouError, Span, diag
 from ..core.files import guard_output, is_own_output, write_atomic
 from .spec import Study
+from .stimuli import (
+    CACHE,
+    GENERATOR,
+    WORK,
+    Stim,
+    file_sha,
+    jatos_path,
+    load_cache,
+    manifest_path,
+    motion_key,
+    plan_stimuli,
+    render_one,
+    render_settings,
+    robot_file,
+    sha256_hex,
+    video_key,
+)
 
-__all__ = ["GENERATOR", "Stim", "build_study", "manifest_path", "plan_stimuli"]
-
-GENERATOR = "aouc study build"
-#: The study folder's cache of rendered videos (never served: ``serve`` refuses it).
-CACHE = ".aou-cache.json"
-#: Where a video is drawn before it is named by its hash.
-WORK = ".aou-work"
-RENDER_DEFAULTS = {"width": 640, "height": 480, "fps": 30}
-
-
-@dataclass(frozen=True)
-class Stim:
-    """One video: its blind id, role (``A``, or ``low``/``high`` of a pair), the
-    behaviour file it comes from, the text compiled, and what the manifest records."""
-
-    item: str
-    role: str
-    path: str
-    text: str
-    state: str | None
-    descriptor: str | None = None
-    value: float | None = None
-
-    @property
-    def label(self) -> str:
-        return self.item if self.role == "A" else f"{self.item} {self.role}"
-
-
-def manifest_path(site: str) -> str:
-    """The manifest of the site ``site``: beside it, never inside it."""
-    return os.path.normpath(site) + ".manifest.json"
-
-
-def jatos_path(site: str) -> str:
-    return os.path.normpath(site) + ".jzip"
-
-
-def _sha(data: bytes) -> str:
-    return hashlib.sha256(data).hexdigest()
-
-
-def plan_stimuli(study: Study) -> list[Stim]:
-    """Every video the study shows: Part A's behaviours, then each pair's two variants
-    (made as ``aouc variants`` makes them)."""
-    from ..lang.linter import lint_file
-    from ..media.variants import base_stem, make_variants
-
-    out = [Stim(s.id, "A", s.path, _read(s.path), s.state) for s in study.part_a]
-    for p in study.pairs:
-        r = lint_file(p.path)
-        if r.behaviour is None or r.source is None:
-            raise AouError(diag(E702, f"pair {p.id}: `{p.path}` does not lint",
-                                Span.whole_file(study.path)))
-        prefix = os.path.join(os.path.dirname(p.path), f"{base_stem(p.path)}-{p.descriptor}")
-        try:
-            variants = make_variants(r.behaviour, r.source, p.descriptor, p.low, p.high, prefix)
-        except AouError as exc:
-            first = exc.diagnostics[0]
-            raise AouError(diag(E702, f"pair {p.id} ({os.path.basename(p.path)}, "
-                                f"{p.descriptor}): {first.code} {first.message}",
-                                Span.whole_file(study.path))) from None
-        for v in variants:
-            out.append(Stim(p.id, v.label, p.path, v.text, p.state, p.descriptor, v.value))
-    return out
-
-
-def _read(path: str) -> str:
-    from ..core.inputs import read_input_text
-
-    return read_input_text(path, "behaviour")
-
-
-def robot_file(study: Study) -> tuple[str, str]:
-    """(the robot as the compiler takes it, the file that describes it)."""
-    from ..core.robot_specs import ROBOTS
-
-    if study.robot in ROBOTS:
-        import example_robot_data as erd
-
-        sub = ROBOTS[study.robot].urdf
-        return study.robot, os.path.join(erd.getModelPath(sub), sub)
-    path = os.path.join(os.path.dirname(os.path.abspath(study.path)), study.robot)
-    return path, path
-
-
-def render_settings(study: Study) -> dict:
-    return {k: study.render.get(k, v) for k, v in RENDER_DEFAULTS.items()}
-
-
-def video_key(stim: Stim, robot: str, robot_sha: str, render: dict) -> str:
-    """The sha256 of everything a stimulus's video depends on."""
-    from ..version import __version__
-
-    doc = {"aou": __version__, "text": stim.text, "robot": os.path.basename(robot),
-           "robot_sha256": robot_sha, "render": render}
-    return _sha(json.dumps(doc, sort_keys=True).encode())
-
-
-def motion_key(stim: Stim, robot: str, robot_sha: str, render: dict) -> str:
-    """The sha256 of the motion a stimulus's text compiles to (its samples, joints and
-    goal) with the robot and render settings: two texts that differ only where the motion
-    does not (a comment, a variant's value equal to its base's) share a video."""
-    import numpy as np
-
-    from ..build.builder import build_source
-    from ..core.options import BuildOptions
-    from ..version import __version__
-
-    res = build_source(stim.text, stim.path, BuildOptions(robot=robot, check=False))
-    if not res.ok:
-        first = next(d for d in res.diagnostics if d.severity == "error")
-        raise AouError(diag(E702, f"{stim.label} ({os.path.basename(stim.path)}"
-                            f"{f', {stim.descriptor}={stim.value:g}' if stim.descriptor else ''}"
-                            f") does not compile: {first.code} {first.message}",
-                            Span.whole_file(stim.path)))
-    tr = res.trajectory
-    h = hashlib.sha256(json.dumps({"aou": __version__, "robot": os.path.basename(robot),
-                                   "robot_sha256": robot_sha, "render": render,
-                                   "joints": list(tr.joint_names), "goal": tr.goal},
-                                  sort_keys=True).encode())
-    h.update(np.ascontiguousarray(tr.t, dtype="<f8").tobytes())
-    h.update(np.ascontiguousarray(tr.q, dtype="<f8").tobytes())
-    return h.hexdigest()
-
-
-def _render_one(text: str, label: str, robot: str, out: str, render: dict) -> list[str]:
-    """Compile ``text`` and draw its video into ``out`` (in a process of its own); the
-    error messages, none when it worked."""
-    from ..build.builder import build_source
-    from ..core.options import BuildOptions
-    from ..media.render import Camera, render_video
-
-    try:
-        res = build_source(text, label, BuildOptions(robot=robot, check=False))
-        if not res.ok:
-            return [f"{d.code} {d.message}" for d in res.diagnostics if d.severity == "error"]
-        render_video([res.trajectory], out, fps=float(render["fps"]), quiet=True, jobs=1,
-                     camera=Camera(width=int(render["width"]), height=int(render["height"])))
-    except AouError as exc:
-        return [f"{d.code} {d.message}" for d in exc.diagnostics]
-    return []
-
-
-def _file_sha(path: str) -> str | None:
-    try:
-        with open(path, "rb") as fh:
-            return _sha(fh.read())
-    except OSError:
-        return None
-
-
-def _load_cache(site: str, part: str = "videos") -> dict[str, str]:
-    """The cache's key -> video hash entries of ``part`` (``videos``: by text,
-    ``motions``: by motion); an unreadable cache is an empty one."""
-    try:
-        with open(os.path.join(site, CACHE), "rb") as fh:
-            doc = json.loads(fh.read(10_000_000))
-    except (OSError, ValueError):
-        return {}
-    videos = doc.get(part) if isinstance(doc, dict) else None
-    if not isinstance(videos, dict):
-        return {}
-    return {k: v for k, v in videos.items() if isinstance(k, str) and isinstance(v, str)
-            and len(v) == 64 and all(c in "0123456789abcdef" for c in v)}
-
+__all__ = ["GENERATOR", "Stim", "build_study", "manifest_path", "plan_stimuli", "write_jzip"]
 
 def _guard_site(site: str, reads: list[str]) -> None:
     """A site goes into a new or empty folder, or over one this command built."""
@@ -254,7 +105,7 @@ def build_study(study: Study, site: str, *, jobs: int = 1, jspsych: str | None =
                             "write it", Span.whole_file(jatos_path(site))))
     try:
         with open(robot_path, "rb") as fh:
-            robot_sha = _sha(fh.read())
+            robot_sha = sha256_hex(fh.read())
     except OSError as exc:
         raise AouError(diag(E702, f"the robot's file `{robot_path}` cannot be read "
                             f"({exc.strerror})", Span.whole_file(study.path))) from None
@@ -263,12 +114,12 @@ def build_study(study: Study, site: str, *, jobs: int = 1, jspsych: str | None =
     keys = [video_key(s, robot, robot_sha, render) for s in stims]
     stimuli = os.path.join(site, "stimuli")
     os.makedirs(stimuli, exist_ok=True)
-    cache, by_motion = _load_cache(site), _load_cache(site, "motions")
+    cache, by_motion = load_cache(site), load_cache(site, "motions")
     videos: dict[str, str] = {}  # text key -> video sha
     motions: dict[str, str] = {}  # motion key -> video sha
 
     def ok(sha: str | None) -> bool:  # a cached video counts only while it has its hash
-        return bool(sha) and _file_sha(os.path.join(stimuli, f"{sha}.mp4")) == sha
+        return bool(sha) and file_sha(os.path.join(stimuli, f"{sha}.mp4")) == sha
 
     for key in set(keys):
         if ok(cache.get(key)):
@@ -353,7 +204,7 @@ def _draw_all(todo: dict[str, Stim], site: str, robot: str, render: dict, jobs: 
                                 f"{f', {s.descriptor}={s.value:g}' if s.descriptor else ''}) "
                                 f"cannot be rendered: {errors[0]}", Span.whole_file(s.path)))
         tmp = os.path.join(work, f"{key}.mp4")
-        sha = _file_sha(tmp)
+        sha = file_sha(tmp)
         assert sha is not None
         os.replace(tmp, os.path.join(site, "stimuli", f"{sha}.mp4"))
         out[key] = sha
@@ -364,7 +215,7 @@ def _draw_all(todo: dict[str, Stim], site: str, robot: str, render: dict, jobs: 
     try:
         if jobs <= 1 or len(todo) == 1:
             for key, s in todo.items():
-                done(key, _render_one(s.text, s.path, robot,
+                done(key, render_one(s.text, s.path, robot,
                                       os.path.join(work, f"{key}.mp4"), render))
         else:
             import multiprocessing
@@ -372,7 +223,7 @@ def _draw_all(todo: dict[str, Stim], site: str, robot: str, render: dict, jobs: 
 
             with ProcessPoolExecutor(min(jobs, len(todo)),
                                      mp_context=multiprocessing.get_context("spawn")) as pool:
-                futs = {pool.submit(_render_one, s.text, s.path, robot,
+                futs = {pool.submit(render_one, s.text, s.path, robot,
                                     os.path.join(work, f"{key}.mp4"), render): key
                         for key, s in todo.items()}
                 try:
@@ -458,14 +309,14 @@ def manifest(study: Study, stims: list[Stim], keys: list[str], videos: dict[str,
 
     base = os.path.dirname(os.path.abspath(study.path))
     with open(study.path, "rb") as fh:
-        study_sha = _sha(fh.read())
+        study_sha = sha256_hex(fh.read())
     entries = []
     for s, k in zip(stims, keys, strict=True):
         entries.append({
             "item": s.item, "role": s.role,
             "behaviour": os.path.relpath(os.path.abspath(s.path), base),
-            "behaviour_sha256": _file_sha(s.path),
-            "aou_sha256": _sha(s.text.encode()),
+            "behaviour_sha256": file_sha(s.path),
+            "aou_sha256": sha256_hex(s.text.encode()),
             "state": s.state, "descriptor": s.descriptor, "value": s.value,
             "video": f"stimuli/{videos[k]}.mp4", "video_sha256": videos[k], "key": k})
     return {
