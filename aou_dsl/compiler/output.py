@@ -21,6 +21,7 @@ escapes), and a value that is not a number (NaN, an infinity) is ``null``.
 
 from __future__ import annotations
 
+import importlib
 import io
 import json
 import os
@@ -28,20 +29,26 @@ import re
 import zipfile
 from bisect import bisect_right
 from itertools import chain
-from typing import Any
+from types import ModuleType
 
 import numpy as np
-
-try:  # the optional extra `fastjson`
-    import orjson
-except ImportError:  # pragma: no cover - installed with the tests
-    orjson = None  # type: ignore[assignment]
 
 from ..core.codes import I502
 from ..core.diagnostics import AouError, Span, diag
 from ..core.files import write_atomic
 from ..version import __version__
 from .ros import is_bag
+
+
+def _optional(name: str) -> ModuleType | None:
+    """The optional extra ``name`` (``fastjson``: orjson), or None when not installed."""
+    try:
+        return importlib.import_module(name)  # safe: a fixed name, never a file's
+    except ImportError:  # pragma: no cover - installed with the tests
+        return None
+
+
+orjson = _optional("orjson")
 
 __all__ = ["FORMATS", "SAMPLE_KEYS", "array_document", "document_header", "encode",
            "json_bytes", "output_paths", "trajectory_document", "with_samples",
@@ -180,7 +187,7 @@ def _orjson_floats(text: str, *, strings: bool = True) -> str:
     return "".join(out)
 
 
-def _plain(value: Any) -> Any:
+def _plain(value: object) -> object:
     """NumPy arrays and scalars as lists and Python numbers (for the standard module);
     a float that is not a number as None (``null``, as orjson writes it)."""
     if isinstance(value, dict):
@@ -194,13 +201,13 @@ def _plain(value: Any) -> Any:
     return value
 
 
-def _as_list(value: Any) -> Any:
+def _as_list(value: object) -> object:
     if isinstance(value, np.ndarray | np.generic):
         return value.tolist()
     raise TypeError(f"{type(value).__name__} is not JSON serializable")
 
 
-def _std_json(doc: Any) -> str:
+def _std_json(doc: object) -> str:
     """``doc`` as compact JSON text by the standard module, floats as orjson writes them."""
     try:
         text = json.dumps(doc, separators=(",", ":"), ensure_ascii=False, allow_nan=False,
@@ -213,7 +220,7 @@ def _std_json(doc: Any) -> str:
 _PLAIN = frozenset((float, int, str, bool, type(None)))
 
 
-def _orjson_writes_as_lists(value: Any) -> bool:
+def _orjson_writes_as_lists(value: object) -> bool:
     """Whether orjson writes every NumPy value in ``value`` as the standard module
     writes its ``tolist()``: float64, integer and boolean ones do; a float32 it writes
     as the shortest float32 (``0.1``), where its list holds the float64 of it
@@ -235,13 +242,13 @@ def _orjson_writes_as_lists(value: Any) -> bool:
     return True
 
 
-def json_bytes(doc: Any, *, newline: bool = True) -> bytes:
+def json_bytes(doc: object, *, newline: bool = True) -> bytes:
     """``doc`` (dicts, lists, strings, numbers, None; NumPy arrays and scalars) as
     compact JSON in UTF-8, with a final newline unless ``newline`` is False: by orjson
     when it is installed (and writes floats as expected), else by the standard module,
     the same bytes either way. A lone surrogate in a string (a file name that is not
     UTF-8) is written as its ``\\u`` escape."""
-    if _FAST and _orjson_writes_as_lists(doc):
+    if _FAST and orjson is not None and _orjson_writes_as_lists(doc):
         option = orjson.OPT_SERIALIZE_NUMPY | (orjson.OPT_APPEND_NEWLINE if newline else 0)
         try:
             return orjson.dumps(doc, option=option)
@@ -261,7 +268,7 @@ def _csv_rows(t: np.ndarray, q: np.ndarray) -> bytes:
     table = np.ascontiguousarray(np.column_stack([t, q]), dtype=np.float64)
     if len(table) == 0:
         return b""
-    if _FAST and np.isfinite(table).all():
+    if _FAST and orjson is not None and np.isfinite(table).all():
         # [[a,b],[c,d]] -> a,b\nc,d: orjson writes every float; the rest is punctuation
         return orjson.dumps(table, option=orjson.OPT_SERIALIZE_NUMPY)[2:-2].replace(
             b"],[", b"\n") + b"\n"

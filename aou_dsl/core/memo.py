@@ -24,6 +24,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import os
+import stat
 import sys
 import threading
 import time
@@ -212,9 +213,13 @@ _DIGESTS = table("aou_dsl.core.memo.file_digest", FILES_KEPT)
 
 
 def _stamp(path: str) -> tuple[int, int, int, int] | None:
+    """A regular file's identity; None for anything else (reading a device, a FIFO or
+    a folder to hash it may never end: the load that reads it says what it is)."""
     try:
         st = os.stat(path)
     except (OSError, ValueError, TypeError):  # not there, a NUL in it, not a path
+        return None
+    if not stat.S_ISREG(st.st_mode):
         return None
     return st.st_size, st.st_mtime_ns, st.st_ino, st.st_dev
 

@@ -9,6 +9,8 @@ are aou's, each pair's base value at one end, so a researcher reads and edits th
 from __future__ import annotations
 
 import os
+import tomllib
+from importlib import resources
 
 from ..core.files import write_atomic
 
@@ -25,30 +27,15 @@ BASES = {
     "fearful": ("A rapid withdrawal punctuated by freezes and a tremor.",
                 "approach a=0.1\npause 1.25s x4\nretreat 0.06m a=2\nshiver 6deg for 1.25s\n"),
 }
-#: (base, descriptor, low, high): the paper's twenty variations, with aou's values.
-PAIRS = [
-    ("confident", "pause_duration", 0.8, 1.67), ("confident", "approach_acceleration", 0.1, 0.3),
-    ("curious", "pause_duration", 1.25, 2.5), ("curious", "tilt_angle", 10, 30),
-    ("curious", "horizontal_gaze", 10, 20), ("curious", "vertical_gaze", 10, 20),
-    ("curious", "approach_acceleration", 0.05, 0.09), ("curious", "tilt_velocity", 15, 45),
-    ("hesitant", "pause_duration", 0.8, 1.67), ("hesitant", "retreat_distance", 0.03, 0.06),
-    ("hesitant", "tilt_angle", 10, 30), ("hesitant", "retreat_count", 1, 3),
-    ("hesitant", "approach_acceleration", 0.05, 0.1),
-    ("hesitant", "retreat_acceleration", 0.12, 0.5),
-    ("fearful", "pause_duration", 1.25, 2.5), ("fearful", "shiver_amplitude", 3, 6),
-    ("fearful", "pause_count", 2, 4), ("fearful", "retreat_count", 1, 3),
-    ("fearful", "approach_acceleration", 0.05, 0.1), ("fearful", "retreat_acceleration", 1, 2),
-]
-
+#: The paper's design (``static/paper.toml``): its twenty variations (base, descriptor,
+#: low, high) with aou's values, and the bases that add the statement a pair varies.
+_PAPER = tomllib.loads(resources.files(__package__).joinpath("static", "paper.toml")
+                       .read_text(encoding="utf-8"))
+PAIRS = [(b, d, lo, hi) for b, d, lo, hi in _PAPER["pairs"]]
 #: (base, descriptor) -> (file, statement): the paper varied a tilt and a vertical gaze
 #: that its base stimuli did not have. A variant changes one value of a statement the
 #: file holds, so these pairs vary a base with that statement added, written beside it.
-PART_B_BASES = {
-    ("curious", "tilt_angle"): ("curious_tilt", "tilt 20deg v=30deg/s"),
-    ("curious", "tilt_velocity"): ("curious_tilt", "tilt 20deg v=30deg/s"),
-    ("curious", "vertical_gaze"): ("curious_vertical", "gaze vertical 15deg"),
-    ("hesitant", "tilt_angle"): ("hesitant_tilt", "tilt 20deg v=30deg/s"),
-}
+PART_B_BASES = {(b, d): (f, st) for b, d, f, st in _PAPER["added"]}
 
 
 def _pair_file(base: str, descriptor: str) -> str:
