@@ -84,10 +84,16 @@ class Server:
             [*AOUC, "study", "serve", site, "--port", str(port)],
             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
         line = self.proc.stdout.readline()  # type: ignore[union-attr]
-        m = re.search(r"http://127\.0\.0\.1:(\d+)/", line)
-        assert m, f"the server printed no address: {line!r}"
+        m = re.search(r"http://127\.0\.0\.1:(\d+)/\?token=([A-Za-z0-9_-]+)", line)
+        assert m, f"the server printed no address with its token: {line!r}"
         self.port = int(m.group(1))
-        self.url = m.group(0)
+        self.url = m.group(0)  # as printed: the address with the study's token
+        self.base = f"http://127.0.0.1:{self.port}/"
+        self.token = m.group(2)
+
+    def at(self, rel: str) -> str:
+        """``rel`` on this server, with the token in its query."""
+        return f"{self.base}{rel}{'&' if '?' in rel else '?'}token={self.token}"
 
     def kill(self) -> None:
         self.proc.send_signal(signal.SIGKILL)
@@ -143,7 +149,8 @@ def take(browser, url: str, pid: str, *, loops: bool = False, play: bool = True,
     if page is None:
         ctx = browser.new_context()
         page = ctx.new_page()
-        page.goto(f"{url}?PROLIFIC_PID={pid}&STUDY_ID=S1&SESSION_ID=X{pid}")
+        page.goto(f"{url}{'&' if '?' in url else '?'}PROLIFIC_PID={pid}&STUDY_ID=S1"
+                  f"&SESSION_ID=X{pid}")
     seen = []
     while True:
         page.wait_for_selector("#jspsych-html-button-response-stimulus, "
@@ -376,10 +383,10 @@ def test_nothing_served_says_which_stimulus_is_which(built, tmp_path):
         for url in ("../site.manifest.json", "%2e%2e/site.manifest.json", ".aou-cache.json",
                     "answers.sqlite", "answers.sqlite-wal", "study.toml"):
             with pytest.raises(urllib.error.HTTPError) as err:
-                urllib.request.urlopen(server.url + url, timeout=5)
+                urllib.request.urlopen(server.at(url), timeout=5)
             assert err.value.code in (400, 404), url
         for rel in served:
-            with urllib.request.urlopen(server.url + rel, timeout=5) as r:
+            with urllib.request.urlopen(server.at(rel), timeout=5) as r:
                 assert r.status == 200
     finally:
         server.kill()
@@ -449,7 +456,7 @@ def test_a_participant_who_declines_sends_nothing(browser, built):
     server = Server(site)
     try:
         page = browser.new_context().new_page()
-        page.goto(f"{server.url}?PROLIFIC_PID=NOPE")
+        page.goto(server.at("?PROLIFIC_PID=NOPE"))
         page.get_by_role("button", name="I do not agree", exact=True).click()
         page.wait_for_function("() => /did not agree/.test(document.body.innerText)")
         page.wait_for_timeout(500)  # a request the page would send has time to arrive
@@ -480,7 +487,7 @@ def test_the_page_sends_the_participant_back_to_the_platform(browser, built, tmp
                   lambda route: route.fulfill(body="<p id=back>completed</p>",
                                               content_type="text/html"))
         page = ctx.new_page()
-        page.goto(f"{server.url}?PROLIFIC_PID=R1&STUDY_ID=S1&SESSION_ID=X1")
+        page.goto(server.at("?PROLIFIC_PID=R1&STUDY_ID=S1&SESSION_ID=X1"))
         seen, page = take(browser, None, "R1", page=page, play=False, until="demographics")
         assert seen[-1] in ("B", "attention")
         page.fill("input[name=d0]", "40")

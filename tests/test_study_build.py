@@ -263,9 +263,12 @@ def server(copy):
     srv.server_close()
 
 
-def _request(srv, method, path, body=None, host=None, headers=None):
+def _request(srv, method, path, body=None, host=None, headers=None, token=True):
+    """A request as the study's page sends it: its own Host and, unless ``token`` is
+    False, the cookie that carries the study's token."""
     c = http.client.HTTPConnection("127.0.0.1", srv.port, timeout=10)
-    h = {"Host": host or f"127.0.0.1:{srv.port}", **(headers or {})}
+    cookie = {"Cookie": f"{srv.gate.cookie(srv.port)}={srv.gate.token}"} if token else {}
+    h = {"Host": host or f"127.0.0.1:{srv.port}", **cookie, **(headers or {})}
     c.request(method, path, body=body, headers=h)
     r = c.getresponse()
     data = r.read()
@@ -277,11 +280,43 @@ def test_the_server_answers_only_to_its_own_address(server):
     assert _request(server, "GET", "/")[0] == 200
     assert _request(server, "GET", "/", host=f"localhost:{server.port}")[0] == 200
     for host in ("evil.example", f"evil.example:{server.port}", "127.0.0.1:1"):
-        assert _request(server, "GET", "/", host=host)[0] == 421, host
-        assert _request(server, "POST", "/submit", b"{}", host=host)[0] == 421, host
+        assert _request(server, "GET", "/", host=host)[0] == 403, host
+        assert _request(server, "POST", "/submit", b"{}", host=host)[0] == 403, host
     for path in ("/answers.sqlite", "/.aou-cache.json", "/../site.manifest.json",
                  "/stimuli/../timeline.json", "/experiment.js/", "/stimuli/x.mp4"):
         assert _request(server, "GET", path)[0] == 404, path
+
+
+def test_the_server_answers_only_its_own_page_with_the_studys_token(server, copy):
+    """No token, a wrong one, or a page of another site posting answers: 403, nothing
+    stored. The address the command prints brings the token and sets the cookie the
+    page's own requests carry; a server started again on the folder keeps the token."""
+    body = json.dumps({"participant": "x1", "data": []}).encode()
+    assert _request(server, "GET", "/", token=False)[0] == 403
+    assert _request(server, "GET", "/", token=False,
+                    headers={"Cookie": f"{server.gate.cookie(server.port)}=guess"})[0] == 403
+    assert _request(server, "POST", "/submit", body, token=False)[0] == 403
+    assert _request(server, "POST", "/submit", body,
+                    headers={"Origin": "http://evil.example"})[0] == 403
+    c = http.client.HTTPConnection("127.0.0.1", server.port, timeout=10)
+    c.request("GET", "/" + server.url.split("/", 3)[3])  # /?token=..., as printed
+    r = c.getresponse()
+    r.read()
+    c.close()
+    assert r.status == 200 and f"={server.gate.token};" in r.getheader("Set-Cookie", "")
+    assert server.url.startswith(f"http://127.0.0.1:{server.port}/?token=")
+    token_file = os.path.join(copy, "site", ".aou-serve-token")
+    assert oct(os.stat(token_file).st_mode & 0o777) == "0o600"
+    again = StudyServer(os.path.join(copy, "site"), port=0)
+    try:
+        assert again.gate.token == server.gate.token
+    finally:
+        again.server_close()
+    db = sqlite3.connect(os.path.join(copy, "site", "answers.sqlite"))
+    try:
+        assert db.execute("select count(*) from submissions").fetchone()[0] == 0
+    finally:
+        db.close()
 
 
 def test_the_server_stores_each_participant_once(server, copy):

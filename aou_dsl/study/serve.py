@@ -3,9 +3,17 @@
 Standard library only (``http.server``, ``sqlite3``). What is served is a short list:
 ``index.html``, ``experiment.js``, ``timeline.json``, ``stimuli/<sha256>.mp4`` and the
 study's own copy of jsPsych under ``jspsych/``; anything else (the store, the cache, a
-dot file, a path that climbs out) is 404. Every request's ``Host`` header must name this
-server's own address (a page of another site, or a DNS name rebound to this machine, is
-refused with 421), and a request body is at most :data:`MAX_BODY` bytes.
+dot file, a path that climbs out) is 404. A request body is at most :data:`MAX_BODY`
+bytes.
+
+Only the study's own page is answered, as the studio answers only its own
+(:class:`~aou_dsl.studio.gate.Gate`): every request's ``Host`` must name this server (a
+DNS name rebound to this machine is refused), an ``Origin`` must be its own page (a page
+of another site cannot post answers), and every request carries the study's token, in
+the query of the address the command prints (``http://127.0.0.1:PORT/?token=...``) or
+in the cookie the first page sets. The token is the study folder's
+(:data:`TOKEN_FILE`, made on first serve, readable by its owner only): a server
+restarted mid-study takes it again, so a participant's page still reaches it.
 
 A submission (``POST /submit``: ``{"participant": ID, "data": [rows]}``) is stored in one
 transaction of the SQLite store ``answers.sqlite`` in the study folder, in write-ahead
@@ -23,17 +31,23 @@ import json
 import mimetypes
 import os
 import re
+import secrets
 import sqlite3
+import stat
 import sys
 import threading
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 
-from ..core.codes import I504
+from ..core.codes import I501, I504
 from ..core.diagnostics import AouError, Span, diag
+from ..studio.gate import Gate
 
-__all__ = ["MAX_BODY", "STORE", "StudyServer", "open_store", "serve"]
+__all__ = ["MAX_BODY", "STORE", "TOKEN_FILE", "StudyServer", "open_store", "serve",
+           "study_token"]
 
 STORE = "answers.sqlite"
+#: The study folder's token (never served: a dot file).
+TOKEN_FILE = ".aou-serve-token"
 #: The largest submission accepted (bytes): a participant's rows are some tens of kB.
 MAX_BODY = 4_000_000
 #: The most rows one submission may hold.
@@ -56,25 +70,54 @@ def open_store(folder: str) -> sqlite3.Connection:
     return db
 
 
+def study_token(folder: str) -> str:
+    """The token of the study in ``folder``: read from :data:`TOKEN_FILE`, or made and
+    written there (mode 0600) on the first serve.
+
+    Raises:
+        AouError: I501 when the file is there but is not a regular file holding a token.
+    """
+    path = os.path.join(folder, TOKEN_FILE)
+    where = Span.whole_file(path)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    except FileNotFoundError:
+        token = secrets.token_urlsafe(24)
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o600)
+        with os.fdopen(fd, "w") as fh:
+            fh.write(token + "\n")
+        return token
+    except OSError as exc:
+        raise AouError(diag(I501, f"cannot read the study's token `{path}`: "
+                            f"{exc.strerror}", where)) from None
+    with os.fdopen(fd, "rb") as fh:
+        regular = stat.S_ISREG(os.fstat(fh.fileno()).st_mode)
+        text = fh.read(200).decode("ascii", "replace").strip() if regular else ""
+    if not re.fullmatch(r"[A-Za-z0-9_-]{16,100}", text):
+        raise AouError(diag(I501, f"`{path}` does not hold a study's token (remove it: "
+                            "the next serve makes one, and participants need the new "
+                            "address)", where))
+    return text
+
+
 class StudyServer(ThreadingHTTPServer):
-    """The server of one study folder; ``url`` once bound."""
+    """The server of one study folder; ``url`` once bound (with the study's token)."""
 
     daemon_threads = True
     allow_reuse_address = True
 
     def __init__(self, folder: str, host: str = LOCAL, port: int = 8000):
         self.folder = os.path.realpath(folder)
+        self.gate = Gate(host, study_token(self.folder), name="aou-study")
         self.db = open_store(self.folder)
         self.lock = threading.Lock()
         super().__init__((host, port), _Handler)
         self.port = int(self.server_address[1])
-        names = {host, LOCAL, "localhost"} | ({"[::1]"} if host in ("::1", "::") else set())
-        self.hosts = {f"{n}:{self.port}" for n in names}
 
     @property
     def url(self) -> str:
-        host = str(self.server_address[0])
-        return f"http://{host}:{self.port}/"
+        """The address participants open: the server's, with the study's token."""
+        return self.gate.url(self.port)
 
     def store(self, participant: str, data: list) -> bool:
         """Store one submission in one transaction; False when the id already has one."""
@@ -111,15 +154,24 @@ class _Handler(BaseHTTPRequestHandler):
         self.send_header("X-Content-Type-Options", "nosniff")
         for k, v in ({"Cache-Control": "no-store"} | (headers or {})).items():
             self.send_header(k, v)
+        gate, port = self.server.gate, self.server.port
+        if gate.has_token(self.path, port, ()):  # the token came in the address
+            self.send_header("Set-Cookie", f"{gate.cookie(port)}={gate.token}; Path=/; "
+                             "HttpOnly; SameSite=Strict")
         self.end_headers()
         if self.command != "HEAD":
             self.wfile.write(body)
 
     def _host_ok(self) -> bool:
-        if self.headers.get("Host", "") in self.server.hosts:
+        """Whether the request may pass the study's gate (its address, its page, its
+        token); else it is answered 403, saying why."""
+        h = self.headers
+        refused = self.server.gate.verdict(self.path, self.server.port, h.get_all("Host", []),
+                                           h.get_all("Origin", []), h.get_all("Cookie", []))
+        if refused is None:
             return True
         self.close_connection = True
-        self._reply(421, b"this server answers only to its own address\n")
+        self._reply(refused.status, refused.reason.encode() + b"\n")
         return False
 
     def do_GET(self) -> None:  # noqa: N802 - http.server's name
