@@ -2,6 +2,13 @@
 
 Every file is the same bytes for the same answers: numbers are rounded as printed, keys
 keep the analysis's order, the figures are SVG without a date or random ids.
+
+The two figures (``figure-part-a.svg``: the answers chosen per Part A expression, grouped
+bars; ``figure-part-b.svg``: Part B's four answers per pair, stacked bars) are drawn by
+matplotlib (the ``media`` extra), imported only here and only when a report is written.
+Each bar is an SVG group whose id names its question and answer (``A1-confident``,
+``B3-high``), so a reader can find it. Without matplotlib the report says so and has no
+figures.
 """
 
 from __future__ import annotations
@@ -11,12 +18,19 @@ import html
 import io
 import json
 import os
+import re
 
 from ..core.files import write_atomic
 from .answers import Row
 from .spec import PART_B_OPTIONS
 
-__all__ = ["write_report"]
+__all__ = ["FIGURES", "figures", "write_report"]
+
+#: The figures' files, in the report folder, and what each shows.
+FIGURES = {"figure-part-a.svg": "Answers chosen per Part A expression",
+           "figure-part-b.svg": "Part B's answers per pair"}
+#: The colours of Part B's answers (low, high, both, neither) and of Part A's options.
+_B_COLOURS = ("#4c72b0", "#dd8452", "#8c8c8c", "#e5e5e5")
 
 
 def _p(p: float | None) -> str:
@@ -25,7 +39,7 @@ def _p(p: float | None) -> str:
     return "< .001" if p < 0.001 else f"{p:.3f}".lstrip("0")
 
 
-def _markdown(res: dict) -> str:
+def _markdown(res: dict, drawn: bool) -> str:
     parts = res["participants"]
     out = [f"# {res['study']}: results", "",
            f"{parts['answered']} participants answered; {parts['kept']} kept.", ""]
@@ -33,6 +47,10 @@ def _markdown(res: dict) -> str:
         out += ["| participant | excluded because | detail |", "|---|---|---|"]
         out += [f"| {e['participant']} | {e['reason']} | {e['detail']} |"
                 for e in parts["excluded"]] + [""]
+    if drawn:
+        out += [f"![{what}]({name})" for name, what in FIGURES.items()] + [""]
+    else:
+        out += ["(No figures: they need matplotlib, the `media` extra.)", ""]
     out += ["## Part A: which state each expression shows", "",
             f"Chi-squared goodness of fit against even answers; Pearson residuals "
             f"(O - E) / sqrt(E) beyond {res['threshold']} mark an answer chosen more than "
@@ -108,13 +126,17 @@ def _html(markdown: str, title: str) -> str:
         if line.startswith("#"):
             level = len(line) - len(line.lstrip("#"))
             body.append(f"<h{level}>{html.escape(line.lstrip('# '))}</h{level}>")
+        elif m := re.fullmatch(r"!\[([^]]*)\]\(([^)]*)\)", line):
+            alt, src = html.escape(m.group(1)), html.escape(m.group(2))
+            body.append(f'<figure><img src="{src}" alt="{alt}"><figcaption>{alt}'
+                        "</figcaption></figure>")
         elif line:
             body.append(f"<p>{html.escape(line)}</p>")
     if table:
         body.append("</table>")
     return ("<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>"
             f"{html.escape(title)}</title><style>table{{border-collapse:collapse}}"
-            "td{border:1px solid #ccc;padding:2px 6px}</style></head><body>\n"
+            "td{border:1px solid #ccc;padding:2px 6px}img{max-width:100%}</style></head><body>\n"
             + "\n".join(body) + "\n</body></html>\n")
 
 
@@ -131,15 +153,98 @@ def _tidy(rows: list[Row]) -> str:
     return buf.getvalue()
 
 
+def _bars(res: dict, part: str) -> tuple[list[str], list[str], list[list[int]]]:
+    """The questions answered in ``part`` ("part_a" or "part_b"), the options and the
+    counts (one row a question), as the analysis gives them."""
+    entries = [e for e in res[part] if "n" in e]
+    options = list(entries[0]["options"]) if entries else []
+    return ([e["id"] for e in entries], options,
+            [[e["options"][o]["count"] for o in options] for e in entries])
+
+
+def _svg(fig) -> bytes:
+    """``fig`` as SVG, the same bytes every time: ids from a fixed salt, no date, no
+    software version."""
+    import matplotlib
+
+    buf = io.BytesIO()
+    with matplotlib.rc_context({"svg.hashsalt": "aou-study", "svg.id": "aou-figure",
+                                "svg.fonttype": "path"}):
+        fig.savefig(buf, format="svg", metadata={"Date": None, "Creator": None})
+    return buf.getvalue()
+
+
+def figures(res: dict) -> dict[str, bytes]:
+    """The report's figures (:data:`FIGURES`) as SVG bytes.
+
+    Raises:
+        ImportError: matplotlib is not installed.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
+
+    out = {}
+    items, options, counts = _bars(res, "part_a")
+    fig, ax = plt.subplots(figsize=(8, 4))
+    width = 0.8 / max(len(options), 1)
+    cmap = plt.get_cmap("tab10")
+    for j, o in enumerate(options):
+        bars = ax.bar([i + (j - (len(options) - 1) / 2) * width for i in range(len(items))],
+                      [row[j] for row in counts], width, label=o, color=cmap(j % 10))
+        for item, rect in zip(items, bars, strict=True):
+            rect.set_gid(f"{item}-{o}")
+    ax.set_xticks(range(len(items)), items)
+    ax.yaxis.set_major_locator(MaxNLocator(integer=True))
+    ax.set_ylabel("participants")
+    ax.set_title("Part A: the answer chosen for each expression")
+    if options:
+        ax.legend(fontsize="small", ncols=min(len(options), 6), loc="upper center",
+                  bbox_to_anchor=(0.5, -0.1), frameon=False)
+    fig.tight_layout()
+    out["figure-part-a.svg"] = _svg(fig)
+    plt.close(fig)
+    items, options, counts = _bars(res, "part_b")
+    fig, ax = plt.subplots(figsize=(8, 1.5 + 0.3 * len(items)))
+    left = [0] * len(items)
+    for j, o in enumerate(options):
+        col = [row[j] for row in counts]
+        bars = ax.barh(range(len(items)), col, 0.7, left=left, label=o,
+                       color=_B_COLOURS[j % 4], edgecolor="#555555", linewidth=0.5)
+        for item, rect in zip(items, bars, strict=True):
+            rect.set_gid(f"{item}-{o}")
+        left = [a + b for a, b in zip(left, col, strict=True)]
+    ax.set_yticks(range(len(items)), items)
+    ax.invert_yaxis()
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+    ax.set_xlabel("participants")
+    ax.set_title("Part B: which of the pair shows the state more")
+    if options:
+        ax.legend(fontsize="small", ncols=len(options), loc="upper center",
+                  bbox_to_anchor=(0.5, -0.12 * 8 / (1.5 + 0.3 * len(items))),
+                  frameon=False)
+    fig.tight_layout()
+    out["figure-part-b.svg"] = _svg(fig)
+    plt.close(fig)
+    return out
+
+
 def write_report(folder: str, res: dict, rows: list[Row], reads: list[str]) -> list[str]:
-    """The report's files in ``folder`` (made when missing), never over an input."""
-    md = _markdown(res)
-    files = {"results.json": json.dumps(res, indent=2, ensure_ascii=False) + "\n",
-             "report.md": md, "report.html": _html(md, res["study"]),
-             "answers.csv": _tidy(rows)}
+    """The report's files in ``folder`` (made when missing), never over an input: the
+    figures too when matplotlib is installed."""
+    try:
+        drawn: dict[str, bytes] = figures(res)
+    except ImportError:
+        drawn = {}
+    md = _markdown(res, bool(drawn))
+    files = {"results.json": (json.dumps(res, indent=2, ensure_ascii=False) + "\n").encode(),
+             "report.md": md.encode(), "report.html": _html(md, res["study"]).encode(),
+             "answers.csv": _tidy(rows).encode(), **drawn}
     out = []
-    for name, text in files.items():
+    for name, data in files.items():
         path = os.path.join(folder, name)
-        write_atomic(path, text.encode(), inputs=reads)
+        write_atomic(path, data, inputs=reads)
         out.append(path)
     return out
