@@ -103,6 +103,37 @@ def _holm(ps: list[float]) -> list[float]:
     return out
 
 
+def test_the_report_prints_the_papers_figures_for_its_counts(study, tmp_path):
+    """55 participants answer the confident pause-duration pair 46 low, 4 high, 4 both
+    and 1 neither, as the study's participants did: the report prints chi2 = 101.29 and
+    the low variant's residual +8.70, the published two-decimal figures, and the verdict
+    "the low variant" (shorter pauses look more confident)."""
+    from aou_dsl.study.spec import read_study
+
+    s = read_study(str(study))
+    (pair,) = [p for p in s.pairs if p.state == "confident" and
+               p.descriptor == "pause_duration"]
+    answers = ["low"] * 46 + ["high"] * 4 + ["both"] * 4 + ["neither"]
+    rows = []
+    for k, answer in enumerate(answers):
+        pid = f"p{k:02d}"
+        rows += [{"participant": pid, "aou_part": "A", "aou_item": a.id, "state": a.state,
+                  "intensity": 3} for a in s.part_a]
+        rows += [{"participant": pid, "aou_part": "B", "aou_item": p.id,
+                  "answer": answer if p.id == pair.id else "both"} for p in s.pairs]
+        rows.append({"participant": pid, "aou_part": "end", "aou_item": ""})
+    results = tmp_path / "r.json"
+    results.write_text(json.dumps(rows))
+    res = _analyze(study, [results], tmp_path / "rep")
+    (entry,) = [e for e in res["part_b"] if e["id"] == pair.id]
+    assert [entry["options"][o]["count"] for o in ("low", "high", "both", "neither")] == \
+        [46, 4, 4, 1]
+    line = next(ln for ln in (tmp_path / "rep" / "report.md").read_text().splitlines()
+                if ln.startswith(f"| {pair.id} |"))
+    assert "| 46 (+8.70) |" in line and "| 101.29 |" in line, line
+    assert line.rstrip().endswith("| the low variant |"), line
+
+
 def test_exclusions_each_with_its_reason(study, tmp_path):
     """An incomplete participant, one who failed the attention check and one whose id
     answered twice are left out, each named with the reason; the rest are analysed."""
