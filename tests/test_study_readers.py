@@ -267,3 +267,36 @@ def test_a_bad_mapping_or_export_is_e703(study, simulated, tmp_path, edit, says)
                str(mapping), "-o", str(tmp_path / "o"))
     assert run.returncode == 1 and "E703" in run.stderr and says in run.stderr, run.stderr
     assert "Traceback" not in run.stderr and not (tmp_path / "o").exists()
+
+
+def test_an_attention_column_and_an_unnamed_column(study, simulated, tmp_path):
+    """A mapped attention check passes when the label is the check's answer; a column
+    without an id in the export is never taken for an unmapped field."""
+    from aou_dsl.study.analyze import analyze
+    from aou_dsl.study.answers import read_answers
+    from aou_dsl.study.spec import read_study
+
+    checked = study.parent / "checked.toml"
+    checked.write_text(study.read_text() + '\n[attention]\nchecks = [{question = "Pick '
+                       'blue", options = ["red", "blue"], answer = "blue"}]\n')
+    s = read_study(str(checked))
+    lines = _export(json.loads(simulated.read_text()), study, {})
+    lines[0].append("ATT")
+    lines[1].append("Pick blue")
+    lines[2].append('{"ImportId":"QID99"}')
+    for line in lines[3:]:
+        line.append("red" if line[4] == "sim00002" else "blue")
+    lines[0][0] = ""  # StartDate's id gone: an unnamed column
+    for line in lines[3:]:
+        line[0] = "7"
+    export, mapping = tmp_path / "export.csv", tmp_path / "map.toml"
+    _write_csv(export, lines)
+    m = _mapping(study).replace('intensity = "Q1_int"\n', "")
+    mapping.write_text(m + '[attention.C1]\nanswer = "ATT"\n')
+    rows = read_answers([str(export)], s, str(mapping))
+    assert {r.participant: r.passed for r in rows if r.part == "attention"} == \
+        {f"sim{i:05d}": i != 2 for i in range(1, 13)}
+    assert all(r.intensity is None for r in rows if r.part == "A" and r.item == "A1")
+    res = analyze(rows, s)
+    assert [(e["participant"], e["reason"]) for e in res["participants"]["excluded"]] == \
+        [("sim00002", "attention")]

@@ -219,7 +219,7 @@ def _respondent(rec: dict, m: dict, study: Study, where: str) -> list[dict]:
         row = {"participant": pid, "aou_part": "A", "aou_item": qid,
                "state": _label(m["states"], state, study.options, where, c["state"],
                                "states")}
-        if rec.get(c.get("intensity", ""), "").strip():
+        if "intensity" in c and rec.get(c["intensity"], "").strip():
             k = _label(m["intensity"], rec[c["intensity"]],
                        [str(i) for i in range(1, study.intensity + 1)], where,
                        c["intensity"], "intensity")
@@ -233,7 +233,7 @@ def _respondent(rec: dict, m: dict, study: Study, where: str) -> list[dict]:
         if not raw:
             continue
         answer = _label(m["answers"], raw, ANSWERS, where, c["answer"], "answers")
-        left = rec.get(c.get("left", ""), "").strip()
+        left = rec.get(c["left"], "").strip() if "left" in c else ""
         left = _label(m["sides"], left, SIDES, where, c["left"], "sides") if left else None
         if answer in ("left", "right"):
             if left is None:
