@@ -45,8 +45,12 @@ def study_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     sim.add_argument("-o", "--output", required=True, metavar="RESULTS.json")
     ana = acts.add_parser("analyze", help="the study's statistics, as a report")
     ana.add_argument("results", nargs="+", metavar="RESULTS",
-                     help="answers: JSON or CSV of jsPsych rows, or the SQLite store")
+                     help="answers: JSON or CSV of jsPsych rows, the SQLite store, or a "
+                     "JATOS results archive (.jrzip, .zip)")
     ana.add_argument("--study", required=True, metavar="STUDY.toml")
+    ana.add_argument("--map", metavar="MAPPING.toml",
+                     help="read each CSV as a Qualtrics-style export through this column "
+                     "mapping (docs/study.md)")
     ana.add_argument("-o", "--output", required=True, metavar="REPORT_DIR")
     return study
 

@@ -54,9 +54,9 @@ def _analyze(args: argparse.Namespace, study) -> int:
     from ..study.answers import read_answers
     from ..study.report_files import write_report
 
-    rows = read_answers(args.results, study)
+    rows = read_answers(args.results, study, args.map)
     res = analyze(rows, study)
-    reads = [args.study, *args.results]
+    reads = [args.study, *args.results, *([args.map] if args.map else [])]
     for path in write_report(args.output, res, rows, reads):
         print(f"wrote {path}", file=sys.stderr)
     p = res["participants"]

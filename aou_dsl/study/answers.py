@@ -16,9 +16,10 @@ Each answer is a row, as jsPsych records a trial, with aou's fields:
 | `order` | the position at which the question was shown |
 
 Read from a JSON array of rows (jsPsych's `data.get().json()`), a CSV with these
-columns (jsPsych's `.csv()`), or the SQLite store `aouc study serve` keeps (one row per
-submission, its rows as JSON). Every file is untrusted: bounded, parsed as data, every
-value checked against the study (E703 naming the file and the row).
+columns (jsPsych's `.csv()`), the SQLite store `aouc study serve` keeps (one row per
+submission, its rows as JSON), a JATOS results archive or, through a mapping file, a
+Qualtrics-style CSV export (:mod:`.imports`). Every file is untrusted: bounded, parsed
+as data, every value checked against the study (E703 naming the file and the row).
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ from dataclasses import dataclass
 from ..core.codes import E703
 from ..core.diagnostics import AouError, Span, diag
 from ..core.inputs import check_regular, read_input
+from .imports import is_zip, jatos_data, qualtrics_rows, read_mapping
 from .spec import PART_B_OPTIONS, Study
 
 __all__ = ["Row", "read_answers"]
@@ -63,7 +65,8 @@ class Row:
 
 
 def _bad(source: str, message: str) -> AouError:
-    return AouError(diag(E703, f"{source}: {message}", Span.whole_file(source.split("#")[0])))
+    file = source.split("#")[0].split("!/")[0]  # a row of a file, or of an archive's member
+    return AouError(diag(E703, f"{source}: {message}", Span.whole_file(file)))
 
 
 def _text(v, source: str, name: str, most: int = 5000) -> str:
@@ -164,27 +167,41 @@ def _sqlite(path: str, study: Study) -> list[Row]:
     return rows
 
 
-def read_answers(paths: Iterable[str], study: Study) -> list[Row]:
-    """Every answer of ``paths`` (JSON, CSV or the SQLite store), in file order."""
+def read_answers(paths: Iterable[str], study: Study, mapping: str | None = None) -> list[Row]:
+    """Every answer of ``paths`` (JSON, CSV, the SQLite store or a JATOS archive), in
+    file order; with ``mapping``, a CSV is a Qualtrics-style export read through it."""
     rows: list[Row] = []
+    m = read_mapping(mapping, study) if mapping else None
     for path in paths:
         raw = read_input(path, "results")
         if raw.startswith(b"SQLite format 3\0"):
             rows.extend(_sqlite(path, study))
             continue
+        if is_zip(raw):
+            for source, data in jatos_data(raw, path):
+                rows.extend(_rows_of(data, study, source))
+            continue
         try:
             text = raw.decode("utf-8-sig")
         except UnicodeDecodeError:
-            raise _bad(path, "not UTF-8 text, and not a SQLite store") from None
+            raise _bad(path, "not UTF-8 text, a SQLite store or a zip archive") from None
         if text.lstrip().startswith("["):
             try:
                 data = json.loads(text)
             except ValueError as exc:
                 raise _bad(path, f"not JSON: {exc}") from None
             rows.extend(_rows_of(data, study, path))
+        elif m is not None:
+            for source, got in qualtrics_rows(text, path, m, study, MAX_ROWS):
+                rows.extend(_rows_of(got, study, source))
         else:
-            reader = csv.DictReader(io.StringIO(text))
-            if not reader.fieldnames or "aou_part" not in reader.fieldnames:
-                raise _bad(path, "not JSON, and not a CSV with an `aou_part` column")
-            rows.extend(_rows_of(list(reader), study, path))
+            try:
+                reader = csv.DictReader(io.StringIO(text))
+                if not reader.fieldnames or "aou_part" not in reader.fieldnames:
+                    raise _bad(path, "not JSON, and not a CSV with an `aou_part` column "
+                               "(a Qualtrics-style export needs --map)")
+                got = list(reader)
+            except csv.Error as exc:
+                raise _bad(path, f"not CSV: {exc}") from None
+            rows.extend(_rows_of(got, study, path))
     return rows
