@@ -64,6 +64,8 @@ def extra_missing(command: str, exc: ImportError) -> str | None:
         return "cluster"
     if command == "study" and top in ("scipy", "statsmodels"):
         return "study"
+    if command == "study" and top in ("matplotlib", "imageio", "imageio_ffmpeg", "PIL"):
+        return "media"  # its videos and the report's figures
     return "dmp" if top in ("movement_primitives", "pytransform3d") else None
 
 
