@@ -22,6 +22,16 @@ def pytest_configure(config: pytest.Config) -> None:
         signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
+def find_chromium() -> str | None:
+    """The Chromium the browser tests drive: the one ``AOU_CHROMIUM`` names, else
+    Debian's (None: none is installed)."""
+    import os
+    import shutil
+
+    return next((p for p in (os.environ.get("AOU_CHROMIUM"), shutil.which("chromium"),
+                             "/usr/bin/chromium") if p and os.path.exists(p)), None)
+
+
 @pytest.fixture
 def behaviours_dir() -> Path:
     return BEHAVIOURS

@@ -29,11 +29,11 @@ from aou_dsl.api import compile as aou_compile
 from aou_dsl.api import lint, measure
 from aou_dsl.lang.descriptors import REGISTRY
 
+from .conftest import find_chromium
 from .test_studio_forms import PEEK  # a sequence file: sliders scale its statements
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-CHROMIUM = next((p for p in (os.environ.get("AOU_CHROMIUM"), shutil.which("chromium"),
-                             "/usr/bin/chromium") if p and os.path.exists(p)), None)
+CHROMIUM = find_chromium()
 if CHROMIUM is None:
     pytest.skip("no Chromium found for the studio's browser tests: install Debian's "
                 "(apt-get install -y chromium), or set AOU_CHROMIUM to a Chromium binary",

@@ -31,11 +31,11 @@ from aou_dsl.study.build import build_study
 from aou_dsl.study.jspsych import PACKAGES
 from aou_dsl.study.spec import read_study
 
+from .conftest import find_chromium
 from .test_study_build import BEHAVIOURS, write_study
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-CHROMIUM = next((p for p in (os.environ.get("AOU_CHROMIUM"), shutil.which("chromium"),
-                             "/usr/bin/chromium") if p and os.path.exists(p)), None)
+CHROMIUM = find_chromium()
 if CHROMIUM is None:
     pytest.skip("no Chromium found for the study's browser tests: install Debian's "
                 "(apt-get install -y chromium), or set AOU_CHROMIUM to a Chromium binary",
