@@ -336,9 +336,9 @@ def _write_unnamed(folder: str, target: str, data: bytes) -> bool:
         with os.fdopen(fd, "wb", closefd=False) as fh:
             fh.write(data)
         tmp = os.path.join(folder, f"{temp_prefix()}{os.urandom(6).hex()}.link")
-        if not _link(fd, tmp):
-            return False
-        try:
+        try:  # from before the link: a Ctrl-C just after it must not leave the name
+            if not _link(fd, tmp):
+                return False
             os.replace(tmp, target)
         finally:
             if os.path.lexists(tmp):
