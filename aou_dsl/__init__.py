@@ -53,7 +53,8 @@ def __getattr__(name: str) -> Any:
     if name in _LAZY:
         import importlib
 
-        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        module = importlib.import_module(f".{_LAZY[name]}", __name__)  # safe: table _LAZY
+        value = getattr(module, name)
         globals()[name] = value
         return value
     raise AttributeError(f"module 'aou_dsl' has no attribute {name!r}")

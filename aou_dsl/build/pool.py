@@ -83,7 +83,7 @@ def preload(robots: Iterable[str], options: BuildOptions | None = None) -> None:
     from ..safety.replay import check_scene
 
     for name in _STAGES:
-        importlib.import_module(name)
+        importlib.import_module(name)  # safe: a name of the fixed list _STAGES
     import_toppra()
     import_pybullet()
     opts = options or BuildOptions()

@@ -26,7 +26,8 @@ class _LazyModule(types.ModuleType):
     """Stands in for a module until one of its attributes is used, then imports it."""
 
     def __getattr__(self, attr: str):
-        return getattr(importlib.import_module(self.__name__), attr)
+        module = importlib.import_module(self.__name__)  # safe: its own name, toppra
+        return getattr(module, attr)
 
 
 @cached(maxsize=1)
