@@ -244,14 +244,17 @@ def _cube_box(scene: Scene, margin: float) -> tuple[int, int, int, int] | None:
 
 
 def png_grey(img: np.ndarray) -> bytes:
-    """A greyscale PNG of ``img`` (uint8): the renderer loads textures from files."""
+    """The grey image ``img`` (uint8) as an RGB PNG: the renderer loads textures from
+    files and draws them with three channels (with a one-channel file, ``aouc live
+    --render`` died at exit with a corrupted heap about one run in two)."""
     def chunk(kind: bytes, data: bytes) -> bytes:
         body = kind + data
         return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body))
 
     h, w = img.shape
-    raw = b"".join(b"\x00" + img[r].tobytes() for r in range(h))
-    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 0, 0, 0, 0))
+    rgb = np.repeat(np.ascontiguousarray(img, np.uint8)[:, :, None], 3, axis=2)
+    raw = b"".join(b"\x00" + rgb[r].tobytes() for r in range(h))
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
             + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
 
 
