@@ -359,3 +359,22 @@ def test_aouc_live_runs_the_shipped_scenarios(tmp_path, name, states):
     logged = json.loads(out.read_text())["live"]["ticks"]["state"]
     seen = [s for k, s in enumerate(logged) if k == 0 or logged[k - 1] != s]
     assert seen == states
+
+
+def test_detectors_are_freed_without_crashing_the_process():
+    """pupil-apriltags frees a detector's tag families before the detector, whose
+    teardown still reads them: made and dropped often enough, that crashes the
+    process. aou's detector frees them in the safe order."""
+    pytest.importorskip("pupil_apriltags")
+    code = (
+        "import gc, numpy as np\n"
+        "from aou_dsl.live.camera import detector\n"
+        "img = (np.random.default_rng(0).random((240, 320)) * 255).astype(np.uint8)\n"
+        "for _ in range(300):\n"
+        "    d = detector(); d.detect(img)\n"
+        "    junk = [bytearray(1000) for _ in range(100)]\n"
+        "    del d; gc.collect()\n"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=300, cwd=ROOT)
+    assert run.returncode == 0, run.stderr[-2000:]

@@ -102,6 +102,33 @@ def tag_quality(frame: Frame) -> float:
     return min(1.0, frame.margin / MARGIN_REF) * min(1.0, frame.size_px / SIZE_REF)
 
 
+def _free(det: Any) -> None:
+    """Free a detector before its tag families: the detector's own teardown reads
+    each family's decode table, so freeing a family first (as pupil-apriltags'
+    ``__del__`` does) is a use after free that crashes the process some of the time."""
+    ptr, det.tag_detector_ptr = det.tag_detector_ptr, None
+    if ptr is None:
+        return
+    det.libc.apriltag_detector_destroy.restype = None
+    det.libc.apriltag_detector_destroy(ptr)
+    for family, handle in det.tag_families.items():
+        destroy = getattr(det.libc, f"{family}_destroy")
+        destroy.restype = None
+        destroy(handle)
+    det.tag_families = {}
+
+
+def detector() -> Any:
+    """A 36h11 tag detector that frees its memory in the safe order."""
+    from pupil_apriltags import Detector
+
+    class _Detector(Detector):
+        def __del__(self) -> None:
+            _free(self)
+
+    return _Detector(families="tag36h11", nthreads=1, quad_decimate=1.0)
+
+
 class Camera:
     """A rendered camera on a :class:`Scene` (a callable giving the scene at ``t``, or
     one scene); ``seed`` makes its sensor noise repeatable. :meth:`perceive` is a
@@ -109,11 +136,10 @@ class Camera:
 
     def __init__(self, scene: Any, *, seed: int = 0, window: float = WINDOW_S):
         import pybullet as p
-        from pupil_apriltags import Detector
 
         self._scene = scene if callable(scene) else (lambda t: scene)
         self.rng = np.random.default_rng(seed)
-        self.detector = Detector(families="tag36h11", nthreads=1, quad_decimate=1.0)
+        self.detector = detector()
         self.p = p
         self.client = p.connect(p.DIRECT)
         self.window_s = window
