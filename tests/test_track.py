@@ -262,4 +262,4 @@ def test_a_behaviour_the_arm_refuses_is_not_tracked_and_the_user_is_told_to_fit(
     assert main(["check", str(BEHAVIOURS / "fearful.aou"), "--robot", "kinova",
                  "--track"]) == 1
     err = capsys.readouterr().err
-    assert " C308 " in err and "add --fit" in err
+    assert " C308 " in err and "--fit --track" in err

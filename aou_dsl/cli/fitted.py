@@ -120,8 +120,11 @@ def check_fitted(args: argparse.Namespace, read_kw: dict) -> int:
         if args.format != "json":
             print(format_check(args.path, tr.robot, tr.t, report))
         try:
-            more, tracking = run_tracking(args, tr, lint, reads=[args.path],
-                                          out=None if args.format == "json" else sys.stdout)
+            more, tracking = run_tracking(
+                args, tr, lint, reads=[args.path],
+                out=None if args.format == "json" else sys.stdout,
+                written=lint_source(original, args.path) if original is not None else None,
+                fitted=tuple((res.header or {}).get("fitted") or ()))
         except AouError as err:
             more = list(err.diagnostics)
         for d in more:

@@ -24,14 +24,43 @@ __all__ = ["check_tracking", "compile_tracked", "format_tracking", "nothing_to_t
 @contextlib.contextmanager
 def nothing_to_track(args: argparse.Namespace) -> Iterator[None]:
     """Around the compile of ``aouc check FILE.aou --track``: when the arm refuses the
-    file there is no motion to track; say so, and how to get one, before its errors."""
+    file there is no motion to track. Say so before its errors, and what gives one: the
+    command with ``--fit`` when every error is one the fit changes (a value the arm
+    cannot give), else that the errors must be mended first (``--fit`` would refuse
+    too). Errors that are not the arm's refusal (the file's own, a missing file) speak
+    for themselves."""
     try:
         yield
-    except AouError:
+    except AouError as err:
         if getattr(args, "track", False) and args.path.endswith(".aou"):
-            print("aouc check --track: nothing to track, the arm refuses the behaviour as "
-                  "written (below); add --fit to track it fitted to the arm", file=sys.stderr)
+            note = _refusal_note(args, err.diagnostics)
+            if note:
+                print(note, file=sys.stderr)
         raise
+
+
+def _refusal_note(args: argparse.Namespace, diagnostics) -> str | None:
+    import shlex
+
+    from ..compiler.fitting import FITTED
+    from ..core.diagnostics import Severity
+
+    errors = [d for d in diagnostics if d.severity is Severity.ERROR]
+    if not errors or not any(d.code.startswith("C") for d in errors):
+        return None
+    head = "aouc check --track: nothing to track, the arm refuses the behaviour as written"
+    other = sorted({d.code for d in errors if d.code not in FITTED})
+    if other:
+        return (f"{head} (below), and --fit cannot change what {', '.join(other)} "
+                "refuses: mend that first")
+    robot = f" --robot {shlex.quote(args.robot)}" if getattr(args, "robot", None) else ""
+    servo = f" --servo {args.servo}" if getattr(args, "servo", "position") != "position" \
+        else ""
+    lines = sorted({d.span.line for d in errors})
+    return (f"{head} (below). --fit changes the values it cannot give (line"
+            f"{'s' if len(lines) > 1 else ''} {', '.join(map(str, lines))}) and tracks the "
+            f"fitted motion: aouc check {shlex.quote(args.path)}{robot} --fit --track{servo}")
+
 
 _SHORT = {"position": "position", "feedforward": "feedforward", "torque": "torque"}
 
@@ -51,23 +80,67 @@ def _v(v) -> str:
     return "absent" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
 
 
+def _change(c: dict) -> str:
+    """One change of the fit in words: ``shiver frequency 2.5Hz -> 1.1Hz``."""
+    what = c.get("descriptor") or {"f": "shiver frequency", "for": "shiver duration",
+                                   "a": "acceleration", "v": "tilt velocity",
+                                   "length": "approach distance",
+                                   "angle": "angle"}.get(c.get("key", ""), c.get("key", ""))
+    unit = c.get("unit") or ""
+    was = f"{c['declared']}{unit}" if c.get("declared") not in (None, "") else "the default"
+    return f"{what} {was} -> {c.get('fitted')}{unit} (line {c.get('line')})"
+
+
+def _share(v, share: float | None, ok: bool) -> str:
+    text = f"{share:.0%}" if share is not None else _v(v)
+    return text + ("*" if ok else " ")
+
+
+def _at_risk_lines(report) -> list[str]:
+    """What each mode shows of each descriptor at risk, as a share of the declared
+    value, and the modes that keep it."""
+    rows = report.at_risk()
+    if not rows:
+        return ["  no descriptor is at risk: every mode shows what the plan shows"]
+    lines = ["  what the arm shows of each descriptor at risk (share of the declared value; "
+             "* within tolerance):"]
+    decls = []
+    for a in rows:
+        decl = _v(a.declared) + (f" {a.unit}" if a.unit else "")
+        decls.append(decl + (f" (written {_v(a.written)})" if a.written != a.declared
+                             else ""))
+    width = max(len("declared"), *map(len, decls))
+    head = "".join(f" {m:>12s}" for m in (r.mode for r in report.results))
+    lines.append(f"  {'descriptor':24s} {'declared':>{width}s}{head}  kept by")
+    for a, decl in zip(rows, decls, strict=True):
+        cells = "".join(f" {_share(*a.shown[r.mode]):>12s}" for r in report.results)
+        lines.append(f"  {a.name:24s} {decl:>{width}s}{cells}  "
+                     + (", ".join(a.keeps) if a.keeps else "no mode"))
+    return lines
+
+
 def format_tracking(report) -> str:
-    """The report as text: the servo, each mode's speed and tracking error, every
-    descriptor declared beside what each mode gives, and what becomes of the shiver."""
+    """The report as text: the servo, the fit's changes (a fitted behaviour), each
+    mode's tracking error, every descriptor declared beside what each mode gives, what
+    each mode shows of the descriptors at risk, and what becomes of the shiver. No
+    timing: the same plan gives the same text."""
     from ..safety.track_report import MODE_WORDS
 
     s = report.servo
     lines = [f"tracked through the servos of {report.robot} at {s.rate:g} Hz "
              f"({s.source}), {report.duration:.2f} s of motion"]
-    lines.append(f"  {'mode':12s} {'speed':>9s}  max tracking error per joint [deg]")
+    if report.fitted:
+        lines.append("  fitted to the arm before tracking (the arm refuses the file as "
+                     "written): " + "; ".join(_change(c) for c in report.fitted)
+                     + ". What follows is the fitted motion, judged against the fitted text.")
+    lines.append(f"  {'mode':12s} max tracking error per joint [deg]")
     for r in report.results:
         k = r.tracked
-        speed = report.duration / k.seconds if k.seconds > 0 else float("inf")
         err = " ".join(f"{x:.3g}" for x in np.degrees(k.error_max))
         mark = " (chosen)" if r.mode == report.selected else ""
         if r.mode not in s.modes:
             mark += " (not offered by the arm's controller)"
-        lines.append(f"  {r.mode:12s} {speed:>7.0f}x  {err}{mark}")
+        lines.append(f"  {r.mode:12s} {err}{mark}")
     if report.plan is not None:
         head = "".join(f" {_SHORT[r.mode]:>13s}" for r in report.results)
         lines.append(f"  {'descriptor':24s} {'declared':>9s} {'tolerance':>10s} {'plan':>9s}"
@@ -87,15 +160,20 @@ def format_tracking(report) -> str:
             lines.append(f"  {r.mode}: {n} of {len(r.verdict.rows)} descriptors within "
                          f"tolerance; reads as {cv.state.value} (C={cv.C:+.2f} "
                          f"V={cv.V:+.2f})")
-        shiver = next(w for w in report.plan.rows if w.name == _SHIVER)
-        if isinstance(shiver.declared, float) and shiver.declared > 0:
-            parts = []
-            for r in report.results:
-                got = next(x for x in r.verdict.rows if x.name == _SHIVER)
-                share = (got.measured or 0.0) / shiver.declared
-                parts.append(f"{share:.0%} under {MODE_WORDS[r.mode]}")
-            keep = report.keeps(_SHIVER)
-            lines.append(f"  the shiver ({shiver.declared:.3g} deg declared): the arm shows "
+        lines += _at_risk_lines(report)
+        shiver = next((a for a in report.at_risk() if a.name == _SHIVER), None)
+        if shiver is not None:
+            parts = [f"{(shiver.shown[r.mode][1] or 0.0):.0%} under {MODE_WORDS[r.mode]}"
+                     for r in report.results]
+            what = f"{_v(shiver.declared)} deg declared"
+            if shiver.written != shiver.declared:
+                what += f", {_v(shiver.written)} deg written"
+            freq = [c for c in report.fitted if c.get("key") == "f"]
+            if freq:
+                what += (f"; fitted from {freq[0]['declared']} Hz to {freq[0]['fitted']} Hz: "
+                         "a slower shiver than the file's")
+            keep = shiver.keeps
+            lines.append(f"  the shiver ({what}): the arm shows "
                          + "; ".join(parts) + ". "
                          + (f"Kept by: {', '.join(keep)}." if keep
                             else "No servo mode of this arm keeps it."))
@@ -116,9 +194,12 @@ def tracked_document(report, mode: str) -> dict:
 
 
 def run_tracking(args: argparse.Namespace, tr, behaviour, *, reads: list[str],
-                 out: IO[str] | None) -> tuple[list[Diagnostic], dict | None]:
+                 out: IO[str] | None, written=None, fitted=()
+                 ) -> tuple[list[Diagnostic], dict | None]:
     """Track ``tr`` (judged against ``behaviour``, a lint or None), print the report on
-    ``out`` (None: not printed; it is returned as JSON), write ``--tracked``.
+    ``out`` (None: not printed; it is returned as JSON), write ``--tracked``. For a
+    fitted behaviour, ``written`` is the lint of the file as written and ``fitted`` the
+    fit's changes (the report shows both beside the fitted values).
 
     Returns:
         the diagnostics (C322, C323) and the report as JSON.
@@ -133,7 +214,7 @@ def run_tracking(args: argparse.Namespace, tr, behaviour, *, reads: list[str],
     dest = getattr(args, "tracked", None)
     if dest:
         guard_output(dest, reads)
-    report = track_modes(tr, behaviour, selected=args.servo)
+    report = track_modes(tr, behaviour, selected=args.servo, written=written, fitted=fitted)
     robot_span = Span.whole_file("<command line>" if getattr(args, "robot", None)
                                  else tr.path)
     diags = report.diagnostics(robot_span)

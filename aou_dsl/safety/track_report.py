@@ -18,7 +18,7 @@ from ..core.trajectory import Trajectory
 from ..measuring.verdict import Verdict, judge
 from .track import Tracked, arm_servo, track
 
-__all__ = ["ModeResult", "TrackReport", "track_modes"]
+__all__ = ["AtRisk", "ModeResult", "TrackReport", "track_modes"]
 
 #: How each mode reads in a sentence.
 MODE_WORDS = {"position": "plain position set-points",
@@ -36,6 +36,40 @@ class ModeResult:
 
 
 @dataclass(frozen=True)
+class AtRisk:
+    """One descriptor at risk under tracking: what each mode's tracked motion shows of it.
+
+    Attributes:
+        name, unit: the descriptor.
+        declared: the value judged against (the fitted text's, for a fitted behaviour).
+        written: the file's own value when the fit changed it (else equal to ``declared``).
+        shown: per mode, ``(measured, share of declared or None, within tolerance)``.
+        keeps: the modes within tolerance, in :data:`~aou_dsl.core.servo_specs.MODES`
+            order.
+    """
+
+    name: str
+    unit: str
+    declared: float | int | None
+    written: float | int | None
+    shown: dict[str, tuple[float | int | None, float | None, bool]]
+    keeps: tuple[str, ...]
+
+    def to_json(self) -> dict:
+        def r(v):
+            return round(v, 6) if isinstance(v, float) else v
+
+        return {"descriptor": self.name, "unit": self.unit, "declared": r(self.declared),
+                "written": r(self.written), "keeps": list(self.keeps),
+                "modes": {m: {"measured": r(v), "share": r(sh), "ok": ok}
+                          for m, (v, sh, ok) in self.shown.items()}}
+
+
+#: The descriptor a shiver's amplitude is, reported whenever the file declares one.
+SHIVER = "shiver_amplitude"
+
+
+@dataclass(frozen=True)
 class TrackReport:
     """The plan tracked in each mode the arm offers.
 
@@ -45,6 +79,9 @@ class TrackReport:
         results: one per mode offered, in :data:`~aou_dsl.core.servo_specs.MODES` order.
         plan: the plan judged against the behaviour (None without one).
         duration: the plan's length [s].
+        written: for a fitted behaviour, what the file as written declares (the
+            descriptors' values before the fit); None when nothing was fitted.
+        fitted: the fit's changes (the ``fitted`` list of the trajectory's header).
     """
 
     robot: str
@@ -54,6 +91,8 @@ class TrackReport:
     results: tuple[ModeResult, ...]
     plan: Verdict | None
     duration: float
+    written: dict | None = None
+    fitted: tuple[dict, ...] = ()
 
     def result(self, mode: str) -> ModeResult:
         return next(r for r in self.results if r.mode == mode)
@@ -62,6 +101,36 @@ class TrackReport:
         """The modes whose tracked motion shows descriptor ``name`` within tolerance."""
         return [r.mode for r in self.results if r.verdict is not None
                 and next(w for w in r.verdict.rows if w.name == name).ok]
+
+    def at_risk(self) -> list[AtRisk]:
+        """The descriptors a person may not see as declared: each the plan shows within
+        tolerance and some mode's tracked motion does not, the shiver whenever one is
+        declared, and every descriptor the fit changed from the file's value."""
+        if self.plan is None:
+            return []
+        out = []
+        for i, w in enumerate(self.plan.rows):
+            rows = [r.verdict.rows[i] for r in self.results if r.verdict is not None]
+            written = w.declared if self.written is None else self.written.get(w.name)
+            if isinstance(written, float) and isinstance(w.declared, float) \
+                    and abs(written - w.declared) <= 1e-9 * max(1.0, abs(written)):
+                written = w.declared
+            changed = written != w.declared
+            lost = w.ok and any(not x.ok for x in rows)
+            shiver = w.name == SHIVER and isinstance(w.declared, float) and w.declared > 0
+            if not (lost or shiver or changed):
+                continue
+            shown = {}
+            for r in self.results:
+                assert r.verdict is not None
+                x = r.verdict.rows[i]
+                share = (float(x.measured) / float(w.declared)
+                         if isinstance(x.measured, (int, float))
+                         and isinstance(w.declared, (int, float)) and w.declared else None)
+                shown[r.mode] = (x.measured, share, x.ok)
+            out.append(AtRisk(w.name, w.unit, w.declared, written, shown,
+                              tuple(self.keeps(w.name))))
+        return out
 
     def lost(self, mode: str) -> list:
         """The rows the plan keeps and ``mode``'s tracked motion does not."""
@@ -103,11 +172,13 @@ class TrackReport:
                     "tracking_rms_rad": dict(zip(_joints(k), k.error_rms.tolist(),
                                                  strict=True)),
                     "saturated": dict(zip(_joints(k), k.saturated.tolist(), strict=True)),
-                    "simulated_s": self.duration, "wall_s": round(k.seconds, 6),
+                    "simulated_s": self.duration,
                     "descriptors": None if r.verdict is None else
                     [w.to_json() for w in r.verdict.rows]}
         return {"robot": self.robot, "servo": self.servo.to_json(), "generic": self.generic,
-                "selected": self.selected, "modes": [mode_json(r) for r in self.results]}
+                "selected": self.selected, "modes": [mode_json(r) for r in self.results],
+                "at_risk": [a.to_json() for a in self.at_risk()],
+                "fitted": [dict(c) for c in self.fitted]}
 
 
 def _joints(k: Tracked) -> list[str]:
@@ -124,7 +195,8 @@ def _text(v, unit: str = "") -> str:
 
 
 def track_modes(tr: Trajectory, behaviour=None, *, selected: str = "position",
-                servo: ServoTable | None = None) -> TrackReport:
+                servo: ServoTable | None = None, written=None,
+                fitted: tuple[dict, ...] = ()) -> TrackReport:
     """Track ``tr`` in every mode the arm's controller offers (and ``selected``).
 
     Args:
@@ -134,6 +206,9 @@ def track_modes(tr: Trajectory, behaviour=None, *, selected: str = "position",
             error alone.
         selected: the mode whose losses are diagnosed.
         servo: the servo table (default: the arm's, else the generic one).
+        written: for a fitted behaviour, the lint of the file as written (its declared
+            values are reported beside the fitted ones).
+        fitted: the fit's changes (the ``fitted`` list of the build's header).
     """
     generic = False
     if servo is None:
@@ -145,4 +220,15 @@ def track_modes(tr: Trajectory, behaviour=None, *, selected: str = "position",
         k = track(tr, m, servo)
         results.append(ModeResult(m, k, judge(k.trajectory, behaviour)
                                   if behaviour is not None else None))
-    return TrackReport(tr.robot, servo, generic, selected, tuple(results), plan, tr.duration)
+    fitted = tuple(fitted)
+    was = None
+    if written is not None and fitted and written.behaviour is not None \
+            and written.timeline is not None:
+        from ..lang.declared import declared
+        from ..lang.descriptors import REGISTRY
+
+        want = declared(written.behaviour, written.timeline)
+        was = {name: (want.get(name) or 0) if d.is_count else want.get(name)
+               for name, d in REGISTRY.items()}  # a count no statement declares is 0
+    return TrackReport(tr.robot, servo, generic, selected, tuple(results), plan, tr.duration,
+                       was, fitted)

@@ -1,0 +1,120 @@
+"""What `aouc check --track` tells a user: how much of each descriptor at risk the arm
+shows under each servo mode and which modes keep it, for a behaviour fitted to the arm
+too (the file's values beside the fitted ones); where the arm refuses the file, the
+command that tracks the fitted motion; the same report from the same plan."""
+
+import json
+import re
+
+import numpy as np
+import pytest
+
+pytest.importorskip("mujoco")
+
+from aou_dsl.cli.commands import EXIT_OK, main  # noqa: E402
+
+from .conftest import BEHAVIOURS, ROOT  # noqa: E402
+
+FEARFUL = str(BEHAVIOURS / "fearful.aou")
+#: The fitted check, as the refusal's pointer names it (the replay's slow parts off).
+FITTED = ["check", FEARFUL, "--robot", "kinova", "--fit", "--track", "--no-dynamic",
+          "--no-collision-check"]
+
+
+@pytest.fixture(scope="module")
+def fitted_doc():
+    """One fitted compile of fearful on the Kinova for the module (later runs reuse it)."""
+    import contextlib
+    import io
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main([*FITTED, "--format", "json"])
+    assert code == EXIT_OK, err.getvalue()
+    return json.loads(out.getvalue())
+
+
+def _written(key: str, statement: str) -> float:
+    """A value as the shipped file writes it (``a=2`` of its ``retreat`` line)."""
+    text = (BEHAVIOURS / "fearful.aou").read_text()
+    line = next(ln for ln in text.splitlines() if ln.startswith(statement))
+    return float(re.search(rf"\b{key}=([0-9.]+)", line).group(1))
+
+
+def test_the_fitted_report_says_what_each_mode_shows_of_each_descriptor_at_risk(fitted_doc):
+    """Every descriptor some mode loses is listed with its share per mode, computed from
+    that mode's own row; the modes that keep it are exactly the rows within tolerance;
+    the shiver is listed; a fitted descriptor carries the file's value beside it."""
+    t = fitted_doc["tracking"]
+    rows = {m["mode"]: {d["descriptor"]: d for d in m["descriptors"]} for m in t["modes"]}
+    risk = {a["descriptor"]: a for a in t["at_risk"]}
+    assert "shiver_amplitude" in risk
+    for name, a in risk.items():
+        assert a["keeps"] == [m for m in rows if rows[m][name]["ok"]]
+        for mode, got in a["modes"].items():
+            row = rows[mode][name]
+            assert got["ok"] == row["ok"] and got["measured"] == row["measured"]
+            assert got["share"] == pytest.approx(row["measured"] / row["declared"], rel=1e-5)
+    lost = {name for m in rows for name, d in rows[m].items() if not d["ok"]}
+    assert lost <= set(risk)
+    shiver = risk["shiver_amplitude"]
+    assert shiver["modes"]["position"]["share"] < 0.95 and not shiver["modes"]["position"]["ok"]
+    assert "feedforward" in shiver["keeps"]
+    retreat = risk["retreat_acceleration"]
+    assert retreat["written"] == _written("a", "retreat")
+    change = next(c for c in t["fitted"] if c["descriptor"] == "retreat_acceleration")
+    assert retreat["declared"] == pytest.approx(float(change["fitted"]))
+    assert retreat["declared"] < retreat["written"]
+    assert any(c["key"] == "f" for c in t["fitted"])  # the shiver made slower
+
+
+def test_the_fitted_text_report_names_the_slower_shiver_and_the_modes_keeping_it(
+        fitted_doc, capsys):
+    assert main(FITTED) == EXIT_OK
+    out = capsys.readouterr().out
+    f = next(c for c in fitted_doc["tracking"]["fitted"] if c["key"] == "f")
+    assert f"fitted from {f['declared']} Hz to {f['fitted']} Hz" in out
+    assert "fitted to the arm before tracking" in out
+    table = out[out.index("what the arm shows of each descriptor at risk"):]
+    line = next(ln for ln in table.splitlines() if ln.strip().startswith("shiver_amplitude"))
+    keeps = next(a["keeps"] for a in fitted_doc["tracking"]["at_risk"]
+                 if a["descriptor"] == "shiver_amplitude")
+    assert line.endswith(", ".join(keeps))
+    assert "(written 2)" in next(ln for ln in table.splitlines()
+                                 if ln.strip().startswith("retreat_acceleration"))
+
+
+def test_a_refusal_points_to_the_command_that_tracks_the_fitted_motion(capsys):
+    """Fearful as written is refused on the Kinova (C308): the pointer is the exact
+    command, which the tests above run and which works."""
+    assert main(["check", FEARFUL, "--robot", "kinova", "--track"]) == 1
+    err = capsys.readouterr().err
+    assert " C308 " in err
+    assert f"aouc check {FEARFUL} --robot kinova --fit --track" in err
+    assert "line 8" in err
+
+
+def test_a_file_with_errors_of_its_own_is_not_pointed_to_fit(capsys):
+    """--fit fits values to the arm; it cannot mend a file that does not lint, so a
+    refusal of that kind gets no pointer to it."""
+    path = ROOT / "tests" / "invalid" / "invalid_missing_unit.aou"
+    assert main(["check", str(path), "--track"]) != EXIT_OK
+    err = capsys.readouterr().err
+    assert "--fit" not in err and "nothing to track" not in err
+
+
+def test_the_same_plan_gives_the_same_report(capsys):
+    """No timing in the report: two trackings of one plan print the same text and JSON."""
+    from aou_dsl.cli.track_cmd import format_tracking
+    from aou_dsl.core.trajectory import Trajectory
+    from aou_dsl.robot.load import load_arm
+    from aou_dsl.safety.track_report import track_modes
+
+    arm = load_arm("panda")
+    t = np.arange(251) / 250.0
+    q = np.tile(np.array(arm.spec.posture), (len(t), 1))
+    q[:, 5] += np.radians(2.0) * np.sin(2 * np.pi * t) ** 2
+    tr = Trajectory(t, q, arm.joint_names, "panda", None, (0.5, 0.0, 0.3))
+    a, b = track_modes(tr), track_modes(tr)
+    assert format_tracking(a) == format_tracking(b)
+    assert json.dumps(a.to_json()) == json.dumps(b.to_json())
