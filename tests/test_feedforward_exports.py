@@ -91,3 +91,40 @@ def test_a_csv_carries_positions_only():
     header = [ln for ln in encode(_doc(), "csv").decode().splitlines()
               if not ln.startswith("#")][0]
     assert header.split(",") == ["t", *_doc()["joint_names"]]
+
+
+def test_a_csv_with_derivatives_carries_the_documents_own_velocities_and_accelerations(
+        tmp_path, capsys):
+    """``--csv-derivatives``: the positions' columns as in the plain CSV, then a velocity
+    and an acceleration column per joint, read back by NumPy equal to the document's;
+    ``aouc measure`` reads the file as it reads the plain one."""
+    import csv
+
+    from aou_dsl.cli.commands import EXIT_OK, main
+
+    doc = _doc()
+    text = encode(doc, "csv+derivatives").decode()
+    body = [ln for ln in text.splitlines() if not ln.startswith("#")]
+    head = next(csv.reader(body[:1]))
+    names = doc["joint_names"]
+    assert head == ["t", *names, *(f"qd_{n}" for n in names), *(f"qdd_{n}" for n in names)]
+    table = np.loadtxt(body[1:], delimiter=",")
+    n = len(names)
+    assert np.array_equal(table[:, 0], np.asarray(doc["t"]))
+    for k, key in enumerate(("q", "qd", "qdd")):
+        assert np.array_equal(table[:, 1 + k * n:1 + (k + 1) * n], np.asarray(doc[key]))
+
+    src = str(BEHAVIOURS / "inactive.aou")
+    plain, more = tmp_path / "plain.csv", tmp_path / "more.csv"
+    assert main(["compile", src, "--no-check", "-o", str(plain)]) == EXIT_OK
+    assert main(["compile", src, "--no-check", "-o", str(more), "--csv-derivatives"]) \
+        == EXIT_OK
+    assert more.read_text().splitlines()[:6] == plain.read_text().splitlines()[:6]
+    capsys.readouterr()
+    got = []
+    for path in (plain, more):
+        assert main(["measure", str(path), "--format", "json"]) == EXIT_OK
+        got.append(json.loads(capsys.readouterr().out)["descriptors"])
+    assert got[0] == got[1] and got[0]["pause_count"] == 1
+    assert main(["compile", src, "--no-check", "-o", str(tmp_path / "x.json"),
+                 "--csv-derivatives"]) == 2  # only a CSV has them as an option

@@ -186,6 +186,10 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
                       help="output format (default: from -o's extension, else json); mcap: "
                       "a ROS 2 bag (a folder) with one JointTrajectory, yaml: the same "
                       "message as YAML (docs/ros2.md); dmp: a folder of DMPs (docs/dmp.md)")
+    comp.add_argument("--csv-derivatives", action="store_true",
+                      help="with --format csv: after the positions, a velocity and an "
+                      "acceleration column per joint (qd_JOINT, qdd_JOINT), for a "
+                      "controller that reads them (docs/ros2.md)")
     comp.add_argument("--rate", type=RATE, metavar="HZ", help="sample rate in Hz (default 250)")
     _robot(comp)
     comp.add_argument("-j", "--jobs", type=int_in(0, 256), default=1, metavar="N",

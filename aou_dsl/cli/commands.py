@@ -125,6 +125,13 @@ def _cmd_compile(args: argparse.Namespace) -> int:
         dests, fmt = guard_outputs(args, inputs, reads)  # before any work: the output rule
     except AouError as err:
         return _fail(err)
+    if args.csv_derivatives:
+        from ..compiler.output import CSV_DERIVATIVES
+
+        if fmt != "csv" or args.no_output:
+            return usage_error("compile", "--csv-derivatives needs a CSV output "
+                               "(--format csv, or -o FILE.csv)")
+        fmt = CSV_DERIVATIVES
     options = BuildOptions(robot=args.robot, rate=args.rate, check=not args.no_check,
                            scene=SceneOptions(**_scene_kw(args)),
                            collision_check=not args.no_collision_check,

@@ -1,6 +1,8 @@
 """Stage 8, output: the trajectory file, written atomically and deterministically.
 
-Five formats: ``json`` (``aou-trajectory/1``), ``csv`` (``t`` then one column per joint),
+Five formats: ``json`` (``aou-trajectory/1``), ``csv`` (``t`` then one column per joint;
+with ``--csv-derivatives``, :data:`CSV_DERIVATIVES`, a velocity then an acceleration
+column per joint after them),
 ``npz`` (numpy arrays plus the JSON header), and for ROS 2 (:mod:`.ros`) ``mcap`` (a bag
 folder holding one ``trajectory_msgs/msg/JointTrajectory``) and ``yaml`` (that message
 as YAML). Nothing that varies between runs (times, paths, dates) is written, so the same
@@ -50,13 +52,18 @@ def _optional(name: str) -> ModuleType | None:
 
 orjson = _optional("orjson")
 
-__all__ = ["FORMATS", "SAMPLE_KEYS", "array_document", "document_header", "encode",
-           "json_bytes", "output_paths", "trajectory_document", "with_samples",
+__all__ = ["CSV_DERIVATIVES", "FORMATS", "SAMPLE_KEYS", "array_document", "document_header",
+           "encode", "json_bytes", "output_paths", "trajectory_document", "with_samples",
            "write_atomic", "write_output"]
 
 FORMATS = ("json", "csv", "npz", "mcap", "yaml", "dmp")
 #: Formats whose output is a folder (a ROS 2 bag; DMPs, aou_dsl.dmp), not a file.
 FOLDER_FORMATS = ("mcap", "dmp")
+#: The encoding of ``--format csv --csv-derivatives``: the CSV's columns (``t``, one per
+#: joint), then ``qd_JOINT`` per joint, then ``qdd_JOINT`` per joint. Not a format of its
+#: own (the file is a ``.csv``); a reader of the plain CSV that takes the columns it
+#: knows by name reads the positions the same.
+CSV_DERIVATIVES = "csv+derivatives"
 
 
 #: The keys of a trajectory document that hold its samples, one list entry per sample.
@@ -282,17 +289,23 @@ def encode(doc: dict, fmt: str) -> bytes:
     (:func:`array_document`): the bytes are the same."""
     if fmt == "json":
         return json_bytes(doc)
-    if fmt == "csv":
+    if fmt in ("csv", CSV_DERIVATIVES):
         # Comment lines carry what a CSV has no column for; readers skip `#` lines.
         goal = ",".join(_float_text(x) for x in doc["goal"]["position"])
         lines = [f"# format: {doc['format']}", f"# robot: {doc['robot']}",
                  f"# ee_frame: {doc['ee_frame']}", f"# goal: {goal}"]
         lines += [f"# {k}: {json_bytes(doc[k], newline=False).decode()}"
                   for k in ("ee_frame_definition", "robot_identity") if k in doc]
-        lines.append(",".join(["t", *doc["joint_names"]]))
+        names = list(doc["joint_names"])
+        more = ([f"qd_{n}" for n in names] + [f"qdd_{n}" for n in names]
+                if fmt == CSV_DERIVATIVES else [])
+        lines.append(",".join(["t", *names, *more]))
         head = ("\n".join(lines) + "\n").encode("utf-8", "backslashreplace")
         t = np.asarray(doc["t"], dtype=np.float64)
         q = np.asarray(doc["q"], dtype=np.float64).reshape(len(t), -1)
+        if more:
+            q = np.column_stack([q, *(np.asarray(doc[k], dtype=np.float64).reshape(len(t), -1)
+                                      for k in ("qd", "qdd"))])
         return head + _csv_rows(t, q)
     if fmt == "npz":
         buf = io.BytesIO()
