@@ -118,3 +118,17 @@ def test_the_same_plan_gives_the_same_report(capsys):
     a, b = track_modes(tr), track_modes(tr)
     assert format_tracking(a) == format_tracking(b)
     assert json.dumps(a.to_json()) == json.dumps(b.to_json())
+
+
+def test_compile_fit_track_reports_the_files_values_beside_the_fitted_ones(
+        fitted_doc, tmp_path, capsys):
+    """compile --fit --track prints the same report on standard error: what the fit
+    changed, and the file's value beside a fitted one."""
+    out = tmp_path / "f.json"
+    assert main(["compile", FEARFUL, "--robot", "kinova", "--fit", "--track", "--no-check",
+                 "-o", str(out)]) == EXIT_OK
+    err = capsys.readouterr().err
+    assert "fitted to the arm before tracking" in err
+    line = next(ln for ln in err.splitlines() if ln.strip().startswith("retreat_acceleration")
+                and "%" in ln)
+    assert f"(written {_written('a', 'retreat'):g})" in line

@@ -252,8 +252,17 @@ def compile_tracked(args: argparse.Namespace, res, reads: list[str]):
     from ..core.diagnostics import Severity
     from .report import print_diagnostics
 
+    written = None
+    if getattr(res, "fitted_source", None) is not None:  # --fit: the file's values too
+        from ..lang.linter import lint_source
+        from .fitted import original_text
+
+        original = original_text(res).get(res.path)
+        written = lint_source(original, res.path) if original is not None else None
     try:
-        more, _ = run_tracking(args, res.trajectory, res.lint, reads=reads, out=sys.stderr)
+        more, _ = run_tracking(args, res.trajectory, res.lint, reads=reads, out=sys.stderr,
+                               written=written,
+                               fitted=tuple((res.header or {}).get("fitted") or ()))
     except AouError as err:
         more = list(err.diagnostics)
     print_diagnostics(more, sources={res.lint.path: res.lint.source or ""})
