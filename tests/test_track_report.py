@@ -132,3 +132,27 @@ def test_compile_fit_track_reports_the_files_values_beside_the_fitted_ones(
     line = next(ln for ln in err.splitlines() if ln.strip().startswith("retreat_acceleration")
                 and "%" in ln)
     assert f"(written {_written('a', 'retreat'):g})" in line
+
+
+def test_a_servo_without_velocity_gain_says_feedforward_changes_nothing():
+    """The UR5e's published servos have no kv: the report says why its feedforward
+    column equals its position column, and says nothing of the kind for the Panda."""
+    from dataclasses import replace
+
+    from aou_dsl.cli.track_cmd import format_tracking
+    from aou_dsl.core.servo_specs import PANDA
+    from aou_dsl.core.trajectory import Trajectory
+    from aou_dsl.robot.load import load_arm
+    from aou_dsl.safety.track_report import track_modes
+
+    arm = load_arm("panda")
+    t = np.arange(126) / 250.0
+    q = np.tile(np.array(arm.spec.posture), (len(t), 1))
+    q[:, 6] += np.radians(1.0) * np.sin(np.pi * t / t[-1]) ** 2
+    tr = Trajectory(t, q, arm.joint_names, "panda", None, (0.5, 0.0, 0.3))
+    no_kv = replace(PANDA, kv=(0.0,) * 7)
+    report = track_modes(tr, servo=no_kv)
+    pos, ff = (report.result(m).tracked for m in ("position", "feedforward"))
+    assert np.array_equal(pos.trajectory.q, ff.trajectory.q)
+    assert "no velocity gain" in format_tracking(report)
+    assert "no velocity gain" not in format_tracking(track_modes(tr, servo=PANDA))

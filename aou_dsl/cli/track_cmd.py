@@ -133,6 +133,10 @@ def format_tracking(report) -> str:
         lines.append("  fitted to the arm before tracking (the arm refuses the file as "
                      "written): " + "; ".join(_change(c) for c in report.fitted)
                      + ". What follows is the fitted motion, judged against the fitted text.")
+    if "feedforward" in [r.mode for r in report.results] and not any(s.kv):
+        lines.append("  this servo table has no velocity gain (kv 0 on every joint): the "
+                     "velocity feed-forward sends changes nothing in the simulation, so "
+                     "feedforward reads as position; a drive with a velocity loop differs")
     lines.append(f"  {'mode':12s} max tracking error per joint [deg]")
     for r in report.results:
         k = r.tracked
