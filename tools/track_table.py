@@ -20,13 +20,14 @@ import argparse
 import sys
 from pathlib import Path
 
+from aou_dsl.safety.track_report import SHIVER
+
 ROOT = Path(__file__).resolve().parent.parent
 BEHAVIOURS = sorted((ROOT / "behaviours").glob("*.aou"))
 CHECKS = ROOT / "docs" / "checks.md"
 ROBOTS = ROOT / "docs" / "robots.md"
 START = "<!-- track-table:start (written by tools/track_table.py; do not edit by hand) -->"
 END = "<!-- track-table:end -->"
-SHIVER = "shiver_amplitude"
 #: The change of the fit in a row's behaviour cell, by the statement's key.
 KEYS = {"f": "shiver frequency", "for": "shiver duration", "a": "acceleration",
         "v": "tilt velocity", "length": "approach distance", "angle": "angle"}

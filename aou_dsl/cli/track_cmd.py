@@ -65,15 +65,6 @@ def _refusal_note(args: argparse.Namespace, diagnostics) -> str | None:
 _SHORT = {"position": "position", "feedforward": "feedforward", "torque": "torque"}
 
 
-def _shiver_descriptor() -> str:
-    """The descriptor of a shiver's amplitude, by its kind in the descriptor table."""
-    from ..lang.descriptors import REGISTRY
-
-    return next(d.name for d in REGISTRY.values() if d.kind == "shiver"
-                and d.key == "amplitude")
-
-
-_SHIVER = _shiver_descriptor()
 
 
 def _v(v) -> str:
@@ -124,7 +115,7 @@ def format_tracking(report) -> str:
     mode's tracking error, every descriptor declared beside what each mode gives, what
     each mode shows of the descriptors at risk, and what becomes of the shiver. No
     timing: the same plan gives the same text."""
-    from ..safety.track_report import MODE_WORDS
+    from ..safety.track_report import MODE_WORDS, SHIVER
 
     s = report.servo
     lines = [f"tracked through the servos of {report.robot} at {s.rate:g} Hz "
@@ -165,7 +156,7 @@ def format_tracking(report) -> str:
                          f"tolerance; reads as {cv.state.value} (C={cv.C:+.2f} "
                          f"V={cv.V:+.2f})")
         lines += _at_risk_lines(report)
-        shiver = next((a for a in report.at_risk() if a.name == _SHIVER), None)
+        shiver = next((a for a in report.at_risk() if a.name == SHIVER), None)
         if shiver is not None:
             parts = [f"{(shiver.shown[r.mode][1] or 0.0):.0%} under {MODE_WORDS[r.mode]}"
                      for r in report.results]
@@ -258,11 +249,13 @@ def compile_tracked(args: argparse.Namespace, res, reads: list[str]):
 
     written = None
     if getattr(res, "fitted_source", None) is not None:  # --fit: the file's values too
+        from ..core.files import read_text
         from ..lang.linter import lint_source
-        from .fitted import original_text
 
-        original = original_text(res).get(res.path)
-        written = lint_source(original, res.path) if original is not None else None
+        try:
+            written = lint_source(read_text(res.path), res.path)
+        except AouError:  # the file went away since: the fitted values alone
+            written = None
     try:
         more, _ = run_tracking(args, res.trajectory, res.lint, reads=reads, out=sys.stderr,
                                written=written,

@@ -65,8 +65,16 @@ class AtRisk:
                           for m, (v, sh, ok) in self.shown.items()}}
 
 
+def _shiver_descriptor() -> str:
+    """The descriptor of a shiver's amplitude, by its kind in the descriptor table."""
+    from ..lang.descriptors import REGISTRY
+
+    return next(d.name for d in REGISTRY.values() if d.kind == "shiver"
+                and d.key == "amplitude")
+
+
 #: The descriptor a shiver's amplitude is, reported whenever the file declares one.
-SHIVER = "shiver_amplitude"
+SHIVER = _shiver_descriptor()
 
 
 @dataclass(frozen=True)
