@@ -163,3 +163,15 @@ def test_a_servo_without_velocity_gain_says_feedforward_changes_nothing():
     assert np.array_equal(pos.trajectory.q, ff.trajectory.q)
     assert "no velocity gain" in format_tracking(report)
     assert "no velocity gain" not in format_tracking(track_modes(tr, servo=PANDA))
+
+
+def test_the_fitted_json_carries_the_fit_and_the_tracking_diagnostics(fitted_doc):
+    """As check without --fit gives them: the fit's C314 changes, and a C322 for the
+    shiver the chosen mode (plain set-points) loses, naming the modes that keep it."""
+    diags = fitted_doc["diagnostics"]
+    assert {d["code"] for d in diags} >= {"C314", "C322", "C323"}
+    (lost,) = [d for d in diags if d["code"] == "C322"
+               and d["fields"]["descriptor"] == "shiver_amplitude"]
+    keeps = next(a["keeps"] for a in fitted_doc["tracking"]["at_risk"]
+                 if a["descriptor"] == "shiver_amplitude")
+    assert lost["fields"]["keeps"] == keeps and lost["fields"]["mode"] == "position"

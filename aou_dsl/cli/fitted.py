@@ -131,8 +131,10 @@ def check_fitted(args: argparse.Namespace, read_kw: dict) -> int:
             print(format_text(d, lint.source if d.span.path == lint.path else None),
                   file=sys.stderr)
         bad = any(d.severity is Severity.ERROR for d in [*res.diagnostics, *more])
-        if args.format == "json":
-            print(format_json({"path": args.path, **report.to_json(), "tracking": tracking}))
+        if args.format == "json":  # the diagnostics too, as check without --fit gives them
+            print(format_json({"path": args.path, **report.to_json(), "tracking": tracking,
+                               "diagnostics": [d.to_json() for d in
+                                               [*res.diagnostics, *more]]}))
         return EXIT_OK if report.ok and not bad else EXIT_ERRORS
     if args.format == "json":
         print(format_json({"path": args.path, **report.to_json()}))
