@@ -175,3 +175,20 @@ def test_the_fitted_json_carries_the_fit_and_the_tracking_diagnostics(fitted_doc
     keeps = next(a["keeps"] for a in fitted_doc["tracking"]["at_risk"]
                  if a["descriptor"] == "shiver_amplitude")
     assert lost["fields"]["keeps"] == keeps and lost["fields"]["mode"] == "position"
+
+
+def test_a_refusal_the_fit_cannot_change_gets_no_fit_command():
+    """A refusal of a kind --fit does not change (a failed check, C306) beside one it
+    does: the note names it and gives no command, which would fail too."""
+    import argparse
+
+    from aou_dsl.cli.track_cmd import _refusal_note
+    from aou_dsl.core.diagnostics import Span, diag
+
+    span = Span.whole_file(FEARFUL)
+    args = argparse.Namespace(path=FEARFUL, robot="kinova", servo="position", track=True)
+    fit_only = [diag("C308", "a shiver too fast", span)]
+    assert "--fit --track" in _refusal_note(args, fit_only)
+    both = [*fit_only, diag("C306", "table-contact check failed", span)]
+    note = _refusal_note(args, both)
+    assert "C306" in note and "--fit --track" not in note and "mend that first" in note
