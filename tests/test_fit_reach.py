@@ -169,12 +169,14 @@ def test_the_hint_gives_every_reach_change_at_once():
 
 def test_a_too_fast_refusal_s_hint_names_every_statement_too_fast():
     """Two shivers of a sequence too fast for the Z1's wrist: the compiler stops at the
-    first, and its hint adds the second's edit; applied, the file compiles."""
+    first, and its hint adds the second's edit (each narrower at its own frequency:
+    slower, they would read as slow rolls); applied, the file compiles."""
     text = ("robot z1\nsequence {\n  approach 0.1m\n  pause 1s\n  shiver 5deg f=2.5Hz\n"
             "  pause 1s\n  shiver 4deg f=2.2Hz for 2s\n}\n")
     (d,) = _errors(build_source(text, "s.aou", check=False))
     assert d.code == "C308" and d.span.line == 5
-    assert re.search(r"; and `f=[0-9.]+Hz[^`]*` in the shiver at line 7", d.hint), d.hint
+    assert re.search(r"`shiver [0-9.]+deg f=2.5Hz` at line 5; `shiver [0-9.]+deg f=2.2Hz "
+                     r"for 2s` at line 7", d.hint), d.hint
     fixed = apply_hint(text, d)
     again = build_source(fixed, "s.aou")
     assert again.ok, (fixed, [(x.code, x.message) for x in again.diagnostics])
