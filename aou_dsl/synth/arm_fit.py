@@ -19,7 +19,7 @@ from ..core.codes import C304
 from ..core.diagnostics import AouError, has_errors
 from ..core.memo import cached
 from ..lang.ir import DEFAULTS
-from ..lang.primitives import LOOK_SHIVER_F, VISIBLE_SHIVER, shiver_duration
+from ..lang.primitives import MIN_SHIVER_F, shiver_duration
 from .recipe import Recipe, descriptor
 
 __all__ = ["SHIVER_F", "Limits", "fit", "fit_limits", "floor_sig", "goal_line", "robot_line",
@@ -146,33 +146,28 @@ SHIVER_F = "shiver frequency"
 
 
 def _fit_shiver(r: Recipe, lim: Limits) -> Recipe:
-    """The shiver at the language default, slowed while it stays a tremor (at least
-    :data:`~aou_dsl.lang.primitives.LOOK_SHIVER_F`: slower, its swings read as slow
-    rolls), else narrowed at that frequency (not under the visible floor)."""
     node = r.node("shiver")
     f_max = shiver_max_frequency(node.amplitude, node.duration, lim)
     if node.f <= f_max:
         return r.noted(SHIVER_F, "the language default (the study gives none)")
-    if f_max >= LOOK_SHIVER_F:
+    if f_max >= MIN_SHIVER_F:
         f = floor_sig(f_max)
         return r.with_node(node.replace(f=f, duration=_whole(node.duration, f))).noted(
             SHIVER_F, f"the language default {node.f:g} Hz, lowered to {f:g} Hz for "
             f"{lim.robot}'s {lim.roll_joint} (the amplitude stays)")
     # the peaks are proportional to the amplitude at a fixed frequency
-    amp = floor_sig(math.degrees(node.amplitude) * (f_max / LOOK_SHIVER_F) ** 2)
-    least = math.degrees(VISIBLE_SHIVER)
-    while amp > least and shiver_max_frequency(math.radians(amp), node.duration,
-                                               lim) < LOOK_SHIVER_F:
+    amp = floor_sig(math.degrees(node.amplitude) * (f_max / MIN_SHIVER_F) ** 2)
+    while amp > 1.0 and shiver_max_frequency(math.radians(amp), node.duration,
+                                             lim) < MIN_SHIVER_F:
         amp = floor_sig(amp * 0.9)
     name = descriptor("shiver", "amplitude").name
     note = (f"{r.notes.get(name, '')}; reduced from {math.degrees(node.amplitude):g} to "
             f"{amp:g} deg: {lim.robot}'s {lim.roll_joint} cannot shiver wider at "
-            f"{LOOK_SHIVER_F:g} Hz")
-    return (r.with_node(node.replace(f=LOOK_SHIVER_F, amplitude=math.radians(amp),
-                                     duration=_whole(node.duration, LOOK_SHIVER_F)))
-            .noted(SHIVER_F, f"{LOOK_SHIVER_F:g} Hz, the slowest that still reads as a "
-                   f"tremor ({lim.robot}'s {lim.roll_joint} follows a wide one only slower)")
-            .noted(name, note))
+            f"{MIN_SHIVER_F:g} Hz")
+    return (r.with_node(node.replace(f=MIN_SHIVER_F, amplitude=math.radians(amp),
+                                     duration=_whole(node.duration, MIN_SHIVER_F)))
+            .noted(SHIVER_F, f"lowered to {MIN_SHIVER_F:g} Hz for {lim.robot}'s "
+                   f"{lim.roll_joint}").noted(name, note))
 
 
 def _whole(duration: float, f: float) -> float:
