@@ -168,7 +168,10 @@ def report() -> str:
                        f"{passing + fits} of {len(BEHAVIOURS)} | {'; '.join(failing)} |")
     head = [START, "", f"{all_pass} of {len(ROBOTS)} arms compile all {len(BEHAVIOURS)} "
             "shipped behaviours, pass the checks and measure as declared; "
-            f"{all_fit} of {len(ROBOTS)} do with --fit (the fitted values stated below).",
+            f"{all_fit} of {len(ROBOTS)} do with --fit (the fitted values stated below"
+            + ("; where no fit keeps what a person sees, --fit refuses with C315, the reason"
+               " stated below" if "| refused (C315) |" in "\n".join(sections) else "")
+            + ").",
             "", "| arm | as declared | as declared or with --fit | the others (binding) |",
             "|---|---|---|---|", *summary, ""]
     return "\n".join(head + every_arm(status) + sections + [END]) + "\n"
