@@ -75,7 +75,7 @@ def test_each_front_end_rule_example_triggers_its_own_code(code):
 #: keeps within the jerk limits by construction (tests/test_jerk.py has both sides).
 UNREACHED = {"C303", "C305", "C311"}
 #: Codes said only when a build fits the behaviour to the arm (``--fit``).
-FIT_CODES = {"C314"}
+FIT_CODES = {"C314", "C315"}
 #: Codes said only by ``aouc check`` (inverse dynamics, the physics replay, --track):
 #: tests/test_torque.py and tests/test_track.py reach each.
 CHECK_CODES = {"C320", "C321", "C322", "C323"}

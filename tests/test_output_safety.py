@@ -335,9 +335,11 @@ def fit_ws(tmp_path, monkeypatch):
     is a file of the folder, with a mesh; and a trajectory compiled from it."""
     monkeypatch.chdir(tmp_path)
     _workspace(tmp_path)
-    Path("arm.toml").write_text('robot = "ur5"\n')
+    # a wrist that follows fearful's shiver, made 4 Hz, at 2.8 Hz (still a tremor)
+    Path("arm.toml").write_text('robot = "ur5"\njoint_accel = [5, 5, 5, 5, 5, 18]\n')
     Path("b.aou").write_text((BEHAVIOURS / "fearful.aou").read_text().replace(
-        "behaviour fearful : fearful", 'behaviour fearful : fearful\nrobot "arm.toml"'))
+        "behaviour fearful : fearful", 'behaviour fearful : fearful\nrobot "arm.toml"')
+        .replace("shiver 6deg for 1.25s", "shiver 6deg f=4Hz for 0.8s"))
     return tmp_path
 
 

@@ -1,7 +1,7 @@
 """A shiver's `for`: given once, and the C308 fix that changes it writes one.
 
 A repeated `for` was accepted (the last one won) where a repeated `a=` or a second count
-is an error; the C308 hint on `shiver 30deg f=12Hz for 1s` (Panda) sets `f=` and `for`
+is an error; the C308 hint on `shiver 5deg f=12Hz for 0.5s` (Panda) sets `f=` and `for`
 together, and an editor's quick fix that set `f=` alone wrote a second `for`.
 """
 
@@ -14,7 +14,7 @@ from aou_dsl.compiler.fitting import apply_edit
 from aou_dsl.core.diagnostics import Span
 from aou_dsl.lang.linter import lint_source
 
-REFUSED = "behaviour f : fearful\nrobot panda\nshiver 30deg f=12Hz for 1s\n"
+REFUSED = "behaviour f : fearful\nrobot panda\nshiver 5deg f=12Hz for 0.5s\n"
 
 
 @pytest.mark.parametrize("stmt", ["shiver 30deg f=1.3Hz for 2.31s for 1s",

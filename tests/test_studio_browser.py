@@ -373,7 +373,11 @@ def test_fit_lists_the_fitted_values_in_the_page_and_fits_each_move(tmp_path, op
 
     path = tmp_path / "fearful.aou"
     shutil.copy(os.path.join(ROOT, "behaviours", "fearful.aou"), path)
-    studio = Studio(str(path), robot="ur5", port=0, fit=True).start()
+    path.write_text(path.read_text().replace("shiver 6deg for 1.25s",
+                                             "shiver 6deg f=4Hz for 0.8s"))
+    arm = tmp_path.parent / f"{tmp_path.name}-ur5.toml"  # its wrist follows 2.8 Hz
+    arm.write_text('robot = "ur5"\njoint_accel = [5, 5, 5, 5, 5, 18]\n')
+    studio = Studio(str(path), robot=str(arm), port=0, fit=True).start()
     try:
         page = open_page(studio)
         item = page.locator('#aou-fitted li[data-key="a"]')

@@ -41,7 +41,9 @@ def _advice(d, arm) -> tuple[str, str]:
     if d.code == "C308":
         limit = f.get("limit", "acceleration")
         fits = (f"shiver at most {f['max_frequency']:g} Hz at this amplitude (or a smaller "
-                "amplitude at 2.5 Hz)" if f.get("max_frequency") else "a smaller shiver")
+                "amplitude at 2.5 Hz)" if f.get("max_frequency") else
+                "no shiver that still looks like one (see --fit)" if f.get("look")
+                else "a smaller shiver")
         return (f"{f['joint']} {limit}" + (f" ({_limit(arm, f['joint'])})"
                                            if limit == "acceleration" else ""),
                 f"{fits}, or pin a higher `joint_{'accel' if limit == 'acceleration' else limit}`"
@@ -113,7 +115,11 @@ def _fitted(path: Path, robot: str, notes: list[str]) -> str:
     same = res.measured is not None and res.lint.cv is not None and \
         res.measured.cv.state == res.lint.cv.state
     good = res.ok and same and not any(d.code == "C310" for d in res.diagnostics)
+    look = [d for d in res.diagnostics if d.code == "C315"]
     said = "; ".join(d.message for d in changes) or "nothing fitted"
+    if look:  # refused rather than change the kind of motion a person sees
+        notes.append(f"{path.stem} with --fit: refused, C315 {look[0].message}.")
+        return "refused (C315)"
     notes.append(f"{path.stem} with --fit: {said}.")
     return "yes" if good else "no"
 
@@ -162,7 +168,10 @@ def report() -> str:
                        f"{passing + fits} of {len(BEHAVIOURS)} | {'; '.join(failing)} |")
     head = [START, "", f"{all_pass} of {len(ROBOTS)} arms compile all {len(BEHAVIOURS)} "
             "shipped behaviours, pass the checks and measure as declared; "
-            f"{all_fit} of {len(ROBOTS)} do with --fit (the fitted values stated below).",
+            f"{all_fit} of {len(ROBOTS)} do with --fit (the fitted values stated below"
+            + ("; where no fit keeps what a person sees, --fit refuses with C315, the reason"
+               " stated below" if "| refused (C315) |" in "\n".join(sections) else "")
+            + ").",
             "", "| arm | as declared | as declared or with --fit | the others (binding) |",
             "|---|---|---|---|", *summary, ""]
     return "\n".join(head + every_arm(status) + sections + [END]) + "\n"

@@ -1,31 +1,50 @@
-"""A shiver no frequency fits (C308 without a frequency: even 1 Hz, the slowest the
-language has, is too fast at that amplitude) is fitted by its amplitude instead, at its
-frequency, by the rule of the other values: the widest amplitude the shiver joint
-follows at that frequency is its bound ``P`` (the shiver's peaks grow in proportion to
-the amplitude, so ``P`` is the amplitude over its largest ratio to a limit), and the
-declared amplitude is compressed under it by
+"""A shiver no frequency fits that still looks like one (C308 without a frequency: at
+its amplitude the arm follows it only slower than
+:data:`~aou_dsl.lang.primitives.LOOK_SHIVER_F`, where its swings read as slow rolls) is
+fitted by its amplitude instead, by the rule of the other values: the widest amplitude
+the shiver joint follows at a frequency is its bound ``P`` (the shiver's peaks grow in
+proportion to the amplitude, so ``P`` is the amplitude over its largest ratio to a
+limit), and the declared amplitude is compressed under it by
 :func:`~aou_dsl.compiler.fitting.compress`, an increasing map, so a variant pair keeps
-its order. The change is the refusal's hint (``write `shiver 2.05deg f=2.5Hz` at line
-5``) and its field ``reach`` (read by ``--fit``); an amplitude too small to be seen is not
-offered.
+its order.
+
+The frequency tried first is the declared one (one change); when the amplitude that fits
+there is narrower than a person sees (:data:`~aou_dsl.lang.primitives.VISIBLE_SHIVER`), a
+declared frequency above the look's floor is lowered to the floor too, where a wider
+shiver fits. The change is the refusal's hint (``write `shiver 2.05deg` at line 5``) and
+its field ``reach`` (read by ``--fit``). When neither gives a shiver that is fast enough
+and wide enough to look like one, and keeps the file's state, nothing is offered and the
+refusal's field ``look`` says why (``--fit`` reports it as C315): a fit never turns a
+shiver into a slow roll.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Any
 
 from ..core.codes import C308
-from ..core.diagnostics import Severity
+from ..core.diagnostics import Diagnostic, Severity
 from ..lang.linter import lint_source
 from .reach_fit import Statement, offered
 
 __all__ = ["with_amplitude_fit"]
 
 
+def _refused(res: Any, d: Diagnostic, why: str) -> Any:
+    """``res`` with ``d`` saying why no shiver keeps its look (field ``look``, and its
+    hint when it has none: there is no edit to offer)."""
+    hint = d.hint or f"no shiver this arm follows keeps the look: {why}"
+    res.diagnostics = [replace(x, hint=hint, fields={**x.fields, "look": why}) if x is d
+                       else x for x in res.diagnostics]
+    return res
+
+
 def with_amplitude_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...]) -> Any:
     """``res`` (a build result) with its C308 that no frequency answers given the
-    amplitude that fits at the declared frequency."""
+    amplitude that fits (at the declared frequency, else at the slowest shiver that
+    looks like one), or the reason none does."""
     lint, b = res.lint, res.lint.behaviour
     d = next((x for x in res.diagnostics if x.code == C308 and x.severity is Severity.ERROR
               and not x.fields.get("max_frequency") and x.span.path == lint.path), None)
@@ -36,21 +55,54 @@ def with_amplitude_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...
     st = Statement(lint.source, d.span.line, d.span.col, d.span.end_col, ("shiver",))
     if ep is None or not st.ok or st.dim != "angle":
         return res
-    from ..compiler.fitting import compress
+    from ..compiler.fitting import Change, apply, compress, shiver_keys
     from ..compiler.oscillation import shiver_ratios
-    from ..lang.primitives import MIN_ANGLE
+    from ..core.diagnostics import Span
+    from ..lang.primitives import LOOK_SHIVER_F, VISIBLE_SHIVER, Shiver, shiver_duration
     from ..robot.load import load_arm
 
     arm = load_arm(robot or b.settings.robot, None, package_dirs)
-    bound = ep.amplitude / max(shiver_ratios(arm, ep.amplitude, ep.f, ep.duration))
-    stmt, text = st.with_value(compress(abs(st.value), bound))
-    fitted = Statement(stmt, 1, 1, len(stmt) + 1, ("shiver",))
-    if not fitted.ok or abs(fitted.value) < MIN_ANGLE or not math.isfinite(bound):
+    node = next((n for n in b.primitives if n.span == d.span), None)
+    timed = isinstance(node, Shiver) and node.timed
+    asked = node.duration if isinstance(node, Shiver) else ep.duration
+    least = math.degrees(VISIBLE_SHIVER)
+    why = ""
+    for fa in (ep.f,) if ep.f <= LOOK_SHIVER_F else (ep.f, LOOK_SHIVER_F):
+        dur = shiver_duration(asked, fa)
+        bound = ep.amplitude / max(shiver_ratios(arm, ep.amplitude, fa, dur))
+        if not math.isfinite(bound):
+            return res
+        stmt, text = st.with_value(compress(abs(st.value), bound))
+        fitted = Statement(stmt, 1, 1, len(stmt) + 1, ("shiver",))
+        if not fitted.ok or abs(fitted.value) < VISIBLE_SHIVER * (1.0 - 1e-9):
+            why = (f"at {fa:g} Hz the arm follows a shiver of {math.degrees(bound):.3g} deg "
+                   f"at most, under the {least:g} deg a person sees; a slower one than "
+                   f"{min(ep.f, LOOK_SHIVER_F):g} Hz would read as slow rolls, not a tremor")
+            continue
+        keys = shiver_keys(fa, asked if timed else None) if fa != ep.f else []
+        one = Span(d.span.path, 1, 1, 1, len(stmt) + 1)
+        stmt = apply(stmt, [Change(one, k, "", v, u, None, None, None) for k, v, u, _ in keys])
+        row = lint.source.split("\n")
+        row[st.line - 1] = row[st.line - 1][:st.col - 1] + stmt + row[st.line - 1][st.stop:]
+        text = "\n".join(row)
+        again = lint_source(text, lint.path)
+        if not again.ok:
+            return res
+        if b.state is not None and (again.cv is None or again.cv.state != b.state):
+            found = again.cv.state.value if again.cv is not None else "nothing"
+            why = (f"the {fitted.written} deg shiver the arm follows at {fa:g} Hz would make "
+                   f"the file express `{found}`, not `{b.state.value}`, and a slower one "
+                   f"than {min(ep.f, LOOK_SHIVER_F):g} Hz would read as slow rolls, not a "
+                   "tremor")
+            continue
+        joint, limit = d.fields.get("joint"), d.fields.get("limit")
+        records = [st.record(fitted.written, stmt, bound, joint, limit)]
+        was = {"f": d.fields.get("f"), "for": d.fields.get("duration")}
+        for k, v, u, desc in keys:
+            w = was.get(k)
+            records.append(records[0] | {
+                "key": k, "declared": "" if w is None else f"{w:.3g}", "fitted": v,
+                "unit": u, "bound": fa if k == "f" else float(v), "descriptor": desc})
+        res.diagnostics = [offered(x, records) if x is d else x for x in res.diagnostics]
         return res
-    again = lint_source(text, lint.path)
-    if b.state is not None and (again.cv is None or again.cv.state != b.state):
-        return res  # the smaller shiver would express another state: nothing to offer
-    record = st.record(fitted.written, stmt, bound, d.fields.get("joint"),
-                       d.fields.get("limit"))
-    res.diagnostics = [offered(x, [record]) if x is d else x for x in res.diagnostics]
-    return res
+    return _refused(res, d, why)

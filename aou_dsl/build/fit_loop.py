@@ -5,7 +5,11 @@ Each change is a C314 warning at its statement ("declared -> fitted", the joint 
 limit that bind); the fitted file's text is kept (``fitted_source``, written by
 ``--write-fitted``) and the document lists the changes (``fitted``). A fit that would
 make the file express another state than the one it declares is not made: the build
-stays refused, and a C314 says why.
+stays refused, and a C314 says why. Nor is one that would make an episode look like
+another kind than it declares (each kind's invariant,
+:meth:`~aou_dsl.lang.primitives.Kind.keeps_look`: a shiver slower than a tremor, a tilt
+faster than declared, a retreat too short to see): C315 says why, as it does for a
+shiver no frequency and no visible amplitude fits (:mod:`~aou_dsl.build.amplitude_fit`).
 """
 
 from __future__ import annotations
@@ -16,10 +20,11 @@ from dataclasses import replace
 from typing import Any
 
 from ..compiler.fitting import FITTED, Change, apply, plan
-from ..core.codes import C314
+from ..core.codes import C314, C315
 from ..core.diagnostics import Diagnostic, diag
 from ..core.repeats import said_once
 from ..lang.linter import FileResult, lint_source
+from ..lang.primitives import look_changed
 
 __all__ = ["MAX_ROUNDS", "fit_loop"]
 
@@ -50,7 +55,12 @@ def _not_fitted(todo: list[Diagnostic], where: Any) -> list[Diagnostic]:
     """C314 for each reach refusal no change answers, with why
     (:mod:`~aou_dsl.build.reach_fit`)."""
     return [diag(C314, f"not fitted: {d.fields['reach_fit']}", d.span)
-            for d in todo if d.fields.get("reach_fit")]
+            for d in todo if d.fields.get("reach_fit")] + [
+        diag(C315, f"not fitted: no shiver the arm follows keeps the look: "
+             f"{d.fields['look']}", d.span, hint="a wider or faster shiver needs a "
+             "stronger wrist (a robot description's `joint_accel`, if the arm allows "
+             "more); else leave the shiver out on this arm", look=d.fields["look"])
+        for d in todo if d.fields.get("look")]
 
 
 def fit_loop(lint: FileResult, build: Callable[[FileResult], Any]) -> Any:
@@ -78,6 +88,13 @@ def fit_loop(lint: FileResult, build: Callable[[FileResult], Any]) -> Any:
                 C314, f"not fitted: the changes ({', '.join(c.text for c in changes)}) "
                 f"would make the file express `{found}`, not "
                 f"`{state.value if state else 'what it does'}`", b.span))
+            return res
+        why = None if lint.timeline is None or new_lint.timeline is None else \
+            look_changed(lint.timeline.episodes, new_lint.timeline.episodes)
+        if why is not None:
+            res.diagnostics.append(diag(
+                C315, f"not fitted: the changes ({', '.join(c.text for c in changes)}) "
+                f"would change the kind of motion a person sees: {why}", b.span, look=why))
             return res
         for c in changes:
             key = (c.span.line, c.span.col, c.key)

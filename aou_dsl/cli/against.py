@@ -73,7 +73,8 @@ def cmd_measure_against(args: argparse.Namespace, read) -> int:
             raise
         rec = read(args.path, args, robot=b.settings.robot)
     verdict = judge(rec, lint)
-    outside: list[Diagnostic] = verdict.outside() + verdict.undecided()
+    outside: list[Diagnostic] = verdict.outside() + verdict.undecided() \
+        + verdict.undeclared()
     sources = {lint.path: lint.source or ""}
     if args.format == "json":
         print(format_json(verdict.to_json() | {

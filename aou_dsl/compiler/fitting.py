@@ -34,7 +34,8 @@ from dataclasses import dataclass
 from ..core.codes import C301, C302, C303, C304, C308, C309
 from ..core.diagnostics import Diagnostic, Span
 
-__all__ = ["KNEE", "Change", "apply", "apply_edit", "compress", "hint_edit", "plan"]
+__all__ = ["KNEE", "Change", "apply", "apply_edit", "compress", "hint_edit", "plan",
+           "shiver_keys"]
 
 #: Fraction of the arm's peak below which a declared value is never changed.
 KNEE = 0.9
@@ -98,17 +99,24 @@ def _up(x: float) -> str:
     return f"{math.ceil(x / 10 ** e - 1e-9) * 10 ** e:.{max(0, -e)}f}".rstrip("0").rstrip(".")
 
 
-def _shiver(d: Diagnostic) -> list[tuple[str, str, str, str | None]]:
-    """``(key, fitted, unit, descriptor)`` of a shiver too fast: its highest frequency,
-    and, when the statement says `for`, one of the 3 cycles it then lasts at least."""
-    f_ok = d.fields.get("max_frequency")
-    if not f_ok:
-        return []
+def shiver_keys(f_ok: float, runs: float | None) -> list[tuple[str, str, str, str | None]]:
+    """``(key, fitted, unit, descriptor)`` of a shiver made ``f_ok`` [Hz]: its frequency,
+    and, when the statement says `for` (``runs`` [s], else None), one of the 3 cycles it
+    then lasts at least."""
     out: list[tuple[str, str, str, str | None]] = [("f", _down(f_ok), "Hz", None)]
-    runs = d.fields.get("duration")  # None: the statement has no `for`
     if runs is not None and round(runs * float(_down(f_ok))) < 3:
         out.append(("for", _up(3.0 / float(_down(f_ok))), "s", None))
     return out
+
+
+def _shiver(d: Diagnostic) -> list[tuple[str, str, str, str | None]]:
+    """``(key, fitted, unit, descriptor)`` of a shiver too fast: its highest frequency
+    (one the compiler offers only when it still looks like a shiver), and, when the
+    statement says `for`, one of the 3 cycles it then lasts at least."""
+    f_ok = d.fields.get("max_frequency")
+    if not f_ok:
+        return []
+    return shiver_keys(f_ok, d.fields.get("duration"))  # duration None: no `for`
 
 
 def hint_edit(d: Diagnostic) -> str | None:

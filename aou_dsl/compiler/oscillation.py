@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from ..core.memo import cached
-from ..lang.primitives import MIN_ANGLE, MIN_SHIVER_F
+from ..lang.primitives import LOOK_SHIVER_F, VISIBLE_SHIVER
 from ..robot.kinematics import ArmModel
 from .fits import TimingFailure, largest_fitting, times
 from .peak_limits import JERK_SCALE, LIMIT_SLACK
@@ -111,17 +111,19 @@ def _fits(ratios: tuple[float, ...]) -> bool:
 def _suggestions(arm: ArmModel, amplitude: float, f: float, duration: float, need: float
                  ) -> tuple[float | None, list[str]]:
     """The highest frequency that fits at ``amplitude`` (None when none is found), and
-    the changes to suggest in words: that frequency if the language allows it, and the
-    widest amplitude at ``f``; without a frequency, the widest amplitude at ``f`` or, if
-    that is too small to see, at the slowest shiver."""
+    the changes to suggest in words, each one that keeps the shiver's look: that
+    frequency if it is not under the slowest shiver that looks like one
+    (:data:`~aou_dsl.lang.primitives.LOOK_SHIVER_F`, or ``f`` when it is slower), else the
+    widest amplitude at ``f`` or, if that is too narrow to see, at that slowest shiver."""
     cycles = duration * f  # the same `for` at another frequency: the same peaks
     f_ok = largest_fitting(f / need, lambda fc: _fits(
         shiver_ratios(arm, amplitude, fc, cycles / fc)), below=f)
+    floor = min(f, LOOK_SHIVER_F)
     ways = []
-    if f_ok is not None and f_ok >= MIN_SHIVER_F:
+    if f_ok is not None and f_ok >= floor:
         ways.append(f"at most {f_ok:g} Hz fits at this amplitude")
-    least = math.degrees(MIN_ANGLE)
-    for fa in (f,) if ways else (f, MIN_SHIVER_F):
+    least = math.degrees(VISIBLE_SHIVER)
+    for fa in (f,) if ways or floor == f else (f, floor):
         def fits(deg: float, fa: float = fa) -> bool:
             return _fits(shiver_ratios(arm, math.radians(deg), fa, cycles / fa))
 
@@ -131,7 +133,8 @@ def _suggestions(arm: ArmModel, amplitude: float, f: float, duration: float, nee
             ways.append(f"at most {a_ok:g} deg at {fa:g} Hz")
             break
     if not ways:
-        ways.append(f"not even a {least:g} deg shiver at {MIN_SHIVER_F:g} Hz fits")
+        ways.append(f"not even a {least:g} deg shiver at {floor:g} Hz fits, and a slower "
+                    "one would read as slow rolls")
     return f_ok, ways
 
 

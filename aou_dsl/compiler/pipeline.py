@@ -22,7 +22,7 @@ from ..core.memo import Keyed, cached
 from ..core.trajectory import Trajectory
 from ..lang.ir import Behaviour
 from ..lang.layout import layout
-from ..lang.primitives import KINDS, MIN_SHIVER_F, Shiver, Timing
+from ..lang.primitives import KINDS, LOOK_SHIVER_F, Shiver, Timing
 from ..lang.timeline import Episode, Pose, Timeline
 from ..robot.geometry import ReachFrame, reach_frame
 from ..robot.identity import frame_definition
@@ -244,7 +244,9 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
             seg, shiver_fail = shiver_segment(arm, q, ep.amplitude, ep.f, ep.duration)
             if shiver_fail is not None:
                 f_ok = shiver_fail.wanted
-                ok = bool(f_ok and f_ok >= MIN_SHIVER_F)
+                # a slower shiver than the look's floor reads as slow rolls: then the
+                # amplitude is fitted instead (build/amplitude_fit.py)
+                ok = bool(f_ok and f_ok >= LOOK_SHIVER_F)
                 node = next((n for n in b.primitives if n.span == ep.span), None)
                 timed = isinstance(node, Shiver) and node.timed  # its `for`, as written
                 max_f = f_ok if ok else None

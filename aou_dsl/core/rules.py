@@ -271,6 +271,17 @@ _RULE_LIST = [
          "The fitted behaviour keeps its state and the order of its values (docs/robots.md "
          "gives the rule); --write-fitted writes the file so the change is reviewed.",
          "robot ur5\nshiver 6deg f=2.5Hz\npause 1s"),
+    Rule("C315", "fit-changes-look", _E,
+         "With --fit, no value the arm can give keeps a motion looking like the kind it "
+         "declares: a shiver the arm follows only slower than 2.5 Hz (where its swings "
+         "read as slow rolls), or at 2.5 Hz only narrower than 1 deg or too narrow for "
+         "the file's state; or a change that would make another kind of motion (a tilt "
+         "rolling faster, a retreat under 5 mm).",
+         "A fit keeps what a person sees, not only the eleven descriptors: a shiver made a "
+         "slow roll looks like curious looking around, not fearful trembling. The file is "
+         "not fitted and the refusal stands; docs/robots.md gives each kind's invariant.",
+         "behaviour f : fearful\nrobot kinova\napproach a=0.1\npause 1.25s x4\n"
+         "retreat 0.06m a=2\nshiver 6deg for 1.25s   # aouc compile --fit"),
     *CHECK_RULES,  # what `aouc check` alone says: torques, tracking
     # --- D: behaviours as Dynamic Movement Primitives ------------------------------------
     *DMP_RULES,  # the DMP folders' (rules_dmp.py)
@@ -344,6 +355,15 @@ _RULE_LIST = [
          "inconclusive.",
          "a retreat's peak acceleration measured 0.1205 +- 0.009 m/s^2 against a declared "
          "0.12 +- 0.0036"),
+    Rule("R413", "undeclared-kind", _W,
+         "A recording measured against a behaviour file (`aouc measure REC --against "
+         "FILE.aou`) has episodes that read as a kind of motion the file does not "
+         "declare: a tilt, a gaze, a retreat..., or a shiver slower than 2.5 Hz, whose "
+         "swings read as slow rolls (a tilt).",
+         "The descriptors can pass while a person sees another motion: a tremor slowed "
+         "into rolls looks like looking around, not trembling. The warning gives the "
+         "episodes' times and what that kind looks like.",
+         "a 1.1 Hz shiver measured against a file that declares a shiver and no tilt"),
     *STUDY_RULES,  # perception studies' files (rules_study.py)
     Rule("I501", "cannot-read", _E,
          "An input file or folder cannot be read (missing, a directory, permissions, encoding).",

@@ -228,7 +228,16 @@ def _shiver(c: Context, lobes: list[Lobe]) -> EpisodeValues:
     bottom = _extreme(y, int(np.argmin(y)), -1.0, most)
     return EpisodeValues("shiver", t0, t1, {
         "amplitude": math.degrees(top - bottom), "joint": float(j),
-        "cycles": len(lobes) / 2.0})
+        "cycles": len(lobes) / 2.0, "frequency": _frequency(lobes)})
+
+
+def _frequency(lobes: list[Lobe]) -> float:
+    """A shiver's frequency [Hz]: a lobe is one swing, half a cycle. The swings that fade
+    it in and out are shorter than the full ones, so it is read from the full ones (the
+    lobes within 15 % of the longest)."""
+    longest = max(lb.duration for lb in lobes)
+    full = [lb.duration for lb in lobes if lb.duration >= 0.85 * longest]
+    return 0.5 / max(float(np.median(full)), 1e-9)
 
 
 def _tilt(lb: Lobe) -> EpisodeValues | None:

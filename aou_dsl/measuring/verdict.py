@@ -13,13 +13,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..core.codes import R408, R412
+from ..core.codes import R408, R412, R413
 from ..core.diagnostics import AouError, Diagnostic, Severity, Span, diag
 from ..core.trajectory import Trajectory
 from ..lang.cv import CVPoint
 from ..lang.declared import declared, source_of
 from ..lang.descriptors import REGISTRY, Descriptor
 from ..lang.linter import FileResult, lint_file
+from ..lang.primitives import KINDS
 from .measured import Measured, measure
 
 __all__ = ["FAIL", "INCONCLUSIVE", "PASS", "Row", "Verdict", "judge"]
@@ -80,6 +81,10 @@ class Verdict:
     measured: Measured
     goal_from_file: bool = False
     diagnostics: list[Diagnostic] = field(default_factory=list)
+    #: The kinds of motion the file's episodes make (what they do: an approach of
+    #: negative length is a retreat), and where to say a kind it lacks.
+    kinds: frozenset[str] = frozenset()
+    header: Span | None = None
 
     @property
     def ok(self) -> bool:
@@ -124,6 +129,30 @@ class Verdict:
                             measured=r.measured, tolerance=r.tolerance))
         return out
 
+    def undeclared(self) -> list[Diagnostic]:
+        """R413 for each kind of motion the recording's episodes read as that the file
+        does not declare, each episode read by its kind's invariant
+        (:meth:`~aou_dsl.lang.primitives.Kind.reads_as`: a shiver slower than a tremor
+        reads as slow rolls, a tilt), with the times of those episodes."""
+        seen: dict[str, list[tuple[str, float, float]]] = {}
+        for e in self.measured.episodes:
+            if e.kind not in KINDS:
+                continue
+            reads = KINDS[e.kind].reads_as(e.values, e.t_end - e.t_start)
+            if reads not in self.kinds:
+                seen.setdefault(reads, []).append((e.kind, e.t_start, e.t_end))
+        out = []
+        for kind, eps in seen.items():
+            when = ", ".join(f"{a:.2f}-{b:.2f} s" + (
+                "" if k == kind else f" (measured as a {k}, {_why(k, self.measured, a)})")
+                for k, a, b in eps[:4]) + (f" and {len(eps) - 4} more" if len(eps) > 4 else "")
+            out.append(diag(R413, f"the motion on `{self.path}` reads as a {kind} at "
+                            f"{when}; the file declares no {kind}", self.header or
+                            Span(self.against, 1, 1, 1, 1), hint=f"a {kind} looks like "
+                            f"this: {KINDS[kind].look}", kind=kind,
+                            episodes=[[k, round(a, 4), round(b, 4)] for k, a, b in eps]))
+        return out
+
     def to_json(self) -> dict:
         return {"path": self.path, "against": self.against, "robot": self.robot,
                 "ok": self.ok, "result": self.result,
@@ -137,6 +166,13 @@ def _text(v: float | int | None, unit: str = "") -> str:
     if v is None:
         return "absent"
     return f"{v:.4g}{' ' + unit if unit else ''}"
+
+
+def _why(kind: str, m: Measured, t0: float) -> str:
+    """Why an episode measured as ``kind`` reads as another: its invariant's number."""
+    e = next(x for x in m.episodes if x.kind == kind and x.t_start == t0)
+    f = e.values.get("frequency")
+    return f"{f:.2g} Hz, slower than a tremor" if f is not None else "by its look"
 
 
 def _round(v: float | int | None) -> float | int | None:
@@ -212,5 +248,7 @@ def judge(rec: Trajectory, behaviour: str | FileResult) -> Verdict:
         goal = b.settings.goal or load_robot(rec.robot, rec.package_dirs).spec.goal
         rec = rec.with_(goal=tuple(float(x) for x in goal))
     m = measure(rec)
+    b = lint.behaviour
     return Verdict(rec.path, lint.path, rec.robot, _rows(lint, m), lint.cv, m.cv, m,
-                   from_file, list(m.diagnostics))
+                   from_file, list(m.diagnostics),
+                   frozenset(e.kind for e in lint.timeline.episodes), _absent_at(b))

@@ -8,15 +8,17 @@ from __future__ import annotations
 
 from .approach import Approach, ApproachKind
 from .gaze import GAZE_ANGULAR_ACCEL, Gaze, GazeKind
-from .kind import MIN_ANGLE, MIN_PAUSE, MIN_RETREAT, Kind, Timing
+from .kind import LOOK_SLACK, MIN_ANGLE, MIN_PAUSE, MIN_RETREAT, Kind, Timing
 from .pause import Pause, PauseKind
 from .retreat import Retreat, RetreatKind
-from .shiver import MIN_SHIVER_F, Shiver, ShiverKind, shiver_duration
+from .shiver import LOOK_SHIVER_F, MIN_SHIVER_F, VISIBLE_SHIVER, Shiver, ShiverKind, shiver_duration
 from .tilt import Tilt, TiltKind
 
 __all__ = [
     "GAZE_ANGULAR_ACCEL",
     "KINDS",
+    "LOOK_SHIVER_F",
+    "LOOK_SLACK",
     "MIN_ANGLE",
     "MIN_PAUSE",
     "MIN_RETREAT",
@@ -29,7 +31,9 @@ __all__ = [
     "Retreat",
     "Shiver",
     "Tilt",
+    "VISIBLE_SHIVER",
     "kind_of",
+    "look_changed",
     "shiver_duration",
 ]
 
@@ -37,6 +41,19 @@ __all__ = [
 KINDS: dict[str, Kind] = {k.name: k for k in (
     ApproachKind(), PauseKind(), RetreatKind(), GazeKind(), TiltKind(), ShiverKind(),
 )}
+
+
+def look_changed(declared, fitted) -> str | None:
+    """Why the episodes ``fitted`` (a fitted file's timeline) do not look like
+    ``declared`` (the file's as written), episode by episode by each kind's own
+    invariant (:meth:`Kind.keeps_look`), or None when every one keeps its look."""
+    if len(declared) != len(fitted):
+        return f"it would have {len(fitted)} episodes, not {len(declared)}"
+    for d, f in zip(declared, fitted, strict=True):
+        why = KINDS[d.kind].keeps_look(d, f)
+        if why is not None:
+            return why
+    return None
 
 
 def kind_of(node) -> Kind:

@@ -70,6 +70,7 @@ class ApproachKind(Kind):
     keys = {"a": Key(Dim.ACCEL, "m/s^2", "acceleration"),
             "v": Key(Dim.SPEED, "m/s", "speed")}
     evidence = {"drive": ("peak_acceleration", "max")}
+    look = "moves toward the goal along the line of sight"
 
     def read(self, r):
         length = None

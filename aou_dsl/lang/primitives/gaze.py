@@ -44,6 +44,20 @@ class GazeKind(Kind):
     usage = "gaze horizontal|vertical ANGLE [v=ANGSPEED] [xN]"
     keys = {"v": Key(Dim.ANGULAR_SPEED, "deg/s", "angular speed")}
     evidence = {"exploration": ("angle", "sum")}
+    look = ("holds the goal: the hand turns about it in its plane, its line of sight on the "
+            "goal throughout, and ends on the side it declares")
+
+    def keeps_look(self, declared, fitted):
+        other = super().keeps_look(declared, fitted)
+        if other is not None:
+            return other
+        if fitted.plane != declared.plane:
+            return f"the gaze would turn in the {fitted.plane} plane, not the {declared.plane}"
+        want = _angle_in(declared.end, declared.plane) - _angle_in(declared.start, declared.plane)
+        got = _angle_in(fitted.end, fitted.plane) - _angle_in(fitted.start, fitted.plane)
+        if want * got < 0.0 or (want != 0.0 and got == 0.0):
+            return "the gaze would turn the other way, or not at all"
+        return None
 
     def read(self, r):
         plane = r.word(_PLANES, "`gaze` needs a plane: `horizontal` or `vertical`")

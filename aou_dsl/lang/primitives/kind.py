@@ -26,6 +26,10 @@ if TYPE_CHECKING:
 __all__ = ["MIN_ANGLE", "MIN_PAUSE", "MIN_RETREAT", "Key", "Kind", "Timing", "fmt", "given",
            "move"]
 
+#: How much a measured value may miss an invariant's bound before it counts as broken:
+#: a measurement reads a frequency from a few swings, to a few per cent.
+LOOK_SLACK = 0.05
+
 #: Shortest pause [s] that can be told apart from the stop between two episodes.
 MIN_PAUSE = 0.2
 #: Smallest angle [rad] and retreat [m] a behaviour may ask for: below, nobody sees it
@@ -77,6 +81,9 @@ class Kind(abc.ABC):
     translation: ClassVar[bool] = False
     #: C-V evidence: channel -> (episode value key, "sum" or "max").
     evidence: ClassVar[Mapping[str, tuple[str, str]]]
+    #: What makes its episodes look like this kind to a person, in words: the invariant
+    #: :meth:`keeps_look` holds a fit to and :meth:`reads_as` reads a measured episode by.
+    look: ClassVar[str] = ""
 
     def __init_subclass__(cls, **kw) -> None:
         super().__init_subclass__(**kw)
@@ -106,6 +113,19 @@ class Kind(abc.ABC):
     @abc.abstractmethod
     def format(self, node: Any) -> str:
         """A descriptor-form statement that validates back to ``node``."""
+
+    def keeps_look(self, declared: Episode, fitted: Episode) -> str | None:
+        """None when ``fitted`` (an episode of this kind as a fit changed it) still looks
+        like ``declared`` did, else what it would look like instead, in words. Here: it
+        is still of this kind (a subclass adds its own invariant)."""
+        if fitted.kind != declared.kind:
+            return f"it would be a {fitted.kind}, not a {declared.kind}"
+        return None
+
+    def reads_as(self, kind_values: Mapping[str, float], duration: float) -> str:
+        """The kind a person reads a measured episode of this kind as (its ``values`` and
+        its ``duration`` [s]): this kind, unless a subclass's invariant says otherwise."""
+        return self.name
 
 
 def given(arg: float | None, what: str) -> float:

@@ -29,6 +29,7 @@ class PauseKind(Kind):
     usage = "pause DURATION [xN]"
     timing = Timing.HOLD
     evidence = {"stillness": ("duration", "sum")}
+    look = f"still: every joint at rest, for at least {MIN_PAUSE:g} s"
 
     def read(self, r):
         q = r.quantity("a duration")

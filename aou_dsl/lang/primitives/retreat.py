@@ -35,6 +35,17 @@ class RetreatKind(Kind):
     keys = {"a": Key(Dim.ACCEL, "m/s^2", "acceleration"),
             "v": Key(Dim.SPEED, "m/s", "speed")}
     evidence = {"extent": ("distance", "sum"), "vigour": ("peak_acceleration", "max")}
+    look = (f"moves away: the goal distance grows, by at least {MIN_RETREAT * 1000:g} mm "
+            "(an approach statement of negative length is a retreat, and the reverse)")
+
+    def keeps_look(self, declared, fitted):
+        other = super().keeps_look(declared, fitted)
+        if other is not None:
+            return other
+        if fitted.end.d - fitted.start.d < MIN_RETREAT * (1.0 - 1e-9):
+            return (f"a retreat of {(fitted.end.d - fitted.start.d) * 1000:.3g} mm is under "
+                    f"the {MIN_RETREAT * 1000:g} mm a person sees move away")
+        return None
 
     def read(self, r):
         q = r.quantity("a distance")

@@ -11,10 +11,10 @@ from ...core.units import Dim
 from ..ir import DEFAULTS, Node
 from ..parse import Word
 from ..timeline import Episode, Pose
-from .kind import MIN_ANGLE, Key, Kind, Timing, fmt, repeat
+from .kind import LOOK_SLACK, MIN_ANGLE, MIN_PAUSE, Key, Kind, Timing, fmt, repeat
 
-__all__ = ["MIN_CYCLES", "MIN_SHIVER_F", "Shiver", "ShiverKind", "shiver_cycles",
-           "shiver_duration"]
+__all__ = ["LOOK_SHIVER_F", "MIN_CYCLES", "MIN_SHIVER_F", "Shiver", "ShiverKind",
+           "VISIBLE_SHIVER", "shiver_cycles", "shiver_duration"]
 
 
 @dataclass(frozen=True, kw_only=True, slots=True)
@@ -35,6 +35,23 @@ class Shiver(Node):
 #: back and forth, a small one is measured with a pause inside it (its speed stays under
 #: what tells motion from rest for a while), and its 3 cycles take many seconds.
 MIN_SHIVER_F = 1.0
+#: Slowest shiver that still looks like one [Hz]: the floor a fit keeps and a
+#: measurement reads by (the language accepts down to :data:`MIN_SHIVER_F`, so that files
+#: written for it keep compiling). A shiver is a tremor, a rapid alternating roll: one
+#: motion made of swings, none of them a move of its own. The language's shortest
+#: moment a person tells apart is :data:`~.kind.MIN_PAUSE` (0.2 s, the shortest pause seen
+#: as a stop). A swing (half a cycle, one reversal to the next) that lasts longer is long
+#: enough to be seen as a roll one way and a roll back: a tilt, exploration of the
+#: surroundings rather than a tremor, and the motion drifts from fearful toward curious.
+#: So a swing lasts at most ``MIN_PAUSE``: ``f >= 1 / (2 MIN_PAUSE)`` = 2.5 Hz, the
+#: language's default frequency.
+LOOK_SHIVER_F = 1.0 / (2.0 * MIN_PAUSE)
+#: Narrowest shiver a fit may leave [rad]: the language's least visible angle
+#: (:data:`~.kind.MIN_ANGLE`, 1 deg, twice the 0.5 deg a shiver's amplitude is measured
+#: to, so that a shiver at the floor is read as present beyond its tolerance). Chosen at
+#: it, not above: the study found no perceived effect of a shiver's amplitude on how
+#: fearful a motion looks, so a narrower shiver keeps the look, a slower one does not.
+VISIBLE_SHIVER = MIN_ANGLE
 #: Fewest cycles of a shiver: it fades in over the first and out over the last.
 MIN_CYCLES = 3
 #: The rule of a shiver that lasts longer than its `for` says.
@@ -73,6 +90,30 @@ class ShiverKind(Kind):
     keys = {"f": Key(Dim.FREQUENCY, "Hz", "shiver frequency")}
     timing = Timing.OSCILLATION
     evidence = {"tremor": ("amplitude", "sum")}
+    look = (f"rapid: at least {LOOK_SHIVER_F:g} Hz (each swing over within "
+            f"{MIN_PAUSE:g} s), and at least {math.degrees(VISIBLE_SHIVER):g} deg wide")
+
+    def keeps_look(self, declared, fitted):
+        other = super().keeps_look(declared, fitted)
+        if other is not None:
+            return other
+        floor = min(declared.f, LOOK_SHIVER_F)
+        if fitted.f < floor * (1.0 - 1e-9):
+            return (f"a {fitted.f:g} Hz shiver swings slower than a tremor (at least "
+                    f"{floor:g} Hz): it would read as slow rolls, a tilt")
+        least = min(declared.amplitude, VISIBLE_SHIVER)
+        if fitted.amplitude < least * (1.0 - 1e-9):
+            return (f"a {math.degrees(fitted.amplitude):.3g} deg shiver is under the "
+                    f"{math.degrees(least):g} deg a person sees")
+        return None
+
+    def reads_as(self, kind_values, duration):
+        """A measured shiver slower than :data:`LOOK_SHIVER_F` (beyond the measurement's
+        slack) reads as slow rolls back and forth: a tilt."""
+        f = kind_values.get("frequency")
+        if f is not None and f < LOOK_SHIVER_F * (1.0 - LOOK_SLACK):
+            return "tilt"
+        return self.name
 
     def read(self, r):
         q = r.quantity("an amplitude")

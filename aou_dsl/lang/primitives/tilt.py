@@ -10,7 +10,7 @@ from ...core.codes import V105
 from ...core.units import Dim
 from ..ir import DEFAULTS, Node
 from ..timeline import Episode, Pose
-from .kind import MIN_ANGLE, Key, Kind, Timing, fmt, given, repeat
+from .kind import MIN_ANGLE, MIN_PAUSE, Key, Kind, Timing, fmt, given, repeat
 
 __all__ = ["Tilt", "TiltKind"]
 
@@ -33,6 +33,22 @@ class TiltKind(Kind):
     keys = {"v": Key(Dim.ANGULAR_SPEED, "deg/s", "angular speed")}
     timing = Timing.FIXED
     evidence = {"exploration": ("angle", "sum")}
+    look = ("slow and single: one roll one way, no faster than declared, lasting at least "
+            f"{MIN_PAUSE:g} s (a shorter one is a twitch, a swing of a tremor)")
+
+    def keeps_look(self, declared, fitted):
+        other = super().keeps_look(declared, fitted)
+        if other is not None:
+            return other
+        turn = fitted.end.roll - fitted.start.roll
+        if turn * (declared.end.roll - declared.start.roll) <= 0.0:
+            return "the tilt would roll the other way, or not at all"
+        speed = abs(turn) / fitted.duration
+        if speed > declared.path_length / declared.duration * (1.0 + 1e-9):
+            return f"the tilt would roll faster ({math.degrees(speed):.3g} deg/s) than declared"
+        if fitted.duration < min(declared.duration, MIN_PAUSE) * (1.0 - 1e-9):
+            return f"a {fitted.duration:.3g} s roll is a twitch, not a slow tilt"
+        return None
 
     def read(self, r):
         q = r.quantity("an angle")
