@@ -240,13 +240,17 @@ def test_tracked_never_overwrites_an_input(tmp_path, capsys):
 @pytest.mark.slow
 def test_the_vendor_gen3_with_its_published_servos_keeps_the_shiver_with_feedforward(
         tmp_path, capsys):
-    """The Gen3 URDF in the tests, described with Menagerie's Gen3 table: fearful (fitted
-    to the arm) loses part of its shiver to plain set-points, and feed-forward keeps it."""
+    """The Gen3 URDF in the tests, described with Menagerie's Gen3 table: a tremor
+    (fitted to the arm) loses part of its shiver to plain set-points, and feed-forward
+    keeps it."""
     from .test_fit import GEN3
+    from .test_track_report import TREMBLE
 
     desc = tmp_path / "gen3.toml"
     desc.write_text(f'urdf = "{GEN3}"\n[servo]\ntable = "kinova_gen3"\n')
-    main(["check", str(BEHAVIOURS / "fearful.aou"), "--robot", str(desc), "--fit",
+    src = tmp_path / "tremble.aou"
+    src.write_text(TREMBLE)
+    main(["check", str(src), "--robot", str(desc), "--fit",
           "--no-dynamic", "--no-collision-check", "--track", "--format", "json"])
     doc = json.loads(capsys.readouterr().out)
     assert doc["tracking"]["servo"]["source"].startswith("MuJoCo Menagerie")
@@ -256,10 +260,10 @@ def test_the_vendor_gen3_with_its_published_servos_keeps_the_shiver_with_feedfor
     assert not shiver["position"]["ok"] and shiver["feedforward"]["ok"]
 
 
-def test_a_behaviour_the_arm_refuses_is_not_tracked_and_the_user_is_told_to_fit(capsys):
+def test_a_behaviour_the_arm_refuses_is_not_tracked_and_the_user_is_told_why(capsys):
     """Fearful's shiver is too fast for the Kinova as written (C308): --track says there
-    is no motion to track and that --fit gives one."""
+    is no motion to track, and that --fit cannot give one that stays a fearful tremor."""
     assert main(["check", str(BEHAVIOURS / "fearful.aou"), "--robot", "kinova",
                  "--track"]) == 1
     err = capsys.readouterr().err
-    assert " C308 " in err and "--fit --track" in err
+    assert " C308 " in err and "nothing to track" in err and "C315" in err

@@ -16,28 +16,50 @@ from aou_dsl.cli.commands import EXIT_OK, main  # noqa: E402
 from .conftest import BEHAVIOURS, ROOT  # noqa: E402
 
 FEARFUL = str(BEHAVIOURS / "fearful.aou")
-#: The fitted check, as the refusal's pointer names it (the replay's slow parts off).
-FITTED = ["check", FEARFUL, "--robot", "kinova", "--fit", "--track", "--no-dynamic",
-          "--no-collision-check"]
+#: Hesitant with a small fast tremor: the Kinova's wrist gives it only narrower and
+#: slower, still a tremor (2.5 Hz) and still hesitant, so ``--fit`` fits it. (Fearful's
+#: 6 deg shiver it cannot give at a tremor's rate wide enough to stay fearful.)
+TREMBLE = """behaviour tremble : hesitant
+robot panda
+start 0.30m
+standoff 0.10m
+
+approach a=0.05
+pause 1.67s x5
+retreat 0.06m a=0.12 x3
+shiver 2deg f=5Hz for 1s
+"""
 
 
 @pytest.fixture(scope="module")
-def fitted_doc():
-    """One fitted compile of fearful on the Kinova for the module (later runs reuse it)."""
+def tremble(tmp_path_factory) -> str:
+    path = tmp_path_factory.mktemp("track") / "tremble.aou"
+    path.write_text(TREMBLE)
+    return str(path)
+
+
+def fitted(path: str) -> list[str]:
+    """The fitted check, as the refusal's pointer names it (the replay's slow parts off)."""
+    return ["check", path, "--robot", "kinova", "--fit", "--track", "--no-dynamic",
+            "--no-collision-check"]
+
+
+@pytest.fixture(scope="module")
+def fitted_doc(tremble):
+    """One fitted compile of the tremor on the Kinova for the module."""
     import contextlib
     import io
 
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        code = main([*FITTED, "--format", "json"])
+        code = main([*fitted(tremble), "--format", "json"])
     assert code == EXIT_OK, err.getvalue()
     return json.loads(out.getvalue())
 
 
 def _written(key: str, statement: str) -> float:
-    """A value as the shipped file writes it (``a=2`` of its ``retreat`` line)."""
-    text = (BEHAVIOURS / "fearful.aou").read_text()
-    line = next(ln for ln in text.splitlines() if ln.startswith(statement))
+    """A value as the test's file writes it (``a=0.12`` of its ``retreat`` line)."""
+    line = next(ln for ln in TREMBLE.splitlines() if ln.startswith(statement))
     return float(re.search(rf"\b{key}=([0-9.]+)", line).group(1))
 
 
@@ -60,7 +82,7 @@ def test_the_fitted_report_says_what_each_mode_shows_of_each_descriptor_at_risk(
     shiver = risk["shiver_amplitude"]
     assert shiver["modes"]["position"]["share"] < 0.95 and not shiver["modes"]["position"]["ok"]
     assert "feedforward" in shiver["keeps"]
-    assert t["fitted"]  # the Kinova refuses fearful as written (the test below)
+    assert t["fitted"]  # the Kinova refuses the tremor as written (the test below)
     for change in t["fitted"]:  # each fitted descriptor: the file's value and the fit's
         if change["descriptor"] is None:
             continue
@@ -72,8 +94,8 @@ def test_the_fitted_report_says_what_each_mode_shows_of_each_descriptor_at_risk(
 
 
 def test_the_fitted_text_report_names_the_slower_shiver_and_the_modes_keeping_it(
-        fitted_doc, capsys):
-    assert main(FITTED) == EXIT_OK
+        fitted_doc, tremble, capsys):
+    assert main(fitted(tremble)) == EXIT_OK
     out = capsys.readouterr().out
     for f in (c for c in fitted_doc["tracking"]["fitted"] if c["key"] == "f"):
         assert f"fitted from {f['declared']} Hz to {f['fitted']} Hz" in out
@@ -90,14 +112,24 @@ def test_the_fitted_text_report_names_the_slower_shiver_and_the_modes_keeping_it
             assert f"(written {float(c['declared']):.4g})" in row
 
 
-def test_a_refusal_points_to_the_command_that_tracks_the_fitted_motion(capsys):
-    """Fearful as written is refused on the Kinova (C308): the pointer is the exact
+def test_a_refusal_points_to_the_command_that_tracks_the_fitted_motion(tremble, capsys):
+    """The tremor as written is refused on the Kinova (C308): the pointer is the exact
     command, which the tests above run and which works."""
-    assert main(["check", FEARFUL, "--robot", "kinova", "--track"]) == 1
+    assert main(["check", tremble, "--robot", "kinova", "--track"]) == 1
     err = capsys.readouterr().err
     assert " C308 " in err
-    assert f"aouc check {FEARFUL} --robot kinova --fit --track" in err
-    assert "line 8" in err
+    assert f"aouc check {tremble} --robot kinova --fit --track" in err
+    assert "line 9" in err
+
+
+def test_a_refusal_the_fit_refuses_too_gets_the_fits_reason_not_a_command(capsys):
+    """Fearful on the Kinova: the arm refuses its shiver (C308), and the fit cannot keep
+    it a fearful tremor (C315). The note gives the fit's reason, not a command that
+    would be refused."""
+    assert main(["check", FEARFUL, "--robot", "kinova", "--track"]) == 1
+    err = capsys.readouterr().err
+    note = next(ln for ln in err.splitlines() if ln.startswith("aouc check --track"))
+    assert "C315" in note and "--fit --track" not in note
 
 
 def test_a_file_with_errors_of_its_own_is_not_pointed_to_fit(capsys):
@@ -127,11 +159,11 @@ def test_the_same_plan_gives_the_same_report(capsys):
 
 
 def test_compile_fit_track_reports_the_files_values_beside_the_fitted_ones(
-        fitted_doc, tmp_path, capsys):
+        fitted_doc, tremble, tmp_path, capsys):
     """compile --fit --track prints the same report on standard error: what the fit
     changed, and the file's value beside a fitted one."""
     out = tmp_path / "f.json"
-    assert main(["compile", FEARFUL, "--robot", "kinova", "--fit", "--track", "--no-check",
+    assert main(["compile", tremble, "--robot", "kinova", "--fit", "--track", "--no-check",
                  "-o", str(out)]) == EXIT_OK
     err = capsys.readouterr().err
     assert "fitted to the arm before tracking" in err
@@ -177,7 +209,7 @@ def test_the_fitted_json_carries_the_fit_and_the_tracking_diagnostics(fitted_doc
     assert lost["fields"]["keeps"] == keeps and lost["fields"]["mode"] == "position"
 
 
-def test_a_refusal_the_fit_cannot_change_gets_no_fit_command():
+def test_a_refusal_the_fit_cannot_change_gets_no_fit_command(tremble):
     """A refusal of a kind --fit does not change (a failed check, C306) beside one it
     does: the note names it and gives no command, which would fail too."""
     import argparse
@@ -185,8 +217,8 @@ def test_a_refusal_the_fit_cannot_change_gets_no_fit_command():
     from aou_dsl.cli.track_cmd import _refusal_note
     from aou_dsl.core.diagnostics import Span, diag
 
-    span = Span.whole_file(FEARFUL)
-    args = argparse.Namespace(path=FEARFUL, robot="kinova", servo="position", track=True)
+    span = Span.whole_file(tremble)
+    args = argparse.Namespace(path=tremble, robot="kinova", servo="position", track=True)
     fit_only = [diag("C308", "a shiver too fast", span)]
     assert "--fit --track" in _refusal_note(args, fit_only)
     both = [*fit_only, diag("C306", "table-contact check failed", span)]

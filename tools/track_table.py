@@ -50,9 +50,14 @@ def _arm(robot: str) -> str:
     return f"`{robot}`" + (" (generic servo)" if robot in GENERIC else "")
 
 
+class Refused(str):
+    """A behaviour the arm refuses even fitted: the refusal's code, as the row shows it."""
+
+
 def track(path: Path, robot: str):
     """``path`` compiled for ``robot`` (fitted when the arm refuses it as written) and
-    tracked in every mode: the :class:`~aou_dsl.safety.track_report.TrackReport`."""
+    tracked in every mode: the :class:`~aou_dsl.safety.track_report.TrackReport`, or
+    :class:`Refused` when the fit cannot keep the behaviour's look on this arm."""
     from aou_dsl.build.builder import build_file
     from aou_dsl.lang.linter import lint_file, lint_source
     from aou_dsl.safety.track_report import track_modes
@@ -62,7 +67,8 @@ def track(path: Path, robot: str):
     if not res.ok:
         res = build_file(str(path), robot=robot, check=False, fit=True)
         if not res.ok:
-            raise SystemExit(f"{path.name} on {robot}: refused even fitted")
+            codes = sorted({d.code for d in res.diagnostics if str(d.severity) == "error"})
+            return Refused(", ".join(codes))
         written = lint_file(str(path))
     lint = (lint_source(res.fitted_source, str(path)) if res.fitted_source is not None
             else res.lint)
@@ -120,6 +126,9 @@ def row(path: Path, robot: str, report=None) -> str:
     from aou_dsl.core.servo_specs import MODES
 
     report = report or track(path, robot)
+    if isinstance(report, Refused):
+        return (f"| {_arm(robot)} | {path.stem}, refused even fitted ({report}) | "
+                + " | ".join("not tracked" for _ in MODES) + " |")
     return (f"| {_arm(robot)} | {behaviour_cell(path, report)} | "
             + " | ".join(cell(report, m) for m in MODES) + " |")
 
@@ -131,6 +140,8 @@ def arm_row(robot: str, reports: dict) -> str:
 
     from aou_dsl.core.servo_specs import MODES
 
+    refused = sorted(f"{p.stem} ({r})" for p, r in reports.items() if isinstance(r, Refused))
+    reports = {p: r for p, r in reports.items() if not isinstance(r, Refused)}
     table = next(iter(reports.values())).servo
     cells = []
     for mode in MODES:
@@ -152,7 +163,8 @@ def arm_row(robot: str, reports: dict) -> str:
         cells.append(f"state kept in {kept} of {len(reports)}"
                      + (f"; {', '.join(shiver)}" if shiver else "")
                      + (f"; lost: {what}" if what else "; nothing lost"))
-    return f"| {_arm(robot)} | {table.rate:g} Hz | " + " | ".join(cells) + " |"
+    arm = _arm(robot) + (f"; refused even fitted: {', '.join(refused)}" if refused else "")
+    return f"| {arm} | {table.rate:g} Hz | " + " | ".join(cells) + " |"
 
 
 def tables() -> tuple[str, str]:

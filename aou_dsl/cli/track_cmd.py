@@ -53,6 +53,10 @@ def _refusal_note(args: argparse.Namespace, diagnostics) -> str | None:
     if other:
         return (f"{head} (below), and --fit cannot change what {', '.join(other)} "
                 "refuses: mend that first")
+    refused = _fit_refusal(args)
+    if refused is not None:
+        return (f"{head} (below), and --fit cannot keep the behaviour's look on this arm "
+                f"either: {refused.code} {refused.message}")
     robot = f" --robot {shlex.quote(args.robot)}" if getattr(args, "robot", None) else ""
     servo = f" --servo {args.servo}" if getattr(args, "servo", "position") != "position" \
         else ""
@@ -60,6 +64,21 @@ def _refusal_note(args: argparse.Namespace, diagnostics) -> str | None:
     return (f"{head} (below). --fit changes the values it cannot give (line"
             f"{'s' if len(lines) > 1 else ''} {', '.join(map(str, lines))}) and tracks the "
             f"fitted motion: aouc check {shlex.quote(args.path)}{robot} --fit --track{servo}")
+
+
+def _fit_refusal(args: argparse.Namespace) -> Diagnostic | None:
+    """The first error of ``--fit`` on the same file and arm, or None when the fit gives
+    a motion: the note points to ``--fit --track`` only where that command tracks."""
+    from ..build.builder import build_file
+    from ..compiler.fitting import FITTED
+    from ..core.diagnostics import Severity
+
+    res = build_file(args.path, robot=getattr(args, "robot", None), check=False, fit=True)
+    if res.ok:
+        return None
+    errors = [d for d in res.diagnostics if d.severity is Severity.ERROR]
+    # the fit's own reason first: the arm's refusal (a FITTED code) is already printed
+    return next((d for d in errors if d.code not in FITTED), errors[0] if errors else None)
 
 
 _SHORT = {"position": "position", "feedforward": "feedforward", "torque": "torque"}
