@@ -1,6 +1,7 @@
-"""How ``--jobs N`` splits a batch where workers are forked: this process builds the
-shortest file first (so the workers are copies of a warm process), a batch with one file
-left to compile after it never starts a worker, and copies of one text stay together."""
+"""How ``--jobs N`` splits a batch where workers are forked: a batch of three files or
+more forks its workers before this process builds anything (each loads the libraries
+while this process does), a batch of two never starts a worker, and copies of one text
+stay together."""
 
 import multiprocessing
 import shutil
@@ -73,6 +74,32 @@ def test_three_files_start_a_worker(monkeypatch):
     monkeypatch.setattr(pool, "BuildPool", _no_pool)
     with pytest.raises(_Started):
         list(build_many(paths, OPTIONS, jobs=2))
+
+
+@forking
+def test_workers_start_before_this_process_builds_anything(monkeypatch):
+    """The loading of a first build (the libraries, the arm) is most of its time: the
+    workers are forked before this process builds, so they load while it does, rather
+    than after it."""
+    if _ran_alone("test_workers_start_before_this_process_builds_anything"):
+        return
+    paths = [str(BEHAVIOURS / f"{n}.aou") for n in ("curious", "confident", "hesitant")]
+    built: list[str] = []
+    real = batch._build_here
+
+    def build_here(lint, *args):
+        built.append(lint.path)
+        return real(lint, *args)
+
+    def started(*args, **kwargs):
+        assert kwargs.get("load_here") is False  # nothing loaded here to share
+        raise _Started(list(built))
+
+    monkeypatch.setattr(batch, "_build_here", build_here)
+    monkeypatch.setattr(pool, "BuildPool", started)
+    with pytest.raises(_Started) as got:
+        list(build_many(paths, OPTIONS, jobs=2))
+    assert got.value.args == ([],)
 
 
 def test_copies_of_a_text_are_one_group_longest_motion_first(tmp_path):
