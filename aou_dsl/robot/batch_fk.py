@@ -16,7 +16,7 @@ import numpy as np
 
 from .kinematics import ArmModel, rotate_columns
 
-__all__ = ["batch_fk", "classical_acceleration", "kept_fk", "linear_jacobian"]
+__all__ = ["batch_fk", "classical_acceleration", "rows_fk", "linear_jacobian"]
 
 _AXES = {"X": 0, "Y": 1, "Z": 2}
 
@@ -91,14 +91,12 @@ def batch_fk(arm: ArmModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return pos.T, times(r_f, c_j).transpose(2, 1, 0)
 
 
-def kept_fk(arm: ArmModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`batch_fk`, with the rows seen before (by this arm) looked up: the checks
-    and the measurement of a build share them, and a recompilation repeats most of
-    them (:mod:`.rows`)."""
-    from .rows import kept
+def rows_fk(arm: ArmModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`batch_fk` of the rows of ``q`` (N, n), each row's values those of any batch
+    of two rows or more holding it (:func:`.rows.by_rows`)."""
+    from .rows import by_rows
 
-    pos, rot = kept(arm, "batch_fk", np.atleast_2d(np.asarray(q, float)),
-                    lambda rows: batch_fk(arm, rows))
+    pos, rot = by_rows(np.asarray(q, float), lambda rows: batch_fk(arm, rows))
     return pos, rot
 
 
