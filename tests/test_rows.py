@@ -46,3 +46,36 @@ def test_row_keys_tell_rows_apart_by_their_bits():
     q = np.array([[0.0, 1.0], [0.0, 1.0], [-0.0, 1.0], [0.0, np.nextafter(1.0, 2.0)]])
     keys = row_keys(q)
     assert keys[0] == keys[1] and len(set(keys)) == 3
+
+
+def test_a_builds_second_look_at_its_samples_is_kept_and_never_lies(monkeypatch):
+    """The checks and the measurement of a build ask forward kinematics and the joints'
+    noise of the same samples: the second answer is the first, kept by the samples'
+    bytes; a copy (changing it changes nothing kept), and samples one bit apart are
+    computed again."""
+    from aou_dsl.measuring import signal
+    from aou_dsl.robot import batch_fk as fk_module
+
+    arm = load_arm("panda")
+    t = np.linspace(0.0, 2.0, 500)
+    q = np.sin(np.outer(t, np.arange(1.0, arm.n + 1.0)))
+    calls: list[str] = []
+    real_fk, real_noise = fk_module.batch_fk, signal._joint_noise
+    monkeypatch.setattr(fk_module, "batch_fk", lambda a, r: calls.append("fk") or real_fk(a, r))
+    monkeypatch.setattr(signal, "_joint_noise",
+                        lambda a, b: calls.append("noise") or real_noise(a, b))
+    first = rows_fk(arm, q)
+    noise = signal.joint_noise(t, q)
+    first[0][:] = 0.0
+    noise.sigma[:] = -1.0
+    again, noise_again = rows_fk(arm, q.copy()), signal.joint_noise(t.copy(), q.copy())
+    assert calls == ["fk", "noise"]
+    want = real_fk(arm, q)
+    assert np.array_equal(again[0], want[0]) and np.array_equal(again[1], want[1])
+    assert again[0].flags.f_contiguous == want[0].flags.f_contiguous
+    assert np.array_equal(noise_again.sigma, real_noise(t, q).sigma)
+    moved = q.copy()
+    moved[250, 3] = np.nextafter(moved[250, 3], 9.0)
+    assert not np.array_equal(rows_fk(arm, moved)[0], want[0])
+    signal.joint_noise(t, moved)
+    assert calls == ["fk", "noise", "fk", "noise"]
