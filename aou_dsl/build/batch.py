@@ -1,12 +1,12 @@
 """A batch on this machine's cores that is never slower than one process: this process
 builds too, and workers join as soon as they can take a file.
 
-On Linux (:func:`~aou_dsl.build.pool.can_fork`) this process lints every file (the
-linter is all it has loaded then) and, when at least three files compile, forks ``jobs -
-1`` workers at once: each loads the libraries and the robots the files name while this
-process loads the same for its own first build, so the loading (most of a first build)
-is not paid one process after the other. A batch of two files that compile (or copies
-of two texts) is built here to the end: a worker would add its start and save nothing.
+On Linux (:func:`~aou_dsl.build.pool.can_fork`) this process lints every file and,
+when at least three files compile, loads the libraries and the robots the files name
+(:func:`~aou_dsl.build.pool.preload`) and forks ``jobs - 1`` workers before it builds
+anything: they start warm in milliseconds, sharing what was loaded, and no build waits
+for another process's first one. A batch of two files that compile (or copies of two
+texts) is built here to the end: a worker would add its start and save nothing.
 Elsewhere the workers are fresh interpreters that import, load and build a small
 behaviour first (about a second on a quiet machine, more than a small batch gains), so
 this process does not wait for them. Either way it builds the files itself, shortest
@@ -126,8 +126,7 @@ def shared_map(paths: list[str], options: BuildOptions, jobs: int,
 
     Where workers are forked, a batch of at most two groups that compile is built here
     to the end, as ``jobs=1`` builds it (a worker would only add its start to the time);
-    a larger one forks the workers before anything is loaded here, and each loads what a
-    build needs while this process does.
+    a larger one loads what a build needs and forks the workers before building here.
 
     Args:
         paths: ``.aou`` files.
@@ -143,19 +142,16 @@ def shared_map(paths: list[str], options: BuildOptions, jobs: int,
     session = Session(options)
     groups = _groups(lints)
     results: list[BuildResult | None] = [None] * len(lints)
-    forked = can_fork()
-    if forked and sum(_buildable(lints[g[0]]) for g in groups) < 3:
-        # the shortest built here, one left: a worker would only add its start
+    if can_fork() and sum(_buildable(lints[g[0]]) for g in groups) < 3:
+        # two files at most to compile: a worker would only add its start
         for group in groups:
             for k in group:
                 results[k] = _build_here(lints[k], session, options, encode)
         yield from (r for r in results if r is not None)
         return
-    # Forked now, before this process has loaded anything but the linter: the workers
-    # load the libraries and robots while this process does (the loading is most of a
-    # first build), instead of after it.
-    pool = BuildPool(jobs - 1, robots=_robots(lints, options), options=options, wait=False,
-                     load_here=not forked)
+    # Forked before this process builds anything: once the libraries and robots are
+    # loaded here (the workers share them), every build can go to either process.
+    pool = BuildPool(jobs - 1, robots=_robots(lints, options), options=options, wait=False)
     try:
         queue = _Queue(lints, groups, options, encode, pool)
         queue.start()

@@ -5,10 +5,7 @@ A :class:`BuildPool` starts its workers at once, in one of two ways:
 - forked (Linux, where this process runs no other thread): this process first loads what
   a build needs (:func:`preload`: the libraries, each robot's model), then forks, so a
   worker starts in milliseconds with all of it loaded and no second core is spent
-  importing the same libraries again; or, when this process has loaded nothing yet
-  and has builds of its own to make (``load_here=False``: a batch's start), it forks
-  at once and each worker loads the same (:func:`preload`) while this process does, so
-  the loading is not paid one process after the other;
+  importing the same libraries again;
 - spawned (elsewhere, or when asked): each worker is a fresh interpreter that imports
   the build's stages and builds a small behaviour (:func:`~aou_dsl.build.session.warm`)
   before it takes a file.
@@ -166,30 +163,16 @@ def _encodable(res: BuildResult) -> dict | None:
 
 # --- the pool -----------------------------------------------------------------------------
 
-def _load(robots: tuple[str, ...], options: BuildOptions | None) -> None:
-    """A forked worker's start when its parent had loaded nothing yet: one thread for
-    numerical libraries (as :func:`~aou_dsl.build.session.warm` sets), then
-    :func:`preload`, in the worker, at the same time as the parent loads the same."""
-    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
-        os.environ.setdefault(var, "1")
-    preload(robots, options)
-
-
-def _start(robots: tuple[str, ...], options: BuildOptions | None, ready, warmed,
-           build: bool = True) -> None:
+def _start(robots: tuple[str, ...], options: BuildOptions | None, ready, warmed) -> None:
     """A worker's initializer: SIGINT ignored (the parent stops its workers itself; a
-    terminal's Ctrl-C reaches every process of the group), warm (a small behaviour
-    built, or with ``build`` false only :func:`preload`), then wait for the others,
-    though not for ever: the parent may have gone on or stopped the pool."""
+    terminal's Ctrl-C reaches every process of the group), warm, then wait for the
+    others, though not for ever: the parent may have gone on or stopped the pool."""
     import signal
     import threading
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
-        if build:
-            warm(robots, options)
-        else:
-            _load(robots, options)
+        warm(robots, options)
         with warmed.get_lock():
             warmed.value += 1
     finally:
@@ -251,10 +234,8 @@ class BuildPool:
     each a fresh interpreter that loads them and builds a small behaviour before it
     takes a file (``start="spawn"``, the default elsewhere, and what a pool asked to
     fork does where it cannot; ask for it when this process holds what a copy must not
-    share, such as a display or a connection). ``load_here=False`` forks before
-    anything is loaded here, and each worker loads the libraries and ``robots`` itself
-    (without building), at the same time as this process goes on.
-    :attr:`started` holds one future per worker start, done once a worker is warm.
+    share, such as a display or a connection). :attr:`started` holds one future per
+    worker start, done once a worker is warm.
     :meth:`map` can be called again and again (a sweep that compiles in rounds pays the
     start once). Scripts that make a spawned pool need the
     ``if __name__ == "__main__":`` guard: each worker is a fresh interpreter.
@@ -266,7 +247,7 @@ class BuildPool:
 
     def __init__(self, jobs: int | None = None, *, robots: tuple[str, ...] = ("panda",),
                  options: BuildOptions | None = None, wait: bool = True,
-                 start: str | None = None, load_here: bool = True):
+                 start: str | None = None):
         import multiprocessing
         import threading
         from concurrent.futures import ProcessPoolExecutor
@@ -276,19 +257,15 @@ class BuildPool:
         self.jobs = jobs or default_jobs()
         forked = (start or ("fork" if can_fork() else "spawn")) == "fork" and can_fork()
         self.start = "fork" if forked else "spawn"
-        build = True  # a spawned worker warms up by building a small behaviour
-        if forked and load_here:  # what the workers need, loaded once, here, before
-            preload(robots, options)  # they are copies
+        if forked:  # what the workers need, loaded once, here, before they are copies
+            preload(robots, options)
             robots = ()  # nothing left to warm up in a worker
-        elif forked:  # each worker loads it, at the same time as this process does
-            build = False
         ctx = multiprocessing.get_context(self.start)
         ready = ctx.Barrier(self.jobs + 1) if wait else None
         self._warmed = ctx.Value("i", 0)
         self._pool = ProcessPoolExecutor(max_workers=self.jobs, mp_context=ctx,
                                          initializer=_start,
-                                         initargs=(robots, options, ready, self._warmed,
-                                                   build))
+                                         initargs=(robots, options, ready, self._warmed))
         # Once the workers are stopped, the pool's thread may still put an end-of-work
         # sentinel into the queue that hands out the builds, which nobody reads any more:
         # a pipe that cannot be written then is nothing to report (by default its feeder
