@@ -1,6 +1,6 @@
-"""How ``--jobs N`` splits a batch where workers are forked: this process builds the
-shortest file first (so the workers are copies of a warm process), a batch with one file
-left to compile after it never starts a worker, and copies of one text stay together."""
+"""How ``--jobs N`` splits a batch where workers are forked: a batch of three files or
+more forks its workers before this process builds anything, a batch of two never starts
+a worker, and copies of one text stay together."""
 
 import multiprocessing
 import shutil
@@ -73,6 +73,30 @@ def test_three_files_start_a_worker(monkeypatch):
     monkeypatch.setattr(pool, "BuildPool", _no_pool)
     with pytest.raises(_Started):
         list(build_many(paths, OPTIONS, jobs=2))
+
+
+@forking
+def test_workers_start_before_this_process_builds_anything(monkeypatch):
+    """No build waits for another: the workers are forked (with the libraries and the
+    arm loaded) before this process builds anything, not after its first build."""
+    if _ran_alone("test_workers_start_before_this_process_builds_anything"):
+        return
+    paths = [str(BEHAVIOURS / f"{n}.aou") for n in ("curious", "confident", "hesitant")]
+    built: list[str] = []
+    real = batch._build_here
+
+    def build_here(lint, *args):
+        built.append(lint.path)
+        return real(lint, *args)
+
+    def started(*args, **kwargs):
+        raise _Started(list(built))
+
+    monkeypatch.setattr(batch, "_build_here", build_here)
+    monkeypatch.setattr(pool, "BuildPool", started)
+    with pytest.raises(_Started) as got:
+        list(build_many(paths, OPTIONS, jobs=2))
+    assert got.value.args == ([],)
 
 
 def test_copies_of_a_text_are_one_group_longest_motion_first(tmp_path):

@@ -1,11 +1,12 @@
 """A batch on this machine's cores that is never slower than one process: this process
 builds too, and workers join as soon as they can take a file.
 
-On Linux (:func:`~aou_dsl.build.pool.can_fork`) this process lints every file, builds
-the shortest one itself (which loads the libraries and its robot, as ``--jobs 1`` does
-at its first build), then loads the other robots the files name and forks ``jobs - 1``
-workers, which start warm in milliseconds. A batch with nothing left but one file (or
-copies of one) is built here to the end: a worker would add its start and save nothing.
+On Linux (:func:`~aou_dsl.build.pool.can_fork`) this process lints every file and,
+when at least three files compile, loads the libraries and the robots the files name
+(:func:`~aou_dsl.build.pool.preload`) and forks ``jobs - 1`` workers before it builds
+anything: they start warm in milliseconds, sharing what was loaded, and no build waits
+for another process's first one. A batch of two files that compile (or copies of two
+texts) is built here to the end: a worker would add its start and save nothing.
 Elsewhere the workers are fresh interpreters that import, load and build a small
 behaviour first (about a second on a quiet machine, more than a small batch gains), so
 this process does not wait for them. Either way it builds the files itself, shortest
@@ -67,15 +68,14 @@ class _Queue:
         self.todo = deque(groups)
         self.lock = threading.Lock()
         self.sent: dict[tuple[int, ...], Future] = {}
-        self.chains = 0  # workers being fed
 
     def shortest(self) -> tuple[int, ...] | None:
         with self.lock:
             return self.todo.pop() if self.todo else None
 
     def feed(self, last: Future | None = None) -> None:
-        """Hand a worker the longest group left (after ``last``, its previous one, unless
-        that one failed or was cancelled: the pool is being stopped)."""
+        """Hand a worker the longest group left (after ``last``, its previous one or its
+        start, unless that one failed or was cancelled: the pool is being stopped)."""
         from .pool import build_group
 
         if last is not None and (last.cancelled() or last.exception() is not None):
@@ -93,11 +93,11 @@ class _Queue:
             self.sent[group] = f
         f.add_done_callback(self.feed)
 
-    def start_ready(self) -> None:
-        """Begin feeding each worker that has become ready."""
-        while self.chains < self.pool.warmed:
-            self.chains += 1
-            self.feed()
+    def start(self) -> None:
+        """Feed each worker the moment it has warmed up (its start's future is done then,
+        in the pool's thread), not when this process is between two of its builds."""
+        for f in self.pool.started:
+            f.add_done_callback(self.feed)
 
     def pending(self) -> list[Future]:
         with self.lock:
@@ -124,10 +124,9 @@ def shared_map(paths: list[str], options: BuildOptions, jobs: int,
                encode: str | None = None) -> Iterator[BuildResult]:
     """Build ``paths`` on this process and ``jobs - 1`` workers; results in input order.
 
-    Where workers are forked, this process first builds the shortest group itself: the
-    workers are then copies of a warm process, and a batch whose rest is a single group
-    is built here to the end, as ``jobs=1`` builds it (a worker would only add its start
-    to the time).
+    Where workers are forked, a batch of at most two groups that compile is built here
+    to the end, as ``jobs=1`` builds it (a worker would only add its start to the time);
+    a larger one loads what a build needs and forks the workers before building here.
 
     Args:
         paths: ``.aou`` files.
@@ -143,22 +142,20 @@ def shared_map(paths: list[str], options: BuildOptions, jobs: int,
     session = Session(options)
     groups = _groups(lints)
     results: list[BuildResult | None] = [None] * len(lints)
-    if can_fork():
-        while groups:  # up to the shortest file that compiles (lint's refusals are free)
-            group = groups.pop()
+    if can_fork() and sum(_buildable(lints[g[0]]) for g in groups) < 3:
+        # two files at most to compile: a worker would only add its start
+        for group in groups:
             for k in group:
                 results[k] = _build_here(lints[k], session, options, encode)
-            if _buildable(lints[group[0]]):
-                break
-        if sum(_buildable(lints[g[0]]) for g in groups) < 2:
-            for group in groups:
-                for k in group:
-                    results[k] = _build_here(lints[k], session, options, encode)
-            yield from (r for r in results if r is not None)
-            return
+        yield from (r for r in results if r is not None)
+        return
+    # Forked before this process builds anything: once the libraries and robots are
+    # loaded here (the workers share them), every build can go to either process.
     pool = BuildPool(jobs - 1, robots=_robots(lints, options), options=options, wait=False)
     try:
-        yield from _run(_Queue(lints, groups, options, encode, pool), session, results)
+        queue = _Queue(lints, groups, options, encode, pool)
+        queue.start()
+        yield from _run(queue, session, results)
     finally:
         pool.terminate()  # workers still warming up are not waited for
 
@@ -170,7 +167,6 @@ def _run(queue: _Queue, session: Session, results: list[BuildResult | None]
     are."""
     done = 0
     while done < len(results):
-        queue.start_ready()
         group = queue.shortest()
         if group is not None:
             for k in group:

@@ -234,7 +234,8 @@ class BuildPool:
     each a fresh interpreter that loads them and builds a small behaviour before it
     takes a file (``start="spawn"``, the default elsewhere, and what a pool asked to
     fork does where it cannot; ask for it when this process holds what a copy must not
-    share, such as a display or a connection).
+    share, such as a display or a connection). :attr:`started` holds one future per
+    worker start, done once a worker is warm.
     :meth:`map` can be called again and again (a sweep that compiles in rounds pays the
     start once). Scripts that make a spawned pool need the
     ``if __name__ == "__main__":`` guard: each worker is a fresh interpreter.
@@ -274,8 +275,8 @@ class BuildPool:
             calls._ignore_epipe = True
         try:
             with _sigint_held(), _forking(forked):  # the first task starts every worker
-                for _ in range(self.jobs):
-                    self._pool.submit(os.getpid)
+                #: Done as soon as a worker has warmed up (its first task runs then).
+                self.started = [self._pool.submit(os.getpid) for _ in range(self.jobs)]
             # until every worker has built its warm-up behaviour; a slow or failed start
             # goes on regardless
             if ready is not None:

@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from ..core.memo import cached
 from ..version import __version__
 from .actions_args import dmp_parser, live_parser, study_parser
 from .argtypes import (
@@ -24,7 +25,7 @@ from .argtypes import (
 )
 
 __all__ = ["EXIT_ERRORS", "EXIT_INCONCLUSIVE", "EXIT_INTERRUPTED", "EXIT_OK", "EXIT_USAGE",
-           "build_parser", "number", "usage_error"]
+           "build_parser", "number", "shared_parser", "usage_error"]
 
 EXIT_OK = 0
 EXIT_ERRORS = 1
@@ -48,7 +49,7 @@ def usage_error(command: str, message: str) -> int:
     """A usage error found after parsing (options that only make sense together): the
     command's usage line and ``aouc: error: message`` on stderr, as argparse prints its
     own; returns :data:`EXIT_USAGE`."""
-    build_parser()[1][command].print_usage(sys.stderr)
+    shared_parser()[1][command].print_usage(sys.stderr)
     sys.stderr.write(f"aouc: error: {message}\n")
     return EXIT_USAGE
 
@@ -327,3 +328,12 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
                    help="show the traceback of an internal error")
     sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     return p, _commands(sub)
+
+
+@cached(maxsize=1)
+def shared_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:
+    """:func:`build_parser`'s parser, made once per process: it depends on nothing but
+    this code, parsing leaves it as it was (an appending option copies its default
+    list before it appends), and making it (some 1,800 options) costs each command of a
+    process that runs several (a benchmark, a test) about 5 ms."""
+    return build_parser()

@@ -18,7 +18,7 @@ from ..core.codes import C306, C311, C320, C321
 from ..core.diagnostics import AouError, Diagnostic, Severity, Span
 from ..core.rules import category
 from ..editor import cmd_server
-from .args import EXIT_ERRORS, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, build_parser, usage_error
+from .args import EXIT_ERRORS, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, shared_parser, usage_error
 from .dmp_cmd import cmd_dmp
 from .endings import CtrlC, extra_missing, internal
 from .fmt import cmd_fmt
@@ -382,7 +382,7 @@ _COMMANDS: dict[str, Callable[[argparse.Namespace], int]] = {
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser, commands = build_parser()
+    parser, commands = shared_parser()
     args, extra = parser.parse_known_args(argv)
     if extra:  # said with the usage of the command they were given to
         (commands.get(args.command) or parser).error(

@@ -8,6 +8,7 @@ a joint path with the path coordinate appended as a *virtual joint* (see
 
 from __future__ import annotations
 
+import copy
 import importlib
 import logging
 import sys
@@ -67,13 +68,40 @@ def import_toppra():
 @cached(maxsize=256)
 def _constraints(jv: tuple[float, ...], ja: tuple[float, ...], a: float, vmax: float):
     """TOPP-RA's joint velocity and acceleration constraints, the virtual joint last.
-    They do not depend on the path, and building one formats its limits as text (slow),
-    so they are made once per set of limits."""
-    constraint = import_toppra().constraint
+    They do not depend on the path, so they are made once per set of limits; and since
+    every new motion has its own virtual limits, those are copies of the joints' own
+    (:func:`_joint_constraints`) with the limits set: toppra's constructors describe the
+    limits as text with numpy's printer, about half a millisecond a pair, for a
+    ``repr`` aou never shows. The copies hold the same limits, so the same law comes
+    out; their text is written with Python's float format."""
     vlim = np.column_stack([-np.append(jv, vmax), np.append(jv, vmax)])
     alim = np.column_stack([-np.append(ja, a), np.append(ja, a)])
-    return (constraint.JointVelocityConstraint(vlim),
-            constraint.JointAccelerationConstraint(alim))
+    if np.isnan(vlim).any() or np.isnan(alim).any() or np.any(vlim[:, 0] >= vlim[:, 1]):
+        constraint = import_toppra().constraint  # refused by toppra's own checks
+        return (constraint.JointVelocityConstraint(vlim),
+                constraint.JointAccelerationConstraint(alim))
+    velocity, acceleration = (copy.copy(c) for c in _joint_constraints(jv, ja))
+    velocity.vlim, acceleration.alim = vlim, alim
+    velocity._format_string = _described("Velocity", vlim)
+    acceleration._format_string = _described("Acceleration", alim)
+    return velocity, acceleration
+
+
+@cached(maxsize=64)
+def _joint_constraints(jv: tuple[float, ...], ja: tuple[float, ...]):
+    """toppra's own constraints of the joints' limits, with a virtual joint limited to
+    1 (:func:`_constraints` copies them with its limits)."""
+    constraint = import_toppra().constraint
+    return (constraint.JointVelocityConstraint(
+                np.column_stack([-np.append(jv, 1.0), np.append(jv, 1.0)])),
+            constraint.JointAccelerationConstraint(
+                np.column_stack([-np.append(ja, 1.0), np.append(ja, 1.0)])))
+
+
+def _described(what: str, lim: np.ndarray) -> str:
+    """A constraint's limits as toppra's ``repr`` shows them, one joint a line."""
+    return f"    {what} limit: \n" + "".join(
+        f"      J{i}: [{lo!r} {hi!r}]\n" for i, (lo, hi) in enumerate(lim.tolist(), 1))
 
 
 @cached(maxsize=1)

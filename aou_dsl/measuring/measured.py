@@ -160,9 +160,9 @@ def _context(rec: Trajectory, pinned: JointNoise | None = None
     carried = _carried(rec, cols, grid)
     rest = rest_signals(grid.t, grid.h, grid.q, noise, jn.quantum, grid.density, window,
                         grid.t_last, carried)
-    from ..robot.batch_fk import kept_fk  # the checks of a build met these rows
+    from ..robot.batch_fk import rows_fk
 
-    pos, rot = kept_fk(arm, grid.q)
+    pos, rot = rows_fk(arm, grid.q)
     pos_s = smooth(pos, window, 0, grid.h) if window > 3 else pos
     goal = None if rec.goal is None else np.asarray(rec.goal, float)
     raw = Samples(t - t[0], q, batch_fk(arm, q)[0]) if grid.resampled else None

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.memo import table
 from .savgol import savgol, savgol_weights
 
 __all__ = [
@@ -124,7 +125,26 @@ def _quantum(col: np.ndarray) -> float:
 
 def joint_noise(t: np.ndarray, q: np.ndarray) -> JointNoise:
     """Noise of each joint from its own samples (median absolute residual, robust to
-    the motion); the resolution of rounded columns; still columns have neither."""
+    the motion); the resolution of rounded columns; still columns have neither.
+
+    A build asks it twice of the same samples (its limit check, then its measurement):
+    the last few answers are kept by the samples' bytes, and given back as copies."""
+    from ..robot.rows import content_key
+
+    key = content_key(t, q)
+    kept = _NOISE.get(key)
+    if kept is None:
+        kept = _joint_noise(np.asarray(t), np.asarray(q))
+        _NOISE.put(key, kept)
+    return JointNoise(kept.sigma.copy(), kept.quantum.copy(), kept.moving.copy())
+
+
+#: The last answers of :func:`joint_noise`, by the samples' bytes (a motion's are a
+#: few hundred kilobytes).
+_NOISE = table("aou_dsl.measuring.signal.joint_noise", 4)
+
+
+def _joint_noise(t: np.ndarray, q: np.ndarray) -> JointNoise:
     n = q.shape[1]
     moving = np.ptp(q, axis=0) > 0 if len(q) else np.zeros(n, bool)
     sigma = np.zeros(n)

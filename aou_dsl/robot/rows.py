@@ -1,27 +1,24 @@
-"""Per-configuration results kept between builds, by the configuration's bytes.
+"""Joint rows as bytes, and per-row functions computed as a batch computes them.
 
-A recompilation after one value changed (a pause, one episode's acceleration) moves
-most samples only in time: the arm passes through the same joint values as before. What
-depends on the joint values alone (forward kinematics, a collision engine's distances) is
-the same for those samples, to the bit, so it is looked up instead of computed again.
-Only rows never seen are computed, all together in one call; a call on one row is made
-on two (the row twice), as a batch of one can round differently from a larger batch.
+:func:`row_keys` names a configuration by its bytes: equal keys, equal joint values to
+the bit (the collision sweep keeps PyBullet's answers by them, which cost far more than
+the look-up). :func:`by_rows` computes a per-row function (forward kinematics) on a
+batch; a batch of one row is computed as two (the row twice), as a batch of one can
+round differently from a larger batch.
+
+Forward kinematics is not kept between builds: finding thousands of rows among those
+kept costs about what computing them does (a couple of milliseconds for a motion's
+5,000 samples), and keeping a motion never seen before costs twice that.
 """
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Callable
 from typing import cast
 
 import numpy as np
 
-from ..core.memo import Keyed, cached
-
-__all__ = ["RowMemo", "kept", "row_keys"]
-
-#: Rows a memo holds before it starts again empty (about 100 bytes a row and output).
-MEMO_ROWS = 100_000
+__all__ = ["Content", "by_rows", "content_key", "row_keys"]
 
 
 def row_keys(q: np.ndarray) -> list[bytes]:
@@ -33,83 +30,41 @@ def row_keys(q: np.ndarray) -> list[bytes]:
     return cast("list[bytes]", rows.tolist())  # a void row's item is its bytes
 
 
-class RowMemo:
-    """The arrays a function gives for rows of ``q``, kept row by row (at most ``size``
-    rows: beyond, it starts again empty, so memory stays bounded)."""
+class Content:
+    """Bytes that compare by their whole content and hash by a sample of it (the length
+    and every 4099th byte): a key of arrays of a few hundred kilobytes is hashed in
+    microseconds, and equal keys are still equal arrays to the bit."""
 
-    def __init__(self, size: int = MEMO_ROWS):
-        self.size = size
-        self.index: dict[bytes, int] = {}
-        self.store: list[np.ndarray] = []
-        self.used = 0
-        #: Per output, whether ``fn`` gives it in Fortran order: the copies given back
-        #: are laid out the same, since numpy sums along a contiguous axis pairwise and
-        #: along another one by one (the last bits of a mean would differ).
-        self.fortran: list[bool] = []
+    __slots__ = ("data", "_hash")
 
-    def clear(self) -> None:
-        """Forget every row."""
-        self.index, self.store, self.used, self.fortran = {}, [], 0, []
+    def __init__(self, data: bytes):
+        self.data = data
+        self._hash = hash((len(data), data[::4099], data[-64:]))
 
-    def of(self, q: np.ndarray, fn: Callable[[np.ndarray], tuple[np.ndarray, ...]]
-           ) -> tuple[np.ndarray, ...]:
-        """``fn(q)``, whose outputs are arrays with one row per row of ``q``; rows seen
-        before are not computed again."""
-        q = np.ascontiguousarray(np.atleast_2d(q), dtype=float)
-        if len(q) > self.size:  # more than it keeps: computed, not kept
-            return tuple(fn(q))
-        keys = row_keys(q)
-        at = np.fromiter(map(self.index.get, keys, itertools.repeat(-1)), dtype=np.intp,
-                         count=len(keys))
-        missing = np.flatnonzero(at < 0)
-        if len(missing):
-            if self.used + len(missing) > self.size:
-                self.clear()
-                at[:], missing = -1, np.arange(len(q))
-            at[missing] = self._add(q, keys, missing, fn)
-        return tuple(np.asfortranarray(s[at]) if f else s[at]
-                     for s, f in zip(self.store, self.fortran, strict=True))
+    def __hash__(self) -> int:
+        return self._hash
 
-    def _add(self, q: np.ndarray, keys: list[bytes], missing: np.ndarray,
-             fn: Callable[[np.ndarray], tuple[np.ndarray, ...]]) -> np.ndarray:
-        """Compute the missing rows (each distinct row once) and keep them; their places
-        in the store, in the order of ``missing``."""
-        first: dict[bytes, int] = {}
-        for i in missing.tolist():
-            first.setdefault(keys[i], i)
-        rows = np.fromiter(first.values(), dtype=np.intp, count=len(first))
-        outs = fn(q[rows] if len(rows) > 1 else q[np.r_[rows, rows]])
-        start = self.used
-        self.fortran = [bool(np.asarray(out).flags.f_contiguous
-                             and not np.asarray(out).flags.c_contiguous) for out in outs]
-        for k, out in enumerate(outs):
-            out = np.asarray(out)[:len(rows)]
-            if not self.store or len(self.store) <= k:
-                self.store.append(np.empty((max(1024, 2 * len(rows)), *out.shape[1:]),
-                                           dtype=out.dtype))
-            if start + len(rows) > len(self.store[k]):
-                grown = np.empty((2 * (start + len(rows)), *out.shape[1:]), out.dtype)
-                grown[:start] = self.store[k][:start]
-                self.store[k] = grown
-            self.store[k][start:start + len(rows)] = out
-        self.used = start + len(rows)
-        for n, key in enumerate(first):
-            self.index[key] = start + n
-        return np.fromiter((self.index[keys[i]] for i in missing.tolist()), dtype=np.intp,
-                           count=len(missing))
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Content) and self.data == other.data
 
 
-def kept(owner: object, name: str, q: np.ndarray,
-         fn: Callable[[np.ndarray], tuple[np.ndarray, ...]]) -> tuple[np.ndarray, ...]:
-    """``fn(q)`` through the memo of ``owner`` (an arm, a kinematic chain, kept alive
-    by the memo) and ``name``. A ``q`` of more than a quarter of what a memo holds (a
-    long recording) is computed directly: it would push every other row out."""
-    if len(q) > MEMO_ROWS // 4:
+def content_key(*arrays: np.ndarray) -> tuple:
+    """Arrays by what they hold: each one's type, shape and bytes (equal keys, equal
+    arrays to the bit), for a cache of a function of them."""
+    return tuple((a.dtype.str, a.shape, Content(np.ascontiguousarray(a).tobytes()))
+                 for a in map(np.asarray, arrays))
+
+
+def by_rows(q: np.ndarray, fn: Callable[[np.ndarray], tuple[np.ndarray, ...]]
+            ) -> tuple[np.ndarray, ...]:
+    """``fn(q)`` of the rows of ``q`` (N, n), whose outputs have one row per row of
+    ``q``: each row's values are those of any batch of two rows or more holding it. One
+    row alone is computed as two, and given back laid out as ``fn`` lays out its outputs
+    (C or Fortran order)."""
+    q = np.ascontiguousarray(np.atleast_2d(q), dtype=float)
+    if len(q) != 1:
         return tuple(fn(q))
-    return _memo(Keyed((id(owner), name), owner)).of(q, fn)
-
-
-@cached(maxsize=8)
-def _memo(owner: Keyed) -> RowMemo:
-    """One memo per owner and function (the key holds the owner, so its id stays its)."""
-    return RowMemo()
+    outs = [np.asarray(out) for out in fn(np.vstack([q, q]))]
+    return tuple(np.asfortranarray(out[:1]) if out.flags.f_contiguous
+                 and not out.flags.c_contiguous else np.ascontiguousarray(out[:1])
+                 for out in outs)

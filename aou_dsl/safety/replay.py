@@ -39,7 +39,7 @@ from ..robot.load import load_arm, robot_key
 from ..robot.scene import Scene, urdf_path
 from .limits import Check, check_limits
 from .sweep import CONTACT_MARGIN, QUERY_RANGE, Geometry, Memo, Sweep, geometry
-from .urdf_fk import kept_chain_fk, urdf_chain
+from .urdf_fk import rows_chain_fk, urdf_chain
 
 __all__ = ["CheckReport", "check_scene", "replay"]
 
@@ -227,7 +227,7 @@ def _agreement(sweep: Sweep, arm, frame: str, t: np.ndarray, q: np.ndarray
     once, and by Pinocchio itself at :data:`AGREE_SPOTS` samples spread over the
     motion), and against PyBullet's at every sample the replay put PyBullet in (those
     spots included)."""
-    from ..robot.batch_fk import kept_fk
+    from ..robot.batch_fk import rows_fk
 
     spots = np.unique(np.linspace(0, len(t) - 1, AGREE_SPOTS).astype(int))
     for j in spots:
@@ -235,8 +235,8 @@ def _agreement(sweep: Sweep, arm, frame: str, t: np.ndarray, q: np.ndarray
     chain = urdf_chain(urdf_path(sweep.scene.robot, visuals=False,
                                  package_dirs=sweep.scene.options.package_dirs)[0], frame,
                        arm.joint_names)
-    pos, rot = kept_chain_fk(chain, q)
-    pin_pos, pin_rot = kept_fk(arm, q)
+    pos, rot = rows_chain_fk(chain, q)
+    pin_pos, pin_rot = rows_fk(arm, q)
     dp = np.linalg.norm(pos - pin_pos, axis=1)
     dr = _angles_deg(rot, pin_rot)
     own_pos, own_rot = arm.fk(q[spots])  # Pinocchio's own forward kinematics

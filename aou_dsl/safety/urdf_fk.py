@@ -17,7 +17,7 @@ from ..core.codes import R402
 from ..core.diagnostics import AouError, Span, diag
 from ..core.memo import cached, file_digest
 
-__all__ = ["Chain", "chain_fk", "kept_chain_fk", "urdf_chain"]
+__all__ = ["Chain", "chain_fk", "rows_chain_fk", "urdf_chain"]
 
 
 @dataclass(frozen=True)
@@ -166,11 +166,10 @@ def chain_fk(chain: Chain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return pos.T.copy(), np.ascontiguousarray(rot.transpose(2, 0, 1))
 
 
-def kept_chain_fk(chain: Chain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`chain_fk`, with the rows seen before (by this chain) looked up: a
-    recompilation repeats most of them."""
-    from ..robot.rows import kept
+def rows_chain_fk(chain: Chain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`chain_fk` of the rows of ``q`` (N, n), each row's values those of any batch
+    of two rows or more holding it (:func:`~aou_dsl.robot.rows.by_rows`)."""
+    from ..robot.rows import by_rows
 
-    pos, rot = kept(chain, "chain_fk", np.atleast_2d(np.asarray(q, dtype=float)),
-                    lambda rows: chain_fk(chain, rows))
+    pos, rot = by_rows(np.asarray(q, dtype=float), lambda rows: chain_fk(chain, rows))
     return pos, rot
