@@ -228,6 +228,11 @@ class Regulator:
         """Forget a re-plan the arm did not get: back to a :meth:`checkpoint`."""
         self.expressed, self._last, self._dmp = kept
 
+    def reset(self) -> None:
+        """Forget what was expressed and the last uncertainty used (the plans stay): a
+        new run starts."""
+        self.expressed, self._last, self._dmp, self._u = None, None, None, None
+
     # --- plans ----------------------------------------------------------------------------
 
     def plan(self, state: State, level: float) -> Trajectory:
