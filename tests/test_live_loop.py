@@ -135,7 +135,7 @@ def test_no_chattering_where_a_threshold_is_crossed_slowly(reg):
     def perceive(t: float) -> float:
         return float(np.clip(0.92 - 0.01 * t + rng.normal(0.0, 0.01), 0.0, 1.0))
 
-    r = loop.run(perceive, duration=12.0, rate=100.0, regulator=_fresh(reg))
+    r = loop.run(perceive, duration=16.0, rate=100.0, regulator=_fresh(reg))
     states = _states(r)
     assert states == ["confident", "curious"], states
     # without hysteresis the same signal chatters: the check can fail
@@ -143,7 +143,7 @@ def test_no_chattering_where_a_threshold_is_crossed_slowly(reg):
     bare = Regulator("panda", intensity_step=0.5,
                      hysteresis=Hysteresis(state=0.0, intensity=0.0, uncertainty=0.0))
     bare._plans, bare._texts = reg._plans, reg._texts
-    r2 = loop.run(perceive, duration=12.0, rate=100.0, regulator=bare)
+    r2 = loop.run(perceive, duration=16.0, rate=100.0, regulator=bare)
     assert len(_states(r2)) > 3
 
 
@@ -378,3 +378,4 @@ def test_detectors_are_freed_without_crashing_the_process():
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          timeout=300, cwd=ROOT)
     assert run.returncode == 0, run.stderr[-2000:]
+

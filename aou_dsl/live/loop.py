@@ -37,11 +37,9 @@ if TYPE_CHECKING:
 
 __all__ = ["HYSTERESIS", "Loop", "Run", "Switch", "Tick", "document", "gate", "run", "segments"]
 
-#: The loop's hysteresis (unless the caller gives one): a perception's confidence wanders
-#: from tick to tick at 100 Hz, so a state changes only once the uncertainty is 0.0375
-#: past the border between two states (0.6 C-V units nearer the new state's canonical
-#: point), and an intensity level once the intensity is 0.15 past its midpoint.
-HYSTERESIS = Hysteresis(state=0.6, intensity=0.15, uncertainty=0.05)
+#: The loop's hysteresis (unless the caller gives one): the regulator's default, made
+#: for the rendered camera's confidence noise (:data:`.regulator.CONFIDENCE_NOISE`).
+HYSTERESIS = Hysteresis()
 
 
 @dataclass(frozen=True)

@@ -44,7 +44,8 @@ if TYPE_CHECKING:
     from .dmp_follow import DmpRun
     from .perception import Estimate
 
-__all__ = ["PATH", "Hysteresis", "Regulator", "Replan", "from_uncertainty"]
+__all__ = ["CONFIDENCE_NOISE", "NOISE_MARGIN", "PATH", "Hysteresis", "Regulator", "Replan",
+           "from_uncertainty", "hysteresis_for", "hysteresis_margins"]
 
 _WHERE = Span.whole_file("<live>")
 
@@ -76,9 +77,36 @@ def from_uncertainty(u: float) -> tuple[float, float, float]:
     return c0 + f * (c1 - c0), v0 + f * (v1 - v0), max(0.0, 1.0 - 2.0 * abs(s - nearest))
 
 
+#: The rendered camera's confidence noise: the largest standard deviation of its
+#: confidence at a still scene, as the loop reads it, over the calibration's sweeps
+#: (``tools/calibrate_perception.py --noise`` measures it, docs/perception-noise.csv).
+CONFIDENCE_NOISE = 0.027
+#: An estimate must pass a border by this many standard deviations of that noise.
+NOISE_MARGIN = 2.0
+#: The longest leg of :data:`PATH` [C-V units]: a margin there is the least uncertainty.
+_LONGEST = max(math.dist(CANONICAL[a], CANONICAL[b])
+               for a, b in zip(PATH, PATH[1:], strict=False))
+
+
+def hysteresis_margins(sigma: float, margin: float = NOISE_MARGIN) -> tuple[float, float]:
+    """(state, intensity) margins that hold an uncertainty whose noise has std ``sigma``
+    ``margin`` standard deviations past a border: ``u`` past the border between two
+    states by ``du`` puts the point ``8 L du`` nearer the new state's canonical point
+    than the old one's (L the leg's length, the longest leg the worst), and moves the
+    intensity by ``8 du``."""
+    du = margin * sigma
+    return round(8.0 * _LONGEST * du, 3), round(8.0 * du, 3)
+
+
+_STATE, _INTENSITY = hysteresis_margins(CONFIDENCE_NOISE)
+
+
 @dataclass(frozen=True)
 class Hysteresis:
-    """How far an estimate must move before the expressed behaviour changes.
+    """How far an estimate must move before the expressed behaviour changes. The
+    defaults hold the uncertainty :data:`NOISE_MARGIN` standard deviations of the
+    rendered camera's confidence noise (:data:`CONFIDENCE_NOISE`) past each border
+    (:func:`hysteresis_margins`).
 
     Attributes:
         state: a new state is expressed once the point is this much nearer [C-V units]
@@ -89,9 +117,16 @@ class Hysteresis:
             last value that was used (a backlash).
     """
 
-    state: float = 0.2
-    intensity: float = 0.05
+    state: float = _STATE
+    intensity: float = _INTENSITY
     uncertainty: float = 0.05
+
+
+def hysteresis_for(sigma: float, margin: float = NOISE_MARGIN) -> Hysteresis:
+    """The hysteresis for a confidence whose noise has std ``sigma``
+    (:func:`hysteresis_margins`; the uncertainty's backlash stays the default)."""
+    state, intensity = hysteresis_margins(sigma, margin)
+    return Hysteresis(state=state, intensity=intensity)
 
 
 @dataclass
