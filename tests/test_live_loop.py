@@ -379,3 +379,54 @@ def test_detectors_are_freed_without_crashing_the_process():
                          timeout=300, cwd=ROOT)
     assert run.returncode == 0, run.stderr[-2000:]
 
+
+def test_the_recording_keeps_one_sample_step_across_every_switch(card):
+    """A controller's clock has one step: every transition lasts a whole number of the
+    plan's samples, so the executed motion is sampled evenly from its start to its end
+    (`aouc measure` reads it as one recording)."""
+    t = loop.document(card)["t"]
+    step = np.diff(t)
+    assert len(card.switches) >= 4
+    assert step.max() - step.min() < 1e-9, (step.min(), step.max())
+
+
+def test_a_new_reach_starts_from_rest_after_its_return(card, tmp_path):
+    """At a restart the arm comes back to where the reach starts and holds there
+    RESTART_HOLD before it reaches again; the stretch around it measures as a return, a
+    pause and an approach (the return and the reach run into each other otherwise, and
+    the measurement's own check refused the whole run there)."""
+    from aou_dsl.live.splice import RESTART_HOLD
+
+    tr = card.trajectory
+    doc = loop.document(card)
+    restarts = [s for s in card.switches if s.kind == "restart"]
+    assert restarts
+    for s in restarts:
+        begin = s.start + s.transition
+        held = (tr.t >= begin - RESTART_HOLD + 1e-6) & (tr.t < begin - 1e-6)
+        assert held.sum() >= round(RESTART_HOLD * 250) - 2
+        assert np.abs(tr.qd[held]).max() < 1e-9 and np.abs(tr.qdd[held]).max() < 1e-9
+        t = np.asarray(doc["t"])
+        rows = np.flatnonzero((t >= s.start - 1.0) & (t < begin + 3.0))
+        sub = {k: v for k, v in doc.items() if k not in ("t", "q", "qd", "qdd", "live",
+                                                         "episodes")}
+        sub |= {"t": (t[rows] - t[rows[0]]).tolist(), "episodes": [],
+                "duration": float(t[rows[-1]] - t[rows[0]]),
+                **{k: [doc[k][i] for i in rows] for k in ("q", "qd", "qdd")}}
+        path = tmp_path / f"restart-{s.t:.2f}.json"
+        path.write_text(json.dumps(sub))
+        kinds = [e.kind for e in aou_dsl.measure(str(path)).episodes]
+        assert "pause" in kinds and "approach" in kinds, kinds
+
+
+def test_the_whole_recorded_run_measures(card, tmp_path):
+    """`aouc measure` reads the whole recording of a run, switches and restarts included
+    (its own checks once refused it at a restart)."""
+    path = tmp_path / "run.json"
+    path.write_text(json.dumps(loop.document(card)))
+    m = aou_dsl.measure(str(path))
+    kinds = {e.kind for e in m.episodes}
+    assert {"approach", "pause", "retreat"} <= kinds
+    out = subprocess.run([sys.executable, "-m", "aou_dsl", "measure", str(path)],
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr

@@ -284,10 +284,12 @@ class Regulator:
                                           goal=self.goal)
         text = self._texts[key]
         if text not in self._plans:
+            from .splice import on_grid
+
             res = compiled(text)
             if not res.ok:
                 raise AouError(res.diagnostics)
-            self._plans[text] = res.trajectory
+            self._plans[text] = on_grid(res.trajectory)
         return self._plans[text]
 
     def prepare(self, states: tuple[State, ...] = PATH[:-1]) -> int:
