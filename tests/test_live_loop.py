@@ -430,3 +430,54 @@ def test_the_whole_recorded_run_measures(card, tmp_path):
     out = subprocess.run([sys.executable, "-m", "aou_dsl", "measure", str(path)],
                          capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
+
+
+FOLLOW = """
+duration = 12.0
+goal = [0.55, 0.0, 0.25]
+follow = true
+[scene]
+target = [0.6, 0.0, 0.04]
+[[event]]
+kind = "move"
+what = "target"
+at = 2.0
+duration = 3.0
+to = [0.6, 0.08, 0.04]
+"""
+
+
+def test_the_goal_follows_a_moving_target(reg, tmp_path):
+    """With ``follow``, the goal moves with the target the perception sees (kept where
+    the scenario's goal is from it): the loop re-plans (``retarget``) into plans for the
+    new goal, each checked, and the arm's reach ends where the moved goal puts it."""
+    from aou_dsl.live.scenario import parse
+    from aou_dsl.robot.batch_fk import batch_fk
+
+    sc = parse(FOLLOW)
+    assert sc.offset == pytest.approx((-0.05, 0.0, 0.21))
+    fresh = _fresh(reg)
+    start_goal = fresh.goal
+    fresh.goal = sc.goal
+    try:
+        r = loop.run(Geometric(sc.scene_at), duration=sc.duration, rate=sc.rate,
+                     regulator=fresh, follow=sc.offset)
+        moved = [s for s in r.switches if s.kind == "retarget"]
+        assert moved and not [s for s in r.switches if s.kind == "held"]
+        assert moved[-1].goal == pytest.approx((0.55, 0.08, 0.25), abs=0.021)
+        assert all(b[1] >= a[1] for a, b in zip((s.goal for s in moved),
+                                               (s.goal for s in moved[1:]), strict=False))
+        last = r.switches[-1]
+        plan_new = fresh.plan(State(last.state), last.intensity)
+        fresh.goal = sc.goal
+        plan_old = fresh.plan(State(last.state), last.intensity)
+        arm = fresh.arm
+        end_new = batch_fk(arm, plan_new.q[-1:])[0][0]
+        end_old = batch_fk(arm, plan_old.q[-1:])[0][0]
+        assert end_new - end_old == pytest.approx(np.subtract(last.goal, sc.goal), abs=0.01)
+        doc = loop.document(r)
+        assert doc["live"]["switches"][-1]["goal"] == pytest.approx(list(last.goal))
+        segs = loop.segments(r, doc)
+        assert segs[-1][1]["goal"]["position"] == pytest.approx(list(last.goal))
+    finally:
+        fresh.goal = start_goal

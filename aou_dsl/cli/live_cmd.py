@@ -50,7 +50,7 @@ def cmd_live(args: argparse.Namespace) -> int:
     perception = _perception(args.perception, sc)
     try:
         r = run(perception, duration=sc.duration, rate=sc.rate, regulator=reg,
-                title=sc.title or args.path,
+                title=sc.title or args.path, follow=sc.offset,
                 perception_rate=CAMERA_RATE if args.perception == "camera" else None)
     finally:
         close = getattr(perception, "close", None)

@@ -189,7 +189,7 @@ class Regulator:
         self._sequences: dict[int, tuple] = {}
         self._u: float | None = None
         self._plans: dict[str, Trajectory] = {}  # by text: levels may share a file
-        self._texts: dict[tuple[State, float], str] = {}
+        self._texts: dict[tuple, str] = {}  # by state, level and goal
         #: the last trajectory returned: (it, join time, transition, plan duration, the
         #: phase an inactive hold keeps)
         self._last: tuple[Trajectory, float, float, float, float] | None = None
@@ -278,7 +278,7 @@ class Regulator:
         """
         from ..synth.synthesis import compiled, synthesize
 
-        key = (state, level)
+        key = (state, level, self.goal)  # a goal that follows the target makes new ones
         if key not in self._texts:
             self._texts[key] = synthesize(state, intensity=level, robot=self.robot,
                                           goal=self.goal)

@@ -91,7 +91,7 @@ class Stage:
         reg.reset()
         self.perception = self._perception()
         self.loop: Loop = Loop(self.perception, rate=sc.rate, regulator=reg, keep=False,
-                               perception_rate=self._camera_rate())
+                               perception_rate=self._camera_rate(), follow=sc.offset)
         with _quiet():
             self.server = open_server(self.gate, self.host, self.asked_port,
                                       f"aou studio: {sc.title or self.path}")
