@@ -142,6 +142,18 @@ def test_a_page_moving_the_card_over_the_tag_makes_the_arm_hesitant_and_back(sta
     assert all(s.kind != "held" for s in stage.loop.switches)
 
 
+def test_a_page_dimming_the_light_makes_the_arm_fearful_then_inactive_and_back(stage):
+    """The light's slider, moved by a page: darkness walks the state past hesitant to
+    fearful or inactive, as the mapping says; the light back brings confident back."""
+    wait_for(lambda: 'data-state="confident"' in stage.state.content)
+    assert _send(stage, stage.light, 0.0)[0] == "open"
+    wait_for(lambda: re.search(r'data-state="(fearful|inactive)"', stage.state.content))
+    assert stage.scene_at(0.0).light == 0.0
+    assert 'fill="rgb(0,0,0)" data-part="tag"' in stage.view.content  # a dark view
+    assert _send(stage, stage.light, 1.0)[0] == "open"
+    wait_for(lambda: 'data-state="confident"' in stage.state.content)
+
+
 def test_the_gate_covers_the_scenes_controls(stage):
     """Without the token a page cannot move the card; a value past the slider's range is
     clamped to it before the loop sees it."""
