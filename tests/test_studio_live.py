@@ -93,13 +93,23 @@ size = [0.01, 0.06, 0.12]
 
 
 @pytest.fixture(scope="module")
-def stage(tmp_path_factory):
-    from aou_dsl.studio.stage import Stage
+def reg() -> Regulator:
+    """One regulator whose plans the stages share (each stage starts it afresh)."""
+    return Regulator("panda", intensity_step=0.5, hysteresis=HYSTERESIS)
 
+
+@pytest.fixture(scope="module")
+def still(tmp_path_factory):
     path = tmp_path_factory.mktemp("stage") / "still.toml"
     path.write_text(STILL)
-    reg = Regulator("panda", intensity_step=0.5, hysteresis=HYSTERESIS)
-    s = Stage(str(path), port=0, regulator=reg).start()
+    return str(path)
+
+
+@pytest.fixture(scope="module")
+def stage(reg, still):
+    from aou_dsl.studio.stage import Stage
+
+    s = Stage(still, port=0, regulator=reg).start()
     yield s
     s.close()
 
@@ -184,3 +194,30 @@ def test_aouc_studio_refuses_shaping_flags_with_a_scenario(tmp_path):
                           os.path.join(ROOT, "behaviours", "hesitant.aou"), "--perception",
                           "camera"], capture_output=True, text=True, timeout=120)
     assert out.returncode == 2 and "scenario" in out.stderr, out.stderr
+
+
+def test_the_rendered_camera_plays_live_and_its_frame_is_shown(reg, still, stage):
+    """With the rendered camera the page shows its last frame (a PNG of 320 x 240), and
+    the card over the tag makes the arm hesitant as with the model."""
+    pytest.importorskip("pupil_apriltags", reason="the perception extra is missing")
+    import base64
+    import io
+
+    from PIL import Image
+
+    from aou_dsl.studio.stage import Stage
+
+    stage.close()  # one loop at a time on the shared regulator
+    s = Stage(still, port=0, regulator=reg, perception="camera").start()
+    try:
+        wait_for(lambda: s.drawn > 2 and 'data-state="confident"' in s.state.content)
+        src = re.search(r'<img id="aou-camera" src="data:image/png;base64,([^"]+)"',
+                        s.view.content)
+        assert src is not None
+        img = Image.open(io.BytesIO(base64.b64decode(src.group(1))))
+        assert img.size == (320, 240) and np.asarray(img).std() > 10  # a picture
+        s.place("card", (0.45, OVER, 0.06))
+        wait_for(lambda: 'data-state="hesitant"' in s.state.content)
+        assert "internal error" not in getattr(s.notice, "content", "")
+    finally:
+        s.close()

@@ -138,6 +138,7 @@ class Stage:
         if self.server is not None:
             with _quiet():
                 self.server.stop()
+            self.server = None
 
     # --- the scene the perception sees ----------------------------------------------
 
@@ -307,7 +308,7 @@ class Stage:
         self._place3d(s)
         self._follow(s)
         last = getattr(self.perception, "last", None)
-        self.view.content = (liveview.camera_png(last.grey) if last is not None
+        self.view.content = (liveview.camera_png(last.image) if last is not None
                              else liveview.camera_svg(s, tk.evidence.get("visible")))
         sent = [w for w in lp.switches if w.kind != "held"]
         held = lp.switches[-1].reason if lp.switches and lp.switches[-1].kind == "held" \
