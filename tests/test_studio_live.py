@@ -164,6 +164,20 @@ def test_a_page_dimming_the_light_makes_the_arm_fearful_then_inactive_and_back(s
     wait_for(lambda: 'data-state="confident"' in stage.state.content)
 
 
+def test_a_page_moving_the_target_behind_the_card_makes_the_arm_hesitant(stage):
+    """The target's sliders: moved behind the card (which stays where it is), the tag is
+    hidden and the arm grows hesitant; moved back, confident. The 3D target follows."""
+    x, y, z = stage.sliders["target"]
+    wait_for(lambda: 'data-state="confident"' in stage.state.content)
+    assert _send(stage, y, 0.25)[0] == "open"
+    wait_for(lambda: 'data-state="hesitant"' in stage.state.content)
+    assert stage.scene_at(0.0).target == pytest.approx((0.6, 0.25, 0.04))
+    assert stage.scene_at(0.0).occluders[0].center == pytest.approx((0.45, AWAY, 0.06))
+    wait_for(lambda: tuple(stage.target.position) == pytest.approx((0.6, 0.25, 0.04)))
+    assert _send(stage, y, 0.0)[0] == "open"
+    wait_for(lambda: 'data-state="confident"' in stage.state.content)
+
+
 def test_the_gate_covers_the_scenes_controls(stage):
     """Without the token a page cannot move the card; a value past the slider's range is
     clamped to it before the loop sees it."""

@@ -9,9 +9,10 @@ clock at the scenario's rate, and shows, about ten times a second:
 - what the camera sees (:mod:`.liveview`: the geometric model's view, or the rendered
   camera's frame with ``perception="camera"``), the confidence over the last seconds,
   the state and intensity the arm expresses, and the estimate on the C-V map;
-- sliders for the light and for where each occluder is. The scenario's timeline plays
-  as ``aouc live`` plays it; once the page moves a slider, that occluder (or the light)
-  stays where the page put it, and the arm answers through the same loop.
+- sliders for the light and for where the target and each occluder are. The
+  scenario's timeline plays as ``aouc live`` plays it; once the page moves a slider,
+  what it moves stays where the page put it, and the arm answers through the same loop
+  (with ``follow``, its goal goes with the target).
 
 The page is served as the studio's (:mod:`.serving`): only the printed address with its
 token is answered, and each slider's value is checked and clamped to its range before
@@ -143,18 +144,21 @@ class Stage:
     # --- the scene the perception sees ----------------------------------------------
 
     def scene_at(self, t: float) -> Scene:
-        """The scenario's scene at ``t``, with the occluders and the light the page
-        placed where it placed them."""
+        """The scenario's scene at ``t``, with the target, the occluders and the light
+        the page placed where it placed them."""
         s = self.scenario.scene_at(t)
         with self._lock:
             placed, light = dict(self._placed), self._light
         if placed:
             s = replace(s, occluders=tuple(replace(b, center=placed.get(b.name, b.center))
                                            for b in s.occluders))
+        if "target" in placed:
+            s = replace(s, target=placed["target"], target_velocity=(0.0, 0.0, 0.0))
         return s if light is None else replace(s, light=light)
 
     def place(self, name: str, center: tuple[float, float, float]) -> None:
-        """Put the occluder ``name`` at ``center`` [m] (what its sliders do)."""
+        """Put the occluder ``name`` (or the ``target``) at ``center`` [m] (what its
+        sliders do)."""
         with self._lock:
             self._placed[name] = center
 
@@ -230,14 +234,14 @@ class Stage:
             self.light = gui.add_slider("light", 0.0, 2.0, 0.01, round(s.light, 2),
                                         hint="1 a lit lab, 0 dark")
             self.light.on_update(self._lit)
-            for b in s.occluders:
+            for name, centre in _movable(s):
                 handles = []
-                for axis, (lo, hi), v in zip("xyz", _RANGES, b.center, strict=True):
-                    h = gui.add_slider(f"{b.name} {axis} [m]", min(lo, v), max(hi, v), 0.005,
-                                       round(v, 3), hint=f"where {b.name}'s centre is")
-                    h.on_update(lambda event, name=b.name: self._moved(name, event))
+                for axis, (lo, hi), v in zip("xyz", _RANGES, centre, strict=True):
+                    h = gui.add_slider(f"{name} {axis} [m]", min(lo, v), max(hi, v), 0.005,
+                                       round(v, 3), hint=f"where {name}'s centre is")
+                    h.on_update(lambda event, name=name: self._moved(name, event))
                     handles.append(h)
-                self.sliders[b.name] = tuple(handles)
+                self.sliders[name] = tuple(handles)
 
     def _moved(self, name: str, event: Any) -> None:
         if event.client is not None:  # the page moved it (the timeline's steps do not)
@@ -330,12 +334,12 @@ class Stage:
             placed, light = set(self._placed), self._light
         if light is None and abs(self.light.value - s.light) > 0.005:
             self._write(self.light, round(s.light, 2))
-        for b in s.occluders:
-            handles = self.sliders.get(b.name, ())
+        for name, centre in _movable(s):
+            handles = self.sliders.get(name, ())
             if [self._moved_by_page(h) for h in handles].count(True):
-                self.place(b.name, tuple(float(h.value) for h in handles))  # type: ignore[arg-type]
-            elif b.name not in placed:
-                for h, v in zip(handles, b.center, strict=True):
+                self.place(name, tuple(float(h.value) for h in handles))  # type: ignore[arg-type]
+            elif name not in placed:
+                for h, v in zip(handles, centre, strict=True):
                     if abs(h.value - v) > 0.0025:
                         self._write(h, round(min(max(v, h.min), h.max), 3))
 
@@ -349,3 +353,8 @@ class Stage:
         moved = value != self._wrote.get(id(handle), value)
         self._wrote[id(handle)] = value
         return moved
+
+
+def _movable(s: Scene) -> list[tuple[str, tuple[float, float, float]]]:
+    """What the page may move: the target and each occluder, with its centre [m]."""
+    return [("target", s.target), *((b.name, b.center) for b in s.occluders)]
