@@ -210,6 +210,61 @@ def test_aouc_studio_refuses_shaping_flags_with_a_scenario(tmp_path):
     assert out.returncode == 2 and "scenario" in out.stderr, out.stderr
 
 
+def test_what_a_page_sends_the_scene_controls_breaks_no_page_nor_the_loop(stage, capfd):
+    """A fuzz of the scene's controls as tests/test_studio_fuzz.py sends the studio's:
+    values of every wrong type and size, properties a page must not change, other kinds
+    of message and bytes that are none. Every next page gets the scene, every slider
+    holds a value in its range, the scene the perception sees stays finite and the loop
+    goes on ticking, and nothing says an internal error."""
+    import math
+    import random
+
+    import msgspec
+
+    from .test_studio_fuzz import KEYS, KINDS, NUMBERS, OTHERS
+
+    rng = random.Random(5)
+    handles = [stage.light, *(h for hs in stage.sliders.values() for h in hs)]
+    uuids = [_uuid(h) for h in handles] + ["no-such-control", "", None, 5]
+    sent = []
+    for _ in range(40):
+        roll = rng.random()
+        if roll < 0.75:
+            keys = rng.sample(KEYS, rng.choice((1, 1, 2)))
+            msg = {"type": "GuiUpdateMessage", "uuid": rng.choice(uuids),
+                   "updates": {k: rng.choice(NUMBERS + OTHERS) for k in keys}}
+        elif roll < 0.9:
+            msg = {"type": rng.choice(KINDS), "uuid": rng.choice(uuids), "values": {}}
+        else:
+            sent.append(rng.choice([b"", b"\xc1", b"not msgpack"]))
+            continue
+        try:
+            sent.append(msgspec.msgpack.encode(msg))
+        except (OverflowError, msgspec.EncodeError):
+            continue
+    port, q = stage.port, f"?token={stage.gate.token}"
+    for i in range(0, len(sent), 20):
+        state, _ = asyncio.run(_open(port, query=q, send=sent[i:i + 20], quiet=0.3))
+        assert state in ("open", "closed")
+        state, got = asyncio.run(_open(port, query=q, quiet=0.5))
+        assert state == "open" and got > 10_000, (i, state, got)
+    before = len(stage.ticks) and stage.ticks[-1].t
+    wait_for(lambda: stage.ticks[-1].t > before + 0.5)  # the loop ticks on
+    for h in handles:
+        assert h.min <= h.value <= h.max and math.isfinite(h.value), h.label
+    s = stage.scene_at(stage.ticks[-1].t)
+    assert all(math.isfinite(x) for x in (*s.target, s.light,
+                                          *(c for b in s.occluders for c in b.center)))
+    err = capfd.readouterr().err
+    assert "internal error" not in err and "Traceback" not in err, err[-2000:]
+    assert "internal error" not in stage.notice.content
+    assert stage.inbox.refused > 0
+    # the page's own values again, for the tests after this one
+    for name, centre in (("card", (0.45, AWAY, 0.06)), ("target", (0.6, 0.0, 0.04))):
+        stage.place(name, centre)
+    stage.set_light(1.0)
+
+
 def test_the_rendered_camera_plays_live_and_its_frame_is_shown(reg, still, stage):
     """With the rendered camera the page shows its last frame (a PNG of 320 x 240), and
     the card over the tag makes the arm hesitant as with the model."""
@@ -221,7 +276,7 @@ def test_the_rendered_camera_plays_live_and_its_frame_is_shown(reg, still, stage
 
     from aou_dsl.studio.stage import Stage
 
-    stage.close()  # one loop at a time on the shared regulator
+    stage.close()  # one loop at a time on the shared regulator (this test runs last)
     s = Stage(still, port=0, regulator=reg, perception="camera").start()
     try:
         wait_for(lambda: s.drawn > 2 and 'data-state="confident"' in s.state.content)
