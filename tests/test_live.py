@@ -252,3 +252,86 @@ def test_live_regulation_example_runs(tmp_path):
                          text=True).stdout
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert f"wrote {png}" in out and "re-plans" in out
+
+
+# --- the default hysteresis and the camera's noise --------------------------------------
+
+#: The regulator's default before it was made from the camera's noise: the test below
+#: must find it chattering.
+OLD_DEFAULT = Hysteresis(state=0.2, intensity=0.05, uncertainty=0.05)
+
+
+def test_the_default_hysteresis_is_the_one_the_measured_noise_gives():
+    """The default is made from the calibration's measurement of the camera's confidence
+    noise (docs/perception-noise.csv): its largest std at a still scene, held past each
+    border by NOISE_MARGIN of it on the path's longest leg."""
+    from aou_dsl.live import calibrate
+    from aou_dsl.live.regulator import (
+        CONFIDENCE_NOISE,
+        NOISE_MARGIN,
+        hysteresis_for,
+        hysteresis_margins,
+    )
+
+    rows = calibrate.read_csv((ROOT / "docs" / "perception-noise.csv").read_text())
+    sigma = calibrate.noise_sigma(rows)
+    assert sigma == CONFIDENCE_NOISE > 0
+    assert Hysteresis() == hysteresis_for(sigma)
+    # the margin in uncertainty on the longest leg (confident-curious, 2 C-V units)
+    u = 0.125 + NOISE_MARGIN * sigma
+    c, v, _ = from_uncertainty(u)
+    gain = (np.hypot(c - 1.0, v + 1.0) - np.hypot(c - 1.0, v - 1.0))
+    assert gain == pytest.approx(hysteresis_margins(sigma)[0], abs=1e-3)
+    # the scenes where the detector flickers are among those measured
+    assert max(r["std"] for r in rows) > 10 * np.median([r["std"] for r in rows])
+
+
+def _camera_like(border: float, sigma: float, seed: int, seconds: float = 40.0,
+                 rate: float = 100.0, camera: float = 20.0, window: float = 1.0) -> np.ndarray:
+    """An uncertainty drifting slowly across ``border`` (0.2 over ``seconds``) with noise
+    as the camera's: white per frame at ``camera`` Hz, averaged over its ``window``
+    (std ``sigma`` after it), each answer held until the next frame."""
+    rng = np.random.default_rng(seed)
+    frames = int(seconds * camera)
+    per = int(window * camera)
+    white = rng.normal(0.0, sigma * np.sqrt(per), frames + per)
+    noise = np.convolve(white, np.ones(per) / per, "valid")[:frames]
+    drift = border - 0.1 + 0.2 * np.arange(frames) / frames
+    u = np.clip(drift + noise, 0.0, 1.0)
+    return np.repeat(u, int(rate / camera))
+
+
+def _expressed(hysteresis: Hysteresis, us: np.ndarray) -> list[tuple[State, float]]:
+    """What the regulator expresses tick by tick (its :meth:`decide`, as ``update``
+    calls it; no plan is made)."""
+    reg = Regulator("panda", hysteresis=hysteresis)
+    out = []
+    for u in us:
+        choice = reg.decide(*reg.estimate(uncertainty=float(u)))
+        if choice is not None:
+            reg.expressed = choice
+        out.append(reg.expressed)
+    return out
+
+
+def _flips(seq: list) -> int:
+    return sum(a != b for a, b in zip(seq, seq[1:], strict=False))
+
+
+@pytest.mark.parametrize("border", [0.125, 0.375, 0.625, 0.875])
+def test_the_default_hysteresis_does_not_chatter_on_the_cameras_noise(border):
+    """A slow crossing of each border between two states, with the camera's measured
+    noise: the default changes state once and its intensity a few times; the old
+    default re-plans more than twice as often on the same signals."""
+    from aou_dsl.live.regulator import CONFIDENCE_NOISE
+
+    new = old = 0
+    for seed in range(4):
+        us = _camera_like(border, CONFIDENCE_NOISE, seed)
+        got = _expressed(Hysteresis(), us)
+        assert _flips([s for s, _ in got]) == 1, (border, seed)
+        # the intensity goes down to 0 at the border and up again: a few levels, once
+        assert _flips(got) <= 4, (border, seed, got)
+        new += _flips(got)
+        old += _flips(_expressed(OLD_DEFAULT, us))
+    assert old > 2 * new  # the check can fail: the old default chatters on the same signals

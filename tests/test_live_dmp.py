@@ -14,7 +14,7 @@ from aou_dsl.core.diagnostics import AouError  # noqa: E402
 from aou_dsl.lang.cv import CANONICAL  # noqa: E402
 from aou_dsl.lang.descriptors import REGISTRY  # noqa: E402
 from aou_dsl.lang.ir import State  # noqa: E402
-from aou_dsl.live.regulator import Regulator  # noqa: E402
+from aou_dsl.live.regulator import Hysteresis, Regulator  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -96,8 +96,9 @@ def test_the_changed_motion_stays_within_the_arms_limits(raised):
 def test_update_moves_the_intensity_through_the_dmps():
     """update() with a new intensity level of the expressed state changes it through the
     DMPs (no transition: the trajectory starts at the arm's state); a second change
-    keeps the first one's parts; a new state re-plans as before."""
-    reg = Regulator("panda", through_dmp=True)
+    keeps the first one's parts; a new state re-plans as before (an estimate given
+    directly, not a camera's: a one-level change passes the hysteresis)."""
+    reg = Regulator("panda", through_dmp=True, hysteresis=Hysteresis(intensity=0.05))
     c, v = CANONICAL[State.HESITANT]
     plan = reg.plan(State.HESITANT, 0.5)
     start = reg.update(plan.q[0], C=c, V=v, intensity=0.5)

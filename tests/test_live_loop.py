@@ -135,7 +135,7 @@ def test_no_chattering_where_a_threshold_is_crossed_slowly(reg):
     def perceive(t: float) -> float:
         return float(np.clip(0.92 - 0.01 * t + rng.normal(0.0, 0.01), 0.0, 1.0))
 
-    r = loop.run(perceive, duration=12.0, rate=100.0, regulator=_fresh(reg))
+    r = loop.run(perceive, duration=16.0, rate=100.0, regulator=_fresh(reg))
     states = _states(r)
     assert states == ["confident", "curious"], states
     # without hysteresis the same signal chatters: the check can fail
@@ -143,7 +143,7 @@ def test_no_chattering_where_a_threshold_is_crossed_slowly(reg):
     bare = Regulator("panda", intensity_step=0.5,
                      hysteresis=Hysteresis(state=0.0, intensity=0.0, uncertainty=0.0))
     bare._plans, bare._texts = reg._plans, reg._texts
-    r2 = loop.run(perceive, duration=12.0, rate=100.0, regulator=bare)
+    r2 = loop.run(perceive, duration=16.0, rate=100.0, regulator=bare)
     assert len(_states(r2)) > 3
 
 
@@ -378,3 +378,106 @@ def test_detectors_are_freed_without_crashing_the_process():
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          timeout=300, cwd=ROOT)
     assert run.returncode == 0, run.stderr[-2000:]
+
+
+def test_the_recording_keeps_one_sample_step_across_every_switch(card):
+    """A controller's clock has one step: every transition lasts a whole number of the
+    plan's samples, so the executed motion is sampled evenly from its start to its end
+    (`aouc measure` reads it as one recording)."""
+    t = loop.document(card)["t"]
+    step = np.diff(t)
+    assert len(card.switches) >= 4
+    assert step.max() - step.min() < 1e-9, (step.min(), step.max())
+
+
+def test_a_new_reach_starts_from_rest_after_its_return(card, tmp_path):
+    """At a restart the arm comes back to where the reach starts and holds there
+    RESTART_HOLD before it reaches again; the stretch around it measures as a return, a
+    pause and an approach (the return and the reach run into each other otherwise, and
+    the measurement's own check refused the whole run there)."""
+    from aou_dsl.live.splice import RESTART_HOLD
+
+    tr = card.trajectory
+    doc = loop.document(card)
+    restarts = [s for s in card.switches if s.kind == "restart"]
+    assert restarts
+    for s in restarts:
+        begin = s.start + s.transition
+        held = (tr.t >= begin - RESTART_HOLD + 1e-6) & (tr.t < begin - 1e-6)
+        assert held.sum() >= round(RESTART_HOLD * 250) - 2
+        assert np.abs(tr.qd[held]).max() < 1e-9 and np.abs(tr.qdd[held]).max() < 1e-9
+        t = np.asarray(doc["t"])
+        rows = np.flatnonzero((t >= s.start - 1.0) & (t < begin + 3.0))
+        sub = {k: v for k, v in doc.items() if k not in ("t", "q", "qd", "qdd", "live",
+                                                         "episodes")}
+        sub |= {"t": (t[rows] - t[rows[0]]).tolist(), "episodes": [],
+                "duration": float(t[rows[-1]] - t[rows[0]]),
+                **{k: [doc[k][i] for i in rows] for k in ("q", "qd", "qdd")}}
+        path = tmp_path / f"restart-{s.t:.2f}.json"
+        path.write_text(json.dumps(sub))
+        kinds = [e.kind for e in aou_dsl.measure(str(path)).episodes]
+        assert "pause" in kinds and "approach" in kinds, kinds
+
+
+def test_the_whole_recorded_run_measures(card, tmp_path):
+    """`aouc measure` reads the whole recording of a run, switches and restarts included
+    (its own checks once refused it at a restart)."""
+    path = tmp_path / "run.json"
+    path.write_text(json.dumps(loop.document(card)))
+    m = aou_dsl.measure(str(path))
+    kinds = {e.kind for e in m.episodes}
+    assert {"approach", "pause", "retreat"} <= kinds
+    out = subprocess.run([sys.executable, "-m", "aou_dsl", "measure", str(path)],
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+
+
+FOLLOW = """
+duration = 12.0
+goal = [0.55, 0.0, 0.25]
+follow = true
+[scene]
+target = [0.6, 0.0, 0.04]
+[[event]]
+kind = "move"
+what = "target"
+at = 2.0
+duration = 3.0
+to = [0.6, 0.08, 0.04]
+"""
+
+
+def test_the_goal_follows_a_moving_target(reg, tmp_path):
+    """With ``follow``, the goal moves with the target the perception sees (kept where
+    the scenario's goal is from it): the loop re-plans (``retarget``) into plans for the
+    new goal, each checked, and the arm's reach ends where the moved goal puts it."""
+    from aou_dsl.live.scenario import parse
+    from aou_dsl.robot.batch_fk import batch_fk
+
+    sc = parse(FOLLOW)
+    assert sc.offset == pytest.approx((-0.05, 0.0, 0.21))
+    fresh = _fresh(reg)
+    start_goal = fresh.goal
+    fresh.goal = sc.goal
+    try:
+        r = loop.run(Geometric(sc.scene_at), duration=sc.duration, rate=sc.rate,
+                     regulator=fresh, follow=sc.offset)
+        moved = [s for s in r.switches if s.kind == "retarget"]
+        assert moved and not [s for s in r.switches if s.kind == "held"]
+        assert moved[-1].goal == pytest.approx((0.55, 0.08, 0.25), abs=0.021)
+        assert all(b[1] >= a[1] for a, b in zip((s.goal for s in moved),
+                                               (s.goal for s in moved[1:]), strict=False))
+        last = r.switches[-1]
+        plan_new = fresh.plan(State(last.state), last.intensity)
+        fresh.goal = sc.goal
+        plan_old = fresh.plan(State(last.state), last.intensity)
+        arm = fresh.arm
+        end_new = batch_fk(arm, plan_new.q[-1:])[0][0]
+        end_old = batch_fk(arm, plan_old.q[-1:])[0][0]
+        assert end_new - end_old == pytest.approx(np.subtract(last.goal, sc.goal), abs=0.01)
+        doc = loop.document(r)
+        assert doc["live"]["switches"][-1]["goal"] == pytest.approx(list(last.goal))
+        segs = loop.segments(r, doc)
+        assert segs[-1][1]["goal"]["position"] == pytest.approx(list(last.goal))
+    finally:
+        fresh.goal = start_goal

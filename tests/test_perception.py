@@ -257,6 +257,8 @@ def test_shipped_scenarios_follow_their_schema():
     "duration = 5\n[[occluder]]\nname = \"target\"\ncenter = [0, 0, 0]\nsize = [1, 1, 1]\n",
     "duration = 5\n[[occluder]]\ncenter = [0, 0, 0]\nsize = [0, 1, 1]\n",
     "duration = = 5\n",
+    "duration = 5\nfollow = true\n",  # follow needs a goal
+    "duration = 5\ngoal = [0.5, 0, 0.3]\nfollow = 1\n",
     "duration = 5\nevent = 3\n",
 ])
 def test_a_bad_scenario_is_i507(text):

@@ -451,3 +451,49 @@ def test_a_page_of_another_origin_cannot_open_the_studios_websocket(tmp_path, br
         other.server_close()
         studio.close()
     assert path.read_bytes() == before and os.listdir(tmp_path) == ["h.aou"]
+
+
+def _live_state(page) -> str | None:
+    return page.locator("#aou-live").first.get_attribute("data-state")
+
+
+def test_a_scenario_plays_live_and_dragging_the_card_over_the_tag_makes_the_arm_hesitant(
+        browser, tmp_path):
+    """``aouc studio SCENARIO.toml`` in a browser: the camera's view, the confidence and
+    the C-V map are in the page; typing the card's place over the tag into its slider
+    walks the state the page shows from confident towards hesitant, and taking it away
+    brings confident back."""
+    from aou_dsl.studio.stage import Stage
+
+    from .test_studio_live import AWAY, OVER, STILL
+
+    path = tmp_path / "still.toml"
+    path.write_text(STILL)
+    stage = Stage(str(path), port=0).start()
+    page = browser.new_page()
+    try:
+        page.goto(stage.url)
+        page.locator("canvas").first.wait_for(timeout=60_000)
+        page.locator('#aou-live[data-state="confident"]').wait_for(timeout=60_000)
+        for part in ("#aou-camera", "#aou-confidence", "#aou-cv"):
+            assert page.locator(part).count() == 1, part
+        seen: list[str] = []
+
+        def state_is(want: str) -> bool:
+            got = _live_state(page)
+            if got and (not seen or seen[-1] != got):
+                seen.append(got)
+            return got == want
+
+        assert state_is("confident")
+        type_value(page, "card y [m]", str(OVER))
+        wait_for(lambda: state_is("hesitant"), timeout=90)
+        order = ["confident", "curious", "hesitant"]
+        assert [order.index(s) for s in seen] == sorted(order.index(s) for s in seen), seen
+        assert page.locator('#aou-camera').first.get_attribute("data-visible") == "0.000"
+        type_value(page, "card y [m]", str(AWAY))
+        wait_for(lambda: state_is("confident"), timeout=90)
+        assert stage.scene_at(0.0).occluders[0].center[1] == AWAY
+    finally:
+        page.close()
+        stage.close()

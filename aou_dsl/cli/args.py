@@ -299,7 +299,8 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     force_option(syn)
     c["studio"] = stu = sub.add_parser(
         "studio", help="see a behaviour in 3D in the browser and shape it live (`studio` extra)")
-    stu.add_argument("path", metavar="FILE", help="a .aou file, or a recording with --robot")
+    stu.add_argument("path", metavar="FILE", help="a .aou file, a recording with --robot, or "
+                     "a scenario (.toml) whose perception loop plays live")
     stu.add_argument("--port", type=int_in(1, 65535), default=8080, metavar="P",
                      help="port to serve on (default 8080; the next free one when taken)")
     stu.add_argument("--host", default="127.0.0.1", metavar="H",
@@ -309,6 +310,9 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     stu.add_argument("--fit", action="store_true",
                      help="build as `aouc compile --fit` does (the fitted values shown in the "
                      "page; Save writes the sliders' values)")
+    stu.add_argument("--perception", choices=("geometric", "camera"), default=None,
+                     help="with a scenario: what sees the target, the geometric model "
+                     "(default) or the rendered camera with its tag detector")
     _robot(stu)
     _editor(sub, c)
     c["dmp"] = dmp_parser(sub)

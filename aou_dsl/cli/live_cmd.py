@@ -14,9 +14,8 @@ from .args import EXIT_OK, EXIT_USAGE
 
 __all__ = ["cmd_live"]
 
-#: Video frames per second, and how often the rendered camera is asked in the loop [Hz].
+#: Video frames per second.
 VIDEO_FPS = 10.0
-CAMERA_RATE = 20.0
 _COLOURS = {"confident": (46, 160, 67), "curious": (31, 119, 180), "hesitant": (255, 127, 14),
             "fearful": (214, 39, 40), "inactive": (127, 127, 127)}
 
@@ -25,6 +24,7 @@ def cmd_live(args: argparse.Namespace) -> int:
     """Run the scenario; write the recording (``-o``) and the video (``--render``)."""
     from ..core.files import check_output, write_atomic
     from ..live import scenario as scenarios
+    from ..live.camera import CAMERA_RATE
     from ..live.loop import HYSTERESIS, document, run
     from ..live.regulator import Regulator
 
@@ -50,7 +50,7 @@ def cmd_live(args: argparse.Namespace) -> int:
     perception = _perception(args.perception, sc)
     try:
         r = run(perception, duration=sc.duration, rate=sc.rate, regulator=reg,
-                title=sc.title or args.path,
+                title=sc.title or args.path, follow=sc.offset,
                 perception_rate=CAMERA_RATE if args.perception == "camera" else None)
     finally:
         close = getattr(perception, "close", None)

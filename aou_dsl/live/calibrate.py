@@ -30,12 +30,13 @@ from .geometric import (
 )
 from .world import Box, Scene
 
-__all__ = ["COLUMNS", "evaluate", "fit", "measure", "read_csv", "state_of", "sweeps",
-           "write_csv"]
+__all__ = ["COLUMNS", "NOISE_COLUMNS", "evaluate", "fit", "measure", "noise", "noise_sigma",
+           "read_csv", "state_of", "sweeps", "write_csv"]
 
 COLUMNS = ("set", "sweep", "x", "visible", "size_px", "blur_px", "light", "shake_px",
            "detected",
            "tag", "sharpness", "brightness", "confidence")
+NOISE_COLUMNS = ("sweep", "x", "ticks", "mean", "std", "step")
 BASE = Scene()
 
 
@@ -56,16 +57,9 @@ def sweeps(points: int = 16) -> list[tuple[str, str, float, Scene]]:
     and distance together, a shaking camera)."""
     lin = np.linspace
     out: list[tuple[str, str, float, Scene]] = []
-    for x in lin(0.45, -1.3, points):
-        out.append(("fit", "distance", x, replace(BASE, camera=(x, 0.0, 0.15))))
-    for v in lin(0.0, 1.8, points):
-        out.append(("fit", "speed", v, replace(BASE, target_velocity=(0.0, v, 0.0))))
-    for light in lin(0.0, 1.0, points):
-        out.append(("fit", "light", light, replace(BASE, light=light)))
-    for y in lin(0.08, -0.02, points):
-        out.append(("fit", "card", y, replace(BASE, occluders=(_card(y),))))
-    for v in lin(0.0, 1.5, points):
-        out.append(("fit", "shake", v, replace(BASE, camera_velocity=(0.0, 0.3 * v, v))))
+    for sweep, a, b in (("distance", 0.45, -1.3), ("speed", 0.0, 1.8), ("light", 0.0, 1.0),
+                        ("card", 0.08, -0.02), ("shake", 0.0, 1.5)):
+        out += [("fit", sweep, x, _scene_of(sweep, x)) for x in lin(a, b, points)]
     for a in lin(0.0, 82.0, points):
         out.append(("held", "orbit", a, _orbit(a)))
     for z in lin(0.20, 0.10, points):
@@ -107,12 +101,76 @@ def measure(points: list[tuple[str, str, float, Scene]], repeats: int = 2, seed:
     return rows
 
 
-def write_csv(rows: list[dict[str, Any]]) -> str:
+def noise(points: list[tuple[str, str, float, Scene]], seconds: float = 3.0,
+          bisect: int = 3, seed: int = 0) -> list[dict[str, Any]]:
+    """How much the camera's confidence wanders at a still scene, as the loop reads it:
+    the camera asked at its loop rate for ``seconds`` at each point of the ``fit``
+    sweeps, the confidence's mean, standard deviation and largest step between two
+    answers once its window is full. Where two neighbouring points of a sweep differ by
+    more than 0.1 (the detector's edge: it finds the tag in some frames only, where the
+    noise is largest) the edge is bisected ``bisect`` times, each midpoint measured."""
+    from .camera import CAMERA_RATE, Camera
+    from .geometric import WINDOW_S
+
+    cam = Camera(BASE, seed=seed)
+    ticks = int(round(seconds * CAMERA_RATE))
+    skip = int(round(WINDOW_S * CAMERA_RATE))
+
+    def still(sweep: str, x: float, scene: Scene) -> dict[str, Any]:
+        cam._seen.clear()  # a fresh window for each scene
+        cam._scene = lambda t: scene
+        c = np.array([cam.perceive(k / CAMERA_RATE).confidence for k in range(ticks)])[skip:]
+        return {"sweep": sweep, "x": float(x), "ticks": float(len(c)), "mean": float(c.mean()),
+                "std": float(c.std()), "step": float(np.abs(np.diff(c)).max())}
+
+    rows: list[dict[str, Any]] = []
+    try:
+        by_sweep: dict[str, list[tuple[float, Scene]]] = {}
+        for which, sweep, x, scene in points:
+            if which == "fit":
+                by_sweep.setdefault(sweep, []).append((x, scene))
+        for sweep, pts in by_sweep.items():
+            got = [still(sweep, x, sc) for x, sc in pts]
+            rows += got
+            for (x0, _), (x1, _), a, b in zip(pts, pts[1:], got, got[1:], strict=False):
+                lo, hi, ca, cb = x0, x1, a["mean"], b["mean"]
+                if abs(ca - cb) <= 0.1:
+                    continue
+                for _ in range(bisect):  # towards where the detector flickers
+                    mid = (lo + hi) / 2.0
+                    r = still(sweep, mid, _scene_of(sweep, mid))
+                    rows.append(r)
+                    if abs(r["mean"] - ca) > abs(r["mean"] - cb):
+                        hi, cb = mid, r["mean"]
+                    else:
+                        lo, ca = mid, r["mean"]
+    finally:
+        cam.close()
+    return rows
+
+
+def _scene_of(sweep: str, x: float) -> Scene:
+    """The scene of a ``fit`` sweep at ``x`` (as :func:`sweeps` makes them)."""
+    return {"distance": lambda: replace(BASE, camera=(x, 0.0, 0.15)),
+            "speed": lambda: replace(BASE, target_velocity=(0.0, x, 0.0)),
+            "light": lambda: replace(BASE, light=x),
+            "card": lambda: replace(BASE, occluders=(_card(x),)),
+            "shake": lambda: replace(BASE, camera_velocity=(0.0, 0.3 * x, x))}[sweep]()
+
+
+def noise_sigma(rows: list[dict[str, Any]]) -> float:
+    """The confidence noise the regulator's default hysteresis is made for: the largest
+    standard deviation of the camera's confidence at a still scene over ``rows``
+    (:func:`noise`), to 3 decimals."""
+    return round(max(float(r["std"]) for r in rows), 3)
+
+
+def write_csv(rows: list[dict[str, Any]], columns: tuple[str, ...] = COLUMNS) -> str:
     out = io.StringIO()
     w = csv.writer(out, lineterminator="\n")
-    w.writerow(COLUMNS)
+    w.writerow(columns)
     for r in rows:
-        w.writerow([r[c] if isinstance(r[c], str) else f"{r[c]:.6g}" for c in COLUMNS])
+        w.writerow([r[c] if isinstance(r[c], str) else f"{r[c]:.6g}" for c in columns])
     return out.getvalue()
 
 

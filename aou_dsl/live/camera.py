@@ -46,8 +46,8 @@ from .world import (
     shake_px,
 )
 
-__all__ = ["BRIGHT_REF", "MARGIN_REF", "SHARP_REF", "SIZE_REF", "TAG_CODE", "TAG_WEIGHT",
-           "Camera", "Frame", "fuse", "tag_image"]
+__all__ = ["BRIGHT_REF", "CAMERA_RATE", "MARGIN_REF", "SHARP_REF", "SIZE_REF", "TAG_CODE",
+           "TAG_WEIGHT", "Camera", "Frame", "fuse", "tag_image"]
 
 #: tag36h11 id 0, its 36 bits most significant first.
 TAG_CODE = 0xD7E00984B
@@ -58,6 +58,9 @@ _QUADRANT = ((1, 1), (2, 1), (3, 1), (4, 1), (5, 1), (2, 2), (3, 2), (4, 2), (3,
 #: (The image's references and the tag's share of the confidence are the geometric
 #: model's, so that both fuse alike.)
 MARGIN_REF, SIZE_REF = 80.0, 24.0
+#: How often a loop asks the rendered camera [Hz] (it renders and detects at 30 Hz or
+#: more on one core; the loop keeps its last answer between two).
+CAMERA_RATE = 20.0
 
 
 def tag_image(cell: int = 8) -> np.ndarray:

@@ -30,18 +30,19 @@ import numpy as np
 from ..core.diagnostics import AouError
 from ..lang.ir import State
 from .perception import Estimate, as_perception, uncertainty_of
-from .regulator import Hysteresis, Regulator
+from .regulator import Hysteresis, Regulator, Replan
 
 if TYPE_CHECKING:
     from ..core.trajectory import Trajectory
 
-__all__ = ["HYSTERESIS", "Run", "Switch", "Tick", "document", "gate", "run", "segments"]
+__all__ = ["HYSTERESIS", "Loop", "Run", "Switch", "Tick", "document", "gate", "run", "segments"]
 
-#: The loop's hysteresis (unless the caller gives one): a perception's confidence wanders
-#: from tick to tick at 100 Hz, so a state changes only once the uncertainty is 0.0375
-#: past the border between two states (0.6 C-V units nearer the new state's canonical
-#: point), and an intensity level once the intensity is 0.15 past its midpoint.
-HYSTERESIS = Hysteresis(state=0.6, intensity=0.15, uncertainty=0.05)
+#: The loop's hysteresis (unless the caller gives one): the regulator's default, made
+#: for the rendered camera's confidence noise (:data:`.regulator.CONFIDENCE_NOISE`).
+HYSTERESIS = Hysteresis()
+#: A goal that follows the target moves once the target seen is this far from where the
+#: goal was set [m] (a re-plan each time; closer moves are within the reach's own play).
+FOLLOW_STEP = 0.02
 
 
 @dataclass(frozen=True)
@@ -65,12 +66,14 @@ class Switch:
         t: when the tick asked for it [s]; start: where the new motion begins on the
             run's clock [s] (the arm's sample at that tick).
         kind: ``start``, ``replan`` (the estimate moved), ``restart`` (the reach ended and
-            begins again) or ``held`` (refused: the arm keeps its motion).
+            begins again), ``retarget`` (the target moved: the goal follows it) or
+            ``held`` (refused: the arm keeps its motion).
         state, intensity: what the new motion expresses (for ``held``: what was asked).
         seconds: the re-plan's wall time, from the tick to the checked motion [s].
         reason: why a re-plan was held.
         transition: how long the motion moves into its plan [s]; join: where it joins
-            the plan [s of the plan]; duration: the motion's length [s].
+            the plan [s of the plan]; duration: the motion's length [s]; goal: the goal
+            it reaches for [m].
     """
 
     t: float
@@ -83,6 +86,7 @@ class Switch:
     transition: float = 0.0
     join: float = 0.0
     duration: float = 0.0
+    goal: tuple[float, ...] | None = None
 
 
 @dataclass
@@ -124,7 +128,7 @@ def run(perception: Any, *, robot: str = "panda", duration: float = 10.0,
         rate: float = 100.0, goal: tuple[float, float, float] | None = None,
         perception_rate: float | None = None, hysteresis: Hysteresis | None = None,
         intensity_step: float = 0.25, regulator: Regulator | None = None,
-        title: str = "") -> Run:
+        title: str = "", follow: tuple[float, float, float] | None = None) -> Run:
     """Run the loop for ``duration`` seconds of the arm's time at ``rate`` [Hz].
 
     Args:
@@ -133,66 +137,143 @@ def run(perception: Any, *, robot: str = "panda", duration: float = 10.0,
         perception_rate: how often it is asked [Hz] (default: every tick).
         regulator: one to use (its plans kept); else one is made for ``robot`` with
             ``hysteresis`` (default :data:`HYSTERESIS`).
+        follow: the goal follows the target the perception sees, kept this far from it
+            [m] (a ``retarget`` switch each time it moves :data:`FOLLOW_STEP`).
     """
-    p = as_perception(perception)
-    reg = regulator or Regulator(robot, goal, hysteresis=hysteresis or HYSTERESIS,
-                                 intensity_step=intensity_step)
-    dt = 1.0 / rate
-    every = max(1, round(rate / perception_rate)) if perception_rate else 1
-    start_q = reg.plan(State.CONFIDENT, reg.level(1.0)).q[0]
-    n = reg.arm.n
-    # the executed motion: pieces of returned trajectories, each up to where the next began
-    pieces: list[tuple[float, Trajectory, int]] = []
-    active: Trajectory | None = None
-    since = 0.0
-    ticks: list[Tick] = []
-    switches: list[Switch] = []
-    est: Estimate | None = None
-    perceive_s = 0.0
+    lp = Loop(perception, robot=robot, rate=rate, goal=goal, perception_rate=perception_rate,
+              hysteresis=hysteresis, intensity_step=intensity_step, regulator=regulator,
+              follow=follow)
     for k in range(int(round(duration * rate))):
-        t = k * dt
-        if est is None or k % every == 0:
+        lp.tick(k / rate)
+    return lp.result(title)
+
+
+class Loop:
+    """The loop one tick at a time (:func:`run` runs it for a duration; the studio runs
+    it on the wall clock). Arguments as :func:`run`'s; ``keep=False`` keeps no history
+    of the motion (:meth:`result` then cannot be called), for a loop that runs on.
+
+    Attributes:
+        active: the motion the arm follows (None before the first tick), begun at
+            ``since`` [s] on the loop's clock; switches: every switch so far.
+    """
+
+    def __init__(self, perception: Any, *, robot: str = "panda", rate: float = 100.0,
+                 goal: tuple[float, float, float] | None = None,
+                 perception_rate: float | None = None, hysteresis: Hysteresis | None = None,
+                 intensity_step: float = 0.25, regulator: Regulator | None = None,
+                 keep: bool = True, follow: tuple[float, float, float] | None = None
+                 ) -> None:
+        self.perception = as_perception(perception)
+        self.reg = regulator or Regulator(robot, goal, hysteresis=hysteresis or HYSTERESIS,
+                                          intensity_step=intensity_step)
+        self.rate, self.keep, self.follow = rate, keep, follow
+        self._anchor = None if follow is None else self.reg.goal
+        self.every = max(1, round(rate / perception_rate)) if perception_rate else 1
+        self.start_q = self.reg.plan(State.CONFIDENT, self.reg.level(1.0)).q[0]
+        # the executed motion: pieces of returned trajectories, each up to where the next
+        # began
+        self.pieces: list[tuple[float, Trajectory, int]] = []
+        self.active: Trajectory | None = None
+        self.since = 0.0
+        self.ticks: list[Tick] = []
+        self.switches: list[Switch] = []
+        self.estimate: Estimate | None = None
+        self.perceive_s = 0.0
+        self._k = 0
+
+    def arm_at(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+        """The arm's state at ``t`` on the loop's clock (position, velocity,
+        acceleration) and its sample of :attr:`active` (-1 before the first motion)."""
+        n = self.reg.arm.n
+        if self.active is None:
+            return self.start_q, np.zeros(n), np.zeros(n), -1
+        a = self.active
+        i = max(0, int(np.searchsorted(a.t, t - self.since, side="right")) - 1)
+        assert a.qd is not None and a.qdd is not None
+        return a.q[i], a.qd[i], a.qdd[i], i
+
+    def tick(self, t: float) -> Tick:
+        """One tick at ``t`` [s] (later than the last one's): perceive, regulate, check,
+        and switch the arm's motion or hold it (the module's docstring)."""
+        reg = self.reg
+        if self.estimate is None or self._k % self.every == 0:
             clock = time.perf_counter()
-            est = p.perceive(t)
-            perceive_s += time.perf_counter() - clock
+            self.estimate = self.perception.perceive(t)
+            self.perceive_s += time.perf_counter() - clock
+        self._k += 1
+        est = self.estimate
         u = uncertainty_of(est)
+        active = self.active
+        q, qd, qdd, i = self.arm_at(t)
+        x = (q, qd, qdd)
         if active is None:
-            x = (start_q, np.zeros(n), np.zeros(n))
-            i, ended, elapsed = 0, True, None
+            ended, elapsed = True, None
         else:
-            i = max(0, int(np.searchsorted(active.t, t - since, side="right")) - 1)
-            assert active.qd is not None and active.qdd is not None
-            x = (active.q[i], active.qd[i], active.qdd[i])
-            ended, elapsed = t - since >= active.duration, float(active.t[i])
+            ended, elapsed = t - self.since >= active.duration, float(active.t[i])
         clock = time.perf_counter()
-        kept = reg.checkpoint()
+        kept, goal = reg.checkpoint(), reg.goal
+        moved = self._moved(est) if active is not None else None
+        rep: Replan | None
         try:
-            rep = reg.update(*x, uncertainty=u, restart=ended, elapsed=elapsed)
-            why = None if rep is None else gate(reg, rep.trajectory, x, rate)
+            if moved is not None and reg.expressed is not None:
+                reg.goal = moved  # the same state and level, reaching for the new goal
+                rep = reg.replan(*x, *reg.expressed, restart=ended, elapsed=elapsed)
+            else:
+                rep = reg.update(*x, uncertainty=u, restart=ended, elapsed=elapsed)
+            why = None if rep is None else gate(reg, rep.trajectory, x, self.rate)
         except AouError as exc:
             rep, why = None, exc.diagnostics[0].message if exc.diagnostics else str(exc)
         seconds = time.perf_counter() - clock
-        at = since + (float(active.t[i]) if active is not None else 0.0)
+        at = self.since + (float(active.t[i]) if active is not None else 0.0)
+        switches = self.switches
         if why is not None:
             state, level = (rep.state, rep.intensity) if rep is not None else \
                 (reg.expressed or (State.INACTIVE, 0.0))
             reg.rollback(kept)  # the arm did not get it: it keeps what it was doing
+            reg.goal = goal
             if not _same_hold(switches, why):
-                switches.append(Switch(t, at, "held", str(state), level, seconds, why))
+                switches.append(Switch(t, at, "held", str(state), level, seconds, why,
+                                       goal=moved or goal))
         elif rep is not None:
             kind = "start" if active is None else ("restart" if ended else "replan")
-            if active is not None:
-                pieces.append((since, active, i))
-            active, since = rep.trajectory, at
+            kind = "retarget" if moved is not None else kind
+            if active is not None and self.keep:
+                self.pieces.append((self.since, active, i))
+            self.active, self.since = rep.trajectory, at
             switches.append(Switch(t, at, kind, str(rep.state), rep.intensity, seconds, "",
-                                   rep.transition, rep.join_time, rep.trajectory.duration))
+                                   rep.transition, rep.join_time, rep.trajectory.duration,
+                                   rep.trajectory.goal))
         state, level = reg.expressed or (State.INACTIVE, 0.0)
-        ticks.append(Tick(t, est.confidence, u, str(state), level, est.evidence.to_json()))
-    if active is None:
-        raise AouError(switches_message(switches))
-    pieces.append((since, active, len(active.t)))
-    return Run(_executed(pieces), ticks, switches, reg.robot, rate, title,
-               {"perceive": perceive_s})
+        tk = Tick(t, est.confidence, u, str(state), level, est.evidence.to_json())
+        if self.keep:
+            self.ticks.append(tk)
+        return tk
+
+    def _moved(self, est: Estimate) -> tuple[float, float, float] | None:
+        """The goal that follows the target the estimate sees, when the target has moved
+        :data:`FOLLOW_STEP` from where the goal was last set (None: keep the goal)."""
+        if self.follow is None or est.position is None or self.reg.expressed is None \
+                or self.reg.expressed[0] is State.INACTIVE:
+            return None
+        want = tuple(round(p + o, 3) for p, o in zip(est.position, self.follow, strict=True))
+        if self._anchor is not None and \
+                float(np.linalg.norm(np.subtract(want, self._anchor))) < FOLLOW_STEP:
+            return None
+        self._anchor = want  # type: ignore[assignment]
+        return want  # type: ignore[return-value]
+
+    def result(self, title: str = "") -> Run:
+        """The run so far (a loop made with ``keep``).
+
+        Raises:
+            AouError: C306 when the arm never got a motion.
+        """
+        if self.active is None:
+            raise AouError(switches_message(self.switches))
+        pieces = [*self.pieces, (self.since, self.active, len(self.active.t))]
+        return Run(_executed(pieces), self.ticks, self.switches, self.reg.robot, self.rate,
+                   title, {"perceive": self.perceive_s})
 
 
 def _same_hold(switches: list[Switch], why: str) -> bool:
@@ -269,7 +350,9 @@ def document(r: Run) -> dict[str, Any]:
             "switches": [{"t": s.t, "start": s.start, "kind": s.kind, "state": s.state,
                           "intensity": s.intensity, "reason": s.reason,
                           "transition": s.transition, "join": s.join,
-                          "duration": s.duration} for s in r.switches],
+                          "duration": s.duration,
+                          "goal": None if s.goal is None else list(s.goal)}
+                         for s in r.switches],
         },
         "t": tr.t.tolist(),
         "q": tr.q.tolist(),
@@ -296,6 +379,8 @@ def segments(r: Run, doc: dict[str, Any] | None = None) -> list[tuple[Switch, di
         sub = {key: doc[key] for key in doc if key not in ("t", "q", "qd", "qdd", "live",
                                                          "episodes")}
         t0 = float(t[rows[0]])
+        if s.goal is not None:  # the goal it reached for (it may follow the target)
+            sub["goal"] = {"position": list(s.goal)}
         sub |= {"behaviour": f"{s.state}_{s.intensity:g}".replace(".", "_"),
                 "state": s.state,
                 "duration": float(t[rows[-1]] - t0),

@@ -44,7 +44,8 @@ if TYPE_CHECKING:
     from .dmp_follow import DmpRun
     from .perception import Estimate
 
-__all__ = ["PATH", "Hysteresis", "Regulator", "Replan", "from_uncertainty"]
+__all__ = ["CONFIDENCE_NOISE", "NOISE_MARGIN", "PATH", "Hysteresis", "Regulator", "Replan",
+           "from_uncertainty", "hysteresis_for", "hysteresis_margins"]
 
 _WHERE = Span.whole_file("<live>")
 
@@ -76,9 +77,36 @@ def from_uncertainty(u: float) -> tuple[float, float, float]:
     return c0 + f * (c1 - c0), v0 + f * (v1 - v0), max(0.0, 1.0 - 2.0 * abs(s - nearest))
 
 
+#: The rendered camera's confidence noise: the largest standard deviation of its
+#: confidence at a still scene, as the loop reads it, over the calibration's sweeps
+#: (``tools/calibrate_perception.py --noise`` measures it, docs/perception-noise.csv).
+CONFIDENCE_NOISE = 0.027
+#: An estimate must pass a border by this many standard deviations of that noise.
+NOISE_MARGIN = 2.0
+#: The longest leg of :data:`PATH` [C-V units]: a margin there is the least uncertainty.
+_LONGEST = max(math.dist(CANONICAL[a], CANONICAL[b])
+               for a, b in zip(PATH, PATH[1:], strict=False))
+
+
+def hysteresis_margins(sigma: float, margin: float = NOISE_MARGIN) -> tuple[float, float]:
+    """(state, intensity) margins that hold an uncertainty whose noise has std ``sigma``
+    ``margin`` standard deviations past a border: ``u`` past the border between two
+    states by ``du`` puts the point ``8 L du`` nearer the new state's canonical point
+    than the old one's (L the leg's length, the longest leg the worst), and moves the
+    intensity by ``8 du``."""
+    du = margin * sigma
+    return round(8.0 * _LONGEST * du, 3), round(8.0 * du, 3)
+
+
+_STATE, _INTENSITY = hysteresis_margins(CONFIDENCE_NOISE)
+
+
 @dataclass(frozen=True)
 class Hysteresis:
-    """How far an estimate must move before the expressed behaviour changes.
+    """How far an estimate must move before the expressed behaviour changes. The
+    defaults hold the uncertainty :data:`NOISE_MARGIN` standard deviations of the
+    rendered camera's confidence noise (:data:`CONFIDENCE_NOISE`) past each border
+    (:func:`hysteresis_margins`).
 
     Attributes:
         state: a new state is expressed once the point is this much nearer [C-V units]
@@ -89,9 +117,16 @@ class Hysteresis:
             last value that was used (a backlash).
     """
 
-    state: float = 0.2
-    intensity: float = 0.05
+    state: float = _STATE
+    intensity: float = _INTENSITY
     uncertainty: float = 0.05
+
+
+def hysteresis_for(sigma: float, margin: float = NOISE_MARGIN) -> Hysteresis:
+    """The hysteresis for a confidence whose noise has std ``sigma``
+    (:func:`hysteresis_margins`; the uncertainty's backlash stays the default)."""
+    state, intensity = hysteresis_margins(sigma, margin)
+    return Hysteresis(state=state, intensity=intensity)
 
 
 @dataclass
@@ -154,7 +189,7 @@ class Regulator:
         self._sequences: dict[int, tuple] = {}
         self._u: float | None = None
         self._plans: dict[str, Trajectory] = {}  # by text: levels may share a file
-        self._texts: dict[tuple[State, float], str] = {}
+        self._texts: dict[tuple, str] = {}  # by state, level and goal
         #: the last trajectory returned: (it, join time, transition, plan duration, the
         #: phase an inactive hold keeps)
         self._last: tuple[Trajectory, float, float, float, float] | None = None
@@ -228,6 +263,11 @@ class Regulator:
         """Forget a re-plan the arm did not get: back to a :meth:`checkpoint`."""
         self.expressed, self._last, self._dmp = kept
 
+    def reset(self) -> None:
+        """Forget what was expressed and the last uncertainty used (the plans stay): a
+        new run starts."""
+        self.expressed, self._last, self._dmp, self._u = None, None, None, None
+
     # --- plans ----------------------------------------------------------------------------
 
     def plan(self, state: State, level: float) -> Trajectory:
@@ -238,16 +278,18 @@ class Regulator:
         """
         from ..synth.synthesis import compiled, synthesize
 
-        key = (state, level)
+        key = (state, level, self.goal)  # a goal that follows the target makes new ones
         if key not in self._texts:
             self._texts[key] = synthesize(state, intensity=level, robot=self.robot,
                                           goal=self.goal)
         text = self._texts[key]
         if text not in self._plans:
+            from .splice import on_grid
+
             res = compiled(text)
             if not res.ok:
                 raise AouError(res.diagnostics)
-            self._plans[text] = res.trajectory
+            self._plans[text] = on_grid(res.trajectory)
         return self._plans[text]
 
     def prepare(self, states: tuple[State, ...] = PATH[:-1]) -> int:

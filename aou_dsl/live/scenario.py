@@ -6,6 +6,7 @@ A scenario file (its JSON Schema: ``aou_dsl/schemas/scenario.schema.json``)::
     duration = 30.0            # s
     rate = 100                 # Hz, the controller's tick (default 100)
     goal = [0.55, 0.0, 0.25]   # the arm's goal in its base frame [m] (default: the arm's)
+    follow = false             # true: the goal moves with the target the perception sees
 
     [scene]
     target = [0.6, 0.0, 0.04]  # the target cube's centre [m]
@@ -49,7 +50,7 @@ EVENT_KINDS = ("move", "light", "shake")
 MAX_DURATION, MAX_EVENTS, MAX_OCCLUDERS, MAX_BYTES = 600.0, 200, 20, 256 * 1024
 _SCENE_KEYS = {"target", "target_yaw", "camera", "look_at", "light", "exposure", "noise",
                "fov"}
-_TOP_KEYS = {"title", "duration", "rate", "goal", "scene", "occluder", "event"}
+_TOP_KEYS = {"title", "duration", "rate", "goal", "follow", "scene", "occluder", "event"}
 
 
 @dataclass(frozen=True)
@@ -76,6 +77,15 @@ class Scenario:
     scene: Scene
     events: tuple[Event, ...]
     path: str = "<scenario>"
+    follow: bool = False
+
+    @property
+    def offset(self) -> tuple[float, float, float] | None:
+        """Where the goal is from the target at the start (``follow``), else None."""
+        if not self.follow or self.goal is None:
+            return None
+        g, t = self.goal, self.scene.target
+        return (g[0] - t[0], g[1] - t[1], g[2] - t[2])
 
     def scene_at(self, t: float) -> Scene:
         """The scene at ``t`` [s], with the velocities of whatever moves then."""
@@ -159,6 +169,11 @@ def parse(text: str, path: str = "<scenario>") -> Scenario:
     if not isinstance(title, str) or len(title) > 200:
         raise _bad(path, "`title` must be a string of at most 200 characters")
     goal = _vector(path, doc, "goal", default=None)
+    follow = doc.get("follow", False)
+    if not isinstance(follow, bool):
+        raise _bad(path, f"`follow` must be true or false, found {follow!r:.40}")
+    if follow and goal is None:
+        raise _bad(path, "`follow` needs a `goal`: where the arm reaches, from the target")
     sc = doc.get("scene", {})
     if not isinstance(sc, dict):
         raise _bad(path, "`scene` must be a table")
@@ -197,7 +212,7 @@ def parse(text: str, path: str = "<scenario>") -> Scenario:
                    for i, e in enumerate(_list(path, doc, "event", MAX_EVENTS)))
     _no_overlap(path, events)
     return Scenario(title, duration, rate, goal, replace(scene, occluders=tuple(boxes)),
-                    tuple(sorted(events, key=lambda e: e.at)), path)
+                    tuple(sorted(events, key=lambda e: e.at)), path, follow)
 
 
 def _event(path: str, e: dict, i: int, names: set[str], duration: float) -> Event:

@@ -6,13 +6,16 @@ sample nearest the arm and lasting at least that long, time-optimal under the
 regulator's share of the arm's joint velocity, acceleration and jerk limits. Position,
 velocity and acceleration are therefore continuous where the re-plan takes over and where
 the plan takes over from the transition, and the jerk in between stays within the limits.
-The transition is sampled on the plan's clock and checked (:func:`aou_dsl.check`);
+The transition lasts a whole number of the plan's samples and is sampled on the plan's
+clock, so that a run's recording keeps one sample step across every switch, as a
+controller's clock does; it is checked (:func:`aou_dsl.check`);
 a join whose transition would leave the joint ranges or fail a check is dropped for the
 next candidate.
 """
 
 from __future__ import annotations
 
+import math
 import time
 from typing import TYPE_CHECKING, Protocol
 
@@ -25,8 +28,8 @@ if TYPE_CHECKING:
     from ..core.trajectory import Trajectory
     from ..robot.kinematics import ArmModel
 
-__all__ = ["LEAD", "PHASE_WEIGHT", "VELOCITY_WEIGHT", "brake_and_hold", "join_plan", "phase_in",
-           "transition"]
+__all__ = ["LEAD", "PHASE_WEIGHT", "RESTART_HOLD", "VELOCITY_WEIGHT", "brake_and_hold",
+           "join_plan", "on_grid", "phase_in", "transition"]
 
 #: Weight of the velocity difference when choosing where to join a plan [s]: a sample
 #: moving 1 rad/s differently counts like one 0.1 rad away.
@@ -39,6 +42,10 @@ LEAD = 0.2
 #: new plan goes on from about as far along as the arm was in the old one (a plan passes
 #: near the same pose several times: advance, withdraw, advance).
 PHASE_WEIGHT = 1.0
+#: A new reach (a restart) waits this long at rest where it starts [s]: the arm comes
+#: back and holds before it reaches again, so that the return and the reach are two
+#: motions, not one through a reversal.
+RESTART_HOLD = 0.3
 _WHERE = Span.whole_file("<live>")
 
 State3 = tuple[np.ndarray, np.ndarray, np.ndarray]
@@ -97,12 +104,18 @@ def transition(reg: Regulator, x: State3, target: State3 | None, rate: float,
     if at_least > 0:
         inp.minimum_duration = at_least
     traj = RuckigTrajectory(n)
-    try:
-        result = Ruckig(n).calculate(inp, traj)
-    except RuntimeError:
-        return None
-    if result not in (Result.Working, Result.Finished):
-        return None
+    dt = 1.0 / rate
+    for _ in range(4):  # a whole number of samples: the motion stays on the plan's clock
+        try:
+            result = Ruckig(n).calculate(inp, traj)
+        except RuntimeError:
+            return None
+        if result not in (Result.Working, Result.Finished):
+            return None
+        steps = float(traj.duration) / dt
+        if abs(steps - round(steps)) < 1e-6:
+            break
+        inp.minimum_duration = math.ceil(steps - 1e-6) * dt
     duration = float(traj.duration)
     if duration <= 0.0:  # already there (Ruckig's extrema of an empty motion are zeros)
         end = target if target is not None else (x[0], v_end, a_end)
@@ -170,8 +183,36 @@ def _checked(reg: Regulator, t, q, qd, qdd, goal) -> bool:
     return report.ok
 
 
+def on_grid(plan: Trajectory) -> Trajectory:
+    """``plan`` with its last sample one step after the one before (a compiled plan ends
+    at its exact duration, up to 1.5 steps after its last regular sample), so that a run
+    that follows plans end to end keeps one sample step; its last episodes end there.
+    The state of the last sample is kept: a plan ends at (or within a hair of) rest."""
+    if len(plan.t) < 3:
+        return plan
+    step = float(np.median(np.diff(plan.t)))
+    end = float(plan.t[-2]) + step
+    if abs(float(plan.t[-1]) - end) < 1e-9:
+        return plan
+    t = plan.t.copy()
+    t[-1] = end
+    episodes = tuple((kind, min(a, end), min(b, end)) for kind, a, b in plan.episodes)
+    return plan.with_(t=t, episodes=episodes)
+
+
 def _rate(plan: Trajectory) -> float:
     return 1.0 / float(np.median(np.diff(plan.t))) if len(plan.t) > 1 else 250.0
+
+
+def _held(t, q, qd, qdd, rate: float):
+    """The transition into a new reach, then :data:`RESTART_HOLD` at rest where the reach
+    starts (a transition that moved the arm there and ends at rest)."""
+    if len(t) < 2 or np.abs(qd[-1]).max() > 1e-9 or np.abs(qdd[-1]).max() > 1e-9:
+        return t, q, qd, qdd  # already there (the first reach), or not at rest
+    m = int(round(RESTART_HOLD * rate))
+    extra = t[-1] + np.arange(1, m + 1) / rate
+    still = lambda a: np.vstack([a, np.repeat(a[-1:], m, axis=0)])  # noqa: E731
+    return np.concatenate([t, extra]), still(q), still(qd), still(qdd)
 
 
 def join_plan(reg: Regulator, plan: Trajectory, x: State3, phase: float | None,
@@ -202,6 +243,8 @@ def join_plan(reg: Regulator, plan: Trajectory, x: State3, phase: float | None,
         clock = now
         if not ok:
             continue
+        if phase is None:
+            t, q, qd, qdd = _held(t, q, qd, qdd, rate)
         t_k, T = float(plan.t[k]), float(t[-1])
         episodes = tuple((kind, max(a, t_k) - t_k + T, b - t_k + T)
                          for kind, a, b in plan.episodes if b > t_k)

@@ -7,7 +7,9 @@ shape it live (the ``studio`` extra: viser, yourdfpy, watchfiles).
   text; :mod:`.disk`: reading the file and Save's checks; :mod:`.watch`: reloading when
   the file changes on disk;
 - :mod:`.gate`: only the printed address's page is answered (token, Host, Origin);
-  :mod:`.serving`: viser's server behind it, and the check of what a page sends.
+  :mod:`.serving`: viser's server behind it, and the check of what a page sends;
+- :mod:`.stage`: a scenario's perception loop played live (:mod:`.liveview` draws what
+  the camera sees and the confidence).
 
 docs/studio.md says how to use it.
 """
@@ -16,17 +18,20 @@ from __future__ import annotations
 
 import sys
 import threading
+from typing import Any
 
 __all__ = ["serve"]
 
 
 def serve(path: str, *, robot: str | None = None, host: str = "127.0.0.1", port: int = 8080,
           compare: str | None = None, stop: threading.Event | None = None,
-          package_dirs: tuple[str, ...] = (), fit: bool = False) -> int:
+          package_dirs: tuple[str, ...] = (), fit: bool = False,
+          perception: str = "geometric") -> int:
     """Run the studio of ``path`` until interrupted (or ``stop`` is set); the exit status
     (130 after Ctrl-C, as every aouc command). ``fit``: build as ``aouc compile --fit``
-    does. The address printed carries the per-run token without which the studio
-    answers nothing.
+    does. A scenario (``.toml``) plays the perception loop live (:mod:`.stage`) with
+    ``perception``. The address printed carries the per-run token without which the
+    studio answers nothing.
 
     Raises:
         AouError: the file (or ``compare``) does not build, or the robot cannot be drawn.
@@ -41,8 +46,15 @@ def serve(path: str, *, robot: str | None = None, host: str = "127.0.0.1", port:
     if host not in (LOCAL, "localhost"):
         print(f"aouc: warning: the studio binds {host}: anyone who can reach this machine "
               "can see the page and save into the file", file=sys.stderr)
-    studio = Studio(path, robot=robot, host=host, port=port, compare=compare,
-                    package_dirs=package_dirs, fit=fit).start()
+    studio: Any
+    if path.endswith(".toml"):
+        from .stage import Stage
+
+        studio = Stage(path, robot=robot, perception=perception, host=host,
+                       port=port).start()
+    else:
+        studio = Studio(path, robot=robot, host=host, port=port, compare=compare,
+                        package_dirs=package_dirs, fit=fit).start()
     if studio.port != port:
         print(f"aouc: port {port} is taken: serving on {studio.port} (--port chooses)",
               file=sys.stderr)
