@@ -12,6 +12,7 @@ of the states and intensities the log names.
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -363,20 +364,21 @@ def test_aouc_live_runs_the_shipped_scenarios(tmp_path, name, states):
 
 def test_detectors_are_freed_without_crashing_the_process():
     """pupil-apriltags frees a detector's tag families before the detector, whose
-    teardown still reads them: made and dropped often enough, that crashes the
-    process. aou's detector frees them in the safe order."""
+    teardown still reads them: a use after free. glibc's MALLOC_PERTURB_ fills freed
+    memory with garbage, so that order crashes the process within a few detectors
+    (without it, after some hundreds). aou's detector frees them in the safe order."""
     pytest.importorskip("pupil_apriltags")
     code = (
         "import gc, numpy as np\n"
         "from aou_dsl.live.camera import detector\n"
         "img = (np.random.default_rng(0).random((240, 320)) * 255).astype(np.uint8)\n"
-        "for _ in range(300):\n"
+        "for _ in range(20):\n"
         "    d = detector(); d.detect(img)\n"
-        "    junk = [bytearray(1000) for _ in range(100)]\n"
         "    del d; gc.collect()\n"
     )
+    env = {**os.environ, "MALLOC_PERTURB_": "165"}
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         timeout=300, cwd=ROOT)
+                         timeout=300, cwd=ROOT, env=env)
     assert run.returncode == 0, run.stderr[-2000:]
 
 
