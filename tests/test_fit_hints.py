@@ -184,6 +184,7 @@ def test_applying_any_refusals_hint_once_compiles_over_a_generated_set():
 
 
 @pytest.mark.slow
+@pytest.mark.large
 def test_applying_any_refusals_hint_once_compiles_over_a_bigger_generated_set():
     seen: dict[str, int] = {}
     for i, case in enumerate(langgen.random_cases(160, seed=11)):

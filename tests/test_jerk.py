@@ -195,16 +195,17 @@ def test_a_bang_bang_law_fails_the_jerk_check_at_its_switch():
     assert jerk.limit == 3750.0
 
 
-@pytest.mark.slow
-def test_generated_behaviours_stay_within_joint_jerk_limits_at_1khz():
-    """Over 300 files generated from the whole language (both robots), every compiled
+@pytest.mark.parametrize("n", [pytest.param(40, marks=pytest.mark.slow),
+                               pytest.param(300, marks=pytest.mark.large)])
+def test_generated_behaviours_stay_within_joint_jerk_limits_at_1khz(n):
+    """Over ``n`` files generated from the whole language (both robots), every compiled
     one stays within its robot's joint jerk limits at 1 kHz, and each approach and
     retreat reaches its declared acceleration within 3 % unless C304 says which limit
-    binds."""
+    binds; two in three compile."""
     from . import langgen
 
     compiled = 0
-    for case in langgen.random_cases(300, seed=21):
+    for case in langgen.random_cases(n, seed=21):
         res = build_source(case.text, f"{case.stem}.aou", check=False)
         if not res.ok:
             continue
@@ -212,7 +213,7 @@ def test_generated_behaviours_stay_within_joint_jerk_limits_at_1khz():
         worst, joint = _worst_jerk(res)
         assert worst <= 1.0, (case.text, joint, worst)
         _accelerations_as_declared(res)
-    assert compiled >= 200
+    assert compiled >= 2 * n // 3
 
 
 def test_the_franka_controller_applies_its_published_limits():

@@ -219,6 +219,7 @@ def test_measure_prints_and_writes_every_interval(shipped, tmp_path, capsys):
 
 
 @pytest.mark.slow
+@pytest.mark.large
 def test_generated_behaviours_intervals_hold_the_declared_values():
     """The larger variant: the shipped behaviours and 20 generated ones, at 250 Hz and
     1 kHz, every noise level (also the default's three at 1 kHz)."""

@@ -249,16 +249,17 @@ def sweep(n: int, seed: int, tmp: Path
     return failures, limited, worst, len(items)
 
 
-@pytest.mark.slow
-def test_generated_behaviours_through_every_logger(tmp_path):
-    """The shipped behaviours and 100 generated ones (both forms, every primitive,
+@pytest.mark.parametrize("n", [pytest.param(5, marks=pytest.mark.slow),
+                               pytest.param(100, marks=pytest.mark.large)])
+def test_generated_behaviours_through_every_logger(tmp_path, n):
+    """The shipped behaviours and ``n`` generated ones (both forms, every primitive,
     panda and ur5), each through every logger: all measure as declared, but for the
     documented limit (an acceleration phase shorter than the arm's transients), which
-    stays under 2 % of the recordings."""
-    failures, limited, worst, count = sweep(100, 11, tmp_path)
-    assert count == 105
+    stays under 2 % of the recordings (one, in the default run's small sample)."""
+    failures, limited, worst, count = sweep(n, 11, tmp_path)
+    assert count == n + 5
     assert not failures, "\n".join(failures)
-    assert len(limited) <= 0.02 * count * len(PRESETS), limited
+    assert len(limited) <= max(1, int(0.02 * count * len(PRESETS))), limited
 
 
 if __name__ == "__main__":

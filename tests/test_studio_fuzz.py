@@ -140,5 +140,6 @@ def test_what_a_page_sends_breaks_no_page_and_changes_no_file(studio, capfd, cap
 
 
 @pytest.mark.slow
+@pytest.mark.large
 def test_what_a_page_sends_larger(studio, capfd, caplog):
     _fuzz(studio, capfd, caplog, n=300, batch=60, seed=2)

@@ -315,6 +315,7 @@ def test_twenty_participants_take_the_study(browser, built, tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.large
 def test_fifty_five_participants_take_the_study(browser, built, tmp_path):
     _run(browser, built, 55, tmp_path)
 
