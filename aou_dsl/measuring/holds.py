@@ -328,10 +328,15 @@ def boundaries(r: Rest) -> list[Boundary]:
         h0, h1 = _held(r, t0, t1) if t1 - t0 >= MIN_PAUSE else (t0, t0)
         if h1 - h0 >= max(MIN_PAUSE, 0.5 * (t1 - t0)):
             # Motion too slow to see in the speed but not in the positions (the soft
-            # start of a shiver) is no part of the hold.
-            a, b = soft_pause(r.t, r.q, r.noise, (max(t0, h0), min(t1, h1)), MIN_PAUSE)
-            out.append(Boundary(a, b, i0, i1, True))
-        elif 0 < i0 and i1 < n - 1:
+            # start of a shiver) is no part of the hold. What is left of it may be too
+            # short for a pause: the whole rest was a shiver's soft end or start,
+            # hidden under the noise, and it is the instant between two episodes.
+            a, b = soft_pause(r.t, r.q, r.noise, (max(t0, h0), min(t1, h1)))
+            if b - a >= MIN_PAUSE:
+                out.append(Boundary(a, b, i0, i1, True))
+                continue
+            t0, t1 = a, b
+        if 0 < i0 and i1 < n - 1:
             # The instant between two episodes; when motion too slow to see fills the
             # gap between where one stops and the next starts, that gap belongs to
             # neither (it is the soft end of a shiver, or its soft start).
