@@ -100,6 +100,44 @@ def test_a_trajectory_without_noise_is_measured_exactly(shipped):
         s = m.uncertainty[k]
         assert (s.low, s.high, s.stable) == (v, v, True), k
     assert not [d for d in m.diagnostics if d.code == "R411"]
+    inf = m.inferred
+    assert (inf.C.low, inf.C.high, inf.V.low, inf.V.high) == (m.cv.C, m.cv.C, m.cv.V, m.cv.V)
+    assert inf.states == (m.cv.state.value,)
+    assert (inf.sight_max.low, inf.sight_max.high) == (m.line_of_sight.max,) * 2
+
+
+def test_the_inferred_state_and_the_line_of_sight_carry_their_interval(shipped, tmp_path,
+                                                                       capsys):
+    """The C-V point and the line of sight come from the whole motion: each gets an
+    interval from the same copies. Over logs of the hesitant and the fearful, the point
+    the compiled motion itself measures (the truth) lies inside the recording's
+    intervals, or the copies disagree on the state and R411 says so; at 1e-3 rad and 250
+    Hz the hesitant's state is such a case, and the text, the JSON and the warning
+    show it."""
+    from aou_dsl.build.builder import build_file
+
+    for name, noise, rate, seed in (("hesitant", 3e-4, 1000.0, 1), ("fearful", 6e-4, 250.0, 2),
+                                    ("hesitant", 6e-4, 250.0, 4)):
+        truth = build_file(str(BEHAVIOURS / f"{name}.aou"), check=False).measured.cv
+        _, m = logged(shipped[name][0], logger(noise, rate, seed))
+        inf = m.inferred
+        assert inf.C.sd + inf.V.sd > 0  # (a coordinate at its bound, 1, may not move)
+        if len(inf.states) == 1:
+            assert inf.C.low <= truth.C <= inf.C.high, (name, noise, inf.C, truth)
+            assert inf.V.low <= truth.V <= inf.V.high, (name, noise, inf.V, truth)
+    path = _csv(tmp_path, shipped["hesitant"][0], logger(1e-3, 250.0, 3))
+    assert main(["measure", path, "--robot", "panda", *GOAL]) == 0
+    out, err = capsys.readouterr()
+    line = next(ln for ln in out.splitlines() if "C-V:" in ln)
+    assert line.count("+") >= 3 and "the re-noised copies read" in line, line
+    assert "the inferred state reads" in err and " R411 " in err
+    assert main(["measure", path, "--robot", "panda", *GOAL, "--format", "json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    got = doc["inferred_uncertainty"]
+    assert len(got["states"]) > 1 and doc["cv"]["state"] in got["states"]
+    assert got["C"]["low"] < doc["cv"]["C"] < got["C"]["high"]
+    sight = got["line_of_sight_max_deg"]
+    assert sight["low"] < doc["line_of_sight"]["max_deg"] < sight["high"]
 
 
 def test_more_noise_than_the_segmentation_bears_is_said_with_its_level(shipped):

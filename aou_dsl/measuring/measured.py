@@ -100,6 +100,9 @@ class Measured:
     resolution: tuple[float, ...] = field(default=())
     #: Per descriptor, its :class:`.uncertainty.Spread` (empty when not computed).
     uncertainty: dict[str, Any] = field(default_factory=dict)
+    #: The C-V point's and the line of sight's spread (:class:`.uncertainty.Inferred`;
+    #: None when not computed).
+    inferred: Any = None
 
     def to_json(self) -> dict:
         eps = [{"kind": e.kind, "start": round(e.t_start + self.t_origin, 4),
@@ -119,6 +122,8 @@ class Measured:
             "duration": round(self.duration, 6),
             "diagnostics": [d.to_json() for d in self.diagnostics],
             "uncertainty": {k: s.to_json() for k, s in self.uncertainty.items()},
+            "inferred_uncertainty": (None if self.inferred is None
+                                     else self.inferred.to_json()),
             "uncertainty_level": 0.95,
         }
 
