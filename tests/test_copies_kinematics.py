@@ -82,3 +82,18 @@ def test_intervals_with_first_order_copies_are_those_with_exact_ones():
         assert abs(s.low - e.low) <= 0.02 * width and abs(s.high - e.high) <= 0.02 * width, k
         checked += 1
     assert checked >= 4
+
+
+def test_the_long_slope_through_the_fft_is_the_savitzky_golay_one():
+    """The slow-motion check's 0.3 s slope at 1 kHz (301 weights) runs through the FFT:
+    the same values as the direct filter, ends included, to rounding."""
+    from aou_dsl.measuring.holds import _long_slope
+    from aou_dsl.measuring.signal import smooth
+
+    rng = np.random.default_rng(5)
+    t = np.arange(20000) * 1e-3
+    q = np.column_stack([0.3 * np.sin(1.7 * t) + 1.2, 0.05 * t ** 2 - 0.4,
+                         rng.normal(0.0, 3e-4, len(t))])
+    got, want = _long_slope(q, 301, 1e-3), smooth(q, 301, 1, 1e-3, order=1)
+    assert got.shape == want.shape
+    assert np.abs(got - want).max() < 1e-12
