@@ -100,6 +100,44 @@ def test_a_trajectory_without_noise_is_measured_exactly(shipped):
         s = m.uncertainty[k]
         assert (s.low, s.high, s.stable) == (v, v, True), k
     assert not [d for d in m.diagnostics if d.code == "R411"]
+    inf = m.inferred
+    assert (inf.C.low, inf.C.high, inf.V.low, inf.V.high) == (m.cv.C, m.cv.C, m.cv.V, m.cv.V)
+    assert inf.states == (m.cv.state.value,)
+    assert (inf.sight_max.low, inf.sight_max.high) == (m.line_of_sight.max,) * 2
+
+
+def test_the_inferred_state_and_the_line_of_sight_carry_their_interval(shipped, tmp_path,
+                                                                       capsys):
+    """The C-V point and the line of sight come from the whole motion: each gets an
+    interval from the same copies. Over logs of the hesitant and the fearful, the point
+    the compiled motion itself measures (the truth) lies inside the recording's
+    intervals, or the copies disagree on the state and R411 says so; at 1e-3 rad and 250
+    Hz the hesitant's state is such a case, and the text, the JSON and the warning
+    show it."""
+    from aou_dsl.build.builder import build_file
+
+    for name, noise, rate, seed in (("hesitant", 3e-4, 1000.0, 1), ("fearful", 6e-4, 250.0, 2),
+                                    ("hesitant", 6e-4, 250.0, 4)):
+        truth = build_file(str(BEHAVIOURS / f"{name}.aou"), check=False).measured.cv
+        _, m = logged(shipped[name][0], logger(noise, rate, seed))
+        inf = m.inferred
+        assert inf.C.sd + inf.V.sd > 0  # (a coordinate at its bound, 1, may not move)
+        if len(inf.states) == 1:
+            assert inf.C.low <= truth.C <= inf.C.high, (name, noise, inf.C, truth)
+            assert inf.V.low <= truth.V <= inf.V.high, (name, noise, inf.V, truth)
+    path = _csv(tmp_path, shipped["hesitant"][0], logger(1e-3, 250.0, 3))
+    assert main(["measure", path, "--robot", "panda", *GOAL]) == 0
+    out, err = capsys.readouterr()
+    line = next(ln for ln in out.splitlines() if "C-V:" in ln)
+    assert line.count("+") >= 3 and "the re-noised copies read" in line, line
+    assert "the inferred state reads" in err and " R411 " in err
+    assert main(["measure", path, "--robot", "panda", *GOAL, "--format", "json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    got = doc["inferred_uncertainty"]
+    assert len(got["states"]) > 1 and doc["cv"]["state"] in got["states"]
+    assert got["C"]["low"] < doc["cv"]["C"] < got["C"]["high"]
+    sight = got["line_of_sight_max_deg"]
+    assert sight["low"] < doc["line_of_sight"]["max_deg"] < sight["high"]
 
 
 def test_more_noise_than_the_segmentation_bears_is_said_with_its_level(shipped):
@@ -132,6 +170,40 @@ def test_the_interval_grows_with_the_noise(shipped):
         half.append((s.high - s.low) / 2)
     assert 4 < half[1] / half[0] < 25
 
+
+
+#: A slow retreat straight into a shiver, a pause, a shiver between two approaches: the
+#: shivers' envelopes fade in and out over a cycle, and under the noise their soft ends
+#: look like a hold beside the pauses declared.
+SOFT_ENDS = """robot ur5
+goal (0.46, 0.17, 0.16)
+sequence {
+  approach a=0.1
+  pause 1.5s
+  retreat 5cm a=0.05m/s^2
+  shiver 1.9deg f=2Hz for 1.7s
+  pause 1s
+  approach 3cm a=0.1
+  shiver 3.9deg f=1.5Hz for 2s
+  approach 2cm a=0.1
+}
+"""
+
+
+def test_a_shivers_soft_start_or_end_is_no_pause():
+    """At 250 Hz with 6e-4 and 1e-3 rad, a shiver's fading ends hide under the noise
+    for a fifth of a second: a pause only when the joints hold still once the
+    oscillation's own start and end are found. No log makes every copy read a count
+    the file does not declare (that would fail a verdict on noise alone), and at
+    6e-4 rad most logs read the declared count in every copy."""
+    doc, want, _ = build(SOFT_ENDS, "soft")
+    exact = 0
+    for noise, seed in ((6e-4, 0), (6e-4, 1), (6e-4, 2), (1e-3, 3), (1e-3, 4)):
+        _, m = logged(doc, logger(noise, 250.0, seed))
+        s = m.uncertainty["pause_count"]
+        assert s.low <= want["pause_count"] <= s.high, (noise, seed, s)
+        exact += noise < 1e-3 and s.stable and m.descriptors["pause_count"] == 2
+    assert want["pause_count"] == 2 and exact >= 2
 
 # --- the three-way verdict ---------------------------------------------------------------
 
@@ -218,21 +290,35 @@ def test_measure_prints_and_writes_every_interval(shipped, tmp_path, capsys):
             assert u["low"] < v < u["high"] and u["sd"] > 0, k
 
 
-@pytest.mark.slow
-@pytest.mark.large
-def test_generated_behaviours_intervals_hold_the_declared_values():
-    """The larger variant: the shipped behaviours and 20 generated ones, at 250 Hz and
-    1 kHz, every noise level (also the default's three at 1 kHz)."""
+#: Generated behaviours in the slow calibration (the default run logs three shipped ones).
+CALIBRATION = 100
+
+
+@pytest.fixture(scope="module")
+def calibration_set():
+    """The shipped behaviours and :data:`CALIBRATION` generated ones."""
     items = [build((BEHAVIOURS / f"{s}.aou").read_text(), s)
              for s in ("confident", "curious", "hesitant", "fearful", "inactive")]
-    items += [b for _, b in generated(20, 11)]
-    cov = coverage(items, rates=(250.0, 1000.0))
+    return items + [b for _, b in generated(CALIBRATION, 11)]
+
+
+@pytest.mark.slow
+@pytest.mark.large
+@pytest.mark.parametrize("rate", [250.0, 1000.0])
+@pytest.mark.parametrize("noise", NOISES)
+def test_generated_behaviours_intervals_hold_the_declared_values(calibration_set, noise,
+                                                                 rate):
+    """The larger variant: the shipped behaviours and 100 generated ones, at each rate
+    and noise level (one test each, so that none runs for long): at least 95 % of the
+    trusted values inside their interval, and below 1e-3 rad at least 97 % of the
+    counts the copies agree on exact."""
+    assert len(calibration_set) == 5 + CALIBRATION
+    cov = coverage(calibration_set, noises=(noise,), rates=(rate,))
     values = [ok for (k, _), oks in cov.items() if not REGISTRY[k].is_count for ok in oks]
-    assert np.mean(values) >= 0.95
-    # Below 1e-3 rad the counts the copies agree on are exact.
-    counts = [ok for (k, noise), oks in cov.items() if REGISTRY[k].is_count and noise < 1e-3
-              for ok in oks]
-    assert np.mean(counts) >= 0.97
+    assert np.mean(values) >= 0.95, {k: np.mean(v) for k, v in cov.items()}
+    if noise < 1e-3:
+        counts = [ok for (k, _), oks in cov.items() if REGISTRY[k].is_count for ok in oks]
+        assert np.mean(counts) >= 0.97
 
 
 if __name__ == "__main__":

@@ -179,6 +179,15 @@ def _interval(value, spread) -> str:
     return f"+{up:.2g} -{down:.2g}"
 
 
+def _around(value: float, spread) -> str:
+    """`` +- x`` (or `` +x -y``) after a value the noise leaves uncertain; nothing for an
+    exact one or none known."""
+    if spread is None or spread.low is None or spread.high is None or spread.sd is None:
+        return ""
+    text = _interval(value, spread)
+    return "" if text == "exact" else f" {text}"
+
+
 def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = ()) -> str:
     """``aouc measure``: the eleven descriptors as a table, and the C-V point; ``missing``:
     the descriptors the point could not use (:func:`aou_dsl.lang.cv.missing_descriptors`)."""
@@ -191,12 +200,16 @@ def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = 
         val = "null" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
         lines.append(f"  {k:<22} {val:>10} {_interval(v, m.uncertainty.get(k)):<14} "
                      f"{REGISTRY[k].unit}".rstrip())
-    los = m.line_of_sight
+    los, inf = m.line_of_sight, m.inferred
     if los is not None and len(los.angle):
         # The model assumes the hand looks at the goal throughout: how far it did not.
-        lines.append(f"  line of sight off the goal: median {los.median:.3g} deg, "
-                     f"max {los.max:.3g} deg")
-    point = f"  C-V: C={m.cv.C:+.2f} V={m.cv.V:+.2f} -> {m.cv.state}"
+        lines.append(f"  line of sight off the goal: median {los.median:.3g}"
+                     f"{_around(los.median, inf and inf.sight_median)} deg, "
+                     f"max {los.max:.3g}{_around(los.max, inf and inf.sight_max)} deg")
+    point = (f"  C-V: C={m.cv.C:+.2f}{_around(m.cv.C, inf and inf.C)} "
+             f"V={m.cv.V:+.2f}{_around(m.cv.V, inf and inf.V)} -> {m.cv.state}")
+    if inf is not None and len(inf.states) > 1:  # the noise can flip the state
+        point += f" (the re-noised copies read {', '.join(inf.states)})"
     if missing:  # no state named: a point without the gazes would mislead
         point = (f"  C-V: not placed: without a goal the gaze descriptors "
                  f"{', '.join(missing)} are unknown, and the point needs them (give "

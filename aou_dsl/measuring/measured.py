@@ -20,6 +20,7 @@ The steps (docs/measure.md explains the choices):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -99,6 +100,9 @@ class Measured:
     resolution: tuple[float, ...] = field(default=())
     #: Per descriptor, its :class:`.uncertainty.Spread` (empty when not computed).
     uncertainty: dict[str, Any] = field(default_factory=dict)
+    #: The C-V point's and the line of sight's spread (:class:`.uncertainty.Inferred`;
+    #: None when not computed).
+    inferred: Any = None
 
     def to_json(self) -> dict:
         eps = [{"kind": e.kind, "start": round(e.t_start + self.t_origin, 4),
@@ -118,6 +122,8 @@ class Measured:
             "duration": round(self.duration, 6),
             "diagnostics": [d.to_json() for d in self.diagnostics],
             "uncertainty": {k: s.to_json() for k, s in self.uncertainty.items()},
+            "inferred_uncertainty": (None if self.inferred is None
+                                     else self.inferred.to_json()),
             "uncertainty_level": 0.95,
         }
 
@@ -143,11 +149,17 @@ def _checked(rec: Trajectory, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     return t, q
 
 
-def _context(rec: Trajectory, pinned: JointNoise | None = None
+#: Forward kinematics of the rows of joint positions, on the grid (``"grid"``) or at the
+#: recording's own samples (``"raw"``): positions (N, 3) and rotations (N, 3, 3).
+Kinematics = Callable[[np.ndarray, str], tuple[np.ndarray, np.ndarray]]
+
+
+def _context(rec: Trajectory, pinned: JointNoise | None = None, fk: Kinematics | None = None
              ) -> tuple[Context, list[Boundary], JointNoise]:
     """The per-sample signals of a trajectory and its boundaries; also the joints'
     noise and resolution (``pinned``: that noise, not the one the samples show: the
-    re-noised copies of :mod:`.uncertainty` are read with the recording's filters)."""
+    re-noised copies of :mod:`.uncertainty` are read with the recording's filters;
+    ``fk``: their kinematics, to first order about the recording's)."""
     arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
     cols = rec.columns(arm.joint_names)
     t, q = _checked(rec, cols)
@@ -162,10 +174,12 @@ def _context(rec: Trajectory, pinned: JointNoise | None = None
                         grid.t_last, carried)
     from ..robot.batch_fk import rows_fk
 
-    pos, rot = rows_fk(arm, grid.q)
+    pos, rot = rows_fk(arm, grid.q) if fk is None else fk(grid.q, "grid")
     pos_s = smooth(pos, window, 0, grid.h) if window > 3 else pos
     goal = None if rec.goal is None else np.asarray(rec.goal, float)
-    raw = Samples(t - t[0], q, batch_fk(arm, q)[0]) if grid.resampled else None
+    raw = None
+    if grid.resampled:
+        raw = Samples(t - t[0], q, (batch_fk(arm, q) if fk is None else fk(q, "raw"))[0])
     ctx = Context(arm, rec.path, rest, grid.q, noise, pos, pos_s, rot, roll_angle(rot),
                   goal, rot[0][:, 1].copy(), rot[0][:, 0].copy(), _edge_rest(rec, rest),
                   raw, _computed(noise, grid, carried))
@@ -303,10 +317,10 @@ def measure(rec: Trajectory, *, uncertainty: bool = True) -> Measured:
     return m
 
 
-def _measure(rec: Trajectory, pinned: JointNoise | None = None
+def _measure(rec: Trajectory, pinned: JointNoise | None = None, fk: Kinematics | None = None
              ) -> tuple[Measured, JointNoise]:
     """One measurement, without an uncertainty; with the joints' noise it used."""
-    ctx, bounds, jn = _context(rec, pinned)
+    ctx, bounds, jn = _context(rec, pinned, fk)
     quantum = jn.quantum
     coarse: list[tuple[float, float, float]] = []
     episodes = _episodes(ctx, pieces(ctx, bounds), coarse)

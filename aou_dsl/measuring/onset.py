@@ -122,12 +122,13 @@ def _swings(d: np.ndarray, level: float) -> int:
     return int(np.count_nonzero(np.diff(side)))
 
 
-def soft_pause(t: np.ndarray, q: np.ndarray, noise: np.ndarray, span: tuple[float, float],
-               shortest: float) -> tuple[float, float]:
-    """A pause from ``span[0]`` to ``span[1]`` [s] with each edge that borders an
+def soft_pause(t: np.ndarray, q: np.ndarray, noise: np.ndarray, span: tuple[float, float]
+               ) -> tuple[float, float]:
+    """The hold from ``span[0]`` to ``span[1]`` [s] with each edge that borders an
     oscillation moved to where the oscillation leaves or reaches the held position
-    (:func:`soft_edge`); an edge that would leave the pause shorter than ``shortest``
-    [s] stays."""
+    (:func:`soft_edge`). The result may be short, or empty (its end before its start):
+    then the rest was the oscillation's soft start or end, hidden under the noise, and
+    no pause."""
     a, b = span
     k0 = int(np.searchsorted(t, a, "left"))
     k1 = int(np.searchsorted(t, b, "right")) - 1
@@ -135,10 +136,10 @@ def soft_pause(t: np.ndarray, q: np.ndarray, noise: np.ndarray, span: tuple[floa
         return a, b
     if k0 > 0:
         edge = soft_edge(t, q, noise, (k0, k1), -1)
-        a = edge if edge is not None and edge < b - shortest else a
+        a = a if edge is None else edge
     if k1 < len(t) - 1:
         edge = soft_edge(t, q, noise, (k0, k1), +1)
-        b = edge if edge is not None and edge > a + shortest else b
+        b = b if edge is None else edge
     return a, b
 
 

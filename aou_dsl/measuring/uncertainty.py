@@ -34,7 +34,7 @@ from ..lang.descriptors import REGISTRY
 from .episodes import COMPUTED_NOISE
 from .signal import JointNoise, short_window, smooth, to_grid, unwrap
 
-__all__ = ["REPLICATES", "Spread", "attach"]
+__all__ = ["REPLICATES", "Inferred", "Spread", "attach"]
 
 #: Re-noised copies measured per recording.
 REPLICATES = 10
@@ -144,13 +144,65 @@ def _spread(name: str, value: float | int | None, base: float | int | None,
                   absent)
 
 
+class Linearised:
+    """The forward kinematics of the copies, to first order about the smoothed base's.
+
+    A copy differs from the base by noise of 1e-4 to 1e-3 rad; the hand's pose moves
+    with it by the Jacobian times that noise, and the terms this leaves out are of the
+    noise squared (about 1e-6 m on an arm half a metre long, a thousandth of what the
+    noise itself moves the hand). The first call on each clock (``"grid"`` or ``"raw"``)
+    is the base's: it is computed exactly, with the Jacobian at every sample; later
+    calls on that clock are the copies'. A rotation turns by the angular part,
+    ``exp(W) R ~ (I + W + W^2/2) R``. An arm with joints other than revolute and
+    prismatic, or a clock of another length, is computed exactly every time."""
+
+    def __init__(self, arm) -> None:
+        self.arm = arm
+        # Per clock: the base's joints, hand positions and rotations, and the Jacobian's
+        # linear and angular parts joint by joint, (n, N, 3) each.
+        self.at: dict[str, tuple[np.ndarray, ...]] = {}
+
+    def __call__(self, q: np.ndarray, clock: str) -> tuple[np.ndarray, np.ndarray]:
+        from ..robot.batch_fk import batch_fk, batch_fk_jacobian
+
+        about = self.at.get(clock)
+        if about is None or about[0].shape != q.shape:
+            got = batch_fk_jacobian(self.arm, q) if about is None else None
+            if got is None:
+                return batch_fk(self.arm, q)
+            pos, rot, jac = got
+            self.at[clock] = (np.array(q, float), pos, rot,
+                              np.ascontiguousarray(jac[:, :3].transpose(2, 0, 1)),
+                              np.ascontiguousarray(jac[:, 3:].transpose(2, 0, 1)))
+            return pos, rot
+        q0, pos0, rot0, lin, ang = about
+        dq = q - q0
+        pos, w = pos0.copy(), np.zeros_like(pos0)
+        for j in range(dq.shape[1]):
+            pos += lin[j] * dq[:, j, None]
+            w += ang[j] * dq[:, j, None]
+        turned = _cross(w, rot0)
+        return pos, rot0 + turned + 0.5 * _cross(w, turned)
+
+
+def _cross(w: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """``w x`` each column of ``r``: ``skew(w) @ r`` for ``w`` (N, 3), ``r`` (N, 3, 3)."""
+    out = np.empty_like(r)
+    out[:, 0] = w[:, 1, None] * r[:, 2] - w[:, 2, None] * r[:, 1]
+    out[:, 1] = w[:, 2, None] * r[:, 0] - w[:, 0, None] * r[:, 2]
+    out[:, 2] = w[:, 0, None] * r[:, 1] - w[:, 1, None] * r[:, 0]
+    return out
+
+
 def attach(m, rec: Trajectory, jn: JointNoise,
-           measure_once: Callable[[Trajectory, JointNoise | None], tuple]) -> None:
+           measure_once: Callable[[Trajectory, JointNoise | None, Linearised], tuple]
+           ) -> None:
     """Give ``m`` (a :class:`.measured.Measured` of ``rec``, whose joints' noise is
     ``jn``) its uncertainty, and R411 when a count or a presence is not stable."""
     value = m.descriptors
     if float(jn.effective.max(initial=0.0)) <= COMPUTED_NOISE:
         m.uncertainty = {k: exact(value[k]) for k in REGISTRY}
+        m.inferred = _inferred(m, m, [])
         return
     from ..robot.load import load_arm
 
@@ -158,16 +210,20 @@ def attach(m, rec: Trajectory, jn: JointNoise,
     cols = rec.columns(arm.joint_names)
     rng = np.random.default_rng(SEED)
     base, *copies = _copies(rec, cols, jn, rng)
-    reads = []
+    fk = Linearised(arm)
+    try:
+        smooth_m = measure_once(base, jn, fk)[0]
+    except AouError:
+        smooth_m = None
+    read_m = []
     for copy in copies:
         try:
-            reads.append(measure_once(copy, jn)[0].descriptors)
+            read_m.append(measure_once(copy, jn, fk)[0])
         except AouError:  # a copy the noise made unreadable adds nothing
             continue
-    try:
-        smooth_read = measure_once(base, jn)[0].descriptors
-    except AouError:
-        smooth_read = None
+    reads = [r.descriptors for r in read_m]
+    smooth_read = None if smooth_m is None else smooth_m.descriptors
+    m.inferred = _inferred(m, smooth_m, read_m)
     if len(reads) < 2 or smooth_read is None:
         m.uncertainty = {k: Spread(None, value[k], value[k], False) for k in REGISTRY}
     else:
@@ -178,17 +234,77 @@ def attach(m, rec: Trajectory, jn: JointNoise,
     for k in vague:  # not to be trusted: a verdict on it is inconclusive
         m.uncertainty[k] = replace(m.uncertainty[k], stable=False)
     shaky = [k for k, s in m.uncertainty.items() if not s.stable]
-    if shaky:
+    states = m.inferred.states
+    if shaky or len(states) > 1:
         noise = float(jn.effective.max())
-        what = "; ".join(_shaky_text(k, value[k], m.uncertainty[k], len(reads))
-                         for k in shaky)
+        what = [_shaky_text(k, value[k], m.uncertainty[k], len(reads)) for k in shaky]
+        if len(states) > 1:
+            what.append(f"the inferred state reads {m.cv.state.value}, and "
+                        f"{', '.join(states)} in the re-noised copies")
         m.diagnostics.append(diag(
             R411, f"the joints' noise ({noise:.2g} rad) is more than this recording's "
-            f"segmentation bears: {what}. These descriptors are not to be trusted",
+            f"segmentation bears: {'; '.join(what)}. "
+            f"{'These are' if len(what) > 1 else 'This is'} not to be trusted",
             Span.whole_file(rec.path),
             hint="log at a higher rate or with less noise; a longer pause or a slower "
             "motion stands out of the noise better",
-            noise=noise, descriptors=shaky))
+            noise=noise, descriptors=shaky, states=list(states)))
+
+
+@dataclass(frozen=True)
+class Inferred:
+    """The spread of what is read from the whole motion rather than from one descriptor:
+    the C-V point (each coordinate's :class:`Spread`, and every state the recording and
+    its copies infer, in order) and the line of sight's median and maximum [deg] (None
+    without a goal). Each interval is made as a descriptor's is (the copies' std times
+    Student's t, widened to take in the value less what the noise adds on average)."""
+
+    C: Spread
+    V: Spread
+    states: tuple[str, ...]
+    sight_median: Spread | None
+    sight_max: Spread | None
+
+    def to_json(self) -> dict:
+        def js(s: Spread | None) -> dict | None:
+            return None if s is None else s.to_json()
+
+        return {"C": js(self.C), "V": js(self.V), "states": list(self.states),
+                "line_of_sight_median_deg": js(self.sight_median),
+                "line_of_sight_max_deg": js(self.sight_max)}
+
+
+def _inferred(m, base, copies: list) -> Inferred:
+    """The :class:`Inferred` of ``m`` (a :class:`.measured.Measured`) from the smoothed
+    recording's measurement ``base`` (None when unreadable) and the copies'
+    (``base`` is ``m`` and ``copies`` empty for a trajectory without noise)."""
+    states = tuple(dict.fromkeys([m.cv.state.value] + [c.cv.state.value for c in copies]))
+    exactly = base is m
+
+    def one(get) -> Spread | None:
+        value = get(m)
+        if value is None:
+            return None
+        if exactly:
+            return exact(value)
+        reads = [r for r in (get(c) for c in copies) if r is not None]
+        b = None if base is None else get(base)
+        if len(reads) < 2 or b is None:
+            return Spread(None, value, value, False)
+        sd = float(np.std(reads, ddof=1))
+        corrected = value - (float(np.mean(reads)) - b)
+        return Spread(sd, min(value, corrected) - T95 * sd, max(value, corrected) + T95 * sd,
+                      len(states) == 1)
+
+    def sight(attr: str):
+        def get(x) -> float | None:
+            los = x.line_of_sight
+            return None if los is None or not len(los.angle) else getattr(los, attr)
+        return get
+
+    c, v = one(lambda x: x.cv.C), one(lambda x: x.cv.V)
+    assert c is not None and v is not None
+    return Inferred(c, v, states, one(sight("median")), one(sight("max")))
 
 
 #: A value whose 95 % interval reaches further than this fraction of itself from it is

@@ -17,7 +17,8 @@ import numpy as np
 from ..core.memo import Keyed, table
 from .kinematics import ArmModel, rotate_columns
 
-__all__ = ["batch_fk", "classical_acceleration", "rows_fk", "linear_jacobian"]
+__all__ = ["batch_fk", "batch_fk_jacobian", "classical_acceleration", "linear_jacobian",
+           "rows_fk"]
 
 _AXES = {"X": 0, "Y": 1, "Z": 2}
 
@@ -63,6 +64,28 @@ def batch_fk(arm: ArmModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     chain = _chain(arm)
     if chain is None:
         return arm.fk(q)
+    pos, rot, _ = _chain_fk(arm, chain, q, jacobian=False)
+    return pos, rot
+
+
+def batch_fk_jacobian(arm: ArmModel, q: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """:func:`batch_fk` of every row of ``q`` (N, n) and the end-effector's Jacobian
+    there, (N, 6, n): d(position)/dq above d(rotation)/dq (the rotation's angular
+    velocity per unit joint speed), in the base frame's axes (Pinocchio's
+    ``LOCAL_WORLD_ALIGNED``). None for an arm whose joints are not all revolute or
+    prismatic."""
+    q = np.atleast_2d(np.asarray(q, float))
+    chain = _chain(arm)
+    if chain is None:
+        return None
+    pos, rot, jac = _chain_fk(arm, chain, q, jacobian=True)
+    assert jac is not None
+    return pos, rot, jac
+
+
+def _chain_fk(arm: ArmModel, chain: list, q: np.ndarray, jacobian: bool
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     n = len(q)
     qt = np.ascontiguousarray(q.T)
     # Rotations are kept as (3, 3, N) arrays, column by column with the samples last, so
@@ -89,7 +112,29 @@ def batch_fk(arm: ArmModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     p_f = np.ascontiguousarray(frame.placement.translation, float)
     r_f = np.ascontiguousarray(frame.placement.rotation, float)
     pos = p_j + np.tensordot(p_f, c_j, axes=1)
-    return pos.T, times(r_f, c_j).transpose(2, 1, 0)
+    rot = times(r_f, c_j).transpose(2, 1, 0)
+    if not jacobian:
+        return pos.T, rot, None
+    # Each joint on the way to the frame: its axis in the base frame, and for a
+    # revolute one the lever from its origin to the hand.
+    jac = np.zeros((n, 6, q.shape[1]))
+    on_path, at = set(), int(frame.parentJoint)
+    while at > 0:
+        on_path.add(at)
+        at = int(arm.model.parents[at])
+    for i, (_, iq, kind, axis, _, _) in enumerate(chain, start=1):
+        if i not in on_path:
+            continue
+        z = np.tensordot(axis, cols[i], axes=1)  # (3, N)
+        if kind == "R":
+            lever = pos - poss[i]
+            jac[:, 0, iq] = z[1] * lever[2] - z[2] * lever[1]
+            jac[:, 1, iq] = z[2] * lever[0] - z[0] * lever[2]
+            jac[:, 2, iq] = z[0] * lever[1] - z[1] * lever[0]
+            jac[:, 3:, iq] = z.T
+        else:
+            jac[:, :3, iq] += z.T
+    return pos.T, rot, jac
 
 
 def rows_fk(arm: ArmModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
