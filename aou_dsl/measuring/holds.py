@@ -313,9 +313,13 @@ def _dips(r: Rest, taken: np.ndarray) -> list[tuple[float, float, int]]:
         k = m // 2
         if taken[k] or (m % 2 and taken[k + 1]) or seq[m] > 0.3 * (seq[m] + prom):
             continue
-        if m % 2 and seq[m] + prom < 2.0 * CLEARLY:  # noise flips a slow joint's sign
+        # Between two samples, a minimum is a reversal only where a joint's velocity
+        # crosses zero there; else it is the middle of a flat stretch of equal levels
+        # (a held sample, repeated), read at its sample as any other.
+        rev = bool(m % 2) and k in joint
+        if rev and seq[m] + prom < 2.0 * CLEARLY:  # noise flips a slow joint's sign
             continue
-        if m % 2:  # a reversal between samples k and k + 1
+        if rev:  # a reversal between samples k and k + 1
             j = joint[k]
             pairs = [(k, k + 1), (k - 1, k), (k + 1, k + 2)]
             k = k if abs(r.v[k, j]) <= abs(r.v[k + 1, j]) else k + 1
@@ -324,7 +328,7 @@ def _dips(r: Rest, taken: np.ndarray) -> list[tuple[float, float, int]]:
                               + np.abs(r.v[k + 1]) / r.thr[k + 1]))
             pairs = [(k - 1, k), (k, k + 1)]
         a, b = next(((a, b) for a, b in pairs if 0 <= a and b < n and v[a, j] * v[b, j] <= 0),
-                    pairs[-1 if m % 2 == 0 else 0])
+                    pairs[0 if rev else -1])
         va, vb = v[a, j], v[b, j]
         if va * vb <= 0 and va != vb:
             tk = float(r.t[a] + (r.t[b] - r.t[a]) * va / (va - vb))
