@@ -89,3 +89,29 @@ def test_a_synthesized_file_gets_an_intensity_slider_that_writes_it_again(tmp_pa
         assert path.read_text() == m.text
     finally:
         studio.close()
+
+
+def test_track_ghosts_the_arm_its_servos_give_and_follows_each_new_motion(tmp_path):
+    """--track: the ghost is the shown plan as the Panda's published position servos
+    track it (the same simulation as `aouc check --track`), so fearful's shiver is
+    visibly smaller on it; a slider's new motion gets its own tracked ghost."""
+    pytest.importorskip("mujoco")
+    from aou_dsl.safety.track import track
+
+    studio = Studio(_copy(tmp_path, "fearful"), port=0, track="position").start()
+    try:
+        plan = studio.shown.trajectory
+        want = track(plan, "position").trajectory
+        assert np.array_equal(studio.tracked.trajectory.q, want.q)
+        assert studio.ghost.track is not None
+        assert np.array_equal(studio.ghost.track.t, studio.arm.track.t)
+        wrist = plan.joint_names.index("panda_joint7")
+        swing = np.ptp(plan.q[:, wrist]), np.ptp(want.q[:, wrist])
+        assert swing[1] < swing[0]  # the servos lag the shiver and narrow it
+        assert "ghosted: the arm through its position servos" in studio.status.content
+        m = studio.set_values({**studio.sliders.values(), "pause_duration": 2.0})
+        assert m.ok and studio.shown.trajectory.duration > plan.duration
+        again = track(studio.shown.trajectory, "position").trajectory
+        assert np.array_equal(studio.tracked.trajectory.q, again.q)
+    finally:
+        studio.close()

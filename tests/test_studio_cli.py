@@ -91,3 +91,18 @@ def test_fit_is_for_a_behaviour_and_compare_for_a_aou_file(capsys, tmp_path):
     assert main(["studio", str(path), "--compare", str(rec)]) == 2
     assert "--compare takes a .aou file" in capsys.readouterr().err
     assert sorted(os.listdir(tmp_path)) == ["h.aou", "rec.csv"]
+
+
+def test_track_is_for_a_plan_and_draws_the_one_second_arm(capsys, tmp_path):
+    """A recording is what an arm did: it is not tracked again. --track and --compare
+    would both draw the second arm. Each is a usage error before any work."""
+    pytest.importorskip("viser")
+    rec = tmp_path / "rec.csv"
+    rec.write_text("t,panda_joint1\n0,0\n")
+    assert main(["studio", str(rec), "--robot", "panda", "--track"]) == 2
+    assert "a recording is already what an arm did" in capsys.readouterr().err
+    path = tmp_path / "h.aou"
+    shutil.copy(os.path.join(ROOT, "behaviours", "hesitant.aou"), path)
+    assert main(["studio", str(path), "--track", "--compare", str(path)]) == 2
+    assert "--track and --compare" in capsys.readouterr().err
+    assert sorted(os.listdir(tmp_path)) == ["h.aou", "rec.csv"]

@@ -310,6 +310,13 @@ def _commands(sub) -> dict[str, argparse.ArgumentParser]:
     stu.add_argument("--fit", action="store_true",
                      help="build as `aouc compile --fit` does (the fitted values shown in the "
                      "page; Save writes the sliders' values)")
+    stu.add_argument("--track", action="store_true",
+                     help="draw, ghosted beside the plan, the arm as its servos track it "
+                     "(MuJoCo; the `track` extra)")
+    stu.add_argument("--servo", choices=("position", "feedforward", "torque"),
+                     default="position",
+                     help="with --track: how the motion is sent to the servos (default "
+                     "position set-points)")
     stu.add_argument("--perception", choices=("geometric", "camera"), default=None,
                      help="with a scenario: what sees the target, the geometric model "
                      "(default) or the rendered camera with its tag detector")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import importlib.util
 
 from .args import usage_error
 
@@ -25,9 +26,18 @@ def cmd_studio(args: argparse.Namespace) -> int:
                            "it was measured")
     if args.compare and not args.compare.endswith(".aou"):
         return usage_error("studio", f"--compare takes a .aou file, found {args.compare}")
+    if args.track and recording:
+        return usage_error("studio", "--track simulates the servos following a plan: a "
+                           "recording is already what an arm did")
+    if args.track and args.compare:
+        return usage_error("studio", "--track and --compare each draw the second arm: "
+                           "give one")
+    if args.track and importlib.util.find_spec("mujoco") is None:  # a fixed name
+        return usage_error("studio", "--track needs the track extra (mujoco is missing): "
+                           "pip install '.[track]' in aou's folder")
     return serve(args.path, robot=args.robot, host=args.host, port=args.port,
                  compare=args.compare, package_dirs=package_dirs(args.package_dir),
-                 fit=args.fit)
+                 fit=args.fit, track=args.servo if args.track else None)
 
 
 def _scenario(args: argparse.Namespace) -> int:
@@ -39,7 +49,7 @@ def _scenario(args: argparse.Namespace) -> int:
     from .live_cmd import _missing
 
     for flag, given in (("--fit", args.fit), ("--compare", args.compare),
-                        ("--package-dir", args.package_dir)):
+                        ("--track", args.track), ("--package-dir", args.package_dir)):
         if given:
             return usage_error("studio", f"{flag} shapes a .aou file: a scenario plays "
                                "the loop of `aouc live`")

@@ -26,10 +26,11 @@ __all__ = ["serve"]
 def serve(path: str, *, robot: str | None = None, host: str = "127.0.0.1", port: int = 8080,
           compare: str | None = None, stop: threading.Event | None = None,
           package_dirs: tuple[str, ...] = (), fit: bool = False,
-          perception: str = "geometric") -> int:
+          perception: str = "geometric", track: str | None = None) -> int:
     """Run the studio of ``path`` until interrupted (or ``stop`` is set); the exit status
     (130 after Ctrl-C, as every aouc command). ``fit``: build as ``aouc compile --fit``
-    does. A scenario (``.toml``) plays the perception loop live (:mod:`.stage`) with
+    does; ``track``: a servo mode, the arm as its servos track the motion drawn
+    ghosted. A scenario (``.toml``) plays the perception loop live (:mod:`.stage`) with
     ``perception``. The address printed carries the per-run token without which the
     studio answers nothing.
 
@@ -54,7 +55,7 @@ def serve(path: str, *, robot: str | None = None, host: str = "127.0.0.1", port:
                        port=port).start()
     else:
         studio = Studio(path, robot=robot, host=host, port=port, compare=compare,
-                        package_dirs=package_dirs, fit=fit).start()
+                        package_dirs=package_dirs, fit=fit, track=track).start()
     if studio.port != port:
         print(f"aouc: port {port} is taken: serving on {studio.port} (--port chooses)",
               file=sys.stderr)

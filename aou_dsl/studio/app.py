@@ -50,16 +50,20 @@ class Studio(Filing):
         engine: the build session to use (a new :class:`Engine` by default).
         fit: build as ``aouc compile --fit`` does: what the arm cannot give is fitted
             (shown in the page); Save still writes the values of the sliders.
+        track: a servo mode (``aouc check --track``'s): the arm as its servos track
+            each motion shown, simulated, drawn ghosted beside the plan.
     """
 
     def __init__(self, path: str, *, robot: str | None = None, host: str = LOCAL,
                  port: int = 8080, compare: str | None = None, watch: bool = True,
                  engine: Engine | None = None, package_dirs: tuple[str, ...] = (),
-                 fit: bool = False) -> None:
+                 fit: bool = False, track: str | None = None) -> None:
         self.path = path
         self.recording = not path.endswith(".aou")
         self.engine = engine or Engine(robot, package_dirs, fit=fit)
         self.compare_path = compare
+        self.track_mode = track
+        self.tracked: Any = None  # the shown motion as the servos track it (--track)
         self.host, self.asked_port = host, port
         self._watch = watch
         self.file_text = ""  # the file's text as on disk
@@ -107,6 +111,9 @@ class Studio(Filing):
         self.other: Motion | None = None
         if self.compare_path:
             self._compare(scene)
+        elif self.track_mode:
+            self.ghost = scene.Arm(self.server, self.engine.urdf_path(first.trajectory.robot),
+                                   "/ghost", ghost=True)
         self.server.gui.configure_theme(control_width="large")
         self.server.initial_camera.position = (1.3, -1.1, 0.9)
         self.server.initial_camera.look_at = (0.3, 0.0, 0.25)
@@ -183,10 +190,14 @@ class Studio(Filing):
             self.reload_button.on_click(lambda _: self._guarded(self.reload))
         self.notice = gui.add_html("")  # what the page sent that was not taken as sent
         self.diags = gui.add_html("")
-        if self.ghost is not None and self.compare_path:
+        if self.ghost is not None:
             self.ghost_box = gui.add_checkbox(
                 f"Show {os.path.basename(self.compare_path)}", True,
-                hint="the compared behaviour, ghosted, on the same clock")
+                hint="the compared behaviour, ghosted, on the same clock"
+            ) if self.compare_path else gui.add_checkbox(
+                "Show the tracked arm", True,
+                hint=f"the arm as its servos track the motion ({self.track_mode} mode), "
+                "simulated, ghosted")
             ghost = self.ghost
             self.ghost_box.on_update(lambda _: ghost.set_visible(self.ghost_box.value))
         self.fitted = gui.add_html("")  # with --fit: what was fitted to the arm
@@ -219,6 +230,11 @@ class Studio(Filing):
         with the numbers)."""
         self.drawn = tr
         self.arm.show(tr)
+        if self.track_mode and self.ghost is not None:
+            from ..safety.track import track
+
+            self.tracked = track(tr, self.track_mode)
+            self.ghost.show(self.tracked.trajectory)
         other = self.other.trajectory if self.other is not None else None
         self.player.set_duration(max(tr.duration, other.duration if other else 0.0))
         self._frame(0.0)
@@ -261,6 +277,12 @@ class Studio(Filing):
         s = self.shown
         dur = f"{s.trajectory.duration:.2f} s" if s and s.trajectory is not None else "-"
         last = f"built in {m.seconds:.2f} s" if m.ok else "**the last build failed**"
+        if self.tracked is not None:
+            import numpy as np
+
+            worst = float(np.degrees(self.tracked.error_max).max())
+            last += (f"; ghosted: the arm through its {self.track_mode} servos, "
+                     f"largest tracking error {worst:.2g} deg")
         self.status.content = f"**{os.path.basename(self.path)}**: {dur} of motion; {last}"
 
     # --- shaping ------------------------------------------------------------------

@@ -1,0 +1,106 @@
+"""The signals the rest test works on (:mod:`.holds`): each joint's filtered velocity and
+its rest threshold from the joint's noise, over the velocity filter's window and over a
+longer one that finds motion too slow for the short window to tell from noise."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .onset import REST_SPEED
+from .signal import NOISE_SIGMAS, odd, sg_coefficients, slope_gain, smooth
+
+__all__ = ["LONG_WINDOW", "Rest", "rest_signals"]
+
+#: Window of the slow-motion check inside long rests [s].
+LONG_WINDOW = 0.3
+#: Windows of the slow-motion check from which its filter runs through the FFT (from
+#: about 500 Hz on; below, the direct sum is as fast).
+FFT_WINDOW = 151
+
+
+@dataclass(frozen=True)
+class Rest:
+    """The signals the rest test works on (arrays over the grid's N samples).
+
+    Attributes:
+        t: times [s]; h: the step [s]; window: the velocity filter [samples].
+        v: filtered joint velocities, (N, n).
+        thr: each joint's rest threshold [rad/s] at each sample, (N, n) (larger where
+            a logging gap leaves fewer raw samples).
+        level: the largest joint speed over its threshold, (N,): under 1 is rest.
+        v_long, thr_long: the same over :data:`LONG_WINDOW` (None for clean data).
+        t_last: the recording's end [s].
+        q: joint positions, (N, n); noise: each joint's noise [rad], (n,);
+        quantum: each joint's resolution [rad] (0: none), (n,).
+        held: joint positions filtered over ``window`` (raw for clean data), for the
+            hold test, (N, n); held_gain: that filter's noise std per unit of noise.
+        sparse: how much noisier a filtered value is than where the log has all its
+            samples (above 1 across a logging gap), (N,).
+        carried: the joint velocities and accelerations the file carries on these
+            samples (a compiled trajectory, a logger that records them), or None.
+    """
+
+    t: np.ndarray
+    h: float
+    window: int
+    v: np.ndarray
+    thr: np.ndarray
+    level: np.ndarray
+    v_long: np.ndarray | None
+    thr_long: np.ndarray | None
+    t_last: float
+    q: np.ndarray
+    noise: np.ndarray
+    quantum: np.ndarray
+    held: np.ndarray
+    held_gain: float
+    sparse: np.ndarray
+    carried: tuple[np.ndarray, np.ndarray] | None = None
+
+
+
+def rest_signals(t: np.ndarray, h: float, q: np.ndarray, noise: np.ndarray,
+                 quantum: np.ndarray, density: np.ndarray, window: int, t_last: float,
+                 carried: tuple[np.ndarray, np.ndarray] | None = None) -> Rest:
+    """Joint velocities over ``window`` samples and per-joint rest thresholds from the
+    joints' ``noise`` [rad] (0: a still or clean joint, threshold :data:`REST_SPEED`)."""
+    v = smooth(q, window, 1, h, order=2)
+    scale = 1.0 / np.sqrt(np.clip(density, 1e-3, 1.0))[:, None]
+    thr = np.maximum(NOISE_SIGMAS * noise[None, :] * slope_gain(window, h) * scale,
+                     REST_SPEED)
+    level = np.max(np.abs(v) / thr, axis=1)
+    v_long = thr_long = None
+    held, gain = q, 1.0
+    if window > 3:
+        held = smooth(q, window, 0, h, order=3)
+        gain = float(np.linalg.norm(sg_coefficients(window, 3, 0, 1.0)))
+    if window > 3 and len(t) > odd(LONG_WINDOW / h):
+        wl = odd(LONG_WINDOW / h)
+        v_long = _long_slope(q, wl, h)
+        thr_long = np.maximum(NOISE_SIGMAS * noise[None, :] * slope_gain(wl, h) * scale,
+                              REST_SPEED)
+    return Rest(t, h, window, v, thr, level, v_long, thr_long, t_last, q, noise, quantum,
+                held, gain, scale[:, 0], carried)
+
+
+def _long_slope(q: np.ndarray, window: int, h: float) -> np.ndarray:
+    """The slope of the straight line fitted to ``window`` (odd) samples around each row
+    of ``q`` (N, n), ``h`` [s] apart; near the ends, that of the line through the first
+    or last window (the first-order Savitzky-Golay derivative, as :func:`.signal.smooth`
+    gives it). Through the FFT: at 1 kHz the 0.3 s window has 301 weights, which the
+    direct sum applies one pass over the samples each. The two differ by rounding
+    (about 1e-14 rad/s here, against thresholds of 1e-3 rad/s and more)."""
+    n, half = len(q), window // 2
+    if n < 2 * window or window < FFT_WINDOW:
+        return smooth(q, window, 1, h, order=1)
+    weights = sg_coefficients(window, 1, 1, h)
+    size = 1 << int(math.ceil(math.log2(n + window)))
+    x = q - q.mean(axis=0)  # no offset: the rounding is relative to what moves
+    full = np.fft.irfft(np.fft.rfft(x, size, axis=0)
+                        * np.fft.rfft(weights[::-1], size)[:, None], size, axis=0)
+    inner = full[window - 1:n]  # centred on rows half .. n - half - 1
+    return np.concatenate([np.repeat(inner[:1], half, axis=0), inner,
+                           np.repeat(inner[-1:], half, axis=0)])
