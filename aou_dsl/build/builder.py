@@ -161,16 +161,16 @@ def build_lint(lint: FileResult, options: BuildOptions | None = None,
 
     opts = (options or BuildOptions()).replace(**changes) if changes else (
         options or BuildOptions())
-    from .amplitude_fit import with_amplitude_fit
-    from .every_change import with_every_change
-    from .reach_fit import with_reach_fit
+    from ..fit.amplitude import with_amplitude_fit
+    from ..fit.every_change import with_every_change
+    from ..fit.reach import with_reach_fit
 
     def one(linted: FileResult) -> BuildResult:  # a refusal's hint: the value that fits
         res = with_reach_fit(_build_lint(linted, opts), opts.robot, opts.package_dirs)
         return with_amplitude_fit(res, opts.robot, opts.package_dirs)
 
     if opts.fit:
-        from .fit_loop import fit_loop
+        from ..fit.rounds import fit_loop
 
         res = fit_loop(lint, one)
     else:  # the hint of a refusal: every change the file needs, at once

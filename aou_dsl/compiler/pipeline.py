@@ -20,6 +20,7 @@ from ..core.codes import C303, C304, C305, C308, C309, V124
 from ..core.diagnostics import AouError, Diagnostic, Fix, diag, has_errors
 from ..core.memo import Keyed, cached
 from ..core.trajectory import Trajectory
+from ..fit.plan import hint_edit
 from ..lang.ir import Behaviour
 from ..lang.layout import layout
 from ..lang.primitives import KINDS, LOOK_SHIVER_F, Shiver, Timing
@@ -29,7 +30,6 @@ from ..robot.identity import frame_definition
 from ..robot.ik import IKStatus, solve_path
 from ..robot.kinematics import ArmModel
 from ..robot.load import load_arm
-from .fitting import hint_edit
 from .reuse import solved_path, timed_path
 from .start import CODES, start_diagnostic
 from .timing import (

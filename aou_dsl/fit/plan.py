@@ -1,4 +1,4 @@
-"""Fitting a behaviour to an arm (``--fit``): which values to change, and by how much.
+"""Which values to change to fit a behaviour to an arm (``--fit``), and by how much.
 
 Where the arm cannot give a declared value, the compiler says so with the value that
 fits (C304: the peak acceleration the joints allow; C308: the highest shiver frequency;
@@ -27,52 +27,18 @@ peak) and keeps the fit only when the file still expresses its declared state.
 
 from __future__ import annotations
 
-import math
-import re
-from dataclasses import dataclass
-
 from ..core.codes import C301, C302, C303, C304, C308, C309
 from ..core.diagnostics import Diagnostic, Span
+from .rounding import written
+from .text_edits import Change, value_text
 
-__all__ = ["KNEE", "Change", "apply", "apply_edit", "compress", "hint_edit", "plan",
-           "shiver_keys"]
+__all__ = ["FITTED", "KNEE", "compress", "hint_edit", "plan", "shiver_keys"]
 
 #: Fraction of the arm's peak below which a declared value is never changed.
 KNEE = 0.9
 #: The codes whose values :func:`plan` fits (a reach refusal by the changes the builder
-#: found, its field ``reach``: :mod:`aou_dsl.build.reach_fit`).
+#: found, its field ``reach``: :mod:`aou_dsl.fit.reach`).
 FITTED = (C301, C302, C303, C304, C308, C309)
-
-
-@dataclass(frozen=True)
-class Change:
-    """One value of one statement changed.
-
-    Attributes:
-        span: the statement.
-        key: ``a``, ``f``, ``v`` or ``for``; ``angle`` or ``length`` for the positional
-            value of a gaze, tilt, retreat or approach.
-        declared: the value as written (``2``, absent as ``""``); fitted: as now written.
-        unit: the unit written after the fitted value.
-        joint, limit: what binds (the joint, and which of its limits).
-        descriptor: the descriptor the value sets (None: none, e.g. a shiver's ``f``).
-    """
-
-    span: Span
-    key: str
-    declared: str
-    fitted: str
-    unit: str
-    joint: str | None
-    limit: str | None
-    descriptor: str | None
-
-    @property
-    def text(self) -> str:
-        if self.key in _POSITIONAL:
-            return f"{self.fitted}{self.unit}"
-        return f"{self.key}={self.fitted}{self.unit}" if self.key != "for" else \
-            f"for {self.fitted}{self.unit}"
 
 
 def compress(x: float, cap: float, knee: float = KNEE) -> float:
@@ -85,27 +51,14 @@ def compress(x: float, cap: float, knee: float = KNEE) -> float:
     return k + w * over / (over + w)  # slope 1 at the knee, then ever flatter
 
 
-def _down(x: float, digits: int = 3) -> str:
-    """``x`` with ``digits`` significant digits, rounded down."""
-    if x <= 0:
-        return f"{x:g}"
-    e = math.floor(math.log10(x)) - digits + 1
-    return f"{math.floor(x / 10 ** e + 1e-9) * 10 ** e:.{max(0, -e)}f}".rstrip("0").rstrip(".")
-
-
-def _up(x: float) -> str:
-    """``x`` with 3 significant digits, rounded up."""
-    e = math.floor(math.log10(x)) - 2
-    return f"{math.ceil(x / 10 ** e - 1e-9) * 10 ** e:.{max(0, -e)}f}".rstrip("0").rstrip(".")
-
-
 def shiver_keys(f_ok: float, runs: float | None) -> list[tuple[str, str, str, str | None]]:
     """``(key, fitted, unit, descriptor)`` of a shiver made ``f_ok`` [Hz]: its frequency,
     and, when the statement says `for` (``runs`` [s], else None), one of the 3 cycles it
     then lasts at least."""
-    out: list[tuple[str, str, str, str | None]] = [("f", _down(f_ok), "Hz", None)]
-    if runs is not None and round(runs * float(_down(f_ok))) < 3:
-        out.append(("for", _up(3.0 / float(_down(f_ok))), "s", None))
+    f = written(f_ok, 3)
+    out: list[tuple[str, str, str, str | None]] = [("f", f, "Hz", None)]
+    if runs is not None and round(runs * float(f)) < 3:
+        out.append(("for", written(3.0 / float(f), 3, "up"), "s", None))
     return out
 
 
@@ -122,8 +75,7 @@ def _shiver(d: Diagnostic) -> list[tuple[str, str, str, str | None]]:
 def hint_edit(d: Diagnostic) -> str | None:
     """Every change a C308 needs, as one edit (``f=1.4Hz for 2.15s``)."""
     parts = _shiver(d)
-    return " ".join(f"{k}={v}{u}" if k != "for" else f"for {v}{u}" for k, v, u, _ in parts) \
-        or None
+    return " ".join(value_text(k, v, u) for k, v, u, _ in parts) or None
 
 
 def plan(diagnostics: list[Diagnostic], declared: dict[tuple, float]) -> list[Change]:
@@ -135,7 +87,7 @@ def plan(diagnostics: list[Diagnostic], declared: dict[tuple, float]) -> list[Ch
         joint, limit = d.fields.get("joint"), d.fields.get("limit")
         if d.code == C304 and d.fields.get("achieved"):
             x = declared.get(_at(d, "a"), float(d.fields["declared"]))
-            fitted = _down(compress(x, float(d.fields["achieved"])), 4)
+            fitted = written(compress(x, float(d.fields["achieved"])), 4)
             out.append(Change(d.span, "a", f"{x:g}", fitted, "", joint,
                               limit or "acceleration", d.fields.get("descriptor")))
         elif d.code == C308:
@@ -147,7 +99,7 @@ def plan(diagnostics: list[Diagnostic], declared: dict[tuple, float]) -> list[Ch
         elif d.code == C309 and d.fields.get("max_velocity"):
             v = declared.get(_at(d, "v"), d.fields.get("declared_velocity"))
             cap = float(d.fields["max_velocity"])
-            fitted = _down(compress(float(v), cap) if v else cap, 4)
+            fitted = written(compress(float(v), cap) if v else cap, 4)
             out.append(Change(d.span, "v", "" if v is None else f"{v:g}", fitted, "deg/s",
                               joint, limit, "tilt_velocity"))
         # the changes the builder found (a reach, a shiver's amplitude: field ``reach``)
@@ -159,49 +111,3 @@ def plan(diagnostics: list[Diagnostic], declared: dict[tuple, float]) -> list[Ch
 
 def _at(d: Diagnostic, key: str) -> tuple[int, int, str]:
     return d.span.line, d.span.col, key
-
-
-#: Keys of a statement's positional value (its first quantity of that dimension).
-_POSITIONAL = {"angle": r"[-+]?[\d.]+(?:[eE][-+]?\d+)?(?:deg|rad)(?=\s|;|#|$)",
-               "length": r"[-+]?[\d.]+(?:[eE][-+]?\d+)?(?:mm|cm|m)(?=\s|;|#|$)"}
-_KEY = {"a": r"a=\S+", "f": r"f=\S+", "v": r"v=\S+", "for": r"for\s+\S+", **_POSITIONAL}
-
-
-def apply(text: str, changes: list[Change]) -> str:
-    """``text`` with each change made in its statement: the key's value replaced, or
-    the key added after the statement's first words (its keyword and its positional
-    value). Statements are edited from the last to the first, so spans stay valid."""
-    lines = text.split("\n")
-    by_line: dict[tuple[int, int, int], list[Change]] = {}
-    for c in changes:
-        by_line.setdefault((c.span.line, c.span.col, c.span.end_col), []).append(c)
-    for (line, col, end), group in sorted(by_line.items(), reverse=True):
-        row = lines[line - 1]
-        stop = end - 1 if end > col else len(row)
-        stmt = row[col - 1:stop]
-        for c in group:
-            stmt = _edit(stmt, c)
-        lines[line - 1] = row[:col - 1] + stmt + row[stop:]
-    return "\n".join(lines)
-
-
-def _edit(stmt: str, c: Change) -> str:
-    pattern = re.compile(rf"(?<![\w=]){_KEY[c.key]}")
-    if pattern.search(stmt):
-        return pattern.sub(c.text, stmt, count=1)
-    words = stmt.split(" ")
-    at = 1 if len(words) > 1 and re.match(r"^[-+.\d]", words[1] if len(words) > 1 else "") \
-        and words[0] not in ("gaze",) else 0
-    if words[0] == "gaze":
-        at = 2
-    return " ".join([*words[:at + 1], c.text, *words[at + 1:]])
-
-
-def apply_edit(text: str, span: Span, edit: str) -> str:
-    """``text`` with the edit of a hint (``f=1.4Hz for 2.15s``, ``a=1.2``) made in the
-    statement at ``span``."""
-    changes = []
-    for m in re.finditer(r"(for)\s+([-+.\d]+)(\S*)|(\w+)=([-+.\deE]+)(\S*)", edit):
-        key, value, unit = (m[1], m[2], m[3]) if m[1] else (m[4], m[5], m[6])
-        changes.append(Change(span, key, "", value, unit, None, None, None))
-    return apply(text, changes)

@@ -5,7 +5,7 @@ fitted by its amplitude instead, by the rule of the other values: the widest amp
 the shiver joint follows at a frequency is its bound ``P`` (the shiver's peaks grow in
 proportion to the amplitude, so ``P`` is the amplitude over its largest ratio to a
 limit), and the declared amplitude is compressed under it by
-:func:`~aou_dsl.compiler.fitting.compress`, an increasing map, so a variant pair keeps
+:func:`~aou_dsl.fit.plan.compress`, an increasing map, so a variant pair keeps
 its order.
 
 The frequency tried first is the declared one (one change); when the amplitude that fits
@@ -27,7 +27,7 @@ from typing import Any
 from ..core.codes import C308
 from ..core.diagnostics import Diagnostic, Severity
 from ..lang.linter import lint_source
-from .reach_fit import Statement, offered
+from .reach import Statement, offered
 
 __all__ = ["with_amplitude_fit"]
 
@@ -55,11 +55,11 @@ def with_amplitude_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...
     st = Statement(lint.source, d.span.line, d.span.col, d.span.end_col, ("shiver",))
     if ep is None or not st.ok or st.dim != "angle":
         return res
-    from ..compiler.fitting import Change, apply, compress, shiver_keys
     from ..compiler.oscillation import shiver_ratios
-    from ..core.diagnostics import Span
     from ..lang.primitives import LOOK_SHIVER_F, VISIBLE_SHIVER, Shiver, shiver_duration
     from ..robot.load import load_arm
+    from .plan import compress, shiver_keys
+    from .text_edits import set_value, splice, value_text
 
     arm = load_arm(robot or b.settings.robot, None, package_dirs)
     node = next((n for n in b.primitives if n.span == d.span), None)
@@ -80,11 +80,9 @@ def with_amplitude_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...
                    f"{min(ep.f, LOOK_SHIVER_F):g} Hz would read as slow rolls, not a tremor")
             continue
         keys = shiver_keys(fa, asked if timed else None) if fa != ep.f else []
-        one = Span(d.span.path, 1, 1, 1, len(stmt) + 1)
-        stmt = apply(stmt, [Change(one, k, "", v, u, None, None, None) for k, v, u, _ in keys])
-        row = lint.source.split("\n")
-        row[st.line - 1] = row[st.line - 1][:st.col - 1] + stmt + row[st.line - 1][st.stop:]
-        text = "\n".join(row)
+        for k, v, u, _ in keys:
+            stmt = set_value(stmt, k, value_text(k, v, u))
+        text = splice(lint.source, st.line, st.col, st.stop, stmt)
         again = lint_source(text, lint.path)
         if not again.ok:
             return res

@@ -6,7 +6,7 @@ only (a slower shiver, a shorter retreat, a nearer ``start``). A file may be ref
 more than one reason (out of reach and too fast for the wrist; two shivers of a
 ``sequence`` each too fast): applying the first hint would only reveal the next. So the
 hint's own edit is applied, and where the file is then still refused, the rest is found
-by the machinery of ``--fit`` (:func:`~aou_dsl.build.fit_loop.fit_loop`: the fewest
+by the machinery of ``--fit`` (:func:`~aou_dsl.fit.rounds.fit_loop`: the fewest
 values changed by the least, the state and the order of values kept). The hint then
 names every changed statement, and its field ``edits`` holds them as text edits
 (``line``, ``col``, ``end_line``, ``end_col`` of the statement as written, ``text`` to
@@ -25,6 +25,7 @@ from typing import Any
 from ..core.codes import C308, C309
 from ..core.diagnostics import Diagnostic, Fix, Severity, Span, has_errors
 from ..lang.linter import FileResult, lint_source
+from .text_edits import Change, apply, apply_edit, splice
 
 __all__ = ["statement_edits", "with_every_change"]
 
@@ -71,8 +72,6 @@ def with_every_change(res: Any, build: Callable[[FileResult], Any]) -> Any:
 
 def _own(lint: FileResult, d: Diagnostic) -> str | None:
     """The file's text with ``d``'s own hint applied (None: the hint is no edit)."""
-    from ..compiler.fitting import Change, apply, apply_edit
-
     text = lint.source
     assert text is not None
     if d.span.path != lint.path or d.span.line < 1:
@@ -98,17 +97,14 @@ def _own(lint: FileResult, d: Diagnostic) -> str | None:
         now = f"{_text(text, d.span)}; {start[1]}"
     else:
         return None
-    lines = text.split("\n")
-    row = lines[d.span.line - 1]
-    lines[d.span.line - 1] = row[:d.span.col - 1] + now + row[d.span.end_col - 1:]
-    return "\n".join(lines)
+    return splice(text, d.span.line, d.span.col, d.span.end_col - 1, now)
 
 
 def _complete(lint: FileResult, own: str, build: Callable[[FileResult], Any]
               ) -> tuple[str, str | None]:
     """The text with every change the file needs, from ``own`` (the hint applied), and
     what is then still refused, in words (None: it compiles)."""
-    from .fit_loop import fit_loop
+    from .rounds import fit_loop
 
     again = lint_source(own, lint.path)
     if not again.ok:

@@ -1,5 +1,5 @@
 """``--fit``: build, and where the arm cannot give a declared value, change it by the
-rule of :mod:`aou_dsl.compiler.fitting` and build again, until nothing is left to fit.
+rule of :mod:`aou_dsl.fit.plan` and build again, until nothing is left to fit.
 
 Each change is a C314 warning at its statement ("declared -> fitted", the joint and the
 limit that bind); the fitted file's text is kept (``fitted_source``, written by
@@ -9,7 +9,7 @@ stays refused, and a C314 says why. Nor is one that would make an episode look l
 another kind than it declares (each kind's invariant,
 :meth:`~aou_dsl.lang.primitives.Kind.keeps_look`: a shiver slower than a tremor, a tilt
 faster than declared, a retreat too short to see): C315 says why, as it does for a
-shiver no frequency and no visible amplitude fits (:mod:`~aou_dsl.build.amplitude_fit`).
+shiver no frequency and no visible amplitude fits (:mod:`~aou_dsl.fit.amplitude`).
 """
 
 from __future__ import annotations
@@ -19,12 +19,13 @@ from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
-from ..compiler.fitting import FITTED, Change, apply, plan
 from ..core.codes import C314, C315
 from ..core.diagnostics import Diagnostic, diag
 from ..core.repeats import said_once
 from ..lang.linter import FileResult, lint_source
 from ..lang.primitives import look_changed
+from .plan import FITTED, plan
+from .text_edits import Change, apply
 
 __all__ = ["MAX_ROUNDS", "fit_loop"]
 
@@ -53,7 +54,7 @@ def _warning(c: Change) -> Diagnostic:
 
 def _not_fitted(todo: list[Diagnostic], where: Any) -> list[Diagnostic]:
     """C314 for each reach refusal no change answers, with why
-    (:mod:`~aou_dsl.build.reach_fit`)."""
+    (:mod:`~aou_dsl.fit.reach`)."""
     return [diag(C314, f"not fitted: {d.fields['reach_fit']}", d.span)
             for d in todo if d.fields.get("reach_fit")] + [
         diag(C315, f"not fitted: no shiver the arm follows keeps the look: "
@@ -64,7 +65,7 @@ def _not_fitted(todo: list[Diagnostic], where: Any) -> list[Diagnostic]:
 
 
 def fit_loop(lint: FileResult, build: Callable[[FileResult], Any]) -> Any:
-    """``build(lint)``, then rounds of :func:`~aou_dsl.compiler.fitting.plan` and
+    """``build(lint)``, then rounds of :func:`~aou_dsl.fit.plan.plan` and
     ``build`` of the changed text (at most :data:`MAX_ROUNDS` builds)."""
     res = build(lint)
     text, b = lint.source, lint.behaviour
