@@ -25,6 +25,7 @@ from typing import Any
 from ..core.codes import C308, C309
 from ..core.diagnostics import Diagnostic, Fix, Severity, Span, has_errors
 from ..lang.linter import FileResult, lint_source
+from .refusals import first_error
 from .text_edits import Change, apply, apply_edit, splice
 
 __all__ = ["statement_edits", "with_every_change"]
@@ -121,10 +122,9 @@ def _left(diagnostics: list[Diagnostic]) -> str:
     """The first refusal of ``diagnostics``, and why the fit did not answer it."""
     from ..core.codes import C314
 
-    d = next(x for x in diagnostics if x.severity is Severity.ERROR)
     why = [x.message for x in diagnostics if x.code == C314 and x.message.startswith(
         "not fitted")]
-    return f"{d.code} at line {d.span.line} ({d.message})" + "".join(f"; {w}" for w in why)
+    return first_error(diagnostics) + "".join(f"; {w}" for w in why)
 
 
 def _statements(lint: FileResult, keys: set[str]) -> list[Span]:

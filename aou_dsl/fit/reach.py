@@ -35,6 +35,7 @@ from ..core.diagnostics import Diagnostic, Severity, Span, diag
 from ..core.memo import cached
 from ..lang.linter import FileResult, lint_source
 from .quantity import UNITS, first
+from .refusals import first_error
 from .rounding import written
 from .text_edits import splice, statement
 
@@ -207,6 +208,11 @@ def _fits(lint: FileResult, d: Diagnostic, robot: str, package_dirs: tuple[str, 
         # a statement changed before is fitted again from its declared value
         was = first.setdefault((st.line, st.col), (st.written, abs(st.value), st.stop + 1))
         stmt, new_text = st.with_value(compress(was[1], bound))
+        refused = lint_source(new_text, path)
+        if not refused.ok:
+            return f"`{stmt}`, the least change under the arm's bound " \
+                f"({bound / st.scale:.4g}{st.unit}), is a value the language does not " \
+                f"take: {first_error(refused.diagnostics)}"
         if not follows(new_text, path, last):
             return f"`{stmt}` is not followed either"
         changes = [c for c in changes if (c["line"], c["col"]) != (st.line, st.col)]

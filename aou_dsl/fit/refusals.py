@@ -8,7 +8,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["TimingFailure"]
+from ..core.diagnostics import Diagnostic, Severity
+
+__all__ = ["TimingFailure", "first_error"]
 
 
 @dataclass(frozen=True)
@@ -22,3 +24,9 @@ class TimingFailure:
     wanted: float | None = None
     #: The limit exceeded (``velocity``, ``acceleration``, ``jerk``), when one is.
     limit: str | None = None
+
+
+def first_error(diagnostics: list[Diagnostic]) -> str:
+    """The first error of ``diagnostics`` in words: its code, line and message."""
+    d = next(x for x in diagnostics if x.severity is Severity.ERROR)
+    return f"{d.code} at line {d.span.line} ({d.message})"

@@ -25,6 +25,7 @@ from ..core.repeats import said_once
 from ..lang.linter import FileResult, lint_source
 from ..lang.primitives import look_changed
 from .plan import FITTED, plan
+from .refusals import first_error
 from .text_edits import Change, apply
 
 __all__ = ["MAX_ROUNDS", "fit_loop"]
@@ -82,9 +83,15 @@ def fit_loop(lint: FileResult, build: Callable[[FileResult], Any]) -> Any:
             break
         new_text = apply(text, changes)
         new_lint = lint_source(new_text, lint.path)
-        if not new_lint.ok or (state is not None and (
+        if not new_lint.ok:
+            res.diagnostics.append(diag(
+                C314, f"not fitted: the changes ({', '.join(c.text for c in changes)}) "
+                f"are values the language does not take: "
+                f"{first_error(new_lint.diagnostics)}", b.span))
+            return res
+        if (state is not None and (
                 new_lint.cv is None or new_lint.cv.state != state)):
-            found = new_lint.cv.state.value if new_lint.cv is not None else "errors"
+            found = new_lint.cv.state.value if new_lint.cv is not None else "nothing"
             res.diagnostics.append(diag(
                 C314, f"not fitted: the changes ({', '.join(c.text for c in changes)}) "
                 f"would make the file express `{found}`, not "
