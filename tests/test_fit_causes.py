@@ -8,8 +8,9 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 from aou_dsl.core.codes import C301, C308
-from aou_dsl.core.diagnostics import Severity, diag
+from aou_dsl.core.diagnostics import Severity, refused
 from aou_dsl.fit import reach
+from aou_dsl.fit.refusals import ShiverTooFast, Unreachable
 from aou_dsl.fit.rounds import fit_loop
 from aou_dsl.lang.linter import lint_source
 
@@ -24,9 +25,9 @@ def test_a_fitted_text_the_language_refuses_is_named_as_such():
     lint = lint_source(SHIVER, "s.aou")
     assert lint.ok and lint.behaviour is not None
     node = next(p for p in lint.behaviour.primitives if p.kind == "shiver")
-    refused = diag(C308, "too fast", node.span, joint="j7", limit="acceleration",
-                   max_frequency=0.5, duration=None, f=2.5)
-    res = fit_loop(lint, lambda _: SimpleNamespace(diagnostics=[refused], header=None))
+    too_fast = refused(C308, "too fast", node.span,
+                       ShiverTooFast("j7", "acceleration", 0.5, None, 2.5))
+    res = fit_loop(lint, lambda _: SimpleNamespace(diagnostics=[too_fast], header=None))
     said = [d.message for d in res.diagnostics if d.message.startswith("not fitted")]
     fitted = lint_source(SHIVER.replace("f=2.5Hz", "f=0.5Hz"), "s.aou")
     bad = next(d for d in fitted.diagnostics if d.severity is Severity.ERROR)
@@ -56,6 +57,7 @@ def test_a_reach_squeezed_under_the_least_retreat_is_named_as_such(monkeypatch):
     lint = lint_source(RETREAT, "r.aou")
     assert lint.ok and lint.timeline is not None
     ep = next(e for e in lint.timeline.episodes if e.kind == "retreat")
-    why = reach._fits(lint, diag(C301, "", ep.span, joint="j4"), "panda", ())
+    why = reach._fits(lint, refused(C301, "", ep.span, Unreachable("unreachable", 1.0, "j4")),
+                      "panda", ())
     assert isinstance(why, str), why
     assert "V123" in why and "not followed" not in why, why

@@ -24,10 +24,10 @@ import math
 from dataclasses import replace
 from typing import Any
 
-from ..core.codes import C308
 from ..core.diagnostics import Diagnostic, Severity
 from ..lang.linter import lint_source
 from .reach import Statement, offered
+from .refusals import ShiverTooFast
 
 __all__ = ["with_amplitude_fit"]
 
@@ -46,8 +46,9 @@ def with_amplitude_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...
     amplitude that fits (at the declared frequency, else at the slowest shiver that
     looks like one), or the reason none does."""
     lint, b = res.lint, res.lint.behaviour
-    d = next((x for x in res.diagnostics if x.code == C308 and x.severity is Severity.ERROR
-              and not x.fields.get("max_frequency") and x.span.path == lint.path), None)
+    d = next((x for x in res.diagnostics if isinstance(x.refusal, ShiverTooFast)
+              and x.severity is Severity.ERROR and not x.refusal.max_frequency
+              and x.span.path == lint.path), None)
     if d is None or b is None or lint.source is None or lint.timeline is None:
         return res
     ep = next((e for e in lint.timeline.episodes if e.kind == "shiver" and e.span == d.span),
@@ -93,9 +94,9 @@ def with_amplitude_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...
                    f"than {min(ep.f, LOOK_SHIVER_F):g} Hz would read as slow rolls, not a "
                    "tremor")
             continue
-        joint, limit = d.fields.get("joint"), d.fields.get("limit")
-        records = [st.record(fitted.written, stmt, bound, joint, limit)]
-        was = {"f": d.fields.get("f"), "for": d.fields.get("duration")}
+        r = d.refusal
+        records = [st.record(fitted.written, stmt, bound, r.joint, r.limit)]
+        was = {"f": r.f, "for": r.duration}
         for k, v, u, desc in keys:
             w = was.get(k)
             records.append(records[0] | {

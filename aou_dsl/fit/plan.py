@@ -29,6 +29,7 @@ from __future__ import annotations
 
 from ..core.codes import C301, C302, C303, C304, C308, C309
 from ..core.diagnostics import Diagnostic, Span
+from .refusals import AccelerationShort, ShiverTooFast, TiltTooFast
 from .rounding import written
 from .text_edits import Change, value_text
 
@@ -62,50 +63,48 @@ def shiver_keys(f_ok: float, runs: float | None) -> list[tuple[str, str, str, st
     return out
 
 
-def _shiver(d: Diagnostic) -> list[tuple[str, str, str, str | None]]:
+def _shiver(r: ShiverTooFast) -> list[tuple[str, str, str, str | None]]:
     """``(key, fitted, unit, descriptor)`` of a shiver too fast: its highest frequency
     (one the compiler offers only when it still looks like a shiver), and, when the
     statement says `for`, one of the 3 cycles it then lasts at least."""
-    f_ok = d.fields.get("max_frequency")
-    if not f_ok:
+    if not r.max_frequency:
         return []
-    return shiver_keys(f_ok, d.fields.get("duration"))  # duration None: no `for`
+    return shiver_keys(r.max_frequency, r.duration)  # duration None: no `for`
 
 
-def hint_edit(d: Diagnostic) -> str | None:
+def hint_edit(r: ShiverTooFast) -> str | None:
     """Every change a C308 needs, as one edit (``f=1.4Hz for 2.15s``)."""
-    parts = _shiver(d)
-    return " ".join(value_text(k, v, u) for k, v, u, _ in parts) or None
+    return " ".join(value_text(k, v, u) for k, v, u, _ in _shiver(r)) or None
 
 
 def plan(diagnostics: list[Diagnostic], declared: dict[tuple, float]) -> list[Change]:
-    """The changes that fit what ``diagnostics`` refuse. ``declared`` holds, by
-    ``(line, col, key)`` of the statement, the value first declared where an earlier
-    round changed it (the rule is applied from it, not from the fitted value)."""
+    """The changes that fit what ``diagnostics`` refuse (their typed refusals, and the
+    changes the reach and amplitude fits found). ``declared`` holds, by ``(line, col,
+    key)`` of the statement, the value first declared where an earlier round changed it
+    (the rule is applied from it, not from the fitted value)."""
     out = []
     for d in diagnostics:
-        joint, limit = d.fields.get("joint"), d.fields.get("limit")
-        if d.code == C304 and d.fields.get("achieved"):
-            x = declared.get(_at(d, "a"), float(d.fields["declared"]))
-            fitted = written(compress(x, float(d.fields["achieved"])), 4)
-            out.append(Change(d.span, "a", f"{x:g}", fitted, "", joint,
-                              limit or "acceleration", d.fields.get("descriptor")))
-        elif d.code == C308:
-            was = {"f": d.fields.get("f"), "for": d.fields.get("duration")}
-            for key, value, unit, desc in _shiver(d):
+        r = d.refusal
+        if isinstance(r, AccelerationShort) and r.achieved and r.declared is not None:
+            x = declared.get(_at(d, "a"), float(r.declared))
+            fitted = written(compress(x, float(r.achieved)), 4)
+            out.append(Change(d.span, "a", f"{x:g}", fitted, "", r.joint, "acceleration",
+                              r.descriptor))
+        elif isinstance(r, ShiverTooFast):
+            was = {"f": r.f, "for": r.duration}
+            for key, value, unit, desc in _shiver(r):
                 w = was.get(key)
                 out.append(Change(d.span, key, "" if w is None else f"{w:.3g}", value, unit,
-                                  joint, limit, desc))
-        elif d.code == C309 and d.fields.get("max_velocity"):
-            v = declared.get(_at(d, "v"), d.fields.get("declared_velocity"))
-            cap = float(d.fields["max_velocity"])
-            fitted = written(compress(float(v), cap) if v else cap, 4)
+                                  r.joint, r.limit, desc))
+        elif isinstance(r, TiltTooFast) and r.max_velocity:
+            v = declared.get(_at(d, "v"), r.declared_velocity)
+            fitted = written(compress(float(v), r.max_velocity) if v else r.max_velocity, 4)
             out.append(Change(d.span, "v", "" if v is None else f"{v:g}", fitted, "deg/s",
-                              joint, limit, "tilt_velocity"))
+                              r.joint, r.limit, "tilt_velocity"))
         # the changes the builder found (a reach, a shiver's amplitude: field ``reach``)
-        out += [Change(Span(d.span.path, r["line"], r["col"], r["line"], r["end_col"]),
-                       r["key"], r["declared"], r["fitted"], r["unit"], r["joint"],
-                       r["limit"], r["descriptor"]) for r in d.fields.get("reach", ())]
+        out += [Change(Span(d.span.path, c["line"], c["col"], c["line"], c["end_col"]),
+                       c["key"], c["declared"], c["fitted"], c["unit"], c["joint"],
+                       c["limit"], c["descriptor"]) for c in d.fields.get("reach", ())]
     return out
 
 

@@ -31,11 +31,11 @@ from dataclasses import replace
 from typing import Any
 
 from ..core.codes import C301, C302, C303
-from ..core.diagnostics import Diagnostic, Severity, Span, diag
+from ..core.diagnostics import Diagnostic, Severity, Span, refused
 from ..core.memo import cached
 from ..lang.linter import FileResult, lint_source
 from .quantity import UNITS, first
-from .refusals import first_error
+from .refusals import Unreachable, first_error
 from .rounding import written
 from .text_edits import splice, statement
 
@@ -194,7 +194,7 @@ def _fits(lint: FileResult, d: Diagnostic, robot: str, package_dirs: tuple[str, 
     text, path = lint.source or "", lint.path
     changes: list[dict[str, Any]] = []
     first: dict[tuple[int, int], tuple[str, float, int]] = {}
-    span, code, failure = d.span, d.code, d.fields.get("joint")
+    span, code, failure = d.span, d.code, d.refusal.joint
     for _ in range(MOST):
         tl = lint_source(text, path).timeline
         last = -1 if tl is None else max((i for i, e in enumerate(tl.episodes) if (
@@ -246,7 +246,8 @@ def _remembered(source: str, path: str, robot: str, package_dirs: tuple[str, ...
     lint = lint_source(source, path)
     if lint.behaviour is None or lint.timeline is None:
         return "the file does not lint"
-    return _fits(lint, diag(code, "", span, joint=joint), robot, package_dirs)
+    return _fits(lint, refused(code, "", span, Unreachable("", 0.0, joint)), robot,
+                 package_dirs)
 
 
 def with_reach_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...]) -> Any:
@@ -259,15 +260,15 @@ def with_reach_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...]) -
         return res
     out = []
     for d in res.diagnostics:
-        if d.code not in REACH or d.severity is not Severity.ERROR or not d.fields.get(
-                "time") or d.span.path != lint.path or d.span.line < 1:
+        if not isinstance(d.refusal, Unreachable) or d.severity is not Severity.ERROR \
+                or not d.refusal.time or d.span.path != lint.path or d.span.line < 1:
             out.append(d)
             continue
         from ..robot.load import robot_key
 
         arm = robot or b.settings.robot
         found = _remembered(lint.source, lint.path, arm, package_dirs, d.code, d.span,
-                            d.fields.get("joint"), robot_key(arm, package_dirs))
+                            d.refusal.joint, robot_key(arm, package_dirs))
         found = found if isinstance(found, str) else [dict(c) for c in found]
         if isinstance(found, str):
             why = f"no smaller angle or distance is offered: {found}"

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from ..core.codes import C304
 from ..core.diagnostics import AouError, has_errors
 from ..core.memo import cached
+from ..fit.refusals import AccelerationShort
 from ..fit.rounding import significant
 from ..fit.search import DIGITS
 from ..lang.ir import DEFAULTS
@@ -107,8 +108,10 @@ def _fit_limits(robot: str, goal: tuple[float, float, float] | None, key: tuple)
     errors = [d for d in res.diagnostics if d.code != C304]
     if has_errors(errors):
         raise AouError([d for d in errors if d.severity.value == "error"])
-    reached = min((float(d.fields["achieved"]) for d in res.diagnostics
-                   if d.code == C304), default=PROBE_ACCEL)
+    reached = min((float(d.refusal.achieved) for d in res.diagnostics
+                   if isinstance(d.refusal, AccelerationShort)
+                   and d.refusal.achieved is not None),
+                  default=PROBE_ACCEL)
     j = arm.joint_names.index(arm.spec.shiver_joint)
     return Limits(robot, goal, reached, significant(MARGIN * reached, DIGITS),
                   arm.spec.shiver_joint,
