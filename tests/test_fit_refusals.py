@@ -44,3 +44,21 @@ def test_a_refusal_carries_its_record_and_its_fields_are_the_records(text, code,
     assert type(d.refusal) is kind, (d.code, d.message, d.refusal)
     assert list(d.to_json()["fields"])[:len(keys)] == keys
     assert {k: d.fields[k] for k in keys} == dataclasses.asdict(d.refusal)
+
+
+def test_what_the_fit_found_is_typed_and_is_its_fields():
+    """The reach fit's changes and the hint's edits (a retreat too far for the small
+    arm) are the refusal's typed answer; the JSON fields say the same, after the
+    refusal's."""
+    from aou_dsl.fit.refusals import Answer
+
+    text = ("behaviour f : fearful\nrobot z1\napproach a=0.1\npause 1.25s x4\n"
+            "retreat 0.3m a=2\nshiver 6deg f=1.1Hz for 2.73s\n")
+    res = build_source(text, "r.aou", check=False)
+    d = next(x for x in res.diagnostics if isinstance(x.refusal, Unreachable))
+    assert type(d.answer) is Answer and d.answer.offered and d.answer.edits, d.answer
+    assert list(d.fields)[:3] == ["reason", "time", "joint"]
+    assert list(d.fields)[-3:] == ["reach", "edits", "edits_complete"]
+    assert d.fields["reach"] == list(d.answer.offered)
+    assert d.fields["edits"] == list(d.answer.edits)
+    assert d.fields["edits_complete"] is d.answer.edits_complete

@@ -246,7 +246,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
             if shiver_fail is not None:
                 f_ok = shiver_fail.wanted
                 # a slower shiver than the look's floor reads as slow rolls: then the
-                # amplitude is fitted instead (build/amplitude_fit.py)
+                # amplitude is fitted instead (fit/amplitude.py)
                 ok = bool(f_ok and f_ok >= LOOK_SHIVER_F)
                 node = next((n for n in b.primitives if n.span == ep.span), None)
                 timed = isinstance(node, Shiver) and node.timed  # its `for`, as written

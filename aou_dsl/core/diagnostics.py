@@ -78,6 +78,9 @@ class Diagnostic:
         fix: the hint as an edit, where it is one (editors apply it; not printed).
         refusal: what the compiler refused, typed, where the fit and the hints read it
             (a record of :mod:`aou_dsl.fit.refusals`; its values are ``fields`` too).
+        answer: what the fit found for the refusal (an ``Answer`` of the same module:
+            the changes that answer it, or why none does, and the hint's text edits;
+            also in ``fields``).
     """
 
     code: str
@@ -88,6 +91,7 @@ class Diagnostic:
     fields: dict[str, Any] = field(default_factory=dict)
     fix: Fix | None = None
     refusal: Any = None
+    answer: Any = None
 
     @property
     def rule(self) -> Rule:

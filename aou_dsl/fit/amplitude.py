@@ -21,13 +21,12 @@ shiver into a slow roll.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from typing import Any
 
 from ..core.diagnostics import Diagnostic, Severity
 from ..lang.linter import lint_source
 from .reach import Statement, offered
-from .refusals import ShiverTooFast
+from .refusals import ShiverTooFast, answered
 
 __all__ = ["with_amplitude_fit"]
 
@@ -36,8 +35,8 @@ def _refused(res: Any, d: Diagnostic, why: str) -> Any:
     """``res`` with ``d`` saying why no shiver keeps its look (field ``look``, and its
     hint when it has none: there is no edit to offer)."""
     hint = d.hint or f"no shiver this arm follows keeps the look: {why}"
-    res.diagnostics = [replace(x, hint=hint, fields={**x.fields, "look": why}) if x is d
-                       else x for x in res.diagnostics]
+    res.diagnostics = [answered(x, hint, look=why) if x is d else x
+                       for x in res.diagnostics]
     return res
 
 

@@ -25,7 +25,7 @@ from typing import Any
 from ..core.codes import C308, C309
 from ..core.diagnostics import Diagnostic, Fix, Severity, Span, has_errors
 from ..lang.linter import FileResult, lint_source
-from .refusals import first_error
+from .refusals import answer_of, answered, first_error
 from .text_edits import Change, apply, apply_edit, splice
 
 __all__ = ["statement_edits", "with_every_change"]
@@ -59,15 +59,14 @@ def with_every_change(res: Any, build: Callable[[FileResult], Any]) -> Any:
     hint = d.hint if final == own else _said(d, edits) + _otherwise(d.hint)
     if left is not None:
         hint = f"{hint}; not every refusal is answered: then {left}"
-    fields = {**d.fields, "edits": edits, "edits_complete": left is None}
     fix = d.fix
     mine = [e for e in edits if (e["line"], e["col"]) == (d.span.line, d.span.col)]
     if fix is None and d.code in _KEYED and mine:  # the refused statement, whole
         e = mine[0]
         fix = Fix(Span(d.span.path, e["line"], e["col"], e["end_line"], e["end_col"]),
                   e["text"])
-    res.diagnostics = [replace(x, hint=hint, fields=fields, fix=fix) if x is d else x
-                       for x in res.diagnostics]
+    res.diagnostics = [replace(answered(x, hint, edits=edits, edits_complete=left is None),
+                               fix=fix) if x is d else x for x in res.diagnostics]
     return res
 
 
@@ -82,10 +81,11 @@ def _own(lint: FileResult, d: Diagnostic) -> str | None:
     said = _SAID.match(d.hint or "")
     if d.fix is None and said and d.code in _KEYED:  # `f=1.3Hz for 2.31s`: two keys
         return apply_edit(text, d.span, said[1])
-    if d.fields.get("reach"):
+    offered = answer_of(d).offered
+    if offered:
         return apply(text, [Change(Span(d.span.path, r["line"], r["col"], r["line"],
                                         r["end_col"]), r["key"], r["declared"], r["fitted"],
-                                   r["unit"], None, None, None) for r in d.fields["reach"]])
+                                   r["unit"]) for r in offered])
     start = _START.search(d.hint or "")
     spans = lint.behaviour.settings.spans if lint.behaviour is not None else {}
     if not (start and d.span in spans.values() and d.span.line == d.span.end_line):

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 from ..core.codes import C301, C302, C303, C304, C308, C309
 from ..core.diagnostics import Diagnostic, Span
-from .refusals import AccelerationShort, ShiverTooFast, TiltTooFast
+from .refusals import AccelerationShort, ShiverTooFast, TiltTooFast, answer_of
 from .rounding import written
 from .text_edits import Change, value_text
 
@@ -104,7 +104,7 @@ def plan(diagnostics: list[Diagnostic], declared: dict[tuple, float]) -> list[Ch
         # the changes the builder found (a reach, a shiver's amplitude: field ``reach``)
         out += [Change(Span(d.span.path, c["line"], c["col"], c["line"], c["end_col"]),
                        c["key"], c["declared"], c["fitted"], c["unit"], c["joint"],
-                       c["limit"], c["descriptor"]) for c in d.fields.get("reach", ())]
+                       c["limit"], c["descriptor"]) for c in answer_of(d).offered]
     return out
 
 

@@ -27,7 +27,6 @@ state is not offered.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from typing import Any
 
 from ..core.codes import C301, C302, C303
@@ -35,7 +34,7 @@ from ..core.diagnostics import Diagnostic, Severity, Span, refused
 from ..core.memo import cached
 from ..lang.linter import FileResult, lint_source
 from .quantity import UNITS, first
-from .refusals import Unreachable, first_error
+from .refusals import Unreachable, answered, first_error
 from .rounding import written
 from .text_edits import splice, statement
 
@@ -272,8 +271,8 @@ def with_reach_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...]) -
         found = found if isinstance(found, str) else [dict(c) for c in found]
         if isinstance(found, str):
             why = f"no smaller angle or distance is offered: {found}"
-            out.append(replace(d, hint=f"{d.hint}; {why}" if d.hint else why,
-                               fields={**d.fields, "reach_fit": found}))
+            out.append(answered(d, f"{d.hint}; {why}" if d.hint else why,
+                                not_offered=found))
             continue
         out.append(offered(d, found))
     res.diagnostics = out
@@ -286,4 +285,4 @@ def offered(d: Diagnostic, records: list[dict[str, Any]]) -> Diagnostic:
     ``reach`` (read by ``--fit``)."""
     said = "; ".join(f"`{c['statement']}` at line {c['line']}" for c in records)
     hint = f"write {said}" + (f"; or {d.hint}" if d.hint else "")
-    return replace(d, hint=hint, fields={**d.fields, "reach": records})
+    return answered(d, hint, offered=records)

@@ -10,12 +10,13 @@ script reads, are the record's values, in its order. Pure Python.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import Any
 
 from ..core.diagnostics import Diagnostic, Severity
 
-__all__ = ["AccelerationShort", "ShiverTooFast", "StartUnreachable", "TiltTooFast",
-           "TimingFailure", "Unreachable", "first_error"]
+__all__ = ["AccelerationShort", "Answer", "ShiverTooFast", "StartUnreachable", "TiltTooFast",
+           "TimingFailure", "Unreachable", "answered", "answer_of", "first_error"]
 
 
 @dataclass(frozen=True)
@@ -87,3 +88,43 @@ def first_error(diagnostics: list[Diagnostic]) -> str:
     """The first error of ``diagnostics`` in words: its code, line and message."""
     d = next(x for x in diagnostics if x.severity is Severity.ERROR)
     return f"{d.code} at line {d.span.line} ({d.message})"
+
+
+@dataclass(frozen=True)
+class Answer:
+    """What the fit found for a refusal (``Diagnostic.answer``).
+
+    Attributes:
+        offered: the changes that answer it, as records (``line``, ``col``, ``end_col``,
+            ``key``, ``declared``, ``fitted``, ``unit``, ``bound``, ``joint``, ``limit``,
+            ``descriptor``, ``statement``): field ``reach``.
+        not_offered: why no angle or distance is offered (field ``reach_fit``).
+        look: why no shiver the arm follows keeps the look (field ``look``).
+        edits: the hint's text edits, every change the file needs (field ``edits``);
+        edits_complete: whether the file then compiles (field ``edits_complete``).
+    """
+
+    offered: tuple[dict[str, Any], ...] = ()
+    not_offered: str | None = None
+    look: str | None = None
+    edits: tuple[dict[str, Any], ...] = ()
+    edits_complete: bool = True
+
+
+#: The field of the diagnostic's JSON that says each part of an :class:`Answer`.
+_FIELD = {"offered": "reach", "not_offered": "reach_fit", "look": "look",
+          "edits": "edits", "edits_complete": "edits_complete"}
+
+
+def answer_of(d: Diagnostic) -> Answer:
+    """``d``'s answer (an empty one when the fit has said nothing of it)."""
+    return d.answer if isinstance(d.answer, Answer) else Answer()
+
+
+def answered(d: Diagnostic, hint: str | None, **parts: Any) -> Diagnostic:
+    """``d`` with ``hint`` and the parts of its :class:`Answer` given (``offered=...``),
+    said in its fields too (added after the others, in the order given)."""
+    typed: dict[str, Any] = {k: tuple(v) if isinstance(v, list) else v
+                             for k, v in parts.items()}
+    return replace(d, hint=hint, answer=replace(answer_of(d), **typed),
+                   fields={**d.fields, **{_FIELD[k]: v for k, v in parts.items()}})

@@ -25,7 +25,7 @@ from ..core.repeats import said_once
 from ..lang.linter import FileResult, lint_source
 from ..lang.primitives import look_changed
 from .plan import FITTED, plan
-from .refusals import first_error
+from .refusals import answer_of, first_error
 from .text_edits import Change, apply
 
 __all__ = ["MAX_ROUNDS", "fit_loop"]
@@ -56,13 +56,13 @@ def _warning(c: Change) -> Diagnostic:
 def _not_fitted(todo: list[Diagnostic], where: Any) -> list[Diagnostic]:
     """C314 for each reach refusal no change answers, with why
     (:mod:`~aou_dsl.fit.reach`)."""
-    return [diag(C314, f"not fitted: {d.fields['reach_fit']}", d.span)
-            for d in todo if d.fields.get("reach_fit")] + [
+    return [diag(C314, f"not fitted: {answer_of(d).not_offered}", d.span)
+            for d in todo if answer_of(d).not_offered] + [
         diag(C315, f"not fitted: no shiver the arm follows keeps the look: "
-             f"{d.fields['look']}", d.span, hint="a wider or faster shiver needs a "
+             f"{answer_of(d).look}", d.span, hint="a wider or faster shiver needs a "
              "stronger wrist (a robot description's `joint_accel`, if the arm allows "
-             "more); else leave the shiver out on this arm", look=d.fields["look"])
-        for d in todo if d.fields.get("look")]
+             "more); else leave the shiver out on this arm", look=answer_of(d).look)
+        for d in todo if answer_of(d).look]
 
 
 def fit_loop(lint: FileResult, build: Callable[[FileResult], Any]) -> Any:

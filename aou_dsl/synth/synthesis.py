@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING
 from ..core.codes import C304, C305, C308, C309, C311, I504
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..core.memo import Keyed, cached
+from ..fit.refusals import AccelerationShort
 from ..fit.rounding import significant
 from ..fit.search import DIGITS
 from ..lang.cv import CANONICAL, classify
@@ -254,7 +255,8 @@ def synthesize(state: State | str | None = None, C: float | None = None,
         i_eff = max(intensity, lo)
         text = make(i_eff)
         why = _failure(text) if verify else None
-        reached = why.fields.get("achieved") if why is not None and why.code == C304 else None
+        reached = why.refusal.achieved if why is not None and isinstance(
+            why.refusal, AccelerationShort) else None
         if not reached:
             break
         # somewhere on this reach the joints reach less than on the probe's line
