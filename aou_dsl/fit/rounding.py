@@ -49,7 +49,8 @@ def written(x: float, digits: int, toward: Toward = "down") -> str:
     if not x > 0:
         return f"{x:g}"
     e = _exponent(x, digits)
-    return f"{significant(x, digits, toward):.{max(0, -e)}f}".rstrip("0").rstrip(".")
+    text = f"{significant(x, digits, toward):.{max(0, -e)}f}"
+    return text.rstrip("0").rstrip(".") if "." in text else text  # 1234000 keeps its zeros
 
 
 def times(ratio: float) -> str:
