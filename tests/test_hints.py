@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 from aou_dsl.build.builder import build_source
-from aou_dsl.compiler.fits import floor_sig, largest_fitting, times
 from aou_dsl.compiler.oscillation import shiver_offset, shiver_ratios
+from aou_dsl.fit.rounding import significant, times
+from aou_dsl.fit.search import largest_fitting
 from aou_dsl.lang.linter import lint_source
 from aou_dsl.robot.load import load_arm
 
@@ -38,7 +39,7 @@ def _at(text: str, d) -> str:
 
 def _apply(text: str, d) -> str:
     """The file with the diagnostic's hint `write `k=VALUE`` applied to its statement."""
-    from aou_dsl.compiler.fitting import apply_edit
+    from aou_dsl.fit.text_edits import apply_edit
 
     m = re.fullmatch(r"write `((\w+)=([0-9.]+)([A-Za-z/]+)( for [0-9.]+s)?)`", d.hint or "")
     assert m, d.hint
@@ -91,12 +92,12 @@ def test_sequence_approach_without_length_cannot_repeat():
 # --- the suggestions' arithmetic ----------------------------------------------------------
 
 
-def test_floor_sig_rounds_down_and_keeps_exact_values():
-    assert floor_sig(2.2734) == 2.2
-    assert floor_sig(2.2) == 2.2  # 2.2 is stored as 2.2000000000000002 or 2.19999...
-    assert floor_sig(84.999) == 84
-    assert floor_sig(0.0123) == 0.012
-    assert floor_sig(100.0) == 100
+def test_significant_rounds_down_and_keeps_exact_values():
+    assert significant(2.2734, 2) == 2.2
+    assert significant(2.2, 2) == 2.2  # 2.2 is stored as 2.2000000000000002 or 2.19999...
+    assert significant(84.999, 2) == 84
+    assert significant(0.0123, 2) == 0.012
+    assert significant(100.0, 2) == 100
 
 
 def test_largest_fitting_searches_both_ways():

@@ -25,7 +25,7 @@ LAYERS = [
     ("version", "core"),
     ("lang",),
     ("robot",),
-    ("compiler",),
+    ("compiler", "fit"),
     ("measuring",),
     ("safety",),
     ("build",),

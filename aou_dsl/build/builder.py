@@ -10,12 +10,13 @@ caller's, so a failed build leaves nothing behind.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
-from ..core.codes import C301, C302, C303, C304, C305, C306, C310, C311
+from ..core.codes import C301, C302, C303, C305, C306, C310, C311
 from ..core.diagnostics import AouError, Diagnostic, Severity, Span, diag, has_errors
 from ..core.options import BuildOptions, SceneOptions
+from ..fit.refusals import AccelerationShort, Unreachable
 from ..lang.linter import FileResult, lint_file, lint_source
 
 if TYPE_CHECKING:  # the numerical stages load only when a build runs
@@ -161,16 +162,16 @@ def build_lint(lint: FileResult, options: BuildOptions | None = None,
 
     opts = (options or BuildOptions()).replace(**changes) if changes else (
         options or BuildOptions())
-    from .amplitude_fit import with_amplitude_fit
-    from .every_change import with_every_change
-    from .reach_fit import with_reach_fit
+    from ..fit.amplitude import with_amplitude_fit
+    from ..fit.every_change import with_every_change
+    from ..fit.reach import with_reach_fit
 
     def one(linted: FileResult) -> BuildResult:  # a refusal's hint: the value that fits
         res = with_reach_fit(_build_lint(linted, opts), opts.robot, opts.package_dirs)
         return with_amplitude_fit(res, opts.robot, opts.package_dirs)
 
     if opts.fit:
-        from .fit_loop import fit_loop
+        from ..fit.rounds import fit_loop
 
         res = fit_loop(lint, one)
     else:  # the hint of a refusal: every change the file needs, at once
@@ -213,7 +214,8 @@ def _build_lint(lint: FileResult, opts: BuildOptions) -> BuildResult:
         res.seconds = time.perf_counter() - start
         return res
     res.declared = want = declared(b, tl)
-    explained = {d.fields.get("descriptor") for d in res.diagnostics if d.code == C304}
+    explained = {d.refusal.descriptor for d in res.diagnostics
+                 if isinstance(d.refusal, AccelerationShort)}
     for mm in compare(want, m.descriptors):
         if mm.name in explained:  # C304 said why the arm gives less than declared
             continue
@@ -257,8 +259,8 @@ def _blames_start(d: Diagnostic) -> bool:
     beyond a joint limit, IK at a joint limit on the way, a failed check (links that
     touch, a joint beyond its range)."""
     return d.severity is Severity.ERROR and (
-        d.code in (C302, C306) or (d.code in (C301, C303) and d.fields.get("time")
-                                       == 0.0))
+        d.code in (C302, C306) or (d.code in (C301, C303) and isinstance(
+            d.refusal, Unreachable) and d.refusal.time == 0.0))
 
 
 def _compile_checked(lint: FileResult, b, tl, copts, opts: BuildOptions
@@ -267,7 +269,6 @@ def _compile_checked(lint: FileResult, b, tl, copts, opts: BuildOptions
     blame, again from each other solution of the start pose
     (:func:`~aou_dsl.compiler.branches.start_alternatives`) until one passes. When none
     does, the first failure is said, with what was tried."""
-    from dataclasses import replace
 
     from ..compiler.branches import start_alternatives
 
@@ -289,9 +290,9 @@ def _compile_checked(lint: FileResult, b, tl, copts, opts: BuildOptions
              "postures turned at one joint): none passes" if seeds else
              "no other joint solution of the start pose was found (IK from postures "
              "turned at one joint)")
-    first.diagnostics = [Diagnostic(d.code, d.severity, d.message, d.span,
-                                    f"{d.hint}; {tried}" if d.hint else tried,
-                                    {**d.fields, "start_solutions_tried": len(seeds)})
+    first.diagnostics = [replace(d, hint=f"{d.hint}; {tried}" if d.hint else tried,
+                                 fields={**d.fields, "start_solutions_tried": len(seeds)},
+                                 fix=None)
                          if _blames_start(d) else d for d in first.diagnostics]
     return first, None
 

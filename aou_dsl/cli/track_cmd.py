@@ -42,8 +42,8 @@ def nothing_to_track(args: argparse.Namespace) -> Iterator[None]:
 def _refusal_note(args: argparse.Namespace, diagnostics) -> str | None:
     import shlex
 
-    from ..compiler.fitting import FITTED
     from ..core.diagnostics import Severity
+    from ..fit.plan import FITTED
 
     errors = [d for d in diagnostics if d.severity is Severity.ERROR]
     if not errors or not any(d.code.startswith("C") for d in errors):
@@ -70,8 +70,8 @@ def _fit_refusal(args: argparse.Namespace) -> Diagnostic | None:
     """The first error of ``--fit`` on the same file and arm, or None when the fit gives
     a motion: the note points to ``--fit --track`` only where that command tracks."""
     from ..build.builder import build_file
-    from ..compiler.fitting import FITTED
     from ..core.diagnostics import Severity
+    from ..fit.plan import FITTED
 
     res = build_file(args.path, robot=getattr(args, "robot", None), check=False, fit=True)
     if res.ok:

@@ -15,9 +15,11 @@ import math
 import numpy as np
 
 from ..core.memo import cached
+from ..fit.refusals import TimingFailure
+from ..fit.rounding import times
+from ..fit.search import largest_fitting
 from ..lang.primitives import LOOK_SHIVER_F, VISIBLE_SHIVER
 from ..robot.kinematics import ArmModel
-from .fits import TimingFailure, largest_fitting, times
 from .peak_limits import JERK_SCALE, LIMIT_SLACK
 
 __all__ = ["JointSegment", "shiver_offset", "shiver_ratios", "shiver_segment"]

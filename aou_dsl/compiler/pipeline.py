@@ -17,9 +17,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.codes import C303, C304, C305, C308, C309, V124
-from ..core.diagnostics import AouError, Diagnostic, Fix, diag, has_errors
+from ..core.diagnostics import AouError, Diagnostic, Fix, diag, has_errors, refused
 from ..core.memo import Keyed, cached
 from ..core.trajectory import Trajectory
+from ..fit.plan import hint_edit
+from ..fit.refusals import AccelerationShort, ShiverTooFast, TiltTooFast, Unreachable
 from ..lang.ir import Behaviour
 from ..lang.layout import layout
 from ..lang.primitives import KINDS, LOOK_SHIVER_F, Shiver, Timing
@@ -29,7 +31,6 @@ from ..robot.identity import frame_definition
 from ..robot.ik import IKStatus, solve_path
 from ..robot.kinematics import ArmModel
 from ..robot.load import load_arm
-from .fitting import hint_edit
 from .reuse import solved_path, timed_path
 from .start import CODES, start_diagnostic
 from .timing import (
@@ -146,9 +147,9 @@ def _ik_diag(ep: Episode, status: IKStatus, t: float, joint: str | None, b: Beha
             f"the default {s.start:g} m"
         hint = (f"this pose is {d:.3g} m from the goal, no closer than the start ({line}): "
                 f"a smaller `start`, or {hint[0].lower()}{hint[1:]}")
-    return diag(CODES.get(status, C303),
-                f"{ep.kind} at t={t:.2f}s: {status.value}{where} on {s.robot}", ep.span,
-                hint=hint, reason=status.name.lower(), time=t, joint=joint)
+    return refused(CODES.get(status, C303),
+                   f"{ep.kind} at t={t:.2f}s: {status.value}{where} on {s.robot}", ep.span,
+                   Unreachable(status.name.lower(), t, joint), hint=hint)
 
 
 def _follows(arm: ArmModel, frame: ReachFrame, options: CompileOptions, tl: Timeline
@@ -190,13 +191,13 @@ def _siblings(arm: ArmModel, frame: ReachFrame, episodes: tuple[Episode, ...],
 
 
 def _too_fast(code: str, fail: TimingFailure, ep: Episode, edit: str | None,
-              **fields) -> Diagnostic:
+              refusal: ShiverTooFast | TiltTooFast) -> Diagnostic:
     """C308 or C309: the limit a shiver or a tilt exceeds; the hint is the edit that
     fits (the value the message gives), when there is one."""
     one_key = edit is not None and len(re.findall(r"\w+=|\bfor\s", edit)) == 1
-    return diag(code, fail.reason, ep.span, hint=f"write `{edit}`" if edit else None,
-                joint=fail.joint, limit=fail.limit, **fields,  # a fix sets one key:
-                fix=Fix(ep.span, edit, edit.split("=")[0]) if edit and one_key else None)
+    return refused(code, fail.reason, ep.span, refusal,
+                   hint=f"write `{edit}`" if edit else None,  # a fix sets one key:
+                   fix=Fix(ep.span, edit, edit.split("=")[0]) if edit and one_key else None)
 
 
 def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
@@ -245,16 +246,15 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
             if shiver_fail is not None:
                 f_ok = shiver_fail.wanted
                 # a slower shiver than the look's floor reads as slow rolls: then the
-                # amplitude is fitted instead (build/amplitude_fit.py)
+                # amplitude is fitted instead (fit/amplitude.py)
                 ok = bool(f_ok and f_ok >= LOOK_SHIVER_F)
                 node = next((n for n in b.primitives if n.span == ep.span), None)
                 timed = isinstance(node, Shiver) and node.timed  # its `for`, as written
                 max_f = f_ok if ok else None
                 dur = node.duration if isinstance(node, Shiver) and timed else None
-                edit = hint_edit(diag(C308, "", ep.span, max_frequency=max_f, duration=dur,
-                                      f=ep.f)) if ok else None
-                res.diagnostics.append(_too_fast(C308, shiver_fail, ep, edit,
-                                                 max_frequency=max_f, duration=dur, f=ep.f))
+                why = ShiverTooFast(shiver_fail.joint, shiver_fail.limit, max_f, dur, ep.f)
+                edit = hint_edit(why) if ok else None
+                res.diagnostics.append(_too_fast(C308, shiver_fail, ep, edit, why))
                 return res
             segments.append(seg)
         else:
@@ -276,9 +276,9 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
                 if tilt_fail is not None:
                     v_ok = tilt_fail.wanted
                     edit = f"v={v_ok:g}deg/s" if v_ok else None
-                    res.diagnostics.append(_too_fast(
-                        C309, tilt_fail, ep, edit, max_velocity=v_ok,
-                        declared_velocity=math.degrees(ep.path_length / ep.duration)))
+                    res.diagnostics.append(_too_fast(C309, tilt_fail, ep, edit, TiltTooFast(
+                        tilt_fail.joint, tilt_fail.limit, v_ok,
+                        math.degrees(ep.path_length / ep.duration))))
                     return res
             else:
                 seg, fail = timed_path(arm, frame, ep, q, options, s, ik.q)
@@ -288,11 +288,11 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
                     return res
                 if fail is not None:
                     unit = "m/s^2" if KINDS[ep.kind].translation else "rad/s^2"
-                    res.diagnostics.append(diag(
+                    res.diagnostics.append(refused(
                         C304, f"{ep.kind} reaches {fail.achieved:.3g} {unit}, not the "
-                        f"declared {fail.wanted:.3g} {unit}: {fail.reason}",
-                        ep.span, joint=fail.joint, achieved=fail.achieved,
-                        declared=fail.wanted, descriptor=f"{ep.kind}_acceleration"))
+                        f"declared {fail.wanted:.3g} {unit}: {fail.reason}", ep.span,
+                        AccelerationShort(fail.joint, fail.achieved, fail.wanted,
+                                          f"{ep.kind}_acceleration")))
             lap("timing")
             segments.append(seg)
             q = ik.q[-1]

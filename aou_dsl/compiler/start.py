@@ -14,7 +14,8 @@ import math
 from collections.abc import Callable
 
 from ..core.codes import C301, C302, C303
-from ..core.diagnostics import Diagnostic, diag
+from ..core.diagnostics import Diagnostic, refused
+from ..fit.refusals import StartUnreachable
 from ..lang.ir import Behaviour
 from ..lang.timeline import Pose, Timeline
 from ..robot.geometry import ReachFrame
@@ -44,10 +45,10 @@ def start_diagnostic(arm: ArmModel, frame: ReachFrame, b: Behaviour, failure: IK
         hint = f"at `start {fits}cm` every pose of the motion is within reach; or {other}" \
             if fits is not None else f"a smaller `start`, or {other}"
     where = next((s.spans[k] for k in blame if k in s.spans), b.span)
-    return diag(CODES.get(failure.status, C303), f"the start pose, {s.start:g} m from "
-                f"the goal ({said}): {failure.status.value}{joint} on {s.robot}", where,
-                hint=hint, reason=failure.status.name.lower(), time=0.0,
-                joint=failure.joint, start=s.start)
+    return refused(CODES.get(failure.status, C303), f"the start pose, {s.start:g} m from "
+                   f"the goal ({said}): {failure.status.value}{joint} on {s.robot}", where,
+                   StartUnreachable(failure.status.name.lower(), 0.0, failure.joint, s.start),
+                   hint=hint)
 
 
 def _reached(arm: ArmModel, frame: ReachFrame, cm: int) -> bool:

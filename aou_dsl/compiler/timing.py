@@ -29,8 +29,10 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..fit.refusals import TimingFailure
+from ..fit.rounding import times
+from ..fit.search import largest_fitting
 from ..robot.kinematics import ArmModel
-from .fits import TimingFailure, largest_fitting, times
 from .oscillation import JointSegment, shiver_ratios, shiver_segment
 from .peak_limits import (
     JERK_SCALE,

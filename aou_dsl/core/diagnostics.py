@@ -21,6 +21,7 @@ __all__ = [
     "Span",
     "diag",
     "has_errors",
+    "refused",
 ]
 
 
@@ -75,6 +76,11 @@ class Diagnostic:
         hint: how to fix it, where one helps.
         fields: structured data for machine consumers (JSON output).
         fix: the hint as an edit, where it is one (editors apply it; not printed).
+        refusal: what the compiler refused, typed, where the fit and the hints read it
+            (a record of :mod:`aou_dsl.fit.refusals`; its values are ``fields`` too).
+        answer: what the fit found for the refusal (an ``Answer`` of the same module:
+            the changes that answer it, or why none does, and the hint's text edits;
+            also in ``fields``).
     """
 
     code: str
@@ -84,6 +90,8 @@ class Diagnostic:
     hint: str | None = None
     fields: dict[str, Any] = field(default_factory=dict)
     fix: Fix | None = None
+    refusal: Any = None
+    answer: Any = None
 
     @property
     def rule(self) -> Rule:
@@ -147,3 +155,13 @@ def diag(
     """Build a diagnostic of rule ``code``, with the rule's severity unless overridden."""
     rule = RULES[code]
     return Diagnostic(code, severity or rule.severity, message, span, hint, dict(fields), fix)
+
+
+def refused(code: str, message: str, span: Span, refusal: Any, *, hint: str | None = None,
+            fix: Fix | None = None) -> Diagnostic:
+    """A diagnostic of the refusal ``refusal`` (a dataclass): its values are the
+    diagnostic's ``fields``, in the order of the refusal's own."""
+    from dataclasses import asdict
+
+    return Diagnostic(code, RULES[code].severity, message, span, hint, asdict(refusal), fix,
+                      refusal)

@@ -54,7 +54,7 @@ class BuildOptions:
         collision_check: False accepts a robot without collision shapes (C312).
         controller: ``"franka"`` or ``"ur"``: that motion generator's limits are checked too.
         fit: change what the arm cannot give to what it can (``--fit``; the rule is in
-            :mod:`aou_dsl.compiler.fitting`, for a reach :mod:`aou_dsl.build.reach_fit`),
+            :mod:`aou_dsl.fit.plan`, for a reach :mod:`aou_dsl.fit.reach`),
             each change a C314 warning.
     """
 

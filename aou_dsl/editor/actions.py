@@ -5,6 +5,7 @@ from __future__ import annotations
 from lsprotocol import types
 
 from ..core.diagnostics import Diagnostic, Fix, Span
+from ..fit.refusals import answer_of
 from . import lsp_engine as engine
 from .convert import to_lsp, to_range
 from .state import Document
@@ -37,8 +38,8 @@ def _overlaps(a: types.Range, b: types.Range) -> bool:
 def _action(doc: Document, d: Diagnostic) -> types.CodeAction:
     """The quick fix of ``d``: every edit of its hint (a refusal's, which may change
     several statements: one workspace edit, applied at once), else its one ``fix``."""
-    every = d.fields.get("edits")
-    preferred = d.fields.get("edits_complete", True)  # not when it leaves a refusal
+    answer = answer_of(d)
+    every, preferred = answer.edits, answer.edits_complete  # not when it leaves a refusal
     if every:
         edits = [types.TextEdit(range=to_range(Span(doc.path, e["line"], e["col"],
                                                      e["end_line"], e["end_col"]),
@@ -59,7 +60,7 @@ def _action(doc: Document, d: Diagnostic) -> types.CodeAction:
 
 def _fixable(doc: Document, d: Diagnostic) -> bool:
     """Whether ``d``'s hint is an edit of this document."""
-    if d.fields.get("edits"):
+    if answer_of(d).edits:
         return d.span.path == doc.path
     return d.fix is not None and d.fix.span.path == doc.path
 

@@ -103,8 +103,8 @@ class Engine:
         (None when it does not compile): the studio plays it while :meth:`build` checks
         and measures the same text. The compiler is deterministic, so :meth:`build`
         makes this very motion; only a check it fails can take it off screen."""
-        from ..compiler.fitting import FITTED
         from ..compiler.pipeline import CompileOptions, compile_behaviour
+        from ..fit.plan import FITTED
 
         with self._lock:
             lint = self.session.lint(text, path)

@@ -14,15 +14,17 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from ..compiler.fits import floor_sig
 from ..core.codes import C304
 from ..core.diagnostics import AouError, has_errors
 from ..core.memo import cached
+from ..fit.refusals import AccelerationShort
+from ..fit.rounding import significant
+from ..fit.search import DIGITS
 from ..lang.ir import DEFAULTS
 from ..lang.primitives import MIN_SHIVER_F, shiver_duration
 from .recipe import Recipe, descriptor
 
-__all__ = ["SHIVER_F", "Limits", "fit", "fit_limits", "floor_sig", "goal_line", "robot_line",
+__all__ = ["SHIVER_F", "Limits", "fit", "fit_limits", "goal_line", "robot_line",
            "shiver_max_frequency"]
 
 #: Fraction of a limit synthesis plans up to (the rest is margin for the path's bends).
@@ -106,10 +108,13 @@ def _fit_limits(robot: str, goal: tuple[float, float, float] | None, key: tuple)
     errors = [d for d in res.diagnostics if d.code != C304]
     if has_errors(errors):
         raise AouError([d for d in errors if d.severity.value == "error"])
-    reached = min((float(d.fields["achieved"]) for d in res.diagnostics
-                   if d.code == C304), default=PROBE_ACCEL)
+    reached = min((float(d.refusal.achieved) for d in res.diagnostics
+                   if isinstance(d.refusal, AccelerationShort)
+                   and d.refusal.achieved is not None),
+                  default=PROBE_ACCEL)
     j = arm.joint_names.index(arm.spec.shiver_joint)
-    return Limits(robot, goal, reached, floor_sig(MARGIN * reached), arm.spec.shiver_joint,
+    return Limits(robot, goal, reached, significant(MARGIN * reached, DIGITS),
+                  arm.spec.shiver_joint,
                   MARGIN * float(arm.plan_vmax[j]), MARGIN * float(arm.plan_amax[j]), key)
 
 
@@ -151,15 +156,15 @@ def _fit_shiver(r: Recipe, lim: Limits) -> Recipe:
     if node.f <= f_max:
         return r.noted(SHIVER_F, "the language default (the study gives none)")
     if f_max >= MIN_SHIVER_F:
-        f = floor_sig(f_max)
+        f = significant(f_max, DIGITS)
         return r.with_node(node.replace(f=f, duration=_whole(node.duration, f))).noted(
             SHIVER_F, f"the language default {node.f:g} Hz, lowered to {f:g} Hz for "
             f"{lim.robot}'s {lim.roll_joint} (the amplitude stays)")
     # the peaks are proportional to the amplitude at a fixed frequency
-    amp = floor_sig(math.degrees(node.amplitude) * (f_max / MIN_SHIVER_F) ** 2)
+    amp = significant(math.degrees(node.amplitude) * (f_max / MIN_SHIVER_F) ** 2, DIGITS)
     while amp > 1.0 and shiver_max_frequency(math.radians(amp), node.duration,
                                              lim) < MIN_SHIVER_F:
-        amp = floor_sig(amp * 0.9)
+        amp = significant(amp * 0.9, DIGITS)
     name = descriptor("shiver", "amplitude").name
     note = (f"{r.notes.get(name, '')}; reduced from {math.degrees(node.amplitude):g} to "
             f"{amp:g} deg: {lim.robot}'s {lim.roll_joint} cannot shiver wider at "
@@ -186,7 +191,7 @@ def _fit_tilt(r: Recipe, lim: Limits) -> Recipe:
     if node.v <= v_max:
         return r.noted(name, "the language default (the study gives none; no clear effect "
                        "on curious)")
-    v_deg = floor_sig(math.degrees(v_max))
+    v_deg = significant(math.degrees(v_max), DIGITS)
     return r.with_node(node.replace(v=math.radians(v_deg))).noted(
         name, f"the language default {math.degrees(node.v):g} deg/s, lowered to {v_deg:g} "
         f"for {lim.robot}'s {lim.roll_joint} (no clear effect on curious)")

@@ -13,11 +13,12 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any
 
+from ..fit.rounding import significant
 from ..lang.descriptors import REGISTRY, Descriptor
 from ..lang.ir import State
 from ..lang.primitives import KINDS
 
-__all__ = ["SLOTS", "Recipe", "descriptor", "sig", "slot_of"]
+__all__ = ["SLOTS", "Recipe", "descriptor", "slot_of"]
 
 #: The statements of a descriptor-form file, by (kind, gaze plane), in the order written.
 SLOTS: tuple[tuple[str, str | None], ...] = (
@@ -25,11 +26,6 @@ SLOTS: tuple[tuple[str, str | None], ...] = (
     ("gaze", "vertical"), ("tilt", None), ("shiver", None))
 
 Slot = tuple[str, str | None]
-
-
-def sig(x: float, digits: int = 3) -> float:
-    """``x`` rounded to ``digits`` significant digits (monotone, so order survives)."""
-    return float(f"{x:.{digits}g}")
 
 
 def descriptor(kind: str, key: str) -> Descriptor:
@@ -110,7 +106,8 @@ class Recipe:
             for d in REGISTRY.values():
                 if slot_of(d) == slot and not d.is_count:
                     v = sum(w[s] * r.value(d) for s, r in having.items()) / total
-                    node = node.replace(**{d.ir_field: sig(v) * d.scale})
+                    node = node.replace(
+                        **{d.ir_field: significant(v, 3, "nearest") * d.scale})
             nodes[slot] = node
         out = cls(nodes)
         need = (out.count("retreat") + 1 if out.count("retreat") else 0) + \

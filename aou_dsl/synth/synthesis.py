@@ -34,12 +34,15 @@ from typing import TYPE_CHECKING
 from ..core.codes import C304, C305, C308, C309, C311, I504
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..core.memo import Keyed, cached
+from ..fit.refusals import AccelerationShort
+from ..fit.rounding import significant
+from ..fit.search import DIGITS
 from ..lang.cv import CANONICAL, classify
 from ..lang.descriptors import REGISTRY, Descriptor
 from ..lang.ir import State
 from ..lang.linter import lint_source
-from .arm_fit import Limits, fit, fit_limits, floor_sig
-from .recipe import Recipe, descriptor, sig
+from .arm_fit import Limits, fit, fit_limits
+from .recipe import Recipe, descriptor
 from .writer import render
 
 if TYPE_CHECKING:
@@ -118,13 +121,13 @@ def _vary(state: State, d: Descriptor, r: Recipe, x: float) -> Recipe:
         return r.with_value(d, n, note)
     if v0:
         note = (f"study {v0:g}; reads more {state} when {'higher' if sign > 0 else 'lower'}: "
-                f"{sig(v0 * span ** -sign):g} at intensity 0, {v0:g} at 0.5, "
-                f"{sig(v0 * span ** sign):g} at 1")
-        return r.with_value(d, sig(v0 * span ** (sign * x)), note)
+                f"{significant(v0 * span ** -sign, 3, 'nearest'):g} at intensity 0, "
+                f"{v0:g} at 0.5, {significant(v0 * span ** sign, 3, 'nearest'):g} at 1")
+        return r.with_value(d, significant(v0 * span ** (sign * x), 3, "nearest"), note)
     grown = span * x
     note = (f"absent from the study's stimulus; reads more {state} when larger: grows from "
             f"intensity 0.5 to {span:g} at 1")
-    return r.with_value(d, sig(grown), note, count=GROWN_COUNT) \
+    return r.with_value(d, significant(grown, 3, "nearest"), note, count=GROWN_COUNT) \
         if grown >= MIN_GROWN_ANGLE else r
 
 
@@ -252,12 +255,13 @@ def synthesize(state: State | str | None = None, C: float | None = None,
         i_eff = max(intensity, lo)
         text = make(i_eff)
         why = _failure(text) if verify else None
-        reached = why.fields.get("achieved") if why is not None and why.code == C304 else None
+        reached = why.refusal.achieved if why is not None and isinstance(
+            why.refusal, AccelerationShort) else None
         if not reached:
             break
         # somewhere on this reach the joints reach less than on the probe's line
-        limits = replace(limits, accel=min(floor_sig(0.9 * float(reached)),
-                                           floor_sig(0.9 * limits.accel)))
+        limits = replace(limits, accel=min(significant(0.9 * float(reached), DIGITS),
+                                           significant(0.9 * limits.accel, DIGITS)))
     if why is not None:
         text = _lowered(make, i_eff, lo, why, (st, limits) if st is not None else None)
     return _with_reading(text)

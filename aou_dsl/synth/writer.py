@@ -5,10 +5,12 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from ..fit.rounding import significant
+from ..fit.search import DIGITS
 from ..lang.descriptors import REGISTRY
 from ..lang.ir import State
 from ..lang.primitives import KINDS
-from .arm_fit import MARGIN, SHIVER_F, floor_sig, goal_line, robot_line
+from .arm_fit import MARGIN, SHIVER_F, goal_line, robot_line
 from .recipe import SLOTS, slot_of
 
 if TYPE_CHECKING:
@@ -63,7 +65,7 @@ def render(r: Recipe, state: State, intensity: float, limits: Limits, *,
         lines.append(f"# Intensity lowered to {used:g}: a stronger {state} fails on "
                      f"{limits.robot}{cause}.")
     where = ("on the probe's line, less on this file's path"
-             if limits.accel < floor_sig(MARGIN * limits.reached) else "on this reach")
+             if limits.accel < significant(MARGIN * limits.reached, DIGITS) else "on this reach")
     lines.append(f"# Fitted to {limits.robot}: accelerations up to {limits.accel:g} m/s^2 "
                  f"(its joints reach about {limits.reached:.2g} m/s^2 {where}).")
     lines += [f"behaviour {state}_synth : {state}", robot_line(limits.robot)]

@@ -12,7 +12,7 @@ The rule, for the statement a refusal points at (the one whose episode IK failed
   fixed grid (0 to :data:`SPAN` of the quantity, halved :data:`STEPS` times), so two
   files that differ only in that value find the same bound.
 - The declared magnitude is compressed under ``R`` by the same increasing map as an
-  acceleration (:func:`~aou_dsl.compiler.fitting.compress`), so two files that differ
+  acceleration (:func:`~aou_dsl.fit.plan.compress`), so two files that differ
   only in that value are fitted to values in the same order (a Part B variant pair keeps
   its contrast); the sign (a direction in a sequence) stays.
 - When a later statement then fails, it is fitted the same way, and so on: the changes
@@ -27,14 +27,16 @@ state is not offered.
 from __future__ import annotations
 
 import math
-import re
-from dataclasses import replace
 from typing import Any
 
 from ..core.codes import C301, C302, C303
-from ..core.diagnostics import Diagnostic, Severity, Span, diag
+from ..core.diagnostics import Diagnostic, Severity, Span, refused
 from ..core.memo import cached
 from ..lang.linter import FileResult, lint_source
+from .quantity import UNITS, first
+from .refusals import Unreachable, answered, first_error
+from .rounding import written
+from .text_edits import splice, statement
 
 __all__ = ["REACH", "STEPS", "Statement", "offered", "with_reach_fit"]
 
@@ -47,10 +49,6 @@ SPAN = {"angle": math.pi, "length": 2.0}
 #: Statements more than this are not fitted in one refusal.
 MOST = 4
 
-_UNITS = {"m": ("length", 1.0), "cm": ("length", 0.01), "mm": ("length", 0.001),
-          "deg": ("angle", math.pi / 180.0), "rad": ("angle", 1.0)}
-_QUANTITY = re.compile(r"(?<=\s)([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)(mm|cm|m|deg|rad)"
-                       r"(?=\s|;|#|$)")
 _LIMIT = {C301: "reach", C302: "position", C303: "singularity"}
 
 
@@ -68,17 +66,15 @@ class Statement:
     def __init__(self, text: str, line: int, col: int, end_col: int,
                  kinds: tuple[str, ...] = ("gaze", "retreat", "tilt", "approach")) -> None:
         self.text, self.line, self.col = text, line, col
-        row = text.split("\n")[line - 1]
-        self.stop = end_col - 1 if end_col > col else len(row)
-        self.stmt = row[col - 1:self.stop]
-        self.match = _QUANTITY.search(" " + self.stmt)
+        self.stmt, self.stop = statement(text, line, col, end_col)
+        self.match = first(self.stmt)
         words = self.stmt.split()
         self.ok = bool(words) and words[0] in kinds \
             and self.match is not None
         if self.ok:
             assert self.match is not None
-            self.written, self.unit = self.match[1], self.match[2]
-            self.dim, self.scale = _UNITS[self.unit]
+            self.written, self.unit = self.match["number"], self.match["unit"]
+            self.dim, self.scale = UNITS[self.unit]
             self.value = float(self.written) * self.scale  # SI, signed
             self.descriptor = _descriptor(words)
 
@@ -95,21 +91,12 @@ class Statement:
         """The statement and the file's text with the magnitude ``si`` (SI) written in
         the statement's unit, rounded down to 4 significant digits."""
         assert self.match is not None
-        shown = _down(si / self.scale)
+        shown = written(si / self.scale, 4)
         if self.value < 0:
             shown = "-" + shown
-        a, b = self.match.span(1)
-        stmt = self.stmt[:a - 1] + shown + self.stmt[b - 1:]
-        lines = self.text.split("\n")
-        row = lines[self.line - 1]
-        lines[self.line - 1] = row[:self.col - 1] + stmt + row[self.stop:]
-        return stmt, "\n".join(lines)
-
-
-def _down(x: float) -> str:
-    """``x`` > 0 with 4 significant digits, rounded down."""
-    e = math.floor(math.log10(x)) - 3
-    return f"{math.floor(x / 10 ** e + 1e-9) * 10 ** e:.{max(0, -e)}f}".rstrip("0").rstrip(".")
+        a, b = self.match.span("number")
+        stmt = self.stmt[:a] + shown + self.stmt[b:]
+        return stmt, splice(self.text, self.line, self.col, self.stop, stmt)
 
 
 def _reach(lint: FileResult, robot: str, package_dirs: tuple[str, ...]) -> Any:
@@ -192,7 +179,7 @@ def _fits(lint: FileResult, d: Diagnostic, robot: str, package_dirs: tuple[str, 
           ) -> list[dict[str, Any]] | str:
     """Every change the motion needs to be followed, as records (see the module), or
     why none is offered."""
-    from ..compiler.fitting import compress
+    from .plan import compress
 
     reaches = _reach(lint, robot, package_dirs)
 
@@ -206,7 +193,7 @@ def _fits(lint: FileResult, d: Diagnostic, robot: str, package_dirs: tuple[str, 
     text, path = lint.source or "", lint.path
     changes: list[dict[str, Any]] = []
     first: dict[tuple[int, int], tuple[str, float, int]] = {}
-    span, code, failure = d.span, d.code, d.fields.get("joint")
+    span, code, failure = d.span, d.code, d.refusal.joint
     for _ in range(MOST):
         tl = lint_source(text, path).timeline
         last = -1 if tl is None else max((i for i, e in enumerate(tl.episodes) if (
@@ -220,6 +207,11 @@ def _fits(lint: FileResult, d: Diagnostic, robot: str, package_dirs: tuple[str, 
         # a statement changed before is fitted again from its declared value
         was = first.setdefault((st.line, st.col), (st.written, abs(st.value), st.stop + 1))
         stmt, new_text = st.with_value(compress(was[1], bound))
+        refused = lint_source(new_text, path)
+        if not refused.ok:
+            return f"`{stmt}`, the least change under the arm's bound " \
+                f"({bound / st.scale:.4g}{st.unit}), is a value the language does not " \
+                f"take: {first_error(refused.diagnostics)}"
         if not follows(new_text, path, last):
             return f"`{stmt}` is not followed either"
         changes = [c for c in changes if (c["line"], c["col"]) != (st.line, st.col)]
@@ -253,7 +245,8 @@ def _remembered(source: str, path: str, robot: str, package_dirs: tuple[str, ...
     lint = lint_source(source, path)
     if lint.behaviour is None or lint.timeline is None:
         return "the file does not lint"
-    return _fits(lint, diag(code, "", span, joint=joint), robot, package_dirs)
+    return _fits(lint, refused(code, "", span, Unreachable("", 0.0, joint)), robot,
+                 package_dirs)
 
 
 def with_reach_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...]) -> Any:
@@ -266,20 +259,20 @@ def with_reach_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...]) -
         return res
     out = []
     for d in res.diagnostics:
-        if d.code not in REACH or d.severity is not Severity.ERROR or not d.fields.get(
-                "time") or d.span.path != lint.path or d.span.line < 1:
+        if not isinstance(d.refusal, Unreachable) or d.severity is not Severity.ERROR \
+                or not d.refusal.time or d.span.path != lint.path or d.span.line < 1:
             out.append(d)
             continue
         from ..robot.load import robot_key
 
         arm = robot or b.settings.robot
         found = _remembered(lint.source, lint.path, arm, package_dirs, d.code, d.span,
-                            d.fields.get("joint"), robot_key(arm, package_dirs))
+                            d.refusal.joint, robot_key(arm, package_dirs))
         found = found if isinstance(found, str) else [dict(c) for c in found]
         if isinstance(found, str):
             why = f"no smaller angle or distance is offered: {found}"
-            out.append(replace(d, hint=f"{d.hint}; {why}" if d.hint else why,
-                               fields={**d.fields, "reach_fit": found}))
+            out.append(answered(d, f"{d.hint}; {why}" if d.hint else why,
+                                not_offered=found))
             continue
         out.append(offered(d, found))
     res.diagnostics = out
@@ -292,4 +285,4 @@ def offered(d: Diagnostic, records: list[dict[str, Any]]) -> Diagnostic:
     ``reach`` (read by ``--fit``)."""
     said = "; ".join(f"`{c['statement']}` at line {c['line']}" for c in records)
     hint = f"write {said}" + (f"; or {d.hint}" if d.hint else "")
-    return replace(d, hint=hint, fields={**d.fields, "reach": records})
+    return answered(d, hint, offered=records)

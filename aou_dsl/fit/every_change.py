@@ -6,7 +6,7 @@ only (a slower shiver, a shorter retreat, a nearer ``start``). A file may be ref
 more than one reason (out of reach and too fast for the wrist; two shivers of a
 ``sequence`` each too fast): applying the first hint would only reveal the next. So the
 hint's own edit is applied, and where the file is then still refused, the rest is found
-by the machinery of ``--fit`` (:func:`~aou_dsl.build.fit_loop.fit_loop`: the fewest
+by the machinery of ``--fit`` (:func:`~aou_dsl.fit.rounds.fit_loop`: the fewest
 values changed by the least, the state and the order of values kept). The hint then
 names every changed statement, and its field ``edits`` holds them as text edits
 (``line``, ``col``, ``end_line``, ``end_col`` of the statement as written, ``text`` to
@@ -25,6 +25,8 @@ from typing import Any
 from ..core.codes import C308, C309
 from ..core.diagnostics import Diagnostic, Fix, Severity, Span, has_errors
 from ..lang.linter import FileResult, lint_source
+from .refusals import answer_of, answered, first_error
+from .text_edits import Change, apply, apply_edit, splice
 
 __all__ = ["statement_edits", "with_every_change"]
 
@@ -57,22 +59,19 @@ def with_every_change(res: Any, build: Callable[[FileResult], Any]) -> Any:
     hint = d.hint if final == own else _said(d, edits) + _otherwise(d.hint)
     if left is not None:
         hint = f"{hint}; not every refusal is answered: then {left}"
-    fields = {**d.fields, "edits": edits, "edits_complete": left is None}
     fix = d.fix
     mine = [e for e in edits if (e["line"], e["col"]) == (d.span.line, d.span.col)]
     if fix is None and d.code in _KEYED and mine:  # the refused statement, whole
         e = mine[0]
         fix = Fix(Span(d.span.path, e["line"], e["col"], e["end_line"], e["end_col"]),
                   e["text"])
-    res.diagnostics = [replace(x, hint=hint, fields=fields, fix=fix) if x is d else x
-                       for x in res.diagnostics]
+    res.diagnostics = [replace(answered(x, hint, edits=edits, edits_complete=left is None),
+                               fix=fix) if x is d else x for x in res.diagnostics]
     return res
 
 
 def _own(lint: FileResult, d: Diagnostic) -> str | None:
     """The file's text with ``d``'s own hint applied (None: the hint is no edit)."""
-    from ..compiler.fitting import Change, apply, apply_edit
-
     text = lint.source
     assert text is not None
     if d.span.path != lint.path or d.span.line < 1:
@@ -82,10 +81,11 @@ def _own(lint: FileResult, d: Diagnostic) -> str | None:
     said = _SAID.match(d.hint or "")
     if d.fix is None and said and d.code in _KEYED:  # `f=1.3Hz for 2.31s`: two keys
         return apply_edit(text, d.span, said[1])
-    if d.fields.get("reach"):
+    offered = answer_of(d).offered
+    if offered:
         return apply(text, [Change(Span(d.span.path, r["line"], r["col"], r["line"],
                                         r["end_col"]), r["key"], r["declared"], r["fitted"],
-                                   r["unit"], None, None, None) for r in d.fields["reach"]])
+                                   r["unit"]) for r in offered])
     start = _START.search(d.hint or "")
     spans = lint.behaviour.settings.spans if lint.behaviour is not None else {}
     if not (start and d.span in spans.values() and d.span.line == d.span.end_line):
@@ -98,17 +98,14 @@ def _own(lint: FileResult, d: Diagnostic) -> str | None:
         now = f"{_text(text, d.span)}; {start[1]}"
     else:
         return None
-    lines = text.split("\n")
-    row = lines[d.span.line - 1]
-    lines[d.span.line - 1] = row[:d.span.col - 1] + now + row[d.span.end_col - 1:]
-    return "\n".join(lines)
+    return splice(text, d.span.line, d.span.col, d.span.end_col - 1, now)
 
 
 def _complete(lint: FileResult, own: str, build: Callable[[FileResult], Any]
               ) -> tuple[str, str | None]:
     """The text with every change the file needs, from ``own`` (the hint applied), and
     what is then still refused, in words (None: it compiles)."""
-    from .fit_loop import fit_loop
+    from .rounds import fit_loop
 
     again = lint_source(own, lint.path)
     if not again.ok:
@@ -125,10 +122,9 @@ def _left(diagnostics: list[Diagnostic]) -> str:
     """The first refusal of ``diagnostics``, and why the fit did not answer it."""
     from ..core.codes import C314
 
-    d = next(x for x in diagnostics if x.severity is Severity.ERROR)
     why = [x.message for x in diagnostics if x.code == C314 and x.message.startswith(
         "not fitted")]
-    return f"{d.code} at line {d.span.line} ({d.message})" + "".join(f"; {w}" for w in why)
+    return first_error(diagnostics) + "".join(f"; {w}" for w in why)
 
 
 def _statements(lint: FileResult, keys: set[str]) -> list[Span]:

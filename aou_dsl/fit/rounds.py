@@ -1,5 +1,5 @@
 """``--fit``: build, and where the arm cannot give a declared value, change it by the
-rule of :mod:`aou_dsl.compiler.fitting` and build again, until nothing is left to fit.
+rule of :mod:`aou_dsl.fit.plan` and build again, until nothing is left to fit.
 
 Each change is a C314 warning at its statement ("declared -> fitted", the joint and the
 limit that bind); the fitted file's text is kept (``fitted_source``, written by
@@ -9,7 +9,7 @@ stays refused, and a C314 says why. Nor is one that would make an episode look l
 another kind than it declares (each kind's invariant,
 :meth:`~aou_dsl.lang.primitives.Kind.keeps_look`: a shiver slower than a tremor, a tilt
 faster than declared, a retreat too short to see): C315 says why, as it does for a
-shiver no frequency and no visible amplitude fits (:mod:`~aou_dsl.build.amplitude_fit`).
+shiver no frequency and no visible amplitude fits (:mod:`~aou_dsl.fit.amplitude`).
 """
 
 from __future__ import annotations
@@ -19,12 +19,14 @@ from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
-from ..compiler.fitting import FITTED, Change, apply, plan
 from ..core.codes import C314, C315
 from ..core.diagnostics import Diagnostic, diag
 from ..core.repeats import said_once
 from ..lang.linter import FileResult, lint_source
 from ..lang.primitives import look_changed
+from .plan import FITTED, plan
+from .refusals import answer_of, first_error
+from .text_edits import Change, apply
 
 __all__ = ["MAX_ROUNDS", "fit_loop"]
 
@@ -53,18 +55,18 @@ def _warning(c: Change) -> Diagnostic:
 
 def _not_fitted(todo: list[Diagnostic], where: Any) -> list[Diagnostic]:
     """C314 for each reach refusal no change answers, with why
-    (:mod:`~aou_dsl.build.reach_fit`)."""
-    return [diag(C314, f"not fitted: {d.fields['reach_fit']}", d.span)
-            for d in todo if d.fields.get("reach_fit")] + [
+    (:mod:`~aou_dsl.fit.reach`)."""
+    return [diag(C314, f"not fitted: {answer_of(d).not_offered}", d.span)
+            for d in todo if answer_of(d).not_offered] + [
         diag(C315, f"not fitted: no shiver the arm follows keeps the look: "
-             f"{d.fields['look']}", d.span, hint="a wider or faster shiver needs a "
+             f"{answer_of(d).look}", d.span, hint="a wider or faster shiver needs a "
              "stronger wrist (a robot description's `joint_accel`, if the arm allows "
-             "more); else leave the shiver out on this arm", look=d.fields["look"])
-        for d in todo if d.fields.get("look")]
+             "more); else leave the shiver out on this arm", look=answer_of(d).look)
+        for d in todo if answer_of(d).look]
 
 
 def fit_loop(lint: FileResult, build: Callable[[FileResult], Any]) -> Any:
-    """``build(lint)``, then rounds of :func:`~aou_dsl.compiler.fitting.plan` and
+    """``build(lint)``, then rounds of :func:`~aou_dsl.fit.plan.plan` and
     ``build`` of the changed text (at most :data:`MAX_ROUNDS` builds)."""
     res = build(lint)
     text, b = lint.source, lint.behaviour
@@ -81,9 +83,15 @@ def fit_loop(lint: FileResult, build: Callable[[FileResult], Any]) -> Any:
             break
         new_text = apply(text, changes)
         new_lint = lint_source(new_text, lint.path)
-        if not new_lint.ok or (state is not None and (
+        if not new_lint.ok:
+            res.diagnostics.append(diag(
+                C314, f"not fitted: the changes ({', '.join(c.text for c in changes)}) "
+                f"are values the language does not take: "
+                f"{first_error(new_lint.diagnostics)}", b.span))
+            return res
+        if (state is not None and (
                 new_lint.cv is None or new_lint.cv.state != state)):
-            found = new_lint.cv.state.value if new_lint.cv is not None else "errors"
+            found = new_lint.cv.state.value if new_lint.cv is not None else "nothing"
             res.diagnostics.append(diag(
                 C314, f"not fitted: the changes ({', '.join(c.text for c in changes)}) "
                 f"would make the file express `{found}`, not "

@@ -5,7 +5,7 @@ fitted by its amplitude instead, by the rule of the other values: the widest amp
 the shiver joint follows at a frequency is its bound ``P`` (the shiver's peaks grow in
 proportion to the amplitude, so ``P`` is the amplitude over its largest ratio to a
 limit), and the declared amplitude is compressed under it by
-:func:`~aou_dsl.compiler.fitting.compress`, an increasing map, so a variant pair keeps
+:func:`~aou_dsl.fit.plan.compress`, an increasing map, so a variant pair keeps
 its order.
 
 The frequency tried first is the declared one (one change); when the amplitude that fits
@@ -21,13 +21,12 @@ shiver into a slow roll.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from typing import Any
 
-from ..core.codes import C308
 from ..core.diagnostics import Diagnostic, Severity
 from ..lang.linter import lint_source
-from .reach_fit import Statement, offered
+from .reach import Statement, offered
+from .refusals import ShiverTooFast, answered
 
 __all__ = ["with_amplitude_fit"]
 
@@ -36,8 +35,8 @@ def _refused(res: Any, d: Diagnostic, why: str) -> Any:
     """``res`` with ``d`` saying why no shiver keeps its look (field ``look``, and its
     hint when it has none: there is no edit to offer)."""
     hint = d.hint or f"no shiver this arm follows keeps the look: {why}"
-    res.diagnostics = [replace(x, hint=hint, fields={**x.fields, "look": why}) if x is d
-                       else x for x in res.diagnostics]
+    res.diagnostics = [answered(x, hint, look=why) if x is d else x
+                       for x in res.diagnostics]
     return res
 
 
@@ -46,8 +45,9 @@ def with_amplitude_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...
     amplitude that fits (at the declared frequency, else at the slowest shiver that
     looks like one), or the reason none does."""
     lint, b = res.lint, res.lint.behaviour
-    d = next((x for x in res.diagnostics if x.code == C308 and x.severity is Severity.ERROR
-              and not x.fields.get("max_frequency") and x.span.path == lint.path), None)
+    d = next((x for x in res.diagnostics if isinstance(x.refusal, ShiverTooFast)
+              and x.severity is Severity.ERROR and not x.refusal.max_frequency
+              and x.span.path == lint.path), None)
     if d is None or b is None or lint.source is None or lint.timeline is None:
         return res
     ep = next((e for e in lint.timeline.episodes if e.kind == "shiver" and e.span == d.span),
@@ -55,11 +55,11 @@ def with_amplitude_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...
     st = Statement(lint.source, d.span.line, d.span.col, d.span.end_col, ("shiver",))
     if ep is None or not st.ok or st.dim != "angle":
         return res
-    from ..compiler.fitting import Change, apply, compress, shiver_keys
     from ..compiler.oscillation import shiver_ratios
-    from ..core.diagnostics import Span
     from ..lang.primitives import LOOK_SHIVER_F, VISIBLE_SHIVER, Shiver, shiver_duration
     from ..robot.load import load_arm
+    from .plan import compress, shiver_keys
+    from .text_edits import set_value, splice, value_text
 
     arm = load_arm(robot or b.settings.robot, None, package_dirs)
     node = next((n for n in b.primitives if n.span == d.span), None)
@@ -80,11 +80,9 @@ def with_amplitude_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...
                    f"{min(ep.f, LOOK_SHIVER_F):g} Hz would read as slow rolls, not a tremor")
             continue
         keys = shiver_keys(fa, asked if timed else None) if fa != ep.f else []
-        one = Span(d.span.path, 1, 1, 1, len(stmt) + 1)
-        stmt = apply(stmt, [Change(one, k, "", v, u, None, None, None) for k, v, u, _ in keys])
-        row = lint.source.split("\n")
-        row[st.line - 1] = row[st.line - 1][:st.col - 1] + stmt + row[st.line - 1][st.stop:]
-        text = "\n".join(row)
+        for k, v, u, _ in keys:
+            stmt = set_value(stmt, k, value_text(k, v, u))
+        text = splice(lint.source, st.line, st.col, st.stop, stmt)
         again = lint_source(text, lint.path)
         if not again.ok:
             return res
@@ -95,9 +93,9 @@ def with_amplitude_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...
                    f"than {min(ep.f, LOOK_SHIVER_F):g} Hz would read as slow rolls, not a "
                    "tremor")
             continue
-        joint, limit = d.fields.get("joint"), d.fields.get("limit")
-        records = [st.record(fitted.written, stmt, bound, joint, limit)]
-        was = {"f": d.fields.get("f"), "for": d.fields.get("duration")}
+        r = d.refusal
+        records = [st.record(fitted.written, stmt, bound, r.joint, r.limit)]
+        was = {"f": r.f, "for": r.duration}
         for k, v, u, desc in keys:
             w = was.get(k)
             records.append(records[0] | {

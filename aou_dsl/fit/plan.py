@@ -1,0 +1,112 @@
+"""Which values to change to fit a behaviour to an arm (``--fit``), and by how much.
+
+Where the arm cannot give a declared value, the compiler says so with the value that
+fits (C304: the peak acceleration the joints allow; C308: the highest shiver frequency;
+C309: the fastest tilt). :func:`plan` turns those into :class:`Change`s of the file's
+text, by this rule:
+
+- Change only what the arm refused, at the statement it refused; nothing else.
+- A shiver's frequency is not one of the eleven descriptors: a shiver too fast is made
+  slower (``f=``) at the same amplitude, and its ``for`` lengthened to the 3 cycles a
+  shiver lasts at least (what the compiler would do anyway, said in the file). No
+  descriptor changes.
+- A descriptor the arm cannot reach (an acceleration, a tilt velocity) is compressed
+  toward the arm's peak ``cap`` by one increasing map, :func:`compress`: values up to
+  90 % of the peak stay, higher ones approach the peak without reaching it
+  (``k + w d / (d + w)``, ``k`` 90 % of the peak, ``w`` the other 10 %, ``d`` how far the
+  value is above ``k``). Two files
+  that differ only in that value are fitted to values in the same order (the map is
+  strictly increasing), so a Part B variant pair keeps its contrast.
+- Fitted descriptors are written with 4 significant digits, a shiver's frequency with 3,
+  rounded toward what fits.
+
+The builder applies the changes, compiles again (a fitted value can land a little
+off the arm's real peak; the rule is applied again from the declared value with the new
+peak) and keeps the fit only when the file still expresses its declared state.
+"""
+
+from __future__ import annotations
+
+from ..core.codes import C301, C302, C303, C304, C308, C309
+from ..core.diagnostics import Diagnostic, Span
+from .refusals import AccelerationShort, ShiverTooFast, TiltTooFast, answer_of
+from .rounding import written
+from .text_edits import Change, value_text
+
+__all__ = ["FITTED", "KNEE", "compress", "hint_edit", "plan", "shiver_keys"]
+
+#: Fraction of the arm's peak below which a declared value is never changed.
+KNEE = 0.9
+#: The codes whose values :func:`plan` fits (a reach refusal by the changes the builder
+#: found, its field ``reach``: :mod:`aou_dsl.fit.reach`).
+FITTED = (C301, C302, C303, C304, C308, C309)
+
+
+def compress(x: float, cap: float, knee: float = KNEE) -> float:
+    """``x`` brought under ``cap`` by a strictly increasing map: unchanged up to
+    ``knee * cap``, then approaching ``cap`` (never reaching it)."""
+    k = knee * cap
+    if x <= k:
+        return x
+    w, over = cap - k, x - k
+    return k + w * over / (over + w)  # slope 1 at the knee, then ever flatter
+
+
+def shiver_keys(f_ok: float, runs: float | None) -> list[tuple[str, str, str, str | None]]:
+    """``(key, fitted, unit, descriptor)`` of a shiver made ``f_ok`` [Hz]: its frequency,
+    and, when the statement says `for` (``runs`` [s], else None), one of the 3 cycles it
+    then lasts at least."""
+    f = written(f_ok, 3)
+    out: list[tuple[str, str, str, str | None]] = [("f", f, "Hz", None)]
+    if runs is not None and round(runs * float(f)) < 3:
+        out.append(("for", written(3.0 / float(f), 3, "up"), "s", None))
+    return out
+
+
+def _shiver(r: ShiverTooFast) -> list[tuple[str, str, str, str | None]]:
+    """``(key, fitted, unit, descriptor)`` of a shiver too fast: its highest frequency
+    (one the compiler offers only when it still looks like a shiver), and, when the
+    statement says `for`, one of the 3 cycles it then lasts at least."""
+    if not r.max_frequency:
+        return []
+    return shiver_keys(r.max_frequency, r.duration)  # duration None: no `for`
+
+
+def hint_edit(r: ShiverTooFast) -> str | None:
+    """Every change a C308 needs, as one edit (``f=1.4Hz for 2.15s``)."""
+    return " ".join(value_text(k, v, u) for k, v, u, _ in _shiver(r)) or None
+
+
+def plan(diagnostics: list[Diagnostic], declared: dict[tuple, float]) -> list[Change]:
+    """The changes that fit what ``diagnostics`` refuse (their typed refusals, and the
+    changes the reach and amplitude fits found). ``declared`` holds, by ``(line, col,
+    key)`` of the statement, the value first declared where an earlier round changed it
+    (the rule is applied from it, not from the fitted value)."""
+    out = []
+    for d in diagnostics:
+        r = d.refusal
+        if isinstance(r, AccelerationShort) and r.achieved and r.declared is not None:
+            x = declared.get(_at(d, "a"), float(r.declared))
+            fitted = written(compress(x, float(r.achieved)), 4)
+            out.append(Change(d.span, "a", f"{x:g}", fitted, "", r.joint, "acceleration",
+                              r.descriptor))
+        elif isinstance(r, ShiverTooFast):
+            was = {"f": r.f, "for": r.duration}
+            for key, value, unit, desc in _shiver(r):
+                w = was.get(key)
+                out.append(Change(d.span, key, "" if w is None else f"{w:.3g}", value, unit,
+                                  r.joint, r.limit, desc))
+        elif isinstance(r, TiltTooFast) and r.max_velocity:
+            v = declared.get(_at(d, "v"), r.declared_velocity)
+            fitted = written(compress(float(v), r.max_velocity) if v else r.max_velocity, 4)
+            out.append(Change(d.span, "v", "" if v is None else f"{v:g}", fitted, "deg/s",
+                              r.joint, r.limit, "tilt_velocity"))
+        # the changes the builder found (a reach, a shiver's amplitude: field ``reach``)
+        out += [Change(Span(d.span.path, c["line"], c["col"], c["line"], c["end_col"]),
+                       c["key"], c["declared"], c["fitted"], c["unit"], c["joint"],
+                       c["limit"], c["descriptor"]) for c in answer_of(d).offered]
+    return out
+
+
+def _at(d: Diagnostic, key: str) -> tuple[int, int, str]:
+    return d.span.line, d.span.col, key
