@@ -288,13 +288,23 @@ def test_compare_draws_the_second_arm_ghosted_on_the_same_clock(tmp_path, open_p
         both = paused_at(page, studio, t)
         page.get_by_text("Show fearful.aou").click()  # the page's checkbox hides the ghost
         wait_for(lambda: not studio.ghost_box.value)
-        alone = scene_only(page, settled(page))
-        ghost = np.abs(both - alone).sum(axis=2) > 30
+
+        def differs(shot: np.ndarray) -> np.ndarray:
+            return np.abs(shot - both).sum(axis=2) > 30
+
+        # A loaded machine draws WebGL in software slowly: wait for each change to be
+        # drawn rather than take one frame (the test fails after wait_for's minute).
+        def hidden() -> list[np.ndarray]:
+            shot = scene_only(page, settled(page))
+            return [shot] if differs(shot).sum() > 200 else []
+
+        (alone,) = wait_for(hidden, timeout=90)
+        ghost = differs(alone)
         assert ghost.sum() > 200, "the compared arm is not drawn"
         page.get_by_text("Show fearful.aou").click()
         wait_for(lambda: studio.ghost_box.value)
-        again = scene_only(page, settled(page))
-        assert (np.abs(again - both).sum(axis=2) > 30).sum() < 0.1 * ghost.sum()
+        wait_for(lambda: differs(scene_only(page, settled(page))).sum() < 0.1 * ghost.sum(),
+                 timeout=90)
         # the ghost moves with the clock
         later = paused_at(page, studio, 0.0)
         assert (np.abs(later - both).sum(axis=2) > 30).sum() > 200
