@@ -87,7 +87,7 @@ def test_intervals_with_first_order_copies_are_those_with_exact_ones():
 def test_the_long_slope_through_the_fft_is_the_savitzky_golay_one():
     """The slow-motion check's 0.3 s slope at 1 kHz (301 weights) runs through the FFT:
     the same values as the direct filter, ends included, to rounding."""
-    from aou_dsl.measuring.holds import _long_slope
+    from aou_dsl.measuring.rest import _long_slope
     from aou_dsl.measuring.signal import smooth
 
     rng = np.random.default_rng(5)
