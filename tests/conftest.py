@@ -49,6 +49,21 @@ def fails_with(code: str, fn, *args, **kw):
     return d
 
 
+def wait_for(what, timeout: float = 90.0, every: float = 0.1):
+    """Poll ``what()`` until it is truthy and give its value; the test fails on timeout
+    (a page, a server or a loop that never gets there). Tests of live things wait on a
+    condition this way, never on a fixed sleep."""
+    import time
+
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        got = what()
+        if got:
+            return got
+        time.sleep(every)
+    raise AssertionError("timed out waiting for the page")
+
+
 # --- Running on several workers (pytest-xdist, `--dist loadgroup` in pyproject.toml) ---------
 
 #: Modules whose tests share a cached build at module level (not a fixture, so not seen

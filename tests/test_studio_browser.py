@@ -29,7 +29,7 @@ from aou_dsl.api import compile as aou_compile
 from aou_dsl.api import lint, measure
 from aou_dsl.lang.descriptors import REGISTRY
 
-from .conftest import find_chromium
+from .conftest import find_chromium, wait_for
 from .test_studio_forms import PEEK  # a sequence file: sliders scale its statements
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -82,17 +82,6 @@ def studio_of(tmp_path, browser):
         page.close()
     for s in made:
         s.close()
-
-
-def wait_for(what, timeout: float = 60.0, every: float = 0.1):
-    """Poll ``what()`` until it is truthy; its value (the test fails on timeout)."""
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        got = what()
-        if got:
-            return got
-        time.sleep(every)
-    raise AssertionError("timed out waiting for the page")
 
 
 def scene_canvas(page):

@@ -25,6 +25,7 @@ from aou_dsl.live.regulator import Regulator
 from aou_dsl.live.world import Box, Scene, tag_points, visible_fraction
 from aou_dsl.studio import liveview
 
+from .conftest import wait_for
 from .test_studio_gate import _open, _update, _uuid
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -112,16 +113,6 @@ def stage(reg, still):
     s = Stage(still, port=0, regulator=reg).start()
     yield s
     s.close()
-
-
-def wait_for(what, timeout: float = 90.0, every: float = 0.1):
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        got = what()
-        if got:
-            return got
-        time.sleep(every)
-    raise AssertionError("timed out")
 
 
 def _send(stage, handle, value) -> tuple[str, object]:

@@ -177,11 +177,13 @@ def report() -> str:
     return "\n".join(head + every_arm(status) + sections + [END]) + "\n"
 
 
-def page(text: str, new_report: str) -> str:
-    """``text`` with its report replaced by ``new_report`` (appended when it has none)."""
-    if START in text and END in text:
-        before = text[:text.index(START)]
-        after = text[text.index(END) + len(END):].lstrip("\n")
+def page(text: str, new_report: str, start: str = START, end: str = END) -> str:
+    """``text`` with what lies between the markers ``start`` and ``end`` (the report's,
+    by default) replaced by ``new_report``, which holds them (appended when the page has
+    none). tools/track_table.py writes its tables with it too."""
+    if start in text and end in text:
+        before = text[:text.index(start)]
+        after = text[text.index(end) + len(end):].lstrip("\n")
         return before + new_report + ("\n" + after if after else "")
     return text.rstrip("\n") + "\n\n" + new_report
 

@@ -185,11 +185,9 @@ def tables() -> tuple[str, str]:
 
 def page(text: str, table: str) -> str:
     """``text`` with its table replaced by ``table`` (appended when it has none)."""
-    if START in text and END in text:
-        before = text[:text.index(START)]
-        after = text[text.index(END) + len(END):].lstrip("\n")
-        return before + table + ("\n" + after if after else "")
-    return text.rstrip("\n") + "\n\n" + table
+    from robots_report import page as between_markers  # this folder, as the script runs
+
+    return between_markers(text, table, START, END)
 
 
 def main(argv: list[str] | None = None) -> int:
