@@ -27,6 +27,7 @@ from .disk import Disk
 from .engine import Engine, Motion
 from .filing import Filing
 from .gate import Gate
+from .serving import Served
 
 if TYPE_CHECKING:
     from ..core.trajectory import Trajectory
@@ -38,7 +39,7 @@ __all__ = ["LOCAL", "Studio"]
 LOCAL = "127.0.0.1"
 
 
-class Studio(Filing):
+class Studio(Filing, Served):
     """The studio of one file (a ``.aou`` file, or a recording to play).
 
     Args:
@@ -157,15 +158,6 @@ class Studio(Filing):
         self.ghost = scene.Arm(self.server, self.engine.urdf_path(other.trajectory.robot),
                                "/ghost", ghost=True)
         self.ghost.show(other.trajectory)
-
-    @property
-    def port(self) -> int:
-        return int(self.server.get_port())
-
-    @property
-    def url(self) -> str:
-        """The page's address, with the token without which the studio answers nothing."""
-        return self.gate.url(self.port)
 
     def close(self) -> None:
         self._closed = True

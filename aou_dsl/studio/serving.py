@@ -29,7 +29,7 @@ from typing import Any
 
 from .gate import Gate
 
-__all__ = ["Inbox", "open_server"]
+__all__ = ["Inbox", "Served", "open_server"]
 
 #: One server is constructed at a time: the wrapper of ``serve`` is process-wide while
 #: it is in place.
@@ -74,6 +74,23 @@ def open_server(gate: Gate, host: str, port: int, label: str) -> Any:
         raise RuntimeError("viser served its page without aou's check of who asks: this "
                            "version of viser is not one the studio knows")
     return server
+
+
+class Served:
+    """A page served behind its gate (the studio of a file, the stage of a scenario):
+    its viser ``server`` and its :class:`Gate`."""
+
+    server: Any
+    gate: Gate
+
+    @property
+    def port(self) -> int:
+        return int(self.server.get_port())
+
+    @property
+    def url(self) -> str:
+        """The page's address, with the token without which the studio answers nothing."""
+        return self.gate.url(self.port)
 
 
 class Inbox:

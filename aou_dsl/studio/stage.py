@@ -27,6 +27,8 @@ from collections import deque
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
+from .serving import Served
+
 if TYPE_CHECKING:
     from ..live.loop import Loop, Tick
     from ..live.scenario import Scenario
@@ -43,7 +45,7 @@ _BEHIND = 0.5
 _RANGES = ((-0.2, 1.0), (-0.5, 0.5), (0.0, 0.5))
 
 
-class Stage:
+class Stage(Served):
     """The live studio of one scenario file.
 
     Args:
@@ -116,15 +118,6 @@ class Stage:
         from ..live.camera import CAMERA_RATE
 
         return CAMERA_RATE if self.kind == "camera" else None
-
-    @property
-    def port(self) -> int:
-        return int(self.server.get_port())
-
-    @property
-    def url(self) -> str:
-        """The page's address, with the token without which the studio answers nothing."""
-        return self.gate.url(self.port)
 
     def close(self) -> None:
         from .app import _quiet
