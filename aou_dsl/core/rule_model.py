@@ -29,6 +29,7 @@ class Category(enum.Enum):
     USAGE = "I"
     DMP = "D"
     STUDY = "E"
+    PLUGIN = "K"
 
     @property
     def is_usage(self) -> bool:

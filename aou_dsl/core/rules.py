@@ -8,7 +8,7 @@ A code is a stage letter plus three digits:
 - ``C`` compilation (layout, geometry, IK, timing, simulation check),
 - ``R`` reading trajectories (``aouc measure``),
 - ``D`` behaviours as Dynamic Movement Primitives (``--format dmp``, ``aouc dmp``),
-- ``I`` input/output and usage.
+- ``I`` input/output and usage, ``K`` primitive kinds that plugins add.
 
 Codes are never reused; a retired code stays in :data:`RULES` as an alias. Every
 example triggers its own code (the architecture tests run them).
@@ -19,6 +19,7 @@ from __future__ import annotations
 from .rule_model import Category, Rule, Severity
 from .rules_check import CHECK_RULES
 from .rules_dmp import DMP_RULES
+from .rules_plugin import PLUGIN_RULES
 from .rules_study import STUDY_RULES
 
 __all__ = ["RULES", "Category", "Rule", "Severity", "category"]
@@ -364,7 +365,7 @@ _RULE_LIST = [
          "into rolls looks like looking around, not trembling. The warning gives the "
          "episodes' times and what that kind looks like.",
          "a 1.1 Hz shiver measured against a file that declares a shiver and no tilt"),
-    *STUDY_RULES,  # perception studies' files (rules_study.py)
+    *STUDY_RULES, *PLUGIN_RULES,  # studies' files, plugins (rules_study, rules_plugin)
     Rule("I501", "cannot-read", _E,
          "An input file or folder cannot be read (missing, a directory, permissions, encoding).",
          "Nothing can be checked or compiled.",

@@ -15,6 +15,8 @@ from .shiver import LOOK_SHIVER_F, MIN_SHIVER_F, VISIBLE_SHIVER, Shiver, ShiverK
 from .tilt import Tilt, TiltKind
 
 __all__ = [
+    "APPROACH",
+    "GAZE",
     "GAZE_ANGULAR_ACCEL",
     "KINDS",
     "LOOK_SHIVER_F",
@@ -23,6 +25,10 @@ __all__ = [
     "MIN_PAUSE",
     "MIN_RETREAT",
     "MIN_SHIVER_F",
+    "PAUSE",
+    "RETREAT",
+    "SHIVER",
+    "TILT",
     "Approach",
     "Gaze",
     "Kind",
@@ -36,6 +42,13 @@ __all__ = [
     "look_changed",
     "shiver_duration",
 ]
+
+#: The built-in kinds' keywords as the kinds themselves spell them. Every other module
+#: names a kind through these (or a kind object's ``name``), never by a string literal:
+#: ``tests/test_kind_names.py`` fails on one.
+APPROACH, PAUSE, RETREAT, GAZE, TILT, SHIVER = (
+    ApproachKind.name, PauseKind.name, RetreatKind.name, GazeKind.name, TiltKind.name,
+    ShiverKind.name)
 
 #: Every primitive kind, by statement keyword.
 KINDS: dict[str, Kind] = {k.name: k for k in (

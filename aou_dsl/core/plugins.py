@@ -1,0 +1,98 @@
+"""Primitive kinds that other packages add: the ``aou.kinds`` entry point group.
+
+A plugin is an installed distribution that names, in its metadata, an object under the
+entry point group :data:`GROUP`, the way pytest and flake8 find theirs. The entry point's
+name is the kind's keyword. The object it points at gives one part per layer it takes
+part in, as attributes named in :data:`LAYERS` (a module or any object will do); each
+layer reads its own part, checks it, and says with a diagnostic (K802) when a file uses
+the kind for something the plugin gives nothing for. Nothing here imports a name read
+from a file: the names come from the installed packages' own metadata, which is the
+environment the user chose, like a ``pip install``.
+
+``AOU_NO_PLUGINS=1`` in the environment loads none (a clean run, as without them).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from importlib import metadata
+
+from .memo import cached
+
+__all__ = ["GROUP", "LAYERS", "Broken", "Plugin", "loaded", "part", "plugins"]
+
+#: The entry point group aou reads.
+GROUP = "aou.kinds"
+#: The parts a plugin may give, by the layer that reads each: ``kind`` (the syntax piece,
+#: its validation, its C-V evidence and its time law: a ``lang.primitives.kind.Kind``),
+#: ``measure`` (how to recognise its episode in a motion and read its values back),
+#: ``dmp`` (its part of a DMP folder), ``synth`` (its synthesis recipe), ``editor`` (its
+#: completion and hover texts), ``studio`` (its slider and colour), ``media`` (its label
+#: and colour in plots), ``descriptors`` (the descriptors it adds).
+LAYERS = ("kind", "measure", "dmp", "synth", "editor", "studio", "media", "descriptors")
+
+
+@dataclass(frozen=True, slots=True)
+class Plugin:
+    """One loaded plugin: the kind's keyword, the distribution that gave it and the
+    parts it gives, by layer."""
+
+    name: str
+    source: str
+    parts: Mapping[str, object] = field(default_factory=dict)
+
+    def part(self, layer: str) -> object | None:
+        return self.parts.get(layer)
+
+
+@dataclass(frozen=True, slots=True)
+class Broken:
+    """An entry point that could not be used, and why (reported as K801)."""
+
+    name: str
+    source: str
+    why: str
+
+
+def _source(ep: metadata.EntryPoint) -> str:
+    dist = ep.dist
+    return f"{dist.name} {dist.version}" if dist is not None else ep.value
+
+
+@cached(maxsize=1)
+def loaded() -> tuple[tuple[Plugin, ...], tuple[Broken, ...]]:
+    """Every plugin of :data:`GROUP` that loads, in the order of their names, and the
+    entry points that do not."""
+    if os.environ.get("AOU_NO_PLUGINS", "") not in ("", "0"):
+        return (), ()
+    good: list[Plugin] = []
+    bad: list[Broken] = []
+    for ep in sorted(metadata.entry_points(group=GROUP), key=lambda e: (e.name, e.value)):
+        try:
+            obj = ep.load()  # safe: the name comes from installed metadata, not a file
+        except Exception as exc:  # a plugin's import may fail in any way: report it
+            bad.append(Broken(ep.name, _source(ep), f"{type(exc).__name__}: {exc}"))
+            continue
+        parts = {layer: getattr(obj, layer) for layer in LAYERS
+                 if getattr(obj, layer, None) is not None}
+        if "kind" not in parts:
+            bad.append(Broken(ep.name, _source(ep), "it gives no `kind` part"))
+            continue
+        good.append(Plugin(ep.name, _source(ep), parts))
+    return tuple(good), tuple(bad)
+
+
+def plugins() -> tuple[Plugin, ...]:
+    """The plugins that loaded."""
+    return loaded()[0]
+
+
+def part(kind: str, layer: str) -> object | None:
+    """The part for ``layer`` of the plugin whose kind is ``kind``, or None (no such
+    plugin, or it gives nothing for that layer)."""
+    for p in plugins():
+        if p.name == kind:
+            return p.part(layer)
+    return None
