@@ -84,15 +84,16 @@ def _declared(path: tuple[str, ...]) -> bool:
     its ``*.dist-info`` or ``*.egg-info`` folder's ``entry_points.txt`` has the section.
     A few milliseconds, where importing :mod:`importlib.metadata` (email, zipfile, csv)
     and reading every distribution costs tens: ``aouc lint`` pays that only when a
-    plugin is installed. A path entry that is no folder (a zip) is left to
-    :mod:`importlib.metadata` (True)."""
+    plugin is installed. A path entry that is a zip is looked into the same way."""
     for entry in path:
         folder = entry or "."
         try:
             with os.scandir(folder) as found:
                 infos = [e.path for e in found if e.name.endswith((".dist-info", ".egg-info"))]
         except NotADirectoryError:
-            return True
+            if _zip_declares(folder):
+                return True
+            continue
         except OSError:  # a path entry that does not exist (yet)
             continue
         for info in infos:
@@ -103,6 +104,22 @@ def _declared(path: tuple[str, ...]) -> bool:
                         return True
             except OSError:  # no entry points, or an egg-info that is a file
                 continue
+    return False
+
+
+def _zip_declares(archive: str) -> bool:
+    """:func:`_declared` for a zip on the import path (True when it cannot be read: then
+    :mod:`importlib.metadata` decides)."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(archive) as z:
+            for name in z.namelist():
+                if name.endswith("-info/entry_points.txt") and name.count("/") == 1 and \
+                        _SECTION.search(z.read(name).decode("utf-8", "replace")):
+                    return True
+    except (OSError, zipfile.BadZipFile):
+        return True
     return False
 
 
