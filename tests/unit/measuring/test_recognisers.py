@@ -200,3 +200,21 @@ def test_judged_rows_end_with_the_plugin_s_descriptors(monkeypatch, compiled):
     assert rows[fake.DISTANCE.name].declared is None
     assert {r.name for r in v.failed} == {fake.DISTANCE.name, fake.COUNT.name}
     assert all(rows[name].ok for name in REGISTRY)
+
+
+def test_a_noisy_recording_gives_the_plugin_s_descriptors_an_interval(monkeypatch, compiled):
+    """Re-noised copies read the plugin's descriptors as they read the eleven."""
+    import numpy as np
+
+    fake.install(monkeypatch, measure=fake.Claim())
+    _, res = compiled
+    tr = res.trajectory
+    q = np.asarray(tr.q, float)
+    noisy = tr.with_(q=q + np.random.default_rng(3).normal(0.0, 2e-5, q.shape), qd=None,
+                     qdd=None)
+    m = measure(noisy)
+    assert list(m.uncertainty) == [*REGISTRY, fake.DISTANCE.name, fake.COUNT.name]
+    count, dist = m.uncertainty[fake.COUNT.name], m.uncertainty[fake.DISTANCE.name]
+    assert (count.low, count.high) == (1, 1)
+    assert dist.low < m.extra[fake.DISTANCE.name] < dist.high
+    assert dist.high - dist.low < 2e-3
