@@ -11,15 +11,14 @@ import pytest
 from aou_dsl import api
 from aou_dsl.lang.descriptors import REGISTRY
 from aou_dsl.measuring.measured import measure
-
-from ..measuring import fake_plugin as fake
-from ..measuring.test_recognisers import SOURCE
+from tests.unit.measuring import fake_plugin as fake
+from tests.unit.measuring.fake_plugin import COUNTER
 
 
 @pytest.fixture(scope="module")
 def compiled(tmp_path_factory):
     path = tmp_path_factory.mktemp("report") / "counter.aou"
-    path.write_text(SOURCE)
+    path.write_text(COUNTER)
     return api.compile(str(path))
 
 
