@@ -42,7 +42,7 @@ from ..core.diagnostics import AouError, Span, diag
 from ..lang.primitives import PAUSE
 from .allowed import DIVERGED, Diverged, check_goal, check_options
 from .export import DmpSequence
-from .parts import Scaling, Shape, dmp_kinds, shape_of
+from .parts import Scaling, Shape, dmp_kinds, scaled, shape_of
 
 __all__ = ["Rollout", "predict", "roll", "similarity"]
 
@@ -59,8 +59,7 @@ def _name(kind: str, key: str) -> str:
 def _accel() -> dict[str, str]:
     """The moving kinds whose peak acceleration is a descriptor (a rollout may pin it),
     and its name."""
-    return {kind: _name(kind, key) for kind, entry in dmp_kinds().items()
-            for key, how in entry.scaling.items() if how is Scaling.PEAK}
+    return {kind: name for kind, name, how in scaled() if how is Scaling.PEAK}
 
 #: Step of the DMPs' rollouts [s] (the library integrates orientation every millisecond
 #: within it); the rollout is then sampled at the sequence's rate through a cubic spline.
@@ -147,20 +146,18 @@ def predict(seq: DmpSequence, s: float, k: float, factors: dict[str, float],
         if out.get(name) is not None:
             out[name] = out[name] * f
 
-    for kind, entry in dmp_kinds().items():
-        for key, how in entry.scaling.items():
-            name = _name(kind, key)
-            f = factors.get(name, 1.0)
-            if how is Scaling.PEAK:
-                times(name, f if name in pinned else s * f / k ** 2)
-            elif how is Scaling.TIME:
-                times(name, k * f)
-            elif how is Scaling.SPACE:
-                times(name, s)
-            elif how is Scaling.RATE:
-                times(name, 1.0 / k)
-            else:
-                times(name, f)
+    for _kind, name, how in scaled():
+        f = factors.get(name, 1.0)
+        if how is Scaling.PEAK:
+            times(name, f if name in pinned else s * f / k ** 2)
+        elif how is Scaling.TIME:
+            times(name, k * f)
+        elif how is Scaling.SPACE:
+            times(name, s)
+        elif how is Scaling.RATE:
+            times(name, 1.0 / k)
+        else:
+            times(name, f)
     return out
 
 
