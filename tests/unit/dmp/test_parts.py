@@ -76,7 +76,8 @@ def test_a_plugin_part_is_merged_into_every_use(monkeypatch):
 
 
 def test_the_schema_accepts_a_loaded_plugin_kind_and_refuses_unknown_kinds(monkeypatch):
-    from aou_dsl.dmp.schema import Where, _entry as check
+    from aou_dsl.dmp.schema import Where
+    from aou_dsl.dmp.schema import _entry as check
 
     w = Where("x.dmp/manifest.json")
     with pytest.raises(AouError) as no_plugin:
@@ -91,7 +92,8 @@ def test_the_schema_accepts_a_loaded_plugin_kind_and_refuses_unknown_kinds(monke
 
 
 def test_a_plugin_hold_has_no_part_file(monkeypatch):
-    from aou_dsl.dmp.schema import Where, _entry as check
+    from aou_dsl.dmp.schema import Where
+    from aou_dsl.dmp.schema import _entry as check
 
     fake.install(monkeypatch, dmp=_part("hold"))
     with pytest.raises(AouError) as held:
