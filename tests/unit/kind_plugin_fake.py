@@ -38,11 +38,11 @@ DESCRIPTORS = (
 )
 
 
-def _every() -> tuple[Descriptor, ...]:
-    out = list(table.REGISTRY.values())
+def _every() -> dict[str, Descriptor]:
+    out = dict(table.REGISTRY)
     for p in plugins.plugins():
-        out.extend(p.part("descriptors") or ())  # type: ignore[call-overload]
-    return tuple(out)
+        out.update((d.name, d) for d in p.part("descriptors") or ())  # type: ignore[attr-defined]
+    return out
 
 
 def install(monkeypatch: Any, **parts: object) -> plugins.Plugin:
