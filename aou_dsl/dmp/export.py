@@ -177,7 +177,9 @@ def to_dmp(trajectory: Any, *, intensity: float = 0.5, behaviour: str | None = N
             part.end = pose0
             part.values = _shiver_values(q[i0:i1 + 1, j] - q[i0, j], part.duration)
         else:
-            part.kind = PAUSE if shape is not Shape.MOVE else kind
+            # a hold (or a move too short to fit) keeps the pose; a kind no DMP folder
+            # holds is written as a pause
+            part.kind = kind if shape in (Shape.MOVE, Shape.HOLD) else PAUSE
             part.end = pose0
         parts.append(part)
     measured = descriptors or measure(tr).descriptors.to_json()
