@@ -149,9 +149,10 @@ def _touching(ctx: Ctx, tl: Timeline) -> None:
                        hint="put a motion between them, or write one longer pause")
 
 
-def _none_shown(b: Behaviour, kind: str) -> str:
+def _none_shown(b: Behaviour, kind: str, tl: Timeline) -> str:
     """Why no episode of ``kind`` counts in the layout, in words: what the kind needs
-    around it (:attr:`~.primitives.kind.Kind.needs`), and what of that the file lacks."""
+    around it (:attr:`~.primitives.kind.Kind.needs`), and what of that the file lacks or
+    else the rule that stops the layout."""
     article = "an" if kind[0] in "aeiou" else "a"
     needs = KINDS[kind].needs if kind in KINDS else None
     why = needs.words(kind, PAUSE) if needs is not None else None
@@ -159,11 +160,11 @@ def _none_shown(b: Behaviour, kind: str) -> str:
         return f"the layout cannot show {article} {kind}: no {kind} of it counts"
     n_pauses = _count(b, PAUSE)
     wanted = needs.around.count(PAUSE)
-    if wanted and n_pauses < wanted:
-        why += f", and this file has {('no pause', 'only one pause')[n_pauses]}"
-    for other in dict.fromkeys(k for k in needs.around if k != PAUSE):
-        if not _count(b, other):
-            why += f", and this file has no {other}"
+    lacks = [f"this file has {('no pause', 'only one pause')[n_pauses]}"] \
+        if wanted and n_pauses < wanted else []
+    lacks += [f"this file has no {other}" for other in dict.fromkeys(needs.around)
+              if other != PAUSE and not _count(b, other)]
+    why += f", and {lacks[0]}" if lacks else f"; {_stopped_by(b, tl)}"
     return f"the layout cannot show {article} {kind}: {why}"
 
 
@@ -200,7 +201,7 @@ def _realisable(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
         said.add(id(node))
         kind = REGISTRY[m.name].kind
         none = m.measured is None or (REGISTRY[m.name].is_count and m.measured == 0)
-        shows = _none_shown(b, kind) if none else \
+        shows = _none_shown(b, kind, tl) if none else \
             f"its layout shows {_shown(m.name, m.measured)}: {_stopped_by(b, tl)}" \
             if REGISTRY[m.name].is_count else \
             f"its layout shows {_shown(m.name, m.measured)}"
