@@ -10,6 +10,8 @@ from typing import Literal
 import pytest
 
 from aou_dsl import api
+from aou_dsl.lang import kind_needs, primitives, stops
+from aou_dsl.lang import layout as layout_module
 from aou_dsl.lang.descriptors import EpisodeValues, qualify
 from aou_dsl.lang.ir import Node
 from aou_dsl.lang.kind_needs import episode_values, shows_all, why_not
@@ -57,7 +59,11 @@ class WindupKind(Kind):
 
 @pytest.fixture
 def windup(monkeypatch):
-    monkeypatch.setitem(KINDS, WIND, WindupKind())
+    """The kinds with the test kind added, as the modules of the layout and the
+    descriptors read them (whatever holds the kinds, a dict or a live view of plugins)."""
+    kinds = {**KINDS, WIND: WindupKind()}
+    for module in (primitives, stops, kind_needs, layout_module):
+        monkeypatch.setattr(module, "KINDS", kinds)
 
 
 def test_the_built_in_kinds_say_their_needs():
