@@ -108,9 +108,15 @@ def test_a_new_kind_is_laid_out_by_its_needs(windup, state):
 
 
 def test_a_new_kind_whose_neighbour_the_file_lacks_is_named(windup):
-    b = _behaviour("pause 1s\ntilt 10deg\n", Windup(span=_span()))
+    """The need no layout can meet is said once; it bars no gap from the pauses, which
+    still show (a second V121 for them would blame the pauses for the kind's need)."""
+    b = _behaviour("pause 1s x3\ntilt 10deg x2\n", Windup(span=_span(), count=2))
+    b = b.replace(primitives=tuple(p.replace(count=4) if p.kind == PAUSE else p
+                                   for p in b.primitives))  # 4 motions, room for 5
     assert why_not(b) == ("a windup counts only directly before an approach, nothing "
                           "between, and this file has no approach")
+    values = qualify(episode_values(layout(b).episodes))
+    assert sum(1 for e in values if e.kind == PAUSE) == 4
 
 
 def _span():
