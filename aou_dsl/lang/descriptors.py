@@ -282,31 +282,29 @@ class EpisodeValues:
                 **{k: round(v, 6) for k, v in self.values.items()}}
 
 
-#: Kinds that must sit between two pauses (before and after) to count, and kinds that
-#: must be followed by one.
-_BETWEEN_PAUSES = frozenset({"retreat"})
-_ENDS_AT_PAUSE = frozenset({"gaze"})
-
-
 def qualify(episodes: Iterable[EpisodeValues]) -> list[EpisodeValues]:
     """The episodes as the definitions read them: touching pauses merged into one (their
-    durations added), and every episode marked whether it counts."""
+    durations added), and every episode marked whether it counts: whether the episodes
+    next to it are those its kind needs (:attr:`~.primitives.kind.Kind.needs`; none for
+    a kind no registry knows)."""
+    # imported here: a plugin's kinds, loaded with the registry, may read this module
+    from .primitives import KINDS, PAUSE
+
     merged: list[EpisodeValues] = []
     for e in episodes:
         last = merged[-1] if merged else None
-        if e.kind == "pause" and last is not None and last.kind == "pause":
+        if e.kind == PAUSE and last is not None and last.kind == PAUSE:
             duration = last.values.get("duration", 0.0) + e.values.get("duration", 0.0)
             merged[-1] = replace(last, t_end=e.t_end, values={"duration": duration})
         else:
             merged.append(e)
     out = []
     for i, e in enumerate(merged):
-        before = i > 0 and merged[i - 1].kind == "pause"
-        after = i + 1 < len(merged) and merged[i + 1].kind == "pause"
-        if e.kind in _BETWEEN_PAUSES:
-            e = replace(e, counts=before and after)
-        elif e.kind in _ENDS_AT_PAUSE:
-            e = replace(e, counts=after)
+        kind = KINDS.get(e.kind)
+        if kind is not None and kind.needs.around:
+            before = merged[i - 1].kind if i > 0 else None
+            after = merged[i + 1].kind if i + 1 < len(merged) else None
+            e = replace(e, counts=kind.needs.met(before, after))
         out.append(e)
     return out
 
