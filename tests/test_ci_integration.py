@@ -23,8 +23,7 @@ import pytest
 import yaml
 
 from aou_dsl.core.rules import RULES
-
-from .conftest import BEHAVIOURS, INVALID, ROOT
+from tests.conftest import BEHAVIOURS, INVALID, ROOT
 
 AOUC = [sys.executable, "-m", "aou_dsl"]
 SARIF_TITLE = b'"title": "Static Analysis Results Format (SARIF) Version 2.1.0 JSON Schema"'

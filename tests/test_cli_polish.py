@@ -17,8 +17,7 @@ import pytest
 from aou_dsl.cli.commands import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, main
 from aou_dsl.core.diagnostics import AouError
 from aou_dsl.core.files import atomic, check_output, write_atomic
-
-from .conftest import BEHAVIOURS
+from tests.conftest import BEHAVIOURS
 
 ROOT = Path(__file__).resolve().parent.parent
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"

@@ -21,8 +21,7 @@ from aou_dsl.build.builder import build_source
 from aou_dsl.dmp import solve, to_dmp
 from aou_dsl.lang.descriptors import compare
 from aou_dsl.robot.load import load_arm
-
-from .langgen import random_cases  # noqa: E402
+from tests.langgen import random_cases  # noqa: E402
 
 CASES = random_cases(200, seed=26)
 REFUSALS = {"D603", "D604"}

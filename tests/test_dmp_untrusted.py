@@ -22,8 +22,7 @@ import pytest
 pytest.importorskip("movement_primitives")
 
 from aou_dsl.cli.commands import main  # noqa: E402
-
-from . import dmpgen  # noqa: E402
+from tests import dmpgen  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 CODE = re.compile(r" (D60[0-9]|I50[0-9]) ")

@@ -15,7 +15,7 @@ pytest_lsp = pytest.importorskip("pytest_lsp", reason="pytest-lsp is not install
 from lsprotocol import types  # noqa: E402
 from pytest_lsp import LanguageClient  # noqa: E402
 
-from .lsp_server import server_client  # noqa: E402
+from tests.lsp_server import server_client  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 SEEDS = [p.read_text(encoding="utf-8") for p in sorted(ROOT.glob("behaviours/*.aou"))] + [

@@ -14,9 +14,8 @@ from lsprotocol import types  # noqa: E402
 from pytest_lsp import LanguageClient  # noqa: E402
 
 from aou_dsl.build.builder import build_source  # noqa: E402
-
-from .lsp_server import server_client  # noqa: E402
-from .test_editor_server import _apply, _open, _published  # noqa: E402
+from tests.lsp_server import server_client  # noqa: E402
+from tests.test_editor_server import _apply, _open, _published  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 pytestmark = pytest.mark.asyncio(loop_scope="module")

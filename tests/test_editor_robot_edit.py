@@ -13,8 +13,8 @@ pytest_lsp = pytest.importorskip("pytest_lsp", reason="pytest-lsp is not install
 from lsprotocol import types  # noqa: E402
 from pytest_lsp import LanguageClient  # noqa: E402
 
-from .conftest import BEHAVIOURS  # noqa: E402
-from .lsp_server import server_client  # noqa: E402
+from tests.conftest import BEHAVIOURS  # noqa: E402
+from tests.lsp_server import server_client  # noqa: E402
 
 pytestmark = pytest.mark.asyncio(loop_scope="module")
 

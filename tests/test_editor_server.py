@@ -14,8 +14,7 @@ from lsprotocol import types  # noqa: E402
 from pytest_lsp import LanguageClient  # noqa: E402
 
 from aou_dsl.lang.linter import lint_source  # noqa: E402
-
-from .lsp_server import server_client  # noqa: E402
+from tests.lsp_server import server_client  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 pytestmark = pytest.mark.asyncio(loop_scope="module")

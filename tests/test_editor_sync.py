@@ -25,8 +25,7 @@ from lsprotocol import types  # noqa: E402
 from pytest_lsp import ClientServerConfig, LanguageClient  # noqa: E402
 
 from aou_dsl.lang.formatter import format_source  # noqa: E402
-
-from .lsp_server import ROOT  # noqa: E402
+from tests.lsp_server import ROOT  # noqa: E402
 
 pytestmark = pytest.mark.asyncio(loop_scope="function")
 

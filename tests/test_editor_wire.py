@@ -21,7 +21,7 @@ import pytest
 
 pytest.importorskip("pygls", reason="the lsp extra (pygls) is not installed")
 
-from .lsp_raw import ROOT, Raw, frame, hover, request  # noqa: E402
+from tests.lsp_raw import ROOT, Raw, frame, hover, request  # noqa: E402
 
 PARSE, INVALID_REQUEST, NOT_FOUND, INVALID_PARAMS, INTERNAL = -32700, -32600, -32601, \
     -32602, -32603

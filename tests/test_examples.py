@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from .conftest import BEHAVIOURS
+from tests.conftest import BEHAVIOURS
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"

@@ -19,8 +19,7 @@ from pathlib import Path
 import pytest
 
 from aou_dsl.core.diagnostics import RULES, AouError
-
-from . import inputgen as gen
+from tests import inputgen as gen
 
 SEED = 27
 CODE = re.compile(r"\b([SVMCRI]\d{3})\b")

@@ -451,7 +451,7 @@ def test_as_a_process_a_refusal_ends_at_once_small_and_clean(command, argv, role
     import subprocess
     import sys
 
-    from .conftest import ROOT
+    from tests.conftest import ROOT
 
     for k, make in enumerate(["fifo", *roles]):
         root = tmp_path / f"ws{k}"

@@ -20,8 +20,7 @@ from pathlib import Path
 import pytest
 
 from aou_dsl.cli.args import EXIT_INTERRUPTED
-
-from .conftest import BEHAVIOURS, ROOT
+from tests.conftest import BEHAVIOURS, ROOT
 
 pytestmark = [pytest.mark.slow,
               pytest.mark.skipif(not sys.platform.startswith("linux"),

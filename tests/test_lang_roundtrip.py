@@ -19,8 +19,8 @@ from pathlib import Path
 import pytest
 from hypothesis import HealthCheck, given, settings
 
-from . import langgen
-from .hunt import Outcome, cli, run_case
+from tests import langgen
+from tests.hunt import Outcome, cli, run_case
 
 DEFAULT_N, DEFAULT_SEED = 200, 44
 SLOW_N, SLOW_SEED = 1000, 12

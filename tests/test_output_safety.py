@@ -22,9 +22,8 @@ import pytest
 
 from aou_dsl.cli.args import EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE
 from aou_dsl.cli.commands import main
-
-from .conftest import BEHAVIOURS, ROOT
-from .test_fuzz_outputs import _workspace
+from tests.conftest import BEHAVIOURS, ROOT
+from tests.test_fuzz_outputs import _workspace
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"),
                                 reason="makes FIFOs and devices, reads /proc")
@@ -278,8 +277,7 @@ def test_the_files_a_command_reads_follow_the_chain_and_never_block(ws):
     """aou file -> its robot file (and --robot's) -> the URDF it names -> every mesh,
     package:// ones too; a FIFO or a missing file on the way is listed, not opened."""
     from aou_dsl.robot.files_read import files_read
-
-    from .test_fuzz_outputs import _deadline
+    from tests.test_fuzz_outputs import _deadline
 
     got = [os.path.relpath(p) for p in files_read(["y.aou"])]
     assert got[:3] == ["y.aou", "arm/arm.toml", "arm/arm.urdf"]

@@ -24,9 +24,8 @@ from aou_dsl.live.loop import HYSTERESIS
 from aou_dsl.live.regulator import Regulator
 from aou_dsl.live.world import Box, Scene, tag_points, visible_fraction
 from aou_dsl.studio import liveview
-
-from .conftest import wait_for
-from .test_studio_gate import _open, _update, _uuid
+from tests.conftest import wait_for
+from tests.integration.test_studio_gate import _open, _update, _uuid
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OCCLUDER = os.path.join(ROOT, "examples", "scenarios", "occluder.toml")
@@ -212,7 +211,7 @@ def test_what_a_page_sends_the_scene_controls_breaks_no_page_nor_the_loop(stage,
 
     import msgspec
 
-    from .test_studio_fuzz import KEYS, KINDS, NUMBERS, OTHERS
+    from tests.integration.test_studio_fuzz import KEYS, KINDS, NUMBERS, OTHERS
 
     rng = random.Random(5)
     handles = [stage.light, *(h for hs in stage.sliders.values() for h in hs)]

@@ -30,9 +30,8 @@ from aou_dsl.lang.descriptors import REGISTRY
 from aou_dsl.study.build import build_study
 from aou_dsl.study.jspsych import PACKAGES
 from aou_dsl.study.spec import read_study
-
-from .conftest import find_chromium
-from .test_study_build import BEHAVIOURS, write_study
+from tests.conftest import find_chromium
+from tests.test_study_build import BEHAVIOURS, write_study
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CHROMIUM = find_chromium()

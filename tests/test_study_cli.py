@@ -15,8 +15,7 @@ from scipy import stats as sps
 
 from aou_dsl.lang.declared import declared
 from aou_dsl.lang.linter import lint_file
-
-from .conftest import BEHAVIOURS
+from tests.conftest import BEHAVIOURS
 
 AOUC = [sys.executable, "-m", "aou_dsl"]
 
