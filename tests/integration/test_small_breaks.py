@@ -11,7 +11,7 @@ import pytest
 
 from aou_dsl.cli.commands import main
 from tests.conftest import BEHAVIOURS
-from tests.test_fuzz_outputs import _workspace
+from tests.generated.test_fuzz_outputs import _workspace
 
 
 def test_cluster_without_its_extra_names_the_extra(tmp_path, monkeypatch, capsys):

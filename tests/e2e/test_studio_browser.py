@@ -18,6 +18,7 @@ import os
 import shutil
 import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -28,12 +29,12 @@ pytest.importorskip("playwright", reason="playwright is missing: pip install '.[
 from aou_dsl.api import compile as aou_compile
 from aou_dsl.api import lint, measure
 from aou_dsl.lang.descriptors import REGISTRY
-from tests.conftest import find_chromium, wait_for
+from tests.e2e.conftest import find_chromium, wait_for
 from tests.integration.test_studio_forms import (
     PEEK,  # a sequence file: sliders scale its statements
 )
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = str(Path(__file__).resolve().parents[2])
 CHROMIUM = find_chromium()
 if CHROMIUM is None:
     pytest.skip("no Chromium found for the studio's browser tests: install Debian's "
@@ -468,7 +469,7 @@ def test_a_scenario_plays_live_and_dragging_the_card_over_the_tag_makes_the_arm_
     walks the state the page shows from confident towards hesitant, and taking it away
     brings confident back."""
     from aou_dsl.studio.stage import Stage
-    from tests.test_studio_live import AWAY, OVER, STILL
+    from tests.e2e.test_studio_live import AWAY, OVER, STILL
 
     path = tmp_path / "still.toml"
     path.write_text(STILL)

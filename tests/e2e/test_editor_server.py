@@ -16,7 +16,7 @@ from pytest_lsp import LanguageClient  # noqa: E402
 from aou_dsl.lang.linter import lint_source  # noqa: E402
 from tests.lsp_server import server_client  # noqa: E402
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 pytestmark = pytest.mark.asyncio(loop_scope="module")
 
 

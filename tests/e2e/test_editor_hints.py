@@ -14,10 +14,10 @@ from lsprotocol import types  # noqa: E402
 from pytest_lsp import LanguageClient  # noqa: E402
 
 from aou_dsl.build.builder import build_source  # noqa: E402
+from tests.e2e.test_editor_server import _apply, _open, _published  # noqa: E402
 from tests.lsp_server import server_client  # noqa: E402
-from tests.test_editor_server import _apply, _open, _published  # noqa: E402
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 pytestmark = pytest.mark.asyncio(loop_scope="module")
 
 

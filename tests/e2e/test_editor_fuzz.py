@@ -17,7 +17,7 @@ from pytest_lsp import LanguageClient  # noqa: E402
 
 from tests.lsp_server import server_client  # noqa: E402
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 SEEDS = [p.read_text(encoding="utf-8") for p in sorted(ROOT.glob("behaviours/*.aou"))] + [
     (ROOT / "tests" / "valid" / "peek.aou").read_text(encoding="utf-8")]
 JUNK = ["1.", "1e", "-", ".5e-", "0,5", "20°", "x", "x1.5", "=", "a=", "(", ")", "(0.5, 0",

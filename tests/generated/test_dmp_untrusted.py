@@ -24,7 +24,7 @@ pytest.importorskip("movement_primitives")
 from aou_dsl.cli.commands import main  # noqa: E402
 from tests import dmpgen  # noqa: E402
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 CODE = re.compile(r" (D60[0-9]|I50[0-9]) ")
 #: Seconds a refusal may take in a child process (the old reader hung for good).
 TIMEOUT = 120

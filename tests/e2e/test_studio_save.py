@@ -13,6 +13,7 @@ import sys
 import time
 import urllib.error
 import urllib.request
+from pathlib import Path
 
 import pytest
 
@@ -21,7 +22,7 @@ pytest.importorskip("viser", reason="the studio extra is missing: pip install '.
 from aou_dsl.core.diagnostics import AouError
 from aou_dsl.studio.app import Studio
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = str(Path(__file__).resolve().parents[2])
 HESITANT = open(os.path.join(ROOT, "behaviours", "hesitant.aou"), encoding="utf-8").read()
 
 

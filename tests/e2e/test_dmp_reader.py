@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 
 mp_io = pytest.importorskip("movement_primitives.io")
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_each_part_loads_with_the_library_reader_and_plays(tmp_path):

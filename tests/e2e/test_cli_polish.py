@@ -19,7 +19,7 @@ from aou_dsl.core.diagnostics import AouError
 from aou_dsl.core.files import atomic, check_output, write_atomic
 from tests.conftest import BEHAVIOURS
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 

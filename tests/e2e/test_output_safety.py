@@ -1,7 +1,7 @@
 """Never lose a file: the cases where a user's file was replaced, each as it was met, and
 what a killed or interrupted process leaves behind (nothing).
 
-tests/test_fuzz_outputs.py generates the output rule's cases; these are the ones a user
+tests/generated/test_fuzz_outputs.py generates the output rule's cases; these are the ones a user
 met, spelled as they were, plus what the generator cannot see: a run that succeeds
 beside the user's files, a process killed while it writes, and the temporary folders of
 the checks.
@@ -23,7 +23,7 @@ import pytest
 from aou_dsl.cli.args import EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE
 from aou_dsl.cli.commands import main
 from tests.conftest import BEHAVIOURS, ROOT
-from tests.test_fuzz_outputs import _workspace
+from tests.generated.test_fuzz_outputs import _workspace
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"),
                                 reason="makes FIFOs and devices, reads /proc")
@@ -277,7 +277,7 @@ def test_the_files_a_command_reads_follow_the_chain_and_never_block(ws):
     """aou file -> its robot file (and --robot's) -> the URDF it names -> every mesh,
     package:// ones too; a FIFO or a missing file on the way is listed, not opened."""
     from aou_dsl.robot.files_read import files_read
-    from tests.test_fuzz_outputs import _deadline
+    from tests.generated.test_fuzz_outputs import _deadline
 
     got = [os.path.relpath(p) for p in files_read(["y.aou"])]
     assert got[:3] == ["y.aou", "arm/arm.toml", "arm/arm.urdf"]

@@ -21,6 +21,7 @@ import signal
 import sqlite3
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -30,10 +31,10 @@ from aou_dsl.lang.descriptors import REGISTRY
 from aou_dsl.study.build import build_study
 from aou_dsl.study.jspsych import PACKAGES
 from aou_dsl.study.spec import read_study
-from tests.conftest import find_chromium
-from tests.test_study_build import BEHAVIOURS, write_study
+from tests.e2e.conftest import find_chromium
+from tests.e2e.test_study_build import BEHAVIOURS, write_study
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = str(Path(__file__).resolve().parents[2])
 CHROMIUM = find_chromium()
 if CHROMIUM is None:
     pytest.skip("no Chromium found for the study's browser tests: install Debian's "

@@ -3,7 +3,7 @@
 The view is checked against the geometric model's own ray tests; the stage is driven the
 way a page drives it, through its websocket with viser's own messages, so the gate and
 the check of each value are on the path (a page in a real browser: the slow variant in
-tests/test_studio_browser.py).
+tests/e2e/test_studio_browser.py).
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ import re
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -24,10 +25,10 @@ from aou_dsl.live.loop import HYSTERESIS
 from aou_dsl.live.regulator import Regulator
 from aou_dsl.live.world import Box, Scene, tag_points, visible_fraction
 from aou_dsl.studio import liveview
-from tests.conftest import wait_for
+from tests.e2e.conftest import wait_for
 from tests.integration.test_studio_gate import _open, _update, _uuid
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = str(Path(__file__).resolve().parents[2])
 OCCLUDER = os.path.join(ROOT, "examples", "scenarios", "occluder.toml")
 #: Where the card of the shipped scenario covers the tag, and where it leaves it clear.
 OVER, AWAY = 0.0, 0.16
@@ -201,7 +202,7 @@ def test_aouc_studio_refuses_shaping_flags_with_a_scenario(tmp_path):
 
 
 def test_what_a_page_sends_the_scene_controls_breaks_no_page_nor_the_loop(stage, capfd):
-    """A fuzz of the scene's controls as tests/test_studio_fuzz.py sends the studio's:
+    """A fuzz of the scene's controls as tests/integration/test_studio_fuzz.py sends the studio's:
     values of every wrong type and size, properties a page must not change, other kinds
     of message and bytes that are none. Every next page gets the scene, every slider
     holds a value in its range, the scene the perception sees stays finite and the loop

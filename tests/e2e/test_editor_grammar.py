@@ -16,7 +16,7 @@ from aou_dsl.core.units import UNITS
 from aou_dsl.lang.ir import State
 from aou_dsl.lang.validate import KEYWORDS
 
-VSCODE = Path(__file__).resolve().parent.parent / "editors" / "vscode"
+VSCODE = Path(__file__).resolve().parents[2] / "editors" / "vscode"
 GRAMMAR = json.loads((VSCODE / "syntaxes" / "aou.tmLanguage.json").read_text())
 TOOL = "vscode-tmgrammar-test@0.1.3"
 

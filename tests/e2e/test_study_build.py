@@ -16,6 +16,7 @@ import shutil
 import sqlite3
 import threading
 import zipfile
+from pathlib import Path
 
 import jsonschema
 import pytest
@@ -27,7 +28,7 @@ from aou_dsl.study.jspsych import FILES, PACKAGES
 from aou_dsl.study.serve import MAX_BODY, StudyServer
 from aou_dsl.study.spec import read_study
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = str(Path(__file__).resolve().parents[2])
 
 #: Names that must appear nowhere a participant can load.
 BEHAVIOURS = {"zeta.aou": ("zephyr_walk", "confident",
