@@ -71,12 +71,12 @@ def test_each_front_end_rule_example_triggers_its_own_code(code):
 #: Compiler codes no file has been found to reach: the IK's damping and limits report
 #: C301/C302 first, and TOPP-RA has not failed on a path the front end lets through.
 #: C311 is the controller's check of a trajectory file (``aouc check``); a compiled one
-#: keeps within the jerk limits by construction (tests/test_jerk.py has both sides).
+#: keeps within the jerk limits by construction (tests/integration/test_jerk.py has both sides).
 UNREACHED = {"C303", "C305", "C311"}
 #: Codes said only when a build fits the behaviour to the arm (``--fit``).
 FIT_CODES = {"C314", "C315"}
 #: Codes said only by ``aouc check`` (inverse dynamics, the physics replay, --track):
-#: tests/test_torque.py and tests/test_track.py reach each.
+#: tests/integration/test_torque.py and tests/integration/test_track.py reach each.
 CHECK_CODES = {"C320", "C321", "C322", "C323"}
 
 

@@ -165,7 +165,8 @@ def test_a_users_perception_drives_the_regulator(reg):
 def test_jerk_within_limits_and_no_jump_at_any_switch(reg, card):
     """The executed motion at the controller's rate passes the joint-jerk check, and at
     each switch the finite differences stay within the arm's jerk and acceleration
-    limits (a jump in q, qd or qdd breaks them: tests/test_live.py explains the bounds)."""
+    limits (a jump in q, qd or qdd breaks them: tests/integration/test_live.py explains
+    the bounds)."""
     from aou_dsl.safety.controllers import controller_checks
 
     tr = card.trajectory

@@ -10,7 +10,7 @@ must hold is then what the file declares, and nothing but the logger stands betw
 the two. The expected values are the declared ones (``aou_dsl.lang.declared``), never
 what measure printed.
 
-``python -m tests.test_measure_noise [N]`` prints the coverage per noise level and
+``python -m tests.integration.test_measure_noise [N]`` prints the coverage per noise level and
 descriptor over the shipped behaviours and N generated ones (docs/measure.md's table).
 """
 

@@ -1,7 +1,7 @@
 """What a new user met following the README, each as a promise that now holds.
 
 (The bag written into a missing folder, and Ctrl-C's exit status, are in
-tests/test_output_safety.py with the other writes.)
+tests/e2e/test_output_safety.py with the other writes.)
 """
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ velocities within 5 % (or 0.5 deg/s), accelerations within 5 % (3 % for position
 rounded to 6 decimals at 250 Hz). The one documented limit a miss may fall under: an
 acceleration phase shorter than the arm's own transients (0.1 s).
 
-``python -m tests.test_recordings [N] [SEED]`` prints the worst error per logger and
+``python -m tests.integration.test_recordings [N] [SEED]`` prints the worst error per logger and
 descriptor over the shipped behaviours and N generated ones.
 """
 
@@ -35,7 +35,7 @@ from tests.conftest import BEHAVIOURS
 from tests.recsim import PRESETS, Logger, record, to_csv_text, to_json_doc
 
 #: The largest plain error seen per logger and descriptor (filled by check_all; printed
-#: by ``python -m tests.test_recordings``).
+#: by ``python -m tests.integration.test_recordings``).
 ERRORS: dict[str, dict[str, float]] = {}
 #: Encoder noise the tolerances hold for [rad].
 MAX_NOISE = 1.5e-4

@@ -53,7 +53,8 @@ def descriptor_behaviours(draw) -> str:
     if draw(st.booleans()):
         start = draw(st.floats(0.22, 0.34))
         # Stand-offs under 8 cm still fail the round trip (an IK branch flip, a Cartesian
-        # peak between the timing check's samples): tests/test_lang_roundtrip.py draws them.
+        # peak between the timing check's samples): tests/generated/test_lang_roundtrip.py
+        # draws them.
         standoff = draw(st.floats(0.08, 0.14))
         lines += [f"start {_num(start, 'm')}", f"standoff {_num(standoff, 'm')}"]
     if draw(st.booleans()):

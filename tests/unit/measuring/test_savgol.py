@@ -5,7 +5,7 @@ measurement used before and whose numbers its thresholds were calibrated on.
 The comparison with SciPy is exact equality, bit for bit: the filter does its arithmetic
 in the same order, the peak finder only compares and subtracts. SciPy stays a test
 dependency; the package itself no longer imports ``scipy.signal``
-(tests/test_light_measure.py).
+(tests/integration/test_light_measure.py).
 """
 
 from __future__ import annotations
