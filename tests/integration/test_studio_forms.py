@@ -22,7 +22,7 @@ from aou_dsl.lang.linter import lint_source
 from aou_dsl.studio.edits import apply, settable
 from aou_dsl.synth.synthesis import synthesize
 
-ROOT = str(Path(__file__).resolve().parents[1])
+ROOT = str(Path(__file__).resolve().parents[2])
 
 ONE_LINE = "approach a=0.05; pause 1.67s x5; retreat 0.06m a=0.12 x3\n"
 PEEK = """\

@@ -29,7 +29,7 @@ import msgspec
 
 from tests.integration.test_studio_gate import _open, _wait_idle
 
-ROOT = str(Path(__file__).resolve().parents[1])
+ROOT = str(Path(__file__).resolve().parents[2])
 
 NUMBERS = [0, 1, -1, -5, 3, 2.5, 1e-320, -0.0, 0.5, 7, 11, 1e6, -1e6, 1e20, -1e20, 1e308,
            -1e308, math.nan, math.inf, -math.inf, 2 ** 63, -(2 ** 63), 2 ** 64 - 1]

@@ -22,7 +22,7 @@ from websockets.exceptions import ConnectionClosed, InvalidStatus
 
 from aou_dsl.studio.gate import Gate
 
-ROOT = str(Path(__file__).resolve().parents[1])
+ROOT = str(Path(__file__).resolve().parents[2])
 PROTOCOL = f"viser-v{viser.__version__}"
 
 
