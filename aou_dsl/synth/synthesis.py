@@ -77,7 +77,7 @@ STUDY_SOURCE: dict[State, str] = {
 #: results (intensity 0 as far the other way), by the descriptor's (kind, episode key):
 #: a factor for values, episodes added for counts (key ""), the angle reached [deg] for
 #: an exploration the stimulus lacks. Chosen so that every intensity still reads as its
-#: state (tests/integration/test_synth.py checks it).
+#: state (tests/test_synth.py checks it).
 SPANS: dict[State, dict[tuple[str, str], float]] = {
     State.CONFIDENT: {("approach", "peak_acceleration"): 1.5, ("pause", "duration"): 1.5},
     State.CURIOUS: {("approach", "peak_acceleration"): 1.3, ("gaze", "horizontal"): 1.5,
