@@ -1,6 +1,6 @@
 """Every cache of the process, in one registry: what a warm tool keeps between builds.
 
-A warm tool (the language server, the studio, a :class:`~aou_dsl.build.session.Session`,
+A warm tool (the language server, the studio, a :class:`~aou_dsl.driver.session.Session`,
 a pool worker) builds again and again in one process, and keeps what is slow to make: the
 parser, loaded arms, each motion episode's IK and time law, the checks' scenes. Each such
 cache is made here, by :func:`cached` (a function's results, least recently used first

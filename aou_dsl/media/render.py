@@ -399,7 +399,7 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
 
 
 def _cores() -> int:
-    from ..build.parallel import default_jobs
+    from ..driver.parallel import default_jobs
 
     return default_jobs()
 

@@ -101,7 +101,7 @@ def fit_limits(robot: str, goal: tuple[float, float, float] | None = None) -> Li
 
 @cached(maxsize=16)
 def _fit_limits(robot: str, goal: tuple[float, float, float] | None, key: tuple) -> Limits:
-    from ..build.builder import build_source
+    from ..driver.builder import build_source
     from ..robot.load import load_arm
 
     arm = load_arm(robot)

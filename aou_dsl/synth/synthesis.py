@@ -48,8 +48,8 @@ from .recipe import Recipe, descriptor, slot_of
 from .writer import render
 
 if TYPE_CHECKING:
-    from ..build.builder import BuildResult
-    from ..build.session import Session
+    from ..driver.builder import BuildResult
+    from ..driver.session import Session
 
 __all__ = ["SPANS", "STUDY_INTENSITY", "STUDY_SOURCE", "blend_weights", "compiled", "recipe",
            "study", "synthesize"]
@@ -285,7 +285,7 @@ _LIMIT_CODES = frozenset({C304, C308, C309, C311})
 def _session() -> Session:
     """The warm session synthesis and the live regulator build in: arms loaded once, the
     last builds kept, a changed text re-solving only the episodes it changed."""
-    from ..build.session import Session
+    from ..driver.session import Session
 
     return Session(keep=32)
 

@@ -13,7 +13,7 @@ pytest_lsp = pytest.importorskip("pytest_lsp", reason="pytest-lsp is not install
 from lsprotocol import types  # noqa: E402
 from pytest_lsp import LanguageClient  # noqa: E402
 
-from aou_dsl.build.builder import build_source  # noqa: E402
+from aou_dsl.driver.builder import build_source  # noqa: E402
 from tests.e2e.test_editor_server import _apply, _open, _published  # noqa: E402
 from tests.lsp_server import server_client  # noqa: E402
 

@@ -188,6 +188,6 @@ async def test_tilt_too_fast_fix_compiles_clean(client: LanguageClient):
     (action,) = actions
     fixed = _apply(text, action.edit.changes[uri])
     assert fixed.startswith("tilt 90deg v=") and "500deg/s" not in fixed
-    from aou_dsl.build.builder import build_source
+    from aou_dsl.driver.builder import build_source
 
     assert "C309" not in {x.code for x in build_source(fixed).diagnostics}

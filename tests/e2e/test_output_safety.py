@@ -364,7 +364,7 @@ def test_write_fitted_obeys_the_output_rule_before_any_work(fit_ws, argv, capsys
     build starts, every file as it was."""
     os.symlink("b.aou", "link.aou")
     Path("out.json").write_text('{"generator": "aouc 0.2.0"}\n')  # an earlier output
-    import aou_dsl.build.builder as builder
+    import aou_dsl.driver.builder as builder
 
     def no_build(*a, **k):
         raise AssertionError("built before the output rule was checked")

@@ -17,8 +17,8 @@ import pytest
 
 pytest.importorskip("movement_primitives")
 
-from aou_dsl.build.builder import build_source
 from aou_dsl.dmp import solve, to_dmp
+from aou_dsl.driver.builder import build_source
 from aou_dsl.lang.descriptors import compare
 from aou_dsl.robot.load import load_arm
 from tests.langgen import random_cases  # noqa: E402

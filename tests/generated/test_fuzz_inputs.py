@@ -82,7 +82,7 @@ def test_every_hostile_input_fails_cleanly(case, tmp_path):
 def _lint_then_compile(texts: list[str], compiles: int, tmp_path: Path) -> None:
     """Lint never raises; a diagnostic always has a registered code and a span on its
     file; the first ``compiles`` files that lint clean compile without raising."""
-    from aou_dsl.build.builder import build_source
+    from aou_dsl.driver.builder import build_source
     from aou_dsl.lang.linter import lint_source
 
     left = compiles

@@ -12,8 +12,8 @@ import zipfile
 import numpy as np
 import pytest
 
-from aou_dsl.build.builder import build_file
 from aou_dsl.cli.commands import main
+from aou_dsl.driver.builder import build_file
 from aou_dsl.lang.descriptors import REGISTRY
 from tests.conftest import BEHAVIOURS
 from tests.recsim import PRESETS, record, to_csv_text, to_json_doc

@@ -90,7 +90,7 @@ def test_each_compiler_rule_example_triggers_its_own_code(code, tmp_path, monkey
     with its collision shapes removed."""
     import re
 
-    from aou_dsl.build.builder import build_source
+    from aou_dsl.driver.builder import build_source
     from aou_dsl.robot.load import scene_urdf
 
     example = RULES[code].example

@@ -9,11 +9,11 @@ import sys
 
 import pytest
 
-from aou_dsl.build import batch, pool
-from aou_dsl.build.builder import build_file
-from aou_dsl.build.parallel import build_many
 from aou_dsl.compiler.output import encode
 from aou_dsl.core.options import BuildOptions
+from aou_dsl.driver import batch, pool
+from aou_dsl.driver.builder import build_file
+from aou_dsl.driver.parallel import build_many
 from aou_dsl.lang.linter import lint_file
 from tests.conftest import BEHAVIOURS, INVALID, ROOT
 

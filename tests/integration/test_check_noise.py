@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 from aou_dsl.api import check
-from aou_dsl.build.builder import build_file
 from aou_dsl.core.trajectory import Trajectory
+from aou_dsl.driver.builder import build_file
 from aou_dsl.robot.load import load_arm
 from tests.conftest import BEHAVIOURS
 from tests.recsim import Logger, record

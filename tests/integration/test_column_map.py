@@ -8,8 +8,8 @@ import json
 
 import pytest
 
-from aou_dsl.build.builder import build_file
 from aou_dsl.cli.commands import main
+from aou_dsl.driver.builder import build_file
 from tests.conftest import BEHAVIOURS
 from tests.recsim import Logger, record, to_csv_text
 

@@ -9,8 +9,8 @@ import json
 import numpy as np
 import pytest
 
-from aou_dsl.build.builder import build_file
 from aou_dsl.compiler.output import encode, write_output
+from aou_dsl.driver.builder import build_file
 from tests.conftest import BEHAVIOURS
 
 

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from aou_dsl.build.builder import build_file, build_source
 from aou_dsl.cli.commands import main
+from aou_dsl.driver.builder import build_file, build_source
 from aou_dsl.fit.plan import KNEE, compress
 from aou_dsl.lang.linter import lint_source
 from tests.conftest import BEHAVIOURS

@@ -14,7 +14,7 @@ import re
 
 import pytest
 
-from aou_dsl.build.builder import build_source
+from aou_dsl.driver.builder import build_source
 from aou_dsl.lang.linter import lint_source
 from tests import langgen
 from tests.integration.test_fit_reach import apply_hint

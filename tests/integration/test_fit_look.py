@@ -17,9 +17,9 @@ import random
 
 import pytest
 
-from aou_dsl.build.builder import build_file, build_source
 from aou_dsl.cli.commands import main
 from aou_dsl.core.robot_specs import ROBOTS
+from aou_dsl.driver.builder import build_file, build_source
 from aou_dsl.lang.linter import lint_source
 from aou_dsl.lang.primitives import (
     KINDS,

@@ -12,8 +12,8 @@ import re
 
 import pytest
 
-from aou_dsl.build.builder import build_source
 from aou_dsl.core.diagnostics import Span
+from aou_dsl.driver.builder import build_source
 from aou_dsl.fit.text_edits import apply_edit
 from tests import langgen
 

@@ -135,7 +135,7 @@ def test_layout_rules() -> None:
 
 
 def _compiled_bytes(text: str) -> bytes:
-    from aou_dsl.build.builder import build_source
+    from aou_dsl.driver.builder import build_source
 
     res = build_source(text, "x.aou", check=False)
     assert res.ok, [d.message for d in res.diagnostics]

@@ -9,8 +9,8 @@ import re
 import numpy as np
 import pytest
 
-from aou_dsl.build.builder import build_source
 from aou_dsl.compiler.oscillation import shiver_offset, shiver_ratios
+from aou_dsl.driver.builder import build_source
 from aou_dsl.fit.rounding import significant, times
 from aou_dsl.fit.search import largest_fitting
 from aou_dsl.lang.linter import lint_source

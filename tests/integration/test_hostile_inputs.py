@@ -272,8 +272,8 @@ def test_a_mesh_that_is_a_folder_or_a_fifo_is_no_mesh(tmp_path):
 def test_the_vendors_panda_urdf_compiles_as_a_user_urdf(tmp_path):
     """example-robot-data's own panda.urdf, given as a user's URDF: its fingers touch by a
     hair in every pose, so they are allowed to, as on the built-in arm."""
-    from aou_dsl.build.builder import build_source
     from aou_dsl.core.robot_specs import ROBOTS
+    from aou_dsl.driver.builder import build_source
     from aou_dsl.robot.load import _data_path, load_robot
 
     path = _data_path(ROBOTS["panda"].urdf)

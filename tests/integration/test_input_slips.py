@@ -86,7 +86,7 @@ def test_commands_read_a_file_with_a_byte_order_mark(tmp_path, capsys):
     path.write_bytes(b"\xef\xbb\xbfapproach a=0.1\npause 1s\n")
     for argv in (["lint", str(path)], ["explain", str(path)]):
         assert main(argv) == EXIT_OK, capsys.readouterr().err
-    from aou_dsl.build.builder import build_file
+    from aou_dsl.driver.builder import build_file
 
     marked = build_file(str(path), check=False)
     plain = tmp_path / "plain.aou"

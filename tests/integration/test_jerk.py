@@ -11,10 +11,10 @@ import math
 import numpy as np
 import pytest
 
-from aou_dsl.build.builder import build_source
 from aou_dsl.compiler.pipeline import evaluate, sample
 from aou_dsl.compiler.timelaw import SmoothLaw, TimeLaw
 from aou_dsl.core.trajectory import Trajectory
+from aou_dsl.driver.builder import build_source
 from aou_dsl.lang.descriptors import REGISTRY
 from aou_dsl.robot.load import load_arm
 from aou_dsl.safety.controllers import controller_checks

@@ -13,7 +13,7 @@ import math
 
 import pytest
 
-from aou_dsl.build.builder import build_source
+from aou_dsl.driver.builder import build_source
 from aou_dsl.lang.descriptors import REGISTRY
 from aou_dsl.lang.linter import lint_source
 

@@ -46,6 +46,6 @@ def test_compile_check_and_measure_load_no_scipy_signal(tmp_path: Path):
 
 def test_the_pool_preloads_no_scipy_signal():
     """A forked worker gets what its parent preloaded: nothing it does not need."""
-    from aou_dsl.build import pool
+    from aou_dsl.driver import pool
 
     assert not any(m.startswith(HEAVY) for m in pool._STAGES)

@@ -16,7 +16,7 @@ import re
 
 import pytest
 
-from aou_dsl.build.builder import build_source
+from aou_dsl.driver.builder import build_source
 from aou_dsl.lang.descriptors import compare
 from aou_dsl.lang.linter import lint_source
 from tests import langgen

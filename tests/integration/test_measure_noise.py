@@ -91,7 +91,7 @@ def test_intervals_hold_the_declared_values_as_often_as_they_claim(shipped):
 def test_a_trajectory_without_noise_is_measured_exactly(shipped):
     """A compiled trajectory has no noise: every interval is the value itself, and
     nothing warns."""
-    from aou_dsl.build.builder import build_file
+    from aou_dsl.driver.builder import build_file
 
     res = build_file(str(BEHAVIOURS / "hesitant.aou"), check=False)
     m = measure(res.trajectory)
@@ -113,7 +113,7 @@ def test_the_inferred_state_and_the_line_of_sight_carry_their_interval(shipped, 
     intervals, or the copies disagree on the state and R411 says so; at 1e-3 rad and 250
     Hz the hesitant's state is such a case, and the text, the JSON and the warning
     show it."""
-    from aou_dsl.build.builder import build_file
+    from aou_dsl.driver.builder import build_file
 
     for name, noise, rate, seed in (("hesitant", 3e-4, 1000.0, 1), ("fearful", 6e-4, 250.0, 2),
                                     ("hesitant", 6e-4, 250.0, 4)):

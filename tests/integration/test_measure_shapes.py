@@ -19,8 +19,8 @@ import math
 import numpy as np
 import pytest
 
-from aou_dsl.build.builder import build_source
 from aou_dsl.core.trajectory import Trajectory
+from aou_dsl.driver.builder import build_source
 from aou_dsl.measuring.measured import measure
 from aou_dsl.robot.batch_fk import batch_fk, classical_acceleration
 from aou_dsl.robot.load import load_arm

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 import aou_dsl
-from aou_dsl.build.builder import build_file
 from aou_dsl.cli.commands import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, main
+from aou_dsl.driver.builder import build_file
 from aou_dsl.lang.linter import lint_file
 from aou_dsl.robot.load import load_arm
 from tests.conftest import BEHAVIOURS

@@ -271,8 +271,8 @@ def test_the_spec_names_aouc_robot_shows_are_pointed_to_the_file_s_names(tmp_pat
 def aou_csv(tmp_path_factory):
     """A CSV written by `aouc compile` (comment lines say aou wrote it), and the same
     file with its joint columns turned into degrees, as a spreadsheet edit would."""
-    from aou_dsl.build.builder import build_source
     from aou_dsl.compiler.output import encode
+    from aou_dsl.driver.builder import build_source
 
     res = build_source("approach a=0.1\npause 1s x2\nretreat 0.05m a=0.1\n", "b.aou",
                        check=False)

@@ -4,10 +4,10 @@ explained; a robot's unsourced limits (C313) are said once per robot in a run.""
 
 from __future__ import annotations
 
-from aou_dsl.build.builder import build_source
-from aou_dsl.build.parallel import build_many
 from aou_dsl.core.diagnostics import Span, diag
 from aou_dsl.core.repeats import once_per_run, said_once
+from aou_dsl.driver.builder import build_source
+from aou_dsl.driver.parallel import build_many
 
 RETREAT = """behaviour r : fearful
 robot ur5

@@ -22,9 +22,9 @@ import jsonschema
 import numpy as np
 import pytest
 
-from aou_dsl.build.builder import build_file
 from aou_dsl.compiler import output
 from aou_dsl.compiler.output import SAMPLE_KEYS, array_document, encode, json_bytes
+from aou_dsl.driver.builder import build_file
 from aou_dsl.measuring.recording import read_json, read_recording
 from aou_dsl.measuring.schema_files import shipped_text
 from tests.conftest import BEHAVIOURS

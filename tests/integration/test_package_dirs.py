@@ -110,8 +110,8 @@ def test_a_dask_cluster_receives_the_package_dirs(vendor, tmp_path):
     """The options travel to a Dask worker process whole: the build there finds the
     meshes and gives the same document as one in this process."""
     distributed = pytest.importorskip("distributed")
-    from aou_dsl.build.builder import build_file
-    from aou_dsl.build.parallel import build_many
+    from aou_dsl.driver.builder import build_file
+    from aou_dsl.driver.parallel import build_many
 
     root, urdf, pkgs = vendor
     opts = BuildOptions(robot=urdf, package_dirs=(pkgs,), rate=100.0)

@@ -8,10 +8,10 @@ import sys
 
 import pytest
 
-from aou_dsl.build.builder import build_file
-from aou_dsl.build.parallel import BuildPool, build_many, encoded, write_result
 from aou_dsl.compiler.output import encode
 from aou_dsl.core.options import BuildOptions
+from aou_dsl.driver.builder import build_file
+from aou_dsl.driver.parallel import BuildPool, build_many, encoded, write_result
 from tests.conftest import BEHAVIOURS, INVALID, ROOT
 
 #: Valid behaviours, a file that does not exist and an invalid one, interleaved, so that
@@ -51,7 +51,7 @@ def test_a_pool_stays_warm_across_maps(alone, tmp_path, start):
     first), and has the workers encode the documents: the bytes written are those of
     encoding the document built alone. Forked workers (copies of this process, which
     has built before) and fresh ones give the same."""
-    from aou_dsl.build.pool import can_fork
+    from aou_dsl.driver.pool import can_fork
 
     if start == "fork" and sys.platform.startswith("linux") and not can_fork():
         # This process runs another thread (a pytest-xdist worker's), so a pool here

@@ -29,7 +29,7 @@ COUNTS = ("pause_count", "retreat_count")
 def hesitant():
     """The slowest shipped behaviour (its joints stay near a tenth of their limits): the
     hardest to tell from a slow arm. Its compiled document and declared descriptors."""
-    from aou_dsl.build.builder import build_source
+    from aou_dsl.driver.builder import build_source
 
     res = build_source((BEHAVIOURS / "hesitant.aou").read_text(), "hesitant.aou",
                        check=False)

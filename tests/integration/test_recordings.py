@@ -60,7 +60,7 @@ def build(text: str, name: str = "gen"):
     """The compiled document and declared descriptors of a behaviour that compiles and
     measures as declared on its own output; None otherwise (a compiler's problem, not
     this test's)."""
-    from aou_dsl.build.builder import build_source
+    from aou_dsl.driver.builder import build_source
 
     res = build_source(text, f"{name}.aou", check=False)
     if not res.ok or res.measured is None or res.declared is None:

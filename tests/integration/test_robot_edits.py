@@ -19,8 +19,8 @@ import time
 import numpy as np
 import pytest
 
-from aou_dsl.build.session import Session
 from aou_dsl.core import memo
+from aou_dsl.driver.session import Session
 from tests.conftest import BEHAVIOURS, ROOT
 from tests.integration.test_robots import small_arm
 
@@ -224,9 +224,9 @@ forking = pytest.mark.skipif(
 def test_pool_workers_started_after_an_edit_build_on_the_edited_robot(tmp_path):
     """This process built on 2.0 rad/s; the workers of a ``--jobs 2`` run after the file
     says 0.5 are forked from it, with its caches, and refuse as a new process does."""
-    from aou_dsl.build import pool
-    from aou_dsl.build.parallel import build_many
     from aou_dsl.core.options import BuildOptions
+    from aou_dsl.driver import pool
+    from aou_dsl.driver.parallel import build_many
 
     if not pool.can_fork():  # another thread runs here (pytest-xdist): a new pytest
         name = "test_pool_workers_started_after_an_edit_build_on_the_edited_robot"

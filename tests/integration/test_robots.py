@@ -284,7 +284,7 @@ def test_robot_setting_takes_a_quoted_path_from_the_file_s_folder(arm_file, tmp_
 # --- Compiling on a user's robot ---------------------------------------------------------
 
 def _build(tmp_path, behaviour: str, robot: str):
-    from aou_dsl.build.builder import build_file
+    from aou_dsl.driver.builder import build_file
 
     lines = (BEHAVIOURS / f"{behaviour}.aou").read_text().replace("robot panda\n", "")
     lines = lines.splitlines(keepends=True)
@@ -299,7 +299,7 @@ def test_a_copied_urdf_compiles_the_same_as_the_named_robot(tmp_path):
     """The Panda's package copied out of example-robot-data (its mesh paths still name
     the data package) and pinned like the built-in arm compiles the very same
     trajectory, and passes the checks with the copied meshes."""
-    from aou_dsl.build.builder import build_file
+    from aou_dsl.driver.builder import build_file
 
     pkg = _copy_package("panda_description", tmp_path)
     urdf = os.path.relpath(os.path.join(pkg, "urdf", "panda.urdf"), tmp_path)

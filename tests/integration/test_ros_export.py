@@ -8,10 +8,10 @@ import os
 import numpy as np
 import pytest
 
-from aou_dsl.build.builder import build_file
 from aou_dsl.compiler.output import encode, output_paths, write_output
 from aou_dsl.compiler.ros import MSGTYPE, TOPIC
 from aou_dsl.core.diagnostics import AouError
+from aou_dsl.driver.builder import build_file
 from tests.conftest import BEHAVIOURS
 
 

@@ -8,7 +8,7 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from aou_dsl.build.builder import build_file
+from aou_dsl.driver.builder import build_file
 from aou_dsl.lang.descriptors import compare as compare_descriptors
 from tests.conftest import BEHAVIOURS
 

@@ -15,9 +15,9 @@ import zipfile
 import jsonschema
 import pytest
 
-from aou_dsl.build.builder import build_file
 from aou_dsl.compiler.output import encode
 from aou_dsl.core.diagnostics import AouError
+from aou_dsl.driver.builder import build_file
 from aou_dsl.measuring.measured import measure
 from aou_dsl.measuring.recording import read_recording
 from aou_dsl.measuring.schema_files import SCHEMA_NAMES, schema_text, shipped_text

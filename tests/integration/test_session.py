@@ -6,9 +6,9 @@ from __future__ import annotations
 import subprocess
 import sys
 
-from aou_dsl.build.session import Session
 from aou_dsl.compiler.output import encode
 from aou_dsl.core.options import BuildOptions
+from aou_dsl.driver.session import Session
 from tests.conftest import BEHAVIOURS, ROOT
 
 HESITANT = (BEHAVIOURS / "hesitant.aou").read_text()
@@ -67,7 +67,7 @@ def test_an_unreadable_file_is_a_result_with_its_code(tmp_path):
 
 #: A fresh process's build of a file: its document's bytes and its diagnostics.
 _COLD = ("import sys\n"
-         "from aou_dsl.build.builder import build_file\n"
+         "from aou_dsl.driver.builder import build_file\n"
          "from aou_dsl.compiler.output import encode\n"
          "res = build_file(sys.argv[1])\n"
          "open(sys.argv[2], 'wb').write(encode(res.document, 'json'))\n"

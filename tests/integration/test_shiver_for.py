@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import pytest
 
-from aou_dsl.build.builder import build_source
 from aou_dsl.core.diagnostics import Span
+from aou_dsl.driver.builder import build_source
 from aou_dsl.fit.text_edits import apply_edit
 from aou_dsl.lang.linter import lint_source
 

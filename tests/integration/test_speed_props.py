@@ -380,8 +380,8 @@ def test_the_parser_tables_are_cached_and_a_cache_that_cannot_be_written_is_no_e
 def test_a_video_drawn_by_several_processes_is_the_one_drawn_by_one():
     """Frame for frame, side by side clips of different lengths included; held frames
     (drawn once) are the same image as drawing them again."""
-    from aou_dsl.build.builder import build_file
     from aou_dsl.core.options import SceneOptions
+    from aou_dsl.driver.builder import build_file
     from aou_dsl.media.annotate import caption
     from aou_dsl.media.render import Camera, _Clip, _Drawer, _video_frames, render_configurations
 

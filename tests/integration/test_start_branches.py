@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from aou_dsl.build.builder import build_source
 from aou_dsl.compiler.branches import other_starts
+from aou_dsl.driver.builder import build_source
 from aou_dsl.lang.timeline import Pose
 from aou_dsl.robot.geometry import reach_frame
 from aou_dsl.robot.load import load_arm

@@ -28,7 +28,7 @@ LAYERS = [
     ("compiler", "fit"),
     ("measuring",),
     ("safety",),
-    ("build",),
+    ("driver",),
     ("synth",),
     ("dmp",),
     ("live",),

@@ -8,7 +8,7 @@ import dataclasses
 
 import pytest
 
-from aou_dsl.build.builder import build_source
+from aou_dsl.driver.builder import build_source
 from aou_dsl.fit.refusals import (
     AccelerationShort,
     ShiverTooFast,

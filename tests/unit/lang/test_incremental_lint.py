@@ -16,7 +16,7 @@ import re
 
 import pytest
 
-from aou_dsl.build.session import Session
+from aou_dsl.driver.session import Session
 from aou_dsl.lang.linter import FileResult, lint_source
 from aou_dsl.lang.parse import parse
 from aou_dsl.lang.pieces import Pieces

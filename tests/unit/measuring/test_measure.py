@@ -211,7 +211,7 @@ def test_csv_errors_name_row_and_column():
 def test_a_tilt_beside_a_shiver_is_a_tilt():
     """A rest-to-rest tilt right after a tremor, with no rest between, is told apart by
     its duration: the shiver's half periods are equal, the tilt lasts longer."""
-    from aou_dsl.build.builder import build_source
+    from aou_dsl.driver.builder import build_source
 
     res = build_source("tilt 5deg v=8deg/s x1\nshiver 2deg f=2Hz for 1.5s\n", "t.aou",
                        check=False)
@@ -344,8 +344,8 @@ def test_goal_final_is_the_hands_last_position(tmp_path, synths):
 
 
 def test_npz_written_by_aou_reads_back(tmp_path):
-    from aou_dsl.build.builder import build_source
     from aou_dsl.compiler.output import encode
+    from aou_dsl.driver.builder import build_source
 
     res = build_source((BEHAVIOURS / "fearful.aou").read_text(), "fearful.aou", check=False)
     path = tmp_path / "f.npz"
@@ -424,7 +424,7 @@ def test_joint_noise_is_reported(synths):
 
 
 def _built(text: str):
-    from aou_dsl.build.builder import build_source
+    from aou_dsl.driver.builder import build_source
 
     res = build_source(text, "t.aou", check=False)
     assert res.ok, [(d.code, d.message) for d in res.diagnostics]

@@ -161,7 +161,7 @@ class Session:
     def build_file(self, path: str, options: BuildOptions | None = None,
                    **changes: Any) -> BuildResult:
         """:meth:`build` of a file's text; a file that cannot be read is a result with
-        its I501 diagnostic, as :func:`~aou_dsl.build.builder.build_file` gives."""
+        its I501 diagnostic, as :func:`~aou_dsl.driver.builder.build_file` gives."""
         from ..lang.linter import lint_file
         from .builder import build_lint
 

@@ -1,9 +1,9 @@
 """Many builds at once: ``aouc compile --jobs N`` on this machine's cores, and the same
 map on a Dask distributed cluster for sweeps beyond one machine.
 
-:func:`build_many` yields one :class:`~aou_dsl.build.builder.BuildResult` per input path, in the
+:func:`build_many` yields one :class:`~aou_dsl.driver.builder.BuildResult` per input path, in the
 order of the inputs, whatever order they finish in; each result is the one
-:func:`aou_dsl.build.builder.build_file` gives for that path (the documents are the same bytes).
+:func:`aou_dsl.driver.builder.build_file` gives for that path (the documents are the same bytes).
 
 - ``jobs=1``: one file after another, in this process.
 - ``jobs=N``: this process and ``N - 1`` worker processes (:mod:`.batch`): this process

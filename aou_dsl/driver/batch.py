@@ -1,9 +1,9 @@
 """A batch on this machine's cores that is never slower than one process: this process
 builds too, and workers join as soon as they can take a file.
 
-On Linux (:func:`~aou_dsl.build.pool.can_fork`) this process lints every file and,
+On Linux (:func:`~aou_dsl.driver.pool.can_fork`) this process lints every file and,
 when at least three files compile, loads the libraries and the robots the files name
-(:func:`~aou_dsl.build.pool.preload`) and forks ``jobs - 1`` workers before it builds
+(:func:`~aou_dsl.driver.pool.preload`) and forks ``jobs - 1`` workers before it builds
 anything: they start warm in milliseconds, sharing what was loaded, and no build waits
 for another process's first one. A batch of two files that compile (or copies of two
 texts) is built here to the end: a worker would add its start and save nothing.
@@ -133,7 +133,7 @@ def shared_map(paths: list[str], options: BuildOptions, jobs: int,
         options: how to build; the workers receive it whole.
         jobs: processes in all, this one included (at least 2).
         encode: a byte format the results' documents are also encoded in (as
-            :func:`~aou_dsl.build.parallel.build_many` says).
+            :func:`~aou_dsl.driver.parallel.build_many` says).
     """
     from ..lang.linter import lint_file
     from .pool import BuildPool, can_fork

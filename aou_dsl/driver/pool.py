@@ -7,7 +7,7 @@ A :class:`BuildPool` starts its workers at once, in one of two ways:
   worker starts in milliseconds with all of it loaded and no second core is spent
   importing the same libraries again;
 - spawned (elsewhere, or when asked): each worker is a fresh interpreter that imports
-  the build's stages and builds a small behaviour (:func:`~aou_dsl.build.session.warm`)
+  the build's stages and builds a small behaviour (:func:`~aou_dsl.driver.session.warm`)
   before it takes a file.
 
 Either way a worker ignores SIGINT (this process stops it). A build's result goes back
@@ -41,7 +41,7 @@ _STOP_TIMEOUT = 2.0
 #: The modules a build imports as it goes (the compiler, the checks, the measurement and
 #: the libraries under them), imported by :func:`preload`. One missing here is imported
 #: by each worker when its first build needs it: slower, never different.
-_STAGES = ("aou_dsl.build.builder", "aou_dsl.compiler.pipeline", "aou_dsl.compiler.output",
+_STAGES = ("aou_dsl.driver.builder", "aou_dsl.compiler.pipeline", "aou_dsl.compiler.output",
            "aou_dsl.compiler.branches", "aou_dsl.safety.replay", "aou_dsl.safety.controllers",
            "aou_dsl.measuring.measured", "aou_dsl.lang.declared", "scipy.interpolate")
 
