@@ -8,6 +8,7 @@ import re
 
 from lsprotocol import types
 
+from ..core.rule_model import Category
 from ..lang.descriptors import DEFINITIONS, Descriptor
 from ..lang.ir import State
 from ..lang.primitives import KINDS
@@ -19,7 +20,8 @@ from .text import Tok, at, statement_at, tokens_of
 
 __all__ = ["descriptor_for", "describe", "hover"]
 
-_CODE = re.compile(r"\b[SVMCRI]\d{3}\b")
+#: A rule code named in a comment: any category's letter and three digits.
+_CODE = re.compile(rf"\b[{''.join(c.value for c in Category)}]\d{{3}}\b")
 _WAYS = {"": ("more", "fewer"), "s": ("longer", "shorter"), "m": ("longer", "shorter"),
          "deg": ("larger", "smaller")}
 _STATES = (State.CONFIDENT, State.CURIOUS, State.HESITANT, State.FEARFUL)

@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 
 from . import descriptors
-from .descriptors import REGISTRY, Descriptor, EpisodeValues, qualify
+from .descriptors import Descriptor, EpisodeValues, qualify
 from .ir import Behaviour
 from .primitives import APPROACH, KINDS, PAUSE
 from .timeline import Episode
@@ -25,8 +25,7 @@ __all__ = ["descriptor_table", "episode_values", "episodes_of", "every_counts", 
 def descriptor_table() -> Mapping[str, Descriptor]:
     """Every descriptor by name: the registry's eleven and, where the registry gives
     them (its ``every_descriptor``), the loaded plugins' too."""
-    every = getattr(descriptors, "every_descriptor", None)
-    return every() if callable(every) else REGISTRY
+    return descriptors.every_descriptor()
 
 
 def every_counts(kind: str) -> bool:

@@ -98,3 +98,14 @@ def test_ranges_count_utf16_and_skip_a_byte_order_mark():
     shown = to_lsp(other, Text(text), "x.aou")
     assert shown.range.start == shown.range.end == types.Position(0, 0)
     assert shown.message.startswith("arm.toml:7:3: ")
+
+
+def test_a_comment_names_any_registered_code_for_hover():
+    """Hover explains a code a comment names, whatever its category: DMP, study and
+    plugin codes too, not only the front end's and the compiler's."""
+    from aou_dsl.core.rules import RULES
+    from aou_dsl.editor.hover import _CODE, rule_text
+
+    for code in RULES:
+        assert _CODE.findall(f"pause 1s  # {code} is expected here") == [code]
+        assert rule_text(code)
