@@ -11,8 +11,10 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
+from . import dmp
 from .descriptors import DESCRIPTORS
 from .kind import NAME, Anticipate, AnticipateKind
+from .measure import Recognise
 
 __all__ = ["NAME", "Anticipate", "AnticipateKind", "plugin"]
 
@@ -21,4 +23,6 @@ __all__ = ["NAME", "Anticipate", "AnticipateKind", "plugin"]
 plugin = SimpleNamespace(
     kind=AnticipateKind(),
     descriptors=DESCRIPTORS,
+    measure=Recognise(),
+    dmp=dmp,
 )
