@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
-from . import dmp
+from . import dmp, editor
 from .descriptors import DESCRIPTORS
 from .kind import NAME, Anticipate, AnticipateKind
 from .measure import Recognise
@@ -25,4 +25,5 @@ plugin = SimpleNamespace(
     descriptors=DESCRIPTORS,
     measure=Recognise(),
     dmp=dmp,
+    editor=editor,
 )
