@@ -1,0 +1,270 @@
+"""The test plugin ``aou-anticipate`` through every command, as a user runs them: with it
+installed (a ``dist-info`` on the import path, as pip leaves one), uninstalled, and
+installed with a part missing."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests.plugins.install import ROOT, installed, without_plugins
+
+AOUC = [sys.executable, "-m", "aou_dsl"]
+
+#: A sequence whose anticipation draws back 10 mm at 0.4 m/s^2 before approaches at a
+#: tenth of that: its drive (the largest peak acceleration of an approach or an
+#: anticipation) comes from the anticipation alone.
+SEQUENCE = """\
+behaviour wind_up
+robot panda
+start 0.30m
+standoff 0.10m
+sequence {
+  pause 1s
+  anticipate 10mm a=0.4
+  approach 0.1m a=0.04
+  pause 1s
+  approach a=0.04
+}
+"""
+D, A = 0.010, 0.4
+
+
+def aouc(*args: str, env: dict[str, str], cwd: Path | None = None
+         ) -> subprocess.CompletedProcess:
+    return subprocess.run([*AOUC, *args], capture_output=True, text=True, timeout=300,
+                          env=env, cwd=cwd)
+
+
+def no_traceback(run: subprocess.CompletedProcess) -> None:
+    assert "Traceback" not in run.stderr + run.stdout, run.stderr
+
+
+@pytest.fixture(scope="module")
+def env(tmp_path_factory) -> dict[str, str]:
+    """The environment of an ``aouc`` that has the plugin installed."""
+    with installed(tmp_path_factory.mktemp("plugin")) as inst:
+        yield inst.env
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory) -> Path:
+    folder = tmp_path_factory.mktemp("files")
+    (folder / "wind_up.aou").write_text(SEQUENCE, encoding="utf-8")
+    return folder
+
+
+@pytest.fixture(scope="module")
+def compiled(env, files) -> Path:
+    out = files / "wind_up.json"
+    run = aouc("compile", str(files / "wind_up.aou"), "-o", str(out), env=env)
+    assert run.returncode == 0, run.stderr
+    return out
+
+
+def _lint(path: Path, env: dict[str, str]) -> tuple[int, dict]:
+    run = aouc("lint", "--format", "json", str(path), env=env)
+    no_traceback(run)
+    return run.returncode, json.loads(run.stdout)["files"][0]
+
+
+def test_lint_infers_the_state_with_the_plugin_kind(env, files):
+    """The anticipation's evidence (its peak acceleration adds to the drive, the largest
+    counting) is in the point lint infers: the C-V model's formula, fed by hand from the
+    file's definitions, gives lint's point, and without the anticipation's drive the
+    same file would be another state."""
+    from aou_dsl.lang.cv import Composition, infer
+
+    code, out = _lint(files / "wind_up.aou", env)
+    assert code == 0, out
+    assert [d["code"] for d in out["diagnostics"]] == ["M204"]
+    want, _ = infer(Composition(drive=max(A, 0.04), stillness=2.0))
+    without, _ = infer(Composition(drive=0.04, stillness=2.0))
+    assert (out["cv"]["C"], out["cv"]["V"]) == pytest.approx((want.C, want.V), abs=1e-3)
+    assert out["cv"]["state"] == want.state.value
+    assert without.state != want.state  # the test can tell the evidence was used
+
+
+def test_lint_reports_the_plugin_kinds_own_checks(env, tmp_path):
+    """The kind validates its statements with V codes: too small to see (V123), larger
+    than an anticipation (V130), a duration for a distance (V102), repeated in place in a
+    sequence (V113)."""
+    bad = SEQUENCE.replace("  anticipate 10mm a=0.4\n",
+                           "  anticipate 2mm\n  anticipate 8cm\n  anticipate 1s\n"
+                           "  anticipate 10mm x2\n")
+    (tmp_path / "bad.aou").write_text(bad, encoding="utf-8")
+    code, out = _lint(tmp_path / "bad.aou", env)
+    assert code == 1
+    got = sorted((d["line"], d["code"]) for d in out["diagnostics"])
+    assert got == [(7, "V123"), (8, "V130"), (9, "V102"), (10, "V113")], got
+
+
+def test_lint_refuses_an_anticipation_no_approach_follows(env, tmp_path):
+    """What the kind needs around it (an approach, directly after) is checked: an
+    anticipation followed by a pause is refused, naming the kind."""
+    bad = SEQUENCE.replace("  anticipate 10mm a=0.4\n  approach 0.1m a=0.04\n",
+                           "  approach 0.1m a=0.04\n  anticipate 10mm a=0.4\n")
+    (tmp_path / "late.aou").write_text(bad, encoding="utf-8")
+    code, out = _lint(tmp_path / "late.aou", env)
+    assert code == 1, out
+    errors = [d for d in out["diagnostics"] if d["severity"] == "error"]
+    assert errors and all(d["code"].startswith("V") for d in errors), errors
+    assert any("anticipat" in d["message"] for d in errors), errors
+
+
+def test_compile_times_the_kind_by_its_law_and_checks_it(compiled):
+    """The anticipation is an episode of its own in the trajectory, timed rest to rest
+    at its peak acceleration (a bang-bang profile: ``2 sqrt(d / a)`` under the speed
+    cap), and the checks pass."""
+    traj = json.loads(compiled.read_text(encoding="utf-8"))
+    kinds = [e["kind"] for e in traj["episodes"]]
+    assert kinds == ["pause", "anticipate", "approach", "pause", "approach"], kinds
+    ep = traj["episodes"][1]
+    assert ep["t_end"] - ep["t_start"] == pytest.approx(2 * math.sqrt(D / A), rel=0.02)
+    assert all(c["ok"] for c in traj["checks"]["kinematic"]["checks"])
+    assert traj["descriptors"]["declared"]["anticipate_count"] == 1
+    assert traj["descriptors"]["declared"]["anticipate_distance"] == pytest.approx(D)
+
+
+def test_measure_reads_it_back_as_declared(env, files, compiled):
+    run = aouc("measure", str(compiled), "--against", str(files / "wind_up.aou"),
+               "--format", "json", env=env)
+    no_traceback(run)
+    assert run.returncode == 0, run.stdout + run.stderr
+    out = json.loads(run.stdout)
+    got = out["descriptors"]
+    assert got["anticipate_count"] == 1
+    assert got["anticipate_distance"] == pytest.approx(D, abs=1e-3)
+    assert got["retreat_count"] == 0  # the draw-back is not read as a retreat
+    assert [e["kind"] for e in out["episodes"]][:3] == ["pause", "anticipate", "approach"]
+
+
+def test_a_retreat_with_a_pause_after_it_stays_a_retreat(env, tmp_path):
+    """The plugin's measurement claims only a move away that an approach follows at once:
+    a file without the kind measures as it always did."""
+    src = SEQUENCE.replace("  anticipate 10mm a=0.4\n",
+                           "  retreat 10mm a=0.4\n  pause 1s\n")
+    (tmp_path / "r.aou").write_text(src, encoding="utf-8")
+    run = aouc("compile", str(tmp_path / "r.aou"), "-o", str(tmp_path / "r.json"), env=env)
+    assert run.returncode == 0, run.stderr
+    run = aouc("measure", str(tmp_path / "r.json"), "--format", "json", env=env)
+    got = json.loads(run.stdout)["descriptors"]
+    assert got["retreat_count"] == 1 and got["anticipate_count"] == 0, got
+
+
+def test_dmp_export_has_a_part_for_it(env, files, tmp_path):
+    pytest.importorskip("movement_primitives")
+    out = tmp_path / "wind_up.dmp"
+    run = aouc("compile", str(files / "wind_up.aou"), "--format", "dmp", "-o", str(out),
+               env=env)
+    no_traceback(run)
+    assert run.returncode == 0, run.stderr
+    manifest = json.loads((out / "manifest.json").read_text(encoding="utf-8"))
+    assert "anticipate" in json.dumps(manifest)
+    kinds = [p.get("kind") for p in manifest.get("parts", manifest.get("episodes", []))]
+    assert "anticipate" in kinds, kinds
+
+
+@pytest.mark.parametrize("command", [("rules",), ("robot", "panda")])
+def test_rules_and_robot_list_the_plugin(env, command):
+    run = aouc(*command, env=env)
+    assert run.returncode == 0, run.stderr
+    assert "aou-anticipate" in run.stdout and "anticipate" in run.stdout
+    bare = aouc(*command, env=without_plugins())
+    assert "aou-anticipate" not in bare.stdout
+
+
+# --- uninstalled --------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("how", ["not installed", "AOU_NO_PLUGINS=1"])
+def test_uninstalled_the_kind_is_an_unknown_statement_saying_why(files, how, env):
+    run_env = without_plugins() if how == "not installed" else dict(env, AOU_NO_PLUGINS="1")
+    code, out = _lint(files / "wind_up.aou", run_env)
+    assert code == 1
+    (d,) = [d for d in out["diagnostics"] if d["severity"] == "error"]
+    assert d["code"] == "V101" and d["line"] == 7
+    assert "plugin" in d["message"] and "anticipate" in d["message"], d["message"]
+
+
+def test_uninstalled_aou_works_as_before(tmp_path):
+    """A shipped behaviour lints and compiles without the plugin, to the same bytes as
+    with it."""
+    src = ROOT / "behaviours" / "hesitant.aou"
+    outs = []
+    with installed(tmp_path / "with") as inst:
+        for name, env in (("with", inst.env), ("without", without_plugins())):
+            run = aouc("compile", str(src), "-o", str(tmp_path / f"{name}.json"), env=env)
+            assert run.returncode == 0, run.stderr
+            outs.append(json.loads((tmp_path / f"{name}.json").read_text(encoding="utf-8")))
+    for out in outs:
+        out.pop("generator", None)
+    assert outs[0]["q"] == outs[1]["q"]
+    assert outs[0]["episodes"] == outs[1]["episodes"]
+
+
+# --- a plugin with a part missing ---------------------------------------------------------
+
+
+def test_a_plugin_without_a_dmp_part_gets_k802(files, tmp_path):
+    with installed(tmp_path, "aou_anticipate.partial:without_dmp") as inst:
+        run = aouc("compile", str(files / "wind_up.aou"), "--format", "dmp", "-o",
+                   str(tmp_path / "w.dmp"), env=inst.env)
+    no_traceback(run)
+    assert run.returncode != 0
+    assert "K802" in run.stdout + run.stderr
+    assert "anticipate" in run.stdout + run.stderr and "dmp" in run.stdout + run.stderr
+    assert not (tmp_path / "w.dmp").exists()
+
+
+def test_a_plugin_without_a_measure_part_gets_k802(files, compiled, tmp_path):
+    with installed(tmp_path, "aou_anticipate.partial:without_measure") as inst:
+        run = aouc("measure", str(compiled), "--against", str(files / "wind_up.aou"),
+                   env=inst.env)
+    no_traceback(run)
+    assert run.returncode != 0
+    assert "K802" in run.stdout + run.stderr and "measure" in run.stdout + run.stderr
+
+
+def test_a_plugin_that_gives_no_kind_is_reported_k801(files, tmp_path):
+    with installed(tmp_path, "aou_anticipate.partial:nothing") as inst:
+        rules = aouc("rules", env=inst.env)
+        lint = aouc("lint", str(files / "wind_up.aou"), env=inst.env)
+    no_traceback(rules)
+    no_traceback(lint)
+    assert "K801" in rules.stdout + rules.stderr and "aou-anticipate" in rules.stdout + \
+        rules.stderr
+    assert lint.returncode == 1
+
+
+# --- the package itself -------------------------------------------------------------------
+
+
+_TEXT = (".py", ".md", ".json", ".toml", ".txt", ".js", ".html", ".css", ".lark")
+
+
+def naming(folder: Path, word: str = "anticipat") -> list[str]:
+    """The text files under ``folder`` that spell ``word`` (any case)."""
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob("*")
+                  if p.is_file() and p.suffix in _TEXT
+                  and word in p.read_text(encoding="utf-8", errors="replace").lower())
+
+
+def test_no_file_of_the_package_names_the_plugin_kind():
+    """aou knows the kind only through the installed plugin."""
+    assert naming(ROOT / "aou_dsl") == []
+
+
+def test_the_scan_finds_a_planted_name(tmp_path):
+    """The check above can fail: a copy of a module with the kind planted in it is found."""
+    (tmp_path / "lang").mkdir()
+    text = (ROOT / "aou_dsl" / "lang" / "layout.py").read_text(encoding="utf-8")
+    (tmp_path / "lang" / "layout.py").write_text(text + '\nKIND = "Anticipate"\n',
+                                                 encoding="utf-8")
+    (tmp_path / "lang" / "ir.py").write_text("x = 1\n", encoding="utf-8")
+    assert naming(tmp_path) == ["lang/layout.py"]
