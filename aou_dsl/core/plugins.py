@@ -15,11 +15,15 @@ environment the user chose, like a ``pip install``.
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from importlib import metadata
+from typing import TYPE_CHECKING
 
 from .memo import cached
+
+if TYPE_CHECKING:
+    from importlib import metadata
 
 __all__ = ["GROUP", "LAYERS", "Broken", "Plugin", "loaded", "part", "plugins"]
 
@@ -61,12 +65,21 @@ def _source(ep: metadata.EntryPoint) -> str:
     return f"{dist.name} {dist.version}" if dist is not None else ep.value
 
 
-@cached(maxsize=1)
 def loaded() -> tuple[tuple[Plugin, ...], tuple[Broken, ...]]:
     """Every plugin of :data:`GROUP` that loads, in the order of their names, and the
-    entry points that do not."""
-    if os.environ.get("AOU_NO_PLUGINS", "") not in ("", "0"):
+    entry points that do not. Kept by what it depends on: ``AOU_NO_PLUGINS`` and the
+    import path (where installed distributions are found); ``loaded.cache_clear()``
+    forgets it (after installing a package in the same process)."""
+    off = os.environ.get("AOU_NO_PLUGINS", "") not in ("", "0")
+    return _load(off, tuple(sys.path))
+
+
+@cached(maxsize=4)
+def _load(off: bool, path: tuple[str, ...]) -> tuple[tuple[Plugin, ...], tuple[Broken, ...]]:
+    if off:
         return (), ()
+    from importlib import metadata  # here: `import aou_dsl` and `aouc lint` stay light
+
     good: list[Plugin] = []
     bad: list[Broken] = []
     for ep in sorted(metadata.entry_points(group=GROUP), key=lambda e: (e.name, e.value)):
@@ -82,6 +95,9 @@ def loaded() -> tuple[tuple[Plugin, ...], tuple[Broken, ...]]:
             continue
         good.append(Plugin(ep.name, _source(ep), parts))
     return tuple(good), tuple(bad)
+
+
+loaded.cache_clear = _load.cache_clear  # type: ignore[attr-defined]
 
 
 def plugins() -> tuple[Plugin, ...]:
