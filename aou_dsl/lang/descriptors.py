@@ -29,6 +29,8 @@ from ..core import plugins as _plugins
 from ..core.codes import K801, K803
 from ..core.memo import table
 from .ir import State
+from .primitives import KINDS, PAUSE
+from .primitives.kind import Needs
 
 __all__ = [
     "DEFINITIONS",
@@ -282,31 +284,35 @@ class EpisodeValues:
                 **{k: round(v, 6) for k, v in self.values.items()}}
 
 
-#: Kinds that must sit between two pauses (before and after) to count, and kinds that
-#: must be followed by one.
-_BETWEEN_PAUSES = frozenset({"retreat"})
-_ENDS_AT_PAUSE = frozenset({"gaze"})
+def _needs(kind: str) -> Needs:
+    """What an episode of ``kind`` needs around it to count: the kind's own
+    :attr:`~.primitives.kind.Kind.needs` (none for a kind no registry knows)."""
+    k = KINDS.get(kind)
+    return k.needs if k is not None else _NO_NEEDS
+
+
+_NO_NEEDS = Needs()
 
 
 def qualify(episodes: Iterable[EpisodeValues]) -> list[EpisodeValues]:
     """The episodes as the definitions read them: touching pauses merged into one (their
-    durations added), and every episode marked whether it counts."""
+    durations added), and every episode marked whether it counts: whether the episodes
+    next to it are those its kind needs (:class:`~.primitives.kind.Needs`)."""
     merged: list[EpisodeValues] = []
     for e in episodes:
         last = merged[-1] if merged else None
-        if e.kind == "pause" and last is not None and last.kind == "pause":
+        if e.kind == PAUSE and last is not None and last.kind == PAUSE:
             duration = last.values.get("duration", 0.0) + e.values.get("duration", 0.0)
             merged[-1] = replace(last, t_end=e.t_end, values={"duration": duration})
         else:
             merged.append(e)
     out = []
     for i, e in enumerate(merged):
-        before = i > 0 and merged[i - 1].kind == "pause"
-        after = i + 1 < len(merged) and merged[i + 1].kind == "pause"
-        if e.kind in _BETWEEN_PAUSES:
-            e = replace(e, counts=before and after)
-        elif e.kind in _ENDS_AT_PAUSE:
-            e = replace(e, counts=after)
+        needs = _needs(e.kind)
+        if needs.around:
+            before = merged[i - 1].kind if i > 0 else None
+            after = merged[i + 1].kind if i + 1 < len(merged) else None
+            e = replace(e, counts=needs.met(before, after))
         out.append(e)
     return out
 

@@ -11,7 +11,7 @@ from .declared import source_of, written
 from .descriptors import REGISTRY, compare, derive
 from .ir import Behaviour
 from .layout import Laid, episode_values, layout
-from .primitives import KINDS, MIN_RETREAT
+from .primitives import KINDS, MIN_RETREAT, PAUSE
 from .timeline import Timeline
 from .values import Ctx
 
@@ -148,17 +148,27 @@ def _touching(ctx: Ctx, tl: Timeline) -> None:
                        hint="put a motion between them, or write one longer pause")
 
 
-_NEEDS = {"retreat": "a retreat counts only between two pauses, one before and one after it",
-          "gaze": "a gaze counts only when a pause ends it"}
-
-
-def _none_shown(kind: str, n_pauses: int) -> str:
-    """Why no episode of ``kind`` counts in the layout, in words."""
+def _none_shown(b: Behaviour, kind: str) -> str:
+    """Why no episode of ``kind`` counts in the layout, in words: what the kind needs
+    around it (:attr:`~.primitives.kind.Kind.needs`), and what of that the file lacks."""
     article = "an" if kind[0] in "aeiou" else "a"
-    why = _NEEDS.get(kind, f"no {kind} of its layout counts")
-    if kind in _NEEDS and n_pauses < (2 if kind == "retreat" else 1):
+    needs = KINDS[kind].needs if kind in KINDS else None
+    why = needs.words(kind, PAUSE) if needs is not None else None
+    if needs is None or why is None:
+        return f"no layout of this file can show {article} {kind}: no {kind} of its layout counts"
+    n_pauses = _count(b, PAUSE)
+    wanted = needs.around.count(PAUSE)
+    if wanted and n_pauses < wanted:
         why += f", and this file has {('no pause', 'only one pause')[n_pauses]}"
+    for other in dict.fromkeys(k for k in needs.around if k != PAUSE):
+        if not _count(b, other):
+            why += f", and this file has no {other}"
     return f"no layout of this file can show {article} {kind}: {why}"
+
+
+def _count(b: Behaviour, kind: str) -> int:
+    node = b.first(kind)
+    return node.count if node is not None else 0
 
 
 def _shown(name: str, value: float | int | None) -> str:
@@ -171,8 +181,6 @@ def _realisable(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
     """V121: the laid-out descriptor form must show the values the file writes. When no
     episode of a statement counts, one diagnostic says why: its values are absent for
     that one reason."""
-    pause = b.first("pause")
-    n_pauses = pause.count if pause is not None else 0
     said: set[int] = set()
     for m in compare(written(b), derive(episode_values(tl.episodes))):
         node = source_of(b, m.name)
@@ -181,7 +189,7 @@ def _realisable(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
         said.add(id(node))
         kind = REGISTRY[m.name].kind
         none = m.measured is None or (REGISTRY[m.name].is_count and m.measured == 0)
-        shows = _none_shown(kind, n_pauses) if none else \
+        shows = _none_shown(b, kind) if none else \
             f"no layout of this file can show more than {_shown(m.name, m.measured)}" \
             if REGISTRY[m.name].is_count else \
             f"its layout shows {_shown(m.name, m.measured)}"
