@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -27,9 +28,9 @@ standoff 0.10m
 sequence {
   pause 1s
   anticipate 10mm a=0.4
-  approach 0.1m a=0.04
+  approach 0.1m a=0.01
   pause 1s
-  approach a=0.04
+  approach a=0.01
 }
 """
 D, A = 0.010, 0.4
@@ -83,8 +84,8 @@ def test_lint_infers_the_state_with_the_plugin_kind(env, files):
     code, out = _lint(files / "wind_up.aou", env)
     assert code == 0, out
     assert [d["code"] for d in out["diagnostics"]] == ["M204"]
-    want, _ = infer(Composition(drive=max(A, 0.04), stillness=2.0))
-    without, _ = infer(Composition(drive=0.04, stillness=2.0))
+    want, _ = infer(Composition(drive=max(A, 0.01), stillness=2.0))
+    without, _ = infer(Composition(drive=0.01, stillness=2.0))
     assert (out["cv"]["C"], out["cv"]["V"]) == pytest.approx((want.C, want.V), abs=1e-3)
     assert out["cv"]["state"] == want.state.value
     assert without.state != want.state  # the test can tell the evidence was used
@@ -107,8 +108,8 @@ def test_lint_reports_the_plugin_kinds_own_checks(env, tmp_path):
 def test_lint_refuses_an_anticipation_no_approach_follows(env, tmp_path):
     """What the kind needs around it (an approach, directly after) is checked: an
     anticipation followed by a pause is refused, naming the kind."""
-    bad = SEQUENCE.replace("  anticipate 10mm a=0.4\n  approach 0.1m a=0.04\n",
-                           "  approach 0.1m a=0.04\n  anticipate 10mm a=0.4\n")
+    bad = SEQUENCE.replace("  anticipate 10mm a=0.4\n  approach 0.1m a=0.01\n",
+                           "  approach 0.1m a=0.01\n  anticipate 10mm a=0.4\n")
     (tmp_path / "late.aou").write_text(bad, encoding="utf-8")
     code, out = _lint(tmp_path / "late.aou", env)
     assert code == 1, out
@@ -248,11 +249,16 @@ def test_a_plugin_that_gives_no_kind_is_reported_k801(files, tmp_path):
 _TEXT = (".py", ".md", ".json", ".toml", ".txt", ".js", ".html", ".css", ".lark")
 
 
-def naming(folder: Path, word: str = "anticipat") -> list[str]:
-    """The text files under ``folder`` that spell ``word`` (any case)."""
+#: The kind's keyword, its descriptors' names (``anticipate_count``) and its node's class
+#: (``Anticipate``), in any case; not the English verb's other forms (``anticipates``).
+_NAMED = re.compile(r"anticipate(?![a-z])", re.IGNORECASE)
+
+
+def naming(folder: Path) -> list[str]:
+    """The text files under ``folder`` that name the plugin's kind."""
     return sorted(str(p.relative_to(folder)) for p in folder.rglob("*")
                   if p.is_file() and p.suffix in _TEXT
-                  and word in p.read_text(encoding="utf-8", errors="replace").lower())
+                  and _NAMED.search(p.read_text(encoding="utf-8", errors="replace")))
 
 
 def test_no_file_of_the_package_names_the_plugin_kind():

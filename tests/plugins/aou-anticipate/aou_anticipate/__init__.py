@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
-from . import dmp, editor
+from . import dmp, editor, media, studio
 from .descriptors import DESCRIPTORS
 from .kind import NAME, Anticipate, AnticipateKind
 from .measure import Recognise
@@ -26,4 +26,6 @@ plugin = SimpleNamespace(
     measure=Recognise(),
     dmp=dmp,
     editor=editor,
+    studio=studio,
+    media=media,
 )

@@ -14,7 +14,8 @@ from typing import Literal
 from aou_dsl.core.codes import V113, V130
 from aou_dsl.core.units import Dim
 from aou_dsl.lang.ir import DEFAULTS, Node
-from aou_dsl.lang.primitives.kind import MIN_RETREAT, Key, Kind, Timing, fmt, move
+from aou_dsl.lang.primitives import APPROACH
+from aou_dsl.lang.primitives.kind import MIN_RETREAT, Key, Kind, Needs, Timing, fmt, move
 from aou_dsl.lang.timeline import Episode, Pose
 
 __all__ = ["NAME", "Anticipate", "AnticipateKind", "DEFAULT_A", "MAX_DISTANCE"]
@@ -52,6 +53,9 @@ class AnticipateKind(Kind):
     #: The wind-up of a committed approach: its peak acceleration adds to the drive, as
     #: an approach's does (the largest of them counts).
     evidence = {"drive": ("peak_acceleration", "max")}
+    #: It comes directly before an approach, nothing between (a pause would make it a
+    #: retreat of its own): the layout puts it there, and only there does it count.
+    needs = Needs(followed_by=APPROACH)
     look = (f"moves away from the goal, by {MIN_RETREAT * 1000:g} to "
             f"{MAX_DISTANCE * 1000:g} mm, and an approach follows at once")
 
