@@ -112,8 +112,8 @@ def test_the_measure_pass_claims_only_a_draw_back_before_an_approach(plugin, epi
 
 
 def _doc(text: str):
-    from aou_dsl.editor.state import Document
     from aou_dsl.editor.convert import Text
+    from aou_dsl.editor.state import Document
 
     return Document(uri="file:///w.aou", path="/w.aou", view=Text(text))
 
