@@ -137,12 +137,17 @@ def test_measure_reads_it_back_as_declared(env, files, compiled):
                "--format", "json", env=env)
     no_traceback(run)
     assert run.returncode == 0, run.stdout + run.stderr
+    rows = {r["descriptor"]: r for r in json.loads(run.stdout)["descriptors"]}
+    assert (rows["anticipate_count"]["declared"], rows["anticipate_count"]["measured"]) \
+        == (1, 1)
+    assert rows["anticipate_distance"]["declared"] == pytest.approx(D)
+    assert rows["anticipate_distance"]["measured"] == pytest.approx(D, abs=1e-3)
+    assert all(r["result"] == "pass" for r in rows.values()), rows
+    run = aouc("measure", str(compiled), "--format", "json", env=env)
     out = json.loads(run.stdout)
-    got = out["descriptors"]
-    assert got["anticipate_count"] == 1
-    assert got["anticipate_distance"] == pytest.approx(D, abs=1e-3)
-    assert got["retreat_count"] == 0  # the draw-back is not read as a retreat
-    assert [e["kind"] for e in out["episodes"]][:3] == ["pause", "anticipate", "approach"]
+    assert out["descriptors"]["retreat_count"] == 0  # the draw-back is no retreat
+    assert [e["kind"] for e in out["episodes"]] == \
+        ["pause", "anticipate", "approach", "pause", "approach"]
 
 
 def test_a_retreat_with_a_pause_after_it_stays_a_retreat(env, tmp_path):
