@@ -105,9 +105,13 @@ def test_lint_reports_the_plugin_kinds_own_checks(env, tmp_path):
     assert got == [(7, "V123"), (8, "V130"), (9, "V102"), (10, "V113")], got
 
 
+@pytest.mark.xfail(strict=True, reason="a kind's needs are read by the descriptors' "
+                   "qualifying and by V121 in the descriptor form; nothing yet checks a "
+                   "sequence's statements against them")
 def test_lint_refuses_an_anticipation_no_approach_follows(env, tmp_path):
     """What the kind needs around it (an approach, directly after) is checked: an
-    anticipation followed by a pause is refused, naming the kind."""
+    anticipation followed by a pause is refused, naming the kind. Accepted, it would not
+    count as declared, yet be measured as a retreat between two pauses."""
     bad = SEQUENCE.replace("  anticipate 10mm a=0.4\n  approach 0.1m a=0.01\n",
                            "  approach 0.1m a=0.01\n  anticipate 10mm a=0.4\n")
     (tmp_path / "late.aou").write_text(bad, encoding="utf-8")
