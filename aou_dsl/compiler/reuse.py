@@ -15,8 +15,8 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 
 from ..core.memo import Keyed, cached
-from ..lang.primitives import KINDS
 from ..robot.ik import solve_path
+from .kind_timing import timing_of
 from .timing import time_path
 
 if TYPE_CHECKING:
@@ -73,4 +73,4 @@ def _timed(probe: Keyed):
 
 
 def _time(arm, s, q_path, ep):
-    return time_path(arm, s, q_path, ep.a, ep.vmax, cartesian=KINDS[ep.kind].translation)
+    return time_path(arm, s, q_path, ep.a, ep.vmax, cartesian=timing_of(ep.kind).translation)

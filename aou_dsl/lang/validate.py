@@ -18,7 +18,7 @@ from ..core.diagnostics import Diagnostic, Span
 from .ir import Behaviour, Node, State
 from .layout import Laid
 from .parse import Colon, SequenceBlock, Statement, SyntaxTree, Word
-from .primitives import GAZE, KINDS, plugin_problems
+from .primitives import GAZE, KINDS, Timing, plugin_problems
 from .settings import SETTINGS, read_settings
 from .timeline import Timeline
 from .values import Ctx, Reader, did_you_mean, fix_word
@@ -71,7 +71,9 @@ class Validated:
 def primitive(ctx: Ctx, st: Statement, in_sequence: bool) -> Node | None:
     """A primitive statement as IR, or None (with diagnostics) when it does not fit."""
     kind = KINDS[st.keyword]
-    return kind.read(Reader(ctx, st, kind, in_sequence))
+    # an oscillation lasts a number of swings, or `for DURATION`
+    return kind.read(Reader(ctx, st, kind, in_sequence,
+                            takes_for=kind.timing is Timing.OSCILLATION))
 
 
 def _header(ctx: Ctx, st: Statement) -> tuple[str | None, State | None]:

@@ -18,6 +18,7 @@ from types import MappingProxyType
 from ...core import plugins as _plugins
 from ...core.codes import K801, K803
 from ...core.memo import table
+from ..evidence import evidence_problem
 from .approach import Approach, ApproachKind
 from .gaze import GAZE_ANGULAR_ACCEL, Gaze, GazeKind
 from .kind import LOOK_SLACK, MIN_ANGLE, MIN_PAUSE, MIN_RETREAT, Kind, Timing
@@ -100,6 +101,11 @@ def _problem_of_kind(p: _plugins.Plugin, taken: Mapping[str, object]) -> PluginP
     if not _WORD.match(p.name):
         return PluginProblem(K801, p.name, p.source,
                              "its keyword is not a lower-case word of the language")
+    why = evidence_problem(getattr(kind, "evidence", None))
+    if why is None and not isinstance(getattr(kind, "timing", None), Timing):
+        why = "its `timing` is not one of aou's Timing"
+    if why is not None:
+        return PluginProblem(K801, p.name, p.source, why)
     if p.name in taken:
         who = "a built-in kind" if p.name in BUILTIN_KINDS else "an earlier plugin"
         return PluginProblem(K803, p.name, p.source,
