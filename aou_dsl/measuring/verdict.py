@@ -270,7 +270,7 @@ def judge(rec: Trajectory, behaviour: str | FileResult) -> Verdict:
         raise AouError([d for d in lint.diagnostics if d.severity is Severity.ERROR]
                        or lint.diagnostics)
     unread = missing_part({e.kind for e in lint.timeline.episodes},
-                          {p.kind: p.span for p in reversed(lint.behaviour.primitives)})
+                          {e.kind: e.span for e in reversed(lint.timeline.episodes)})
     if unread:  # its episodes would be measured as other kinds: every verdict wrong
         raise AouError(unread)
     from_file = rec.goal is None
