@@ -31,7 +31,7 @@ from ..core.diagnostics import AouError, Severity, Span, diag
 from ..lang.primitives import APPROACH, GAZE, PAUSE, RETREAT, SHIVER, TILT
 
 __all__ = ["LAYER", "PARAMETER_LINES", "DmpKind", "DmpKindPart", "Scaling", "Shape",
-           "dmp_kind", "dmp_kinds", "parameter_lines", "pinnable"]
+           "dmp_kind", "dmp_kinds", "moves", "parameter_lines", "pinnable", "shape_of"]
 
 #: The plugin part this registry reads.
 LAYER = "dmp"
@@ -222,6 +222,17 @@ def parameter_lines() -> list[tuple[tuple[str, str], str]]:
         if name not in BUILTIN:
             out.extend(((name, key), text) for key, text in entry.parameters.items())
     return out
+
+
+def moves() -> tuple[str, ...]:
+    """The kinds whose episodes become a CartesianDMP (:attr:`Shape.MOVE`)."""
+    return tuple(name for name, entry in dmp_kinds().items() if entry.shape is Shape.MOVE)
+
+
+def shape_of(kind: str) -> Shape | None:
+    """The shape of ``kind``'s parts; None for a kind no DMP folder holds."""
+    entry = dmp_kinds().get(kind)
+    return entry.shape if entry is not None else None
 
 
 def pinnable() -> tuple[str, ...]:

@@ -12,6 +12,7 @@ from ..lang.descriptors import DEFINITIONS, REGISTRY, Descriptor
 from ..lang.ir import State
 from ..lang.primitives import KINDS
 from . import lsp_engine as engine
+from .kind_texts import definition, texts_of
 from .state import Document
 from .text import Tok, at, statement_at, tokens_of
 
@@ -37,14 +38,24 @@ def rule_text(code: str) -> str | None:
             f"example:\n\n{example}")
 
 
+def _descriptors() -> tuple[Descriptor, ...]:
+    """The registry's descriptors, then the loaded plugins'."""
+    from ..lang import descriptors as table
+
+    every = getattr(table, "every_descriptor", None)
+    return tuple(every()) if every is not None else tuple(REGISTRY.values())
+
+
 def descriptor_for(keyword: str, slot: str, plane: str | None = None) -> Descriptor | None:
     """The descriptor a statement's argument sets: ``slot`` is a key (``a``), ``x``
     (the count) or ``value`` (the positional quantity)."""
     kind = KINDS.get(keyword)
     if kind is None:
         return None
-    for d in REGISTRY.values():
-        if d.kind != keyword or (keyword == "gaze" and d.key != plane):
+    texts = texts_of(keyword)
+    by_plane = texts is not None and bool(texts.planes)
+    for d in _descriptors():
+        if d.kind != keyword or (by_plane and d.key != plane):
             continue
         if slot == "x" and d.is_count:
             return d
@@ -67,7 +78,8 @@ def describe(d: Descriptor) -> str:
             way = up if d.stronger[s] > 0 else down
             found.append(f"- {s}: looks more {s} as it is {way}")
     study = "\n".join(found) or "- the study found no effect of it on any state"
-    return (f"**{d.name}** ({unit}): {DEFINITIONS[d.name]}.\n\n"
+    meaning = DEFINITIONS.get(d.name) or definition(d.name, d.kind)
+    return (f"**{d.name}** ({unit}): {meaning}.\n\n"
             f"What the study found (one descriptor varied at a time):\n\n{study}")
 
 
@@ -83,7 +95,9 @@ def _key_text(keyword: str, key: str) -> str | None:
 def _argument(stmt: list[Tok], tok: Tok) -> str | None:
     """Hover on an argument: the descriptor it sets, or its key's meaning."""
     keyword = stmt[0].text
-    plane = next((t.text for t in stmt if t.text in ("horizontal", "vertical")), None)
+    texts = texts_of(keyword)
+    planes = texts.planes if texts is not None else ()
+    plane = next((t.text for t in stmt if t.text in planes), None)
     i = stmt.index(tok)
     if tok.text == "=" and i >= 1:
         tok, i = stmt[i - 1], i - 1
@@ -146,9 +160,11 @@ def _episodes(doc: Document, line: int, stmt: list[Tok]) -> str | None:
 
 
 def _planned(ep) -> str:
-    if not ep.moving or ep.kind == "shiver":
-        return f": {math.degrees(ep.amplitude):.3g} deg at {ep.f:g} Hz" \
-            if ep.kind == "shiver" else ""
+    texts = texts_of(ep.kind)
+    if texts is not None and texts.planned is not None:
+        return texts.planned(ep)
+    if not ep.moving:
+        return ""
     peak = min(ep.vmax, math.sqrt(ep.a * ep.path_length)) if ep.a > 0 else ep.vmax
     if KINDS[ep.kind].translation:
         return f": peak speed {peak:.3f} m/s, acceleration {ep.a:.3g} m/s^2"

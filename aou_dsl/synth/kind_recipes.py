@@ -25,8 +25,8 @@ from ..lang.descriptors import REGISTRY, Descriptor
 from ..lang.ir import State
 from ..lang.primitives import APPROACH, GAZE, PAUSE, RETREAT, SHIVER, TILT
 
-__all__ = ["LAYER", "KindRecipe", "SynthKindPart", "descriptors", "kind_recipes", "slots",
-           "span_of", "spans"]
+__all__ = ["LAYER", "KindRecipe", "SynthKindPart", "all_descriptors", "descriptors",
+           "kind_recipes", "pauses_needed", "slots", "span_of", "spans"]
 
 #: The plugin part this registry reads.
 LAYER = "synth"
@@ -120,7 +120,9 @@ def slots() -> tuple[Slot, ...]:
     return tuple((k, plane) for k, r in kind_recipes().items() for plane in r.planes)
 
 
-def _every() -> tuple[Descriptor, ...]:
+def all_descriptors() -> tuple[Descriptor, ...]:
+    """Every descriptor: the registry's, then the loaded plugins' (when the descriptor
+    table offers them)."""
     from ..lang import descriptors as table
 
     every = getattr(table, "every_descriptor", None)
@@ -131,7 +133,7 @@ def descriptors() -> tuple[Descriptor, ...]:
     """The descriptors synthesis reads and writes: the registry's, then the plugin
     kinds' that take part (those of a kind left out are not)."""
     kinds = kind_recipes()
-    return tuple(d for d in _every() if d.kind in kinds)
+    return tuple(d for d in all_descriptors() if d.kind in kinds)
 
 
 def spans() -> dict[State, dict[tuple[str, str], float]]:
@@ -142,6 +144,13 @@ def spans() -> dict[State, dict[tuple[str, str], float]]:
             row = out.setdefault(state, {})
             row.update({(kind, key): span for key, span in by_key.items()})
     return dict(sorted(out.items(), key=lambda i: list(State).index(i[0])))
+
+
+def pauses_needed(count: Callable[[str, str | None], int]) -> int:
+    """The pauses the episodes of a file need around them, ``count(kind, plane)`` the
+    episodes of each statement."""
+    return sum(r.pauses(sum(count(kind, plane) for plane in r.planes))
+               for kind, r in kind_recipes().items())
 
 
 def span_of(state: State, kind: str, key: str) -> float | None:
