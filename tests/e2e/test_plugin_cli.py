@@ -122,6 +122,47 @@ def test_lint_refuses_an_anticipation_no_approach_follows(env, tmp_path):
     assert any("anticipat" in d["message"] for d in errors), errors
 
 
+DESCRIPTOR_FORM = """\
+behaviour wind_up2 : confident
+robot panda
+start 0.35m
+standoff 0.10m
+approach a=0.1
+anticipate 12mm a=0.3 x2
+pause 1s x2
+"""
+
+
+def test_the_descriptor_form_lays_each_anticipation_before_an_approach(env, tmp_path):
+    """Laid out from the kind's needs: each of the two anticipations directly before a
+    piece of the approach, and the file measures as it declares."""
+    src = tmp_path / "d.aou"
+    src.write_text(DESCRIPTOR_FORM, encoding="utf-8")
+    out = tmp_path / "d.json"
+    run = aouc("compile", str(src), "-o", str(out), env=env)
+    no_traceback(run)
+    assert run.returncode == 0, run.stdout + run.stderr
+    kinds = [e["kind"] for e in json.loads(out.read_text(encoding="utf-8"))["episodes"]]
+    at = [i for i, k in enumerate(kinds) if k == "anticipate"]
+    assert len(at) == 2 and all(kinds[i + 1] == "approach" for i in at), kinds
+    run = aouc("measure", str(out), "--against", str(src), "--format", "json", env=env)
+    assert run.returncode == 0, run.stdout + run.stderr
+    rows = {r["descriptor"]: r for r in json.loads(run.stdout)["descriptors"]}
+    assert rows["anticipate_count"]["measured"] == 2
+    assert rows["anticipate_distance"]["measured"] == pytest.approx(0.012, abs=1e-3)
+
+
+def test_the_descriptor_form_without_an_approach_is_refused_by_its_needs(env, tmp_path):
+    """No approach, so no layout can show an anticipation: V121 says what the kind
+    needs."""
+    src = tmp_path / "n.aou"
+    src.write_text(DESCRIPTOR_FORM.replace("approach a=0.1\n", ""), encoding="utf-8")
+    code, out = _lint(src, env)
+    assert code == 1
+    (d,) = [d for d in out["diagnostics"] if d["severity"] == "error"]
+    assert d["code"] == "V121" and "approach" in d["message"], d
+
+
 def test_compile_times_the_kind_by_its_law_and_checks_it(compiled):
     """The anticipation is an episode of its own in the trajectory, timed rest to rest
     at its peak acceleration (a bang-bang profile: ``2 sqrt(d / a)`` under the speed
