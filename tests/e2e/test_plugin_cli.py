@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.plugins.install import ROOT, installed, without_plugins
+from tests.plugins.install import ROOT, for_commands, without_plugins
 
 AOUC = [sys.executable, "-m", "aou_dsl"]
 
@@ -49,8 +49,7 @@ def no_traceback(run: subprocess.CompletedProcess) -> None:
 @pytest.fixture(scope="module")
 def env(tmp_path_factory) -> dict[str, str]:
     """The environment of an ``aouc`` that has the plugin installed."""
-    with installed(tmp_path_factory.mktemp("plugin")) as inst:
-        yield inst.env
+    return for_commands(tmp_path_factory.mktemp("plugin")).env
 
 
 @pytest.fixture(scope="module")
@@ -248,11 +247,11 @@ def test_uninstalled_aou_works_as_before(tmp_path):
     with it."""
     src = ROOT / "behaviours" / "hesitant.aou"
     outs = []
-    with installed(tmp_path / "with") as inst:
-        for name, env in (("with", inst.env), ("without", without_plugins())):
-            run = aouc("compile", str(src), "-o", str(tmp_path / f"{name}.json"), env=env)
-            assert run.returncode == 0, run.stderr
-            outs.append(json.loads((tmp_path / f"{name}.json").read_text(encoding="utf-8")))
+    inst = for_commands(tmp_path / "with")
+    for name, env in (("with", inst.env), ("without", without_plugins())):
+        run = aouc("compile", str(src), "-o", str(tmp_path / f"{name}.json"), env=env)
+        assert run.returncode == 0, run.stderr
+        outs.append(json.loads((tmp_path / f"{name}.json").read_text(encoding="utf-8")))
     for out in outs:
         out.pop("generator", None)
     assert outs[0]["q"] == outs[1]["q"]
@@ -263,9 +262,9 @@ def test_uninstalled_aou_works_as_before(tmp_path):
 
 
 def test_a_plugin_without_a_dmp_part_gets_k802(files, tmp_path):
-    with installed(tmp_path, "aou_anticipate.partial:without_dmp") as inst:
-        run = aouc("compile", str(files / "wind_up.aou"), "--format", "dmp", "-o",
-                   str(tmp_path / "w.dmp"), env=inst.env)
+    inst = for_commands(tmp_path, "aou_anticipate.partial:without_dmp")
+    run = aouc("compile", str(files / "wind_up.aou"), "--format", "dmp", "-o",
+               str(tmp_path / "w.dmp"), env=inst.env)
     no_traceback(run)
     assert run.returncode != 0
     assert "K802" in run.stdout + run.stderr
@@ -274,18 +273,18 @@ def test_a_plugin_without_a_dmp_part_gets_k802(files, tmp_path):
 
 
 def test_a_plugin_without_a_measure_part_gets_k802(files, compiled, tmp_path):
-    with installed(tmp_path, "aou_anticipate.partial:without_measure") as inst:
-        run = aouc("measure", str(compiled), "--against", str(files / "wind_up.aou"),
-                   env=inst.env)
+    inst = for_commands(tmp_path, "aou_anticipate.partial:without_measure")
+    run = aouc("measure", str(compiled), "--against", str(files / "wind_up.aou"),
+               env=inst.env)
     no_traceback(run)
     assert run.returncode != 0
     assert "K802" in run.stdout + run.stderr and "measure" in run.stdout + run.stderr
 
 
 def test_a_plugin_that_gives_no_kind_is_reported_k801(files, tmp_path):
-    with installed(tmp_path, "aou_anticipate.partial:nothing") as inst:
-        rules = aouc("rules", env=inst.env)
-        lint = aouc("lint", str(files / "wind_up.aou"), env=inst.env)
+    inst = for_commands(tmp_path, "aou_anticipate.partial:nothing")
+    rules = aouc("rules", env=inst.env)
+    lint = aouc("lint", str(files / "wind_up.aou"), env=inst.env)
     no_traceback(rules)
     no_traceback(lint)
     assert "K801" in rules.stdout + rules.stderr and "aou-anticipate" in rules.stdout + \

@@ -11,7 +11,7 @@ import sys
 import pytest
 
 from tests.plugins.anticipate_gen import generate
-from tests.plugins.install import installed
+from tests.plugins.install import for_commands
 
 AOUC = [sys.executable, "-m", "aou_dsl"]
 
@@ -39,24 +39,24 @@ def _round_trip(seeds: range, tmp_path) -> None:
         path = tmp_path / f"gen{seed}.aou"
         path.write_text(g.text, encoding="utf-8")
         files.append((path, g))
-    with installed(tmp_path) as inst:
-        out = tmp_path / "out"
-        run = subprocess.run([*AOUC, "compile", *(str(p) for p, _ in files), "-o",
-                              str(out)], capture_output=True, text=True, env=inst.env,
-                             timeout=600)
-        assert run.returncode == 0, run.stdout + run.stderr
-        for path, g in files:
-            traj = out / f"{path.stem}.json"
-            run = subprocess.run([*AOUC, "measure", str(traj), "--against", str(path),
-                                  "--format", "json"], capture_output=True, text=True,
-                                 env=inst.env, timeout=300)
-            assert run.returncode == 0, f"{g.text}\n{run.stdout}{run.stderr}"
-            rows = {r["descriptor"]: r for r in json.loads(run.stdout)["descriptors"]}
-            wrong = {name: (want, rows[name]["declared"], rows[name]["measured"])
-                     for name, want in g.expected.items()
-                     if not (_close(name, want, rows[name]["declared"])
-                             and _close(name, want, rows[name]["measured"]))}
-            assert not wrong, f"{g.text}\n{wrong}"
+    env = for_commands(tmp_path).env
+    out = tmp_path / "out"
+    run = subprocess.run([*AOUC, "compile", *(str(p) for p, _ in files), "-o",
+                          str(out)], capture_output=True, text=True, env=env,
+                         timeout=600)
+    assert run.returncode == 0, run.stdout + run.stderr
+    for path, g in files:
+        traj = out / f"{path.stem}.json"
+        run = subprocess.run([*AOUC, "measure", str(traj), "--against", str(path),
+                              "--format", "json"], capture_output=True, text=True,
+                             env=env, timeout=300)
+        assert run.returncode == 0, f"{g.text}\n{run.stdout}{run.stderr}"
+        rows = {r["descriptor"]: r for r in json.loads(run.stdout)["descriptors"]}
+        wrong = {name: (want, rows[name]["declared"], rows[name]["measured"])
+                 for name, want in g.expected.items()
+                 if not (_close(name, want, rows[name]["declared"])
+                         and _close(name, want, rows[name]["measured"]))}
+        assert not wrong, f"{g.text}\n{wrong}"
 
 
 def test_generated_files_using_the_plugin_measure_as_declared(tmp_path):

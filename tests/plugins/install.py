@@ -19,7 +19,8 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["PACKAGE", "ROOT", "Installed", "clear_caches", "installed", "without_plugins"]
+__all__ = ["PACKAGE", "ROOT", "Installed", "clear_caches", "for_commands", "installed",
+           "without_plugins", "write_dist"]
 
 ROOT = Path(__file__).resolve().parents[2]
 #: The plugin's project folder (its pyproject.toml and the `aou_anticipate` package).
@@ -62,16 +63,24 @@ def _env(paths: list[str]) -> dict[str, str]:
     return env
 
 
-@contextmanager
-def installed(tmp: Path, entry: str = "aou_anticipate:plugin") -> Iterator[Installed]:
-    """The plugin installed (its entry point pointing at ``entry``) while inside."""
+def for_commands(tmp: Path, entry: str = "aou_anticipate:plugin") -> Installed:
+    """The plugin installed in ``tmp`` for ``aouc`` subprocesses only (this process's
+    import path is left as it is): run them with the returned ``env``."""
     site = tmp / "site"
     write_dist(site, entry)
-    paths = [str(site), str(PACKAGE)]
+    return Installed(site, _env([str(site), str(PACKAGE)]))
+
+
+@contextmanager
+def installed(tmp: Path, entry: str = "aou_anticipate:plugin") -> Iterator[Installed]:
+    """The plugin installed (its entry point pointing at ``entry``) while inside, for
+    this process and for ``aouc`` subprocesses."""
+    inst = for_commands(tmp, entry)
+    paths = [str(inst.site), str(PACKAGE)]
     sys.path[:0] = paths
     clear_caches()
     try:
-        yield Installed(site, _env(paths))
+        yield inst
     finally:
         for p in paths:
             sys.path.remove(p)
