@@ -147,6 +147,8 @@ def to_dmp(trajectory: Any, *, intensity: float = 0.5, behaviour: str | None = N
                             "compiler: only a compiled trajectory can become DMPs",
                             _span(tr), hint="compile the .aou file, or give the .json "
                             "`aouc compile` wrote"))
+    shapes = {kind: (entry.shape if (entry := dmp_kind(kind, _span(tr))) else None)
+              for kind in dict.fromkeys(k for k, _a, _e in tr.episodes)}
     arm = load_arm(tr.robot, tr.ee_frame)
     cols = tr.columns(arm.joint_names)
     q = np.asarray(tr.q[:, cols], dtype=float)
@@ -158,8 +160,6 @@ def to_dmp(trajectory: Any, *, intensity: float = 0.5, behaviour: str | None = N
     if acc is None:
         acc = np.gradient(np.gradient(pos, tr.t, axis=0), tr.t, axis=0)
     j = arm.joint_names.index(arm.spec.shiver_joint)
-    shapes = {kind: (entry.shape if (entry := dmp_kind(kind, _span(tr))) else None)
-              for kind in dict.fromkeys(k for k, _a, _e in tr.episodes)}
     parts: list[DmpPart] = []
     for kind, a, e in tr.episodes:
         i0 = int(np.searchsorted(tr.t, a - 1e-9))
@@ -177,7 +177,9 @@ def to_dmp(trajectory: Any, *, intensity: float = 0.5, behaviour: str | None = N
             part.end = pose0
             part.values = _shiver_values(q[i0:i1 + 1, j] - q[i0, j], part.duration)
         else:
-            part.kind = PAUSE if shape is not Shape.MOVE else kind
+            # a hold (or a move too short to fit) keeps the pose; a kind no DMP folder
+            # holds is written as a pause
+            part.kind = kind if shape in (Shape.MOVE, Shape.HOLD) else PAUSE
             part.end = pose0
         parts.append(part)
     measured = descriptors or measure(tr).descriptors.to_json()

@@ -31,7 +31,8 @@ from ..core.diagnostics import AouError, Severity, Span, diag
 from ..lang.primitives import APPROACH, GAZE, PAUSE, RETREAT, SHIVER, TILT
 
 __all__ = ["LAYER", "PARAMETER_LINES", "DmpKind", "DmpKindPart", "Scaling", "Shape",
-           "dmp_kind", "dmp_kinds", "moves", "parameter_lines", "pinnable", "shape_of"]
+           "descriptor_name", "dmp_kind", "dmp_kinds", "moves", "parameter_lines",
+           "pinnable", "scaled", "shape_of"]
 
 #: The plugin part this registry reads.
 LAYER = "dmp"
@@ -235,7 +236,23 @@ def shape_of(kind: str) -> Shape | None:
     return entry.shape if entry is not None else None
 
 
+def descriptor_name(kind: str, key: str) -> str | None:
+    """The name of the descriptor read from ``kind`` episodes by ``key`` (``""``: the
+    count), or None when there is none (a plugin's scaling of a key it does not report)."""
+    from ..synth.kind_recipes import all_descriptors
+
+    return next((d.name for d in all_descriptors() if d.kind == kind
+                 and (d.key == key or (d.is_count and key == ""))), None)
+
+
+def scaled() -> list[tuple[str, str, Scaling]]:
+    """Every ``(kind, descriptor name, scaling)`` a rollout predicts, in the registry's
+    order (scalings of keys without a descriptor are left out)."""
+    return [(kind, name, how) for kind, entry in dmp_kinds().items()
+            for key, how in entry.scaling.items()
+            if (name := descriptor_name(kind, key)) is not None]
+
+
 def pinnable() -> tuple[str, ...]:
     """The kinds whose peak acceleration a rollout may keep (``aouc dmp roll --pin``)."""
-    return tuple(name for name, entry in dmp_kinds().items()
-                 if Scaling.PEAK in entry.scaling.values())
+    return tuple(dict.fromkeys(kind for kind, _name, how in scaled() if how is Scaling.PEAK))

@@ -42,25 +42,17 @@ from ..core.diagnostics import AouError, Span, diag
 from ..lang.primitives import PAUSE
 from .allowed import DIVERGED, Diverged, check_goal, check_options
 from .export import DmpSequence
-from .parts import Scaling, Shape, dmp_kinds, shape_of
+from .parts import Scaling, Shape, descriptor_name, dmp_kinds, scaled, shape_of
 
 __all__ = ["Rollout", "predict", "roll", "similarity"]
 
 _WHERE = Span.whole_file("<dmp>")
 
 
-def _name(kind: str, key: str) -> str:
-    """The descriptor read from ``kind`` episodes by ``key`` (the registry's name)."""
-    from ..synth.recipe import descriptor
-
-    return descriptor(kind, key).name
-
-
 def _accel() -> dict[str, str]:
     """The moving kinds whose peak acceleration is a descriptor (a rollout may pin it),
     and its name."""
-    return {kind: _name(kind, key) for kind, entry in dmp_kinds().items()
-            for key, how in entry.scaling.items() if how is Scaling.PEAK}
+    return {kind: name for kind, name, how in scaled() if how is Scaling.PEAK}
 
 #: Step of the DMPs' rollouts [s] (the library integrates orientation every millisecond
 #: within it); the rollout is then sampled at the sequence's rate through a cubic spline.
@@ -147,20 +139,18 @@ def predict(seq: DmpSequence, s: float, k: float, factors: dict[str, float],
         if out.get(name) is not None:
             out[name] = out[name] * f
 
-    for kind, entry in dmp_kinds().items():
-        for key, how in entry.scaling.items():
-            name = _name(kind, key)
-            f = factors.get(name, 1.0)
-            if how is Scaling.PEAK:
-                times(name, f if name in pinned else s * f / k ** 2)
-            elif how is Scaling.TIME:
-                times(name, k * f)
-            elif how is Scaling.SPACE:
-                times(name, s)
-            elif how is Scaling.RATE:
-                times(name, 1.0 / k)
-            else:
-                times(name, f)
+    for _kind, name, how in scaled():
+        f = factors.get(name, 1.0)
+        if how is Scaling.PEAK:
+            times(name, f if name in pinned else s * f / k ** 2)
+        elif how is Scaling.TIME:
+            times(name, k * f)
+        elif how is Scaling.SPACE:
+            times(name, s)
+        elif how is Scaling.RATE:
+            times(name, 1.0 / k)
+        else:
+            times(name, f)
     return out
 
 
@@ -376,10 +366,11 @@ def _plans(seq: DmpSequence, p0: np.ndarray, s: float, r: np.ndarray, time_scale
             cycles = max(3, int(round(p.values["cycles"] * time_scale)))
             freq = p.values["frequency"]
             amp = math.radians(p.values["amplitude"]) * factors.get(
-                _name(p.kind, "amplitude"), 1.0)
+                descriptor_name(p.kind, "amplitude") or "", 1.0)
             plans.append(_Plan(p.kind, t0, cycles / freq, amplitude=amp, freq=freq))
         else:
-            dur = p.duration * time_scale * factors.get(_name(PAUSE, "duration"), 1.0)
+            hold = descriptor_name(PAUSE, "duration") or ""
+            dur = p.duration * time_scale * factors.get(hold, 1.0)
             # A motion's fitted tails reach into a hold by about half its margin, and
             # stretch with its time scale: the hold gives back what the stretch adds.
             dur += sum(0.5 * seq.parts[j].lead * (ks[j] - 1.0) for j in (i - 1, i + 1)

@@ -8,9 +8,10 @@ import re
 
 from lsprotocol import types
 
-from ..lang.descriptors import DEFINITIONS, REGISTRY, Descriptor
+from ..lang.descriptors import DEFINITIONS, Descriptor
 from ..lang.ir import State
 from ..lang.primitives import KINDS
+from ..synth.kind_recipes import all_descriptors
 from . import lsp_engine as engine
 from .kind_texts import definition, texts_of
 from .state import Document
@@ -38,14 +39,6 @@ def rule_text(code: str) -> str | None:
             f"example:\n\n{example}")
 
 
-def _descriptors() -> tuple[Descriptor, ...]:
-    """The registry's descriptors, then the loaded plugins'."""
-    from ..lang import descriptors as table
-
-    every = getattr(table, "every_descriptor", None)
-    return tuple(every()) if every is not None else tuple(REGISTRY.values())
-
-
 def descriptor_for(keyword: str, slot: str, plane: str | None = None) -> Descriptor | None:
     """The descriptor a statement's argument sets: ``slot`` is a key (``a``), ``x``
     (the count) or ``value`` (the positional quantity)."""
@@ -54,7 +47,7 @@ def descriptor_for(keyword: str, slot: str, plane: str | None = None) -> Descrip
         return None
     texts = texts_of(keyword)
     by_plane = texts is not None and bool(texts.planes)
-    for d in _descriptors():
+    for d in all_descriptors():
         if d.kind != keyword or (by_plane and d.key != plane):
             continue
         if slot == "x" and d.is_count:

@@ -21,6 +21,7 @@ from typing import Protocol, runtime_checkable
 from ..core import plugins as _plugins
 from ..lang.descriptors import REGISTRY, Descriptor
 from ..lang.primitives import APPROACH, GAZE, KINDS, PAUSE, RETREAT, SHIVER, TILT
+from ..synth.kind_recipes import all_descriptors
 
 __all__ = ["DEFAULT_COLOUR", "DEFAULT_RANGE", "EPISODE_COLOURS", "LAYER", "RANGES",
            "KindControls", "StudioKindPart", "colour_of", "descriptor_of", "descriptors",
@@ -129,12 +130,7 @@ def colour_of(kind: str) -> RGB:
 
 def descriptors() -> dict[str, Descriptor]:
     """Every descriptor a slider may set: the registry's, then the loaded plugins'."""
-    from ..lang import descriptors as table
-
-    every = getattr(table, "every_descriptor", None)
-    if every is None:
-        return dict(REGISTRY)
-    return {d.name: d for d in every()}
+    return {d.name: d for d in all_descriptors()}
 
 
 def descriptor_of(name: str) -> Descriptor:

@@ -121,12 +121,12 @@ def slots() -> tuple[Slot, ...]:
 
 
 def all_descriptors() -> tuple[Descriptor, ...]:
-    """Every descriptor: the registry's, then the loaded plugins' (when the descriptor
-    table offers them)."""
+    """Every descriptor: the registry's, then the loaded plugins' (the descriptor table's
+    ``every_descriptor()``, by name, where it offers one)."""
     from ..lang import descriptors as table
 
     every = getattr(table, "every_descriptor", None)
-    return tuple(every()) if every is not None else tuple(REGISTRY.values())
+    return tuple(every().values()) if every is not None else tuple(REGISTRY.values())
 
 
 def descriptors() -> tuple[Descriptor, ...]:

@@ -44,7 +44,7 @@ from ..lang.linter import lint_source
 from ..lang.primitives import PAUSE, RETREAT
 from .arm_fit import Limits, fit, fit_limits
 from .kind_recipes import descriptors, kind_recipes, span_of, spans
-from .recipe import Recipe, descriptor
+from .recipe import Recipe, descriptor, slot_of
 from .writer import render
 
 if TYPE_CHECKING:
@@ -130,7 +130,9 @@ def recipe(state: State, intensity: float = STUDY_INTENSITY) -> Recipe:
     r = study(state)
     every = descriptors()
     for d in every:
-        if state in d.stronger and span_of(state, d.kind, d.key) is not None:
+        # a descriptor is varied where it has a span and the stimulus has its statement
+        if state in d.stronger and span_of(state, d.kind, d.key) is not None \
+                and r.node(*slot_of(d)) is not None:
             r = _vary(state, d, r, x)
     pauses = descriptor(PAUSE, "")
     extra = r.count(RETREAT) - study(state).count(RETREAT)
