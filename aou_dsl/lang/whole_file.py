@@ -10,6 +10,7 @@ from ..core.codes import V110, V119, V120, V121, V123, V124, V125
 from .declared import source_of, written
 from .descriptors import REGISTRY, compare, derive
 from .ir import Behaviour
+from .kind_needs import why_not
 from .layout import Laid, episode_values, layout
 from .primitives import KINDS, MIN_RETREAT, PAUSE
 from .timeline import Timeline
@@ -148,22 +149,23 @@ def _touching(ctx: Ctx, tl: Timeline) -> None:
                        hint="put a motion between them, or write one longer pause")
 
 
-def _none_shown(b: Behaviour, kind: str) -> str:
+def _none_shown(b: Behaviour, kind: str, tl: Timeline) -> str:
     """Why no episode of ``kind`` counts in the layout, in words: what the kind needs
-    around it (:attr:`~.primitives.kind.Kind.needs`), and what of that the file lacks."""
+    around it (:attr:`~.primitives.kind.Kind.needs`), and what of that the file lacks or
+    else the rule that stops the layout."""
     article = "an" if kind[0] in "aeiou" else "a"
     needs = KINDS[kind].needs if kind in KINDS else None
     why = needs.words(kind, PAUSE) if needs is not None else None
     if needs is None or why is None:
-        return f"no layout of this file can show {article} {kind}: no {kind} of its layout counts"
+        return f"the layout cannot show {article} {kind}: no {kind} of it counts"
     n_pauses = _count(b, PAUSE)
     wanted = needs.around.count(PAUSE)
-    if wanted and n_pauses < wanted:
-        why += f", and this file has {('no pause', 'only one pause')[n_pauses]}"
-    for other in dict.fromkeys(k for k in needs.around if k != PAUSE):
-        if not _count(b, other):
-            why += f", and this file has no {other}"
-    return f"no layout of this file can show {article} {kind}: {why}"
+    lacks = [f"this file has {('no pause', 'only one pause')[n_pauses]}"] \
+        if wanted and n_pauses < wanted else []
+    lacks += [f"this file has no {other}" for other in dict.fromkeys(needs.around)
+              if other != PAUSE and not _count(b, other)]
+    why += f", and {lacks[0]}" if lacks else f"; {_stopped_by(b, tl)}"
+    return f"the layout cannot show {article} {kind}: {why}"
 
 
 def _count(b: Behaviour, kind: str) -> int:
@@ -175,6 +177,16 @@ def _shown(name: str, value: float | int | None) -> str:
     """A descriptor's value with its unit, as the file would write it."""
     unit = REGISTRY[name].unit
     return f"{value:.3g} {unit}" if isinstance(value, float) and unit else f"{value}"
+
+
+def _stopped_by(b: Behaviour, tl: Timeline) -> str:
+    """The rule that keeps the layout from showing more, in words: a need of the kinds
+    counting finds, else the search's bound (the orders of stops it tries)."""
+    why = why_not(b)
+    if why is not None:
+        return why
+    return (f"no arrangement the layout tries shows more (its stops in the {tl.state.value} "
+            "order, then in every other order)")
 
 
 def _realisable(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
@@ -189,8 +201,8 @@ def _realisable(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
         said.add(id(node))
         kind = REGISTRY[m.name].kind
         none = m.measured is None or (REGISTRY[m.name].is_count and m.measured == 0)
-        shows = _none_shown(b, kind) if none else \
-            f"no layout of this file can show more than {_shown(m.name, m.measured)}" \
+        shows = _none_shown(b, kind, tl) if none else \
+            f"its layout shows {_shown(m.name, m.measured)}: {_stopped_by(b, tl)}" \
             if REGISTRY[m.name].is_count else \
             f"its layout shows {_shown(m.name, m.measured)}"
         ctx.error(V121, f"{m.name} is declared {_shown(m.name, m.declared)} but {shows}",
