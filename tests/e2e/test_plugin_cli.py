@@ -121,6 +121,19 @@ def test_lint_refuses_an_anticipation_no_approach_follows(env, tmp_path):
     assert any("anticipat" in d["message"] for d in errors), errors
 
 
+@pytest.mark.parametrize(("drawn", "ok"), [(40, True), (10, False)])
+def test_the_standoff_check_counts_the_draw_back(env, tmp_path, drawn, ok):
+    """From 15 cm, an 85 mm approach stays outside a 10 cm standoff only after a 40 mm
+    draw-back (ending at 10.5 cm), not after a 10 mm one (7.5 cm: V120)."""
+    src = tmp_path / "s.aou"
+    src.write_text(SEQUENCE.replace("start 0.30m", "start 0.15m").replace(
+        "  anticipate 10mm a=0.4\n  approach 0.1m a=0.01\n",
+        f"  anticipate {drawn}mm a=0.4\n  approach 85mm a=0.01\n"), encoding="utf-8")
+    code, out = _lint(src, env)
+    codes = [d["code"] for d in out["diagnostics"] if d["severity"] == "error"]
+    assert (code, codes) == ((0, []) if ok else (1, ["V120"])), out["diagnostics"]
+
+
 DESCRIPTOR_FORM = """\
 behaviour wind_up2 : confident
 robot panda
