@@ -181,3 +181,27 @@ def test_the_studio_gives_its_distance_a_slider(plugin):
     lo, hi, step, value = gui.sliders["anticipate_distance"]
     assert (lo, hi, step) == pytest.approx((0.005, 0.05, 0.001))
     assert value == pytest.approx(0.012)
+
+
+def test_the_editor_hovers_the_kind_with_the_plugins_texts(plugin):
+    """Hover over the keyword shows its usage and its laid-out episodes (two, of the
+    kind); over its distance, the plugin's own definition of the descriptor it sets."""
+    pytest.importorskip("lsprotocol")
+    from aou_anticipate.descriptors import DEFINITIONS
+    from lsprotocol import types
+
+    from aou_dsl.api import lint_source
+    from aou_dsl.editor.hover import hover
+
+    src = ("behaviour w : confident\nrobot panda\nstart 0.35m\nstandoff 0.10m\n"
+           "approach a=0.1\nanticipate 12mm a=0.3 x2\npause 1s x2\n")
+    doc = _doc(src)
+    doc.lint = lint_source(src, doc.path)
+
+    def text(col: int) -> str:
+        got = hover(doc, types.Position(line=5, character=col))
+        return got.contents.value if got is not None else ""
+
+    keyword = text(2)
+    assert plugin.kind.usage in keyword and keyword.count("- anticipate at") == 2, keyword
+    assert DEFINITIONS["anticipate_distance"] in text(len("anticipate 1"))
