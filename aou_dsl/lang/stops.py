@@ -14,11 +14,11 @@ them, pauses in the gaps (docs/compiler.md has the rules with a table per state)
    reach never gets closer than the standoff and ends there.
 3. *Pauses* go into the gaps between motion episodes, as the kinds' needs say
    (:attr:`~.primitives.kind.Kind.needs`): first those they need (before and after every
-   retreat; after the first gaze of each plane, since a gaze descriptor is an angle, read
-   at a pause that ends a gaze), then the pause stops, the hold at the end, then any gap
-   left (after the other gazes first), the start last; never where a kind needs another
-   kind next to it (a move directly before an approach). Two pauses never touch: they
-   would read as one.
+   retreat; after the last gaze of each plane unless a pause ends one already, since a
+   gaze descriptor is an angle, read at a pause that ends a gaze), then the pause stops,
+   the hold at the end, then any gap left (after the other gazes first), the start last;
+   never where a kind needs another kind next to it (a move directly before an
+   approach). Two pauses never touch: they would read as one.
 
 That is the first arrangement tried. When it does not show every descriptor the file
 writes (:func:`~.kind_needs.shows_all`), the others are searched in a fixed order (the

@@ -12,7 +12,7 @@ from .descriptors import REGISTRY, compare, derive
 from .ir import Behaviour
 from .kind_needs import why_not
 from .layout import Laid, episode_values, layout
-from .primitives import KINDS, MIN_RETREAT, PAUSE
+from .primitives import APPROACH, GAZE, KINDS, MIN_RETREAT, PAUSE, RETREAT
 from .timeline import Timeline
 from .values import Ctx
 
@@ -52,13 +52,13 @@ def _standoff(ctx: Ctx, b: Behaviour) -> bool:
     dist = s.start
     for node in b.primitives:
         p: Any = node
-        if p.kind not in ("approach", "retreat"):
+        if p.kind not in (APPROACH, RETREAT):
             continue
         for _ in range(p.count):
-            if p.kind == "approach" and p.length is None:
+            if p.kind == APPROACH and p.length is None:
                 dist = s.standoff
                 continue
-            new = dist - p.length if p.kind == "approach" else dist + p.length
+            new = dist - p.length if p.kind == APPROACH else dist + p.length
             if new < s.standoff - 1e-9:
                 left = max(dist - s.standoff, 0.0)
                 ctx.error(V120, f"this {p.kind} would end {s.standoff - new:.3g} m inside "
@@ -85,7 +85,7 @@ def _swept(ctx: Ctx, tl: Timeline) -> None:
     """V123: a gaze moves the end-effector around the goal; an arc shorter than the
     smallest visible motion cannot be seen, whatever its angle."""
     for e in tl.episodes:
-        if e.kind != "gaze":
+        if e.kind != GAZE:
             continue
         turn = math.hypot(e.end.h - e.start.h, e.end.v - e.start.v)
         arc = 2.0 * e.start.d * math.sin(turn / 2.0)
@@ -118,7 +118,7 @@ def _short_moves(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
                   f"least {least_mm} from it, or leave this approach out",
                   moved=e.path_length, least=MIN_RETREAT)
         return
-    pieces = sum(1 for x in tl.episodes if x.kind == "approach")
+    pieces = sum(1 for x in tl.episodes if x.kind == APPROACH)
     ctx.error(V123, f"the layout splits the approach into {pieces} pieces (one to each "
               f"stop, the last to the standoff) and the shortest moves {mm}, too little to "
               f"be seen or measured; {least}", e.span,
@@ -134,7 +134,7 @@ def _further_start(b: Behaviour, pieces: int) -> str:
     for cm in range(math.ceil(first * 100 - 1e-9), round(MAX_REACH_DISTANCE * 100) + 1):
         tl = layout(b.replace(settings=s.replace(start=cm / 100)))
         if all(e.path_length >= MIN_RETREAT for e in tl.episodes
-               if e.kind == "approach"):
+               if e.kind == APPROACH):
             return f"start further from the goal, e.g. `start {cm}cm`, or {fewer}"
     return f"{fewer}, or a start further from the goal (`start`)"
 
@@ -142,7 +142,7 @@ def _further_start(b: Behaviour, pieces: int) -> str:
 def _touching(ctx: Ctx, tl: Timeline) -> None:
     """V125: two pauses in a row are one hold."""
     for a, b in zip(tl.episodes, tl.episodes[1:], strict=False):
-        if a.kind == b.kind == "pause":
+        if a.kind == b.kind == PAUSE:
             ctx.report(V125, f"this pause follows another with no motion between them: "
                        f"they are seen and measured as one hold of "
                        f"{a.duration + b.duration:.3g} s", b.span,
