@@ -233,7 +233,7 @@ def test_dmp_export_has_a_part_for_it(env, files, tmp_path):
     assert "anticipate" in kinds, kinds
 
 
-@pytest.mark.parametrize("command", [("rules",), ("robot", "panda")])
+@pytest.mark.parametrize("command", [("rules",), ("robot", "--list")])
 def test_rules_and_robot_list_the_plugin(env, command):
     run = aouc(*command, env=env)
     assert run.returncode == 0, run.stderr
@@ -303,6 +303,7 @@ def test_a_plugin_that_gives_no_kind_is_reported_k801(files, tmp_path):
     assert "K801" in rules.stdout + rules.stderr and "aou-anticipate" in rules.stdout + \
         rules.stderr
     assert lint.returncode == 1
+    assert ":7:3: K801 [warning]" in lint.stdout and ":7:3: V101 [error]" in lint.stdout
 
 
 # --- the package itself -------------------------------------------------------------------
