@@ -233,6 +233,21 @@ def test_dmp_export_has_a_part_for_it(env, files, tmp_path):
     assert "anticipate" in kinds, kinds
 
 
+def test_synth_leaves_out_a_kind_whose_plugin_gives_no_recipe(env, tmp_path):
+    """The plugin gives no synthesis recipe: synthesis writes what it writes without it,
+    to the byte, and never the kind's statement."""
+    texts = []
+    for name, run_env in (("with", env), ("without", without_plugins())):
+        out = tmp_path / f"{name}.aou"
+        run = aouc("synth", "--state", "hesitant", "--intensity", "0.8", "-o", str(out),
+                   env=run_env)
+        no_traceback(run)
+        assert run.returncode == 0, run.stderr
+        texts.append(out.read_text(encoding="utf-8").replace(f"{name}.aou", ""))
+    assert texts[0] == texts[1]
+    assert "anticipate" not in texts[0]
+
+
 @pytest.mark.parametrize("command", [("rules",), ("robot", "--list")])
 def test_rules_and_robot_list_the_plugin(env, command):
     run = aouc(*command, env=env)
