@@ -234,7 +234,7 @@ def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = 
 
     units = {k: d.unit for k, d in REGISTRY.items()}
     units |= {d.name: d.unit for d in extra_descriptors() if d.name in m.extra}
-    for k, v in (*m.descriptors.items(), *m.extra.items()):  # the plugins' after the eleven
+    for k, v in (dict(m.descriptors) | m.extra).items():  # the plugins' after the eleven
         val = "null" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
         lines.append(f"  {k:<22} {val:>10} {_interval(v, m.uncertainty.get(k)):<14} "
                      f"{units.get(k, '')}".rstrip())

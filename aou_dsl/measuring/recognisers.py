@@ -171,8 +171,9 @@ def extra_descriptors() -> tuple[Descriptor, ...]:
     :data:`~aou_dsl.lang.descriptors.REGISTRY`), each a
     :class:`~aou_dsl.lang.descriptors.Descriptor` whose name is not taken."""
     every = getattr(_descriptors, "every_descriptor", None)
-    if every is not None:
-        found: Iterable[object] = every()
+    if every is not None:  # the registry's own reading: by name, or as records
+        got = every()
+        found: Iterable[object] = got.values() if isinstance(got, Mapping) else got
     else:  # the plugins' own parts, read the way every_descriptor reads them
         found = [d for p in _plugins.plugins()
                  for d in _as_list(p.part("descriptors"))]

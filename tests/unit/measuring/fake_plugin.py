@@ -41,8 +41,9 @@ def install(monkeypatch, *, measure=None, descriptors=(DISTANCE, COUNT)) -> Plug
         parts["measure"] = measure
     plugin = Plugin(KIND, SOURCE, parts)
     monkeypatch.setattr(recognisers, "_plugins", SimpleNamespace(plugins=lambda: (plugin,)))
+    every = {d.name: d for d in (*REGISTRY.values(), *descriptors)}
     monkeypatch.setattr(recognisers, "_descriptors", SimpleNamespace(
-        every_descriptor=lambda: (*REGISTRY.values(), *descriptors)))
+        every_descriptor=lambda: every))
     return plugin
 
 
@@ -50,4 +51,4 @@ def no_plugins(monkeypatch) -> None:
     """No plugin loaded, whatever is installed."""
     monkeypatch.setattr(recognisers, "_plugins", SimpleNamespace(plugins=lambda: ()))
     monkeypatch.setattr(recognisers, "_descriptors", SimpleNamespace(
-        every_descriptor=lambda: tuple(REGISTRY.values())))
+        every_descriptor=lambda: dict(REGISTRY)))
