@@ -72,8 +72,8 @@ _C, _Cu, _H, _F = State.CONFIDENT, State.CURIOUS, State.HESITANT, State.FEARFUL
 _A = "peak_acceleration"
 
 #: The built-in kinds, in the order a descriptor-form file writes their statements. The
-#: spans are chosen so that every intensity still reads as its state (tests/test_synth.py
-#: checks it).
+#: spans are chosen so that every intensity still reads as its state (the synthesis
+#: tests check it).
 BUILTIN: Mapping[str, KindRecipe] = {
     APPROACH: KindRecipe({_C: {_A: 1.5}, _Cu: {_A: 1.3}, _H: {_A: 1.4}, _F: {_A: 1.2}}),
     PAUSE: KindRecipe({_C: {"duration": 1.5}, _H: {"duration": 1.5},
