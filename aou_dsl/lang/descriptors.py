@@ -29,8 +29,6 @@ from ..core import plugins as _plugins
 from ..core.codes import K801, K803
 from ..core.memo import table
 from .ir import State
-from .primitives import KINDS, PAUSE
-from .primitives.kind import Needs
 
 __all__ = [
     "DEFINITIONS",
@@ -284,20 +282,14 @@ class EpisodeValues:
                 **{k: round(v, 6) for k, v in self.values.items()}}
 
 
-def _needs(kind: str) -> Needs:
-    """What an episode of ``kind`` needs around it to count: the kind's own
-    :attr:`~.primitives.kind.Kind.needs` (none for a kind no registry knows)."""
-    k = KINDS.get(kind)
-    return k.needs if k is not None else _NO_NEEDS
-
-
-_NO_NEEDS = Needs()
-
-
 def qualify(episodes: Iterable[EpisodeValues]) -> list[EpisodeValues]:
     """The episodes as the definitions read them: touching pauses merged into one (their
     durations added), and every episode marked whether it counts: whether the episodes
-    next to it are those its kind needs (:class:`~.primitives.kind.Needs`)."""
+    next to it are those its kind needs (:attr:`~.primitives.kind.Kind.needs`; none for
+    a kind no registry knows)."""
+    # imported here: a plugin's kinds, loaded with the registry, may read this module
+    from .primitives import KINDS, PAUSE
+
     merged: list[EpisodeValues] = []
     for e in episodes:
         last = merged[-1] if merged else None
@@ -308,11 +300,11 @@ def qualify(episodes: Iterable[EpisodeValues]) -> list[EpisodeValues]:
             merged.append(e)
     out = []
     for i, e in enumerate(merged):
-        needs = _needs(e.kind)
-        if needs.around:
+        kind = KINDS.get(e.kind)
+        if kind is not None and kind.needs.around:
             before = merged[i - 1].kind if i > 0 else None
             after = merged[i + 1].kind if i + 1 < len(merged) else None
-            e = replace(e, counts=needs.met(before, after))
+            e = replace(e, counts=kind.needs.met(before, after))
         out.append(e)
     return out
 

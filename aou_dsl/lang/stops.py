@@ -21,10 +21,12 @@ them, pauses in the gaps (docs/compiler.md has the rules with a table per state)
    approach). Two pauses never touch: they would read as one.
 
 That is the first arrangement tried. When it does not show every descriptor the file
-writes (:func:`~.kind_needs.shows_all`), the others are searched in a fixed order (the
-state's order first, then the other orders of the file's stops; the gazes' signs then
-alternate in the order they run, and the retreats' clusters and the gazes that share
-their pauses are tried in turn) and the first that shows the file is laid out.
+writes (:func:`~.kind_needs.shows_all`), others are searched in a fixed order (the
+state's order of stops first, then the other orders of the file's stops, with the gazes'
+signs alternating in the order they run; then the same orders with each number of
+retreat clusters and of gaze planes sharing their pauses; at most :data:`MAX_WAYS`) and
+the first that shows the file is laid out. Counting (:func:`~.kind_needs.why_not`)
+skips the search when no arrangement can show the file.
 """
 
 from __future__ import annotations
@@ -38,7 +40,7 @@ from .kind_needs import every_counts, shows_all, why_not
 from .primitives import APPROACH, GAZE, KINDS, PAUSE, RETREAT, SHIVER, TILT, Approach, Gaze
 from .timeline import Episode, Pose
 
-__all__ = ["STOP_ORDER", "descriptor_layout"]
+__all__ = ["MAX_WAYS", "STOP_ORDER", "descriptor_layout"]
 
 #: Which kinds of stop come first along the reach, by state (the composition of each
 #: state: docs/model.md).
@@ -241,19 +243,25 @@ def _arranged(b: Behaviour, approach: Approach | None, way: _Way) -> list[Episod
     return out
 
 
+#: At most this many arrangements are tried after the first: a file's stops have at most
+#: 120 orders, and a retreat's clusters multiply them; the search stays a bounded part of
+#: a lint however large the counts.
+MAX_WAYS = 1000
+
+
 def _ways(b: Behaviour, state: State) -> Iterator[_Way]:
     """The arrangements tried after the state's own, in a fixed order: the state's order
-    of stops first, then every other order of the kinds the file has stops of; for each,
-    the gazes' signs in the order they run, then each number of retreat clusters and of
-    gaze planes that share a retreat's pause."""
+    of stops first, then every other order of the kinds the file has stops of, each with
+    the gazes' signs alternating in the order they run; then the same orders with each
+    number of retreat clusters and of gaze planes that share a retreat's pause."""
     own = STOP_ORDER[state]
     present = [k for k in own if _count(b.first(k))]
     rest = [k for k in own if k not in present]
     n_r = _count(b.first(RETREAT))
     planes = sum(1 for plane in ("horizontal", "vertical") if _count(b.first(GAZE, plane)))
-    for kinds in itertools.permutations(present):
-        order = (*kinds, *rest)
-        yield _Way(order, in_time=True)
+    orders = [(*kinds, *rest) for kinds in itertools.permutations(present)]
+    yield from (_Way(order, in_time=True) for order in orders)
+    for order in orders:
         for clusters in range(1, n_r + 1):
             for share in (None, *range(planes + 1)):
                 yield _Way(order, True, clusters, share)
@@ -268,7 +276,7 @@ def descriptor_layout(b: Behaviour, state: State) -> list[Episode]:
     first = _arranged(b, approach, _Way(STOP_ORDER[state]))
     if shows_all(b, first) or why_not(b) is not None:
         return first  # shown, or no arrangement can show it (counting says why)
-    for way in _ways(b, state):
+    for way in itertools.islice(_ways(b, state), MAX_WAYS):
         eps = _arranged(b, approach, way)
         if shows_all(b, eps):
             return eps

@@ -109,3 +109,14 @@ def test_a_new_kind_whose_neighbour_the_file_lacks_is_named(windup):
 
 def _span():
     return api.lint(source="pause 1s\n").behaviour.primitives[0].span
+
+
+def test_the_docs_give_the_layouts_orders_and_bound():
+    from pathlib import Path
+
+    from aou_dsl.lang.stops import MAX_WAYS, STOP_ORDER
+
+    text = (Path(__file__).resolve().parents[3] / "docs" / "compiler.md").read_text()
+    for state, order in STOP_ORDER.items():
+        assert f"| {state.value} | {', '.join(order)} |" in text
+    assert f"at most {MAX_WAYS} arrangements" in text
