@@ -115,7 +115,7 @@ def test_every_rule_has_kebab_name_and_texts():
     import re
 
     for code, r in RULES.items():
-        assert re.fullmatch(r"[SVMCRIDE]\d{3}", code)
+        assert re.fullmatch(r"[SVMCRIDEK]\d{3}", code)
         assert re.fullmatch(r"[a-z]+(-[a-z]+)*", r.name)
         assert r.what and r.why and r.example
 

@@ -15,6 +15,7 @@ environment the user chose, like a ``pip install``.
 from __future__ import annotations
 
 import os
+import re
 import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -74,9 +75,57 @@ def loaded() -> tuple[tuple[Plugin, ...], tuple[Broken, ...]]:
     return _load(off, tuple(sys.path))
 
 
+#: A section header of :data:`GROUP` in an ``entry_points.txt``.
+_SECTION = re.compile(r"^\s*\[\s*" + re.escape(GROUP) + r"\s*\]", re.MULTILINE)
+
+
+def _declared(path: tuple[str, ...]) -> bool:
+    """Whether a distribution on ``path`` may declare an entry point of :data:`GROUP`:
+    its ``*.dist-info`` or ``*.egg-info`` folder's ``entry_points.txt`` has the section.
+    A few milliseconds, where importing :mod:`importlib.metadata` (email, zipfile, csv)
+    and reading every distribution costs tens: ``aouc lint`` pays that only when a
+    plugin is installed. A path entry that is a zip is looked into the same way."""
+    for entry in path:
+        folder = entry or "."
+        try:
+            with os.scandir(folder) as found:
+                infos = [e.path for e in found if e.name.endswith((".dist-info", ".egg-info"))]
+        except NotADirectoryError:
+            if _zip_declares(folder):
+                return True
+            continue
+        except OSError:  # a path entry that does not exist (yet)
+            continue
+        for info in infos:
+            try:
+                with open(os.path.join(info, "entry_points.txt"), encoding="utf-8",
+                          errors="replace") as f:
+                    if _SECTION.search(f.read()):
+                        return True
+            except OSError:  # no entry points, or an egg-info that is a file
+                continue
+    return False
+
+
+def _zip_declares(archive: str) -> bool:
+    """:func:`_declared` for a zip on the import path (True when it cannot be read: then
+    :mod:`importlib.metadata` decides)."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(archive) as z:
+            for name in z.namelist():
+                if name.endswith("-info/entry_points.txt") and name.count("/") == 1 and \
+                        _SECTION.search(z.read(name).decode("utf-8", "replace")):
+                    return True
+    except (OSError, zipfile.BadZipFile):
+        return True
+    return False
+
+
 @cached(maxsize=4)
 def _load(off: bool, path: tuple[str, ...]) -> tuple[tuple[Plugin, ...], tuple[Broken, ...]]:
-    if off:
+    if off or not _declared(path):
         return (), ()
     from importlib import metadata  # here: `import aou_dsl` and `aouc lint` stay light
 
