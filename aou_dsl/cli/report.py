@@ -130,8 +130,8 @@ def _generic(e) -> str:
         shown = KINDS[e.kind].episode_values(e)
     except Exception:  # a plugin's kind may fail in any way: show where it goes only
         shown = {}
-    return ", ".join([what, *(f"{k} {v:.4g}" for k, v in shown.items()
-                              if isinstance(v, int | float))])
+    values = ", ".join(f"{k}={v:.4g}" for k, v in shown.items() if isinstance(v, int | float))
+    return f"{what} ({values})" if values else what
 
 
 @cached(maxsize=1)
@@ -148,14 +148,15 @@ def format_timeline(behaviour, cv, timeline) -> str:
     """``aouc explain``: the behaviour, its C-V point, and one line per episode."""
     b = behaviour
     declared = f"declared {b.state}" if b.state else "no state declared"
+    w = max([9, *(len(e.kind) + 1 for e in timeline.episodes)])  # a plugin's longer name
     lines = [f"behaviour {b.name} ({declared}; {b.form} form) on {b.settings.robot}",
              f"C-V point: C={cv.C:+.2f} V={cv.V:+.2f} -> {cv.state}; laid out as "
              f"{timeline.state}",
-             f"{'#':>3}  {'episode':<9}{'start':>8}{'dur':>8}  what moves"]
+             f"{'#':>3}  {'episode':<{w}}{'start':>8}{'dur':>8}  what moves"]
     t = 0.0
     for i, e in enumerate(timeline.episodes, 1):
         what = _what_moves().get(e.kind, _generic)(e)
-        lines.append(f"{i:>3}  {e.kind:<9}{t:>7.2f}s{e.duration:>7.2f}s  {what}  "
+        lines.append(f"{i:>3}  {e.kind:<{w}}{t:>7.2f}s{e.duration:>7.2f}s  {what}  "
                      f"(line {e.span.line})")
         t += e.duration
     lines.append(f"planned duration {t:.2f} s (moving episodes at the declared limits; "

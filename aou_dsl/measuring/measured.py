@@ -33,7 +33,6 @@ from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..core.trajectory import Trajectory
 from ..lang.cv import CVPoint, composition, infer
 from ..lang.descriptors import (
-    REGISTRY,
     Descriptor,
     Descriptors,
     EpisodeValues,
@@ -54,7 +53,7 @@ from .episodes import (
     translation,
 )
 from .holds import MIN_PAUSE, REST_SPEED, Boundary, Rest, boundaries, rest_at_end, rest_signals
-from .recognisers import claimed, extra_descriptors, extra_values
+from .recognisers import claimed, every_named, extra_descriptors, extra_values
 from .roll import MIN_TILT, SHAPED_CYCLE, Lobe, lobe, roll_angle, rotations
 from .signal import Grid, JointNoise, joint_noise, short_window, smooth, to_grid, unwrap
 
@@ -308,13 +307,8 @@ def _undersampled(where: Span, t0: float, t1: float, per_cycle: float, h: float
                 frequency=f, samples_per_cycle=per_cycle)
 
 
-def _descriptor(name: str) -> Descriptor:
-    """The descriptor ``name``: one of the eleven, or a plugin's."""
-    return REGISTRY.get(name) or next(x for x in extra_descriptors() if x.name == name)
-
-
-def _unequal(name: str, vals: list[float]) -> bool:
-    return max(vals) - min(vals) > _descriptor(name).tolerance(float(np.median(vals)))
+def _unequal(table: dict[str, Descriptor], name: str, vals: list[float]) -> bool:
+    return max(vals) - min(vals) > table[name].tolerance(float(np.median(vals)))
 
 
 def _spread(episodes: list[EpisodeValues]) -> dict[str, list[float]]:
@@ -369,11 +363,12 @@ def _measure(rec: Trajectory, pinned: JointNoise | None = None, fk: Kinematics |
                           "of sight are not measured; approach and retreat are read along "
                           "the hand's forward axis", where,
                           hint="give it with --goal X,Y,Z, or --goal final"))
+    table = every_named()
     diags += [diag(R403, f"{name} differs between episodes: "
                    f"{', '.join(f'{v:.4g}' for v in vals)}; reporting the "
-                   f"{_descriptor(name).aggregate} {values[name]:.4g}", where,
+                   f"{table[name].aggregate} {values[name]:.4g}", where,
                    descriptor=name, values=vals)
-              for name, vals in _spread(episodes).items() if _unequal(name, vals)]
+              for name, vals in _spread(episodes).items() if _unequal(table, name, vals)]
     diags += unclaimed
     point, _ = infer(composition(episodes))
     los = _line_of_sight(ctx)

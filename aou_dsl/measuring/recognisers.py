@@ -41,7 +41,7 @@ from ..lang.descriptors import REGISTRY, Aggregate, Descriptor, EpisodeValues, q
 from ..lang.primitives import APPROACH, GAZE, PAUSE, RETREAT, SHIVER, TILT
 
 __all__ = ["BUILTIN", "LAYER", "MeasurePart", "Recogniser", "aggregate", "claimed",
-           "extra_descriptors", "extra_values", "missing_part", "moved_along",
+           "every_named", "extra_descriptors", "extra_values", "missing_part", "moved_along",
            "recognisers"]
 
 #: The layer name under which a plugin gives its part (:data:`aou_dsl.core.plugins.LAYERS`).
@@ -184,6 +184,12 @@ def extra_descriptors() -> tuple[Descriptor, ...]:
             seen.add(d.name)
             out.append(d)
     return tuple(out)
+
+
+def every_named() -> dict[str, Descriptor]:
+    """The eleven then the plugins' descriptors, by name, in the order they are
+    reported."""
+    return {**REGISTRY, **{d.name: d for d in extra_descriptors()}}
 
 
 def _as_list(part: object) -> list[object]:

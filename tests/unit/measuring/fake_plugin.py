@@ -15,6 +15,24 @@ from aou_dsl.lang.descriptors import REGISTRY, Aggregate, Descriptor
 from aou_dsl.lang.primitives import APPROACH, RETREAT
 from aou_dsl.measuring import recognisers
 
+#: A retreat of 1 cm straight into an approach (the counter-movement), then a retreat of
+#: 2 cm between two pauses (a retreat as the descriptors count it).
+COUNTER = """behaviour counter
+robot panda
+start 0.30m
+standoff 0.10m
+
+sequence {
+  approach 0.05m a=0.1
+  pause 1s
+  retreat 0.01m a=0.1
+  approach 0.07m a=0.1
+  pause 1s
+  retreat 0.02m a=0.1
+  pause 1s
+}
+"""
+
 KIND = "anticipate"
 SOURCE = "aou-fake 0.1"
 DISTANCE = Descriptor(f"{KIND}_distance", "m", KIND, "distance", Aggregate.MEDIAN,

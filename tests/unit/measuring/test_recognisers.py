@@ -17,32 +17,14 @@ from aou_dsl.lang.primitives import APPROACH, GAZE, PAUSE, RETREAT, SHIVER, TILT
 from aou_dsl.measuring import recognisers
 from aou_dsl.measuring.measured import measure
 from aou_dsl.measuring.verdict import judge
-
-from . import fake_plugin as fake
-
-#: A retreat of 1 cm straight into an approach (the counter-movement), then a retreat of
-#: 2 cm between two pauses (a retreat as the descriptors count it).
-SOURCE = """behaviour counter
-robot panda
-start 0.30m
-standoff 0.10m
-
-sequence {
-  approach 0.05m a=0.1
-  pause 1s
-  retreat 0.01m a=0.1
-  approach 0.07m a=0.1
-  pause 1s
-  retreat 0.02m a=0.1
-  pause 1s
-}
-"""
+from tests.unit.measuring import fake_plugin as fake
+from tests.unit.measuring.fake_plugin import COUNTER
 
 
 @pytest.fixture(scope="module")
 def compiled(tmp_path_factory):
     path = tmp_path_factory.mktemp("counter") / "counter.aou"
-    path.write_text(SOURCE)
+    path.write_text(COUNTER)
     res = api.compile(str(path))
     assert res.trajectory is not None, [d.message for d in res.diagnostics]
     return path, res
@@ -200,3 +182,21 @@ def test_judged_rows_end_with_the_plugin_s_descriptors(monkeypatch, compiled):
     assert rows[fake.DISTANCE.name].declared is None
     assert {r.name for r in v.failed} == {fake.DISTANCE.name, fake.COUNT.name}
     assert all(rows[name].ok for name in REGISTRY)
+
+
+def test_a_noisy_recording_gives_the_plugin_s_descriptors_an_interval(monkeypatch, compiled):
+    """Re-noised copies read the plugin's descriptors as they read the eleven."""
+    import numpy as np
+
+    fake.install(monkeypatch, measure=fake.Claim())
+    _, res = compiled
+    tr = res.trajectory
+    q = np.asarray(tr.q, float)
+    noisy = tr.with_(q=q + np.random.default_rng(3).normal(0.0, 2e-5, q.shape), qd=None,
+                     qdd=None)
+    m = measure(noisy)
+    assert list(m.uncertainty) == [*REGISTRY, fake.DISTANCE.name, fake.COUNT.name]
+    count, dist = m.uncertainty[fake.COUNT.name], m.uncertainty[fake.DISTANCE.name]
+    assert (count.low, count.high) == (1, 1)
+    assert dist.low < m.extra[fake.DISTANCE.name] < dist.high
+    assert dist.high - dist.low < 2e-3
