@@ -181,12 +181,12 @@ def _shown(name: str, value: float | int | None) -> str:
 
 def _stopped_by(b: Behaviour, tl: Timeline) -> str:
     """The rule that keeps the layout from showing more, in words: a need of the kinds
-    counting finds, else the search's bound (the orders of stops it tries)."""
+    counting finds, else the bounds of the search (the orders of stops it tries)."""
     why = why_not(b)
     if why is not None:
         return why
     return (f"no arrangement the layout tries shows more (its stops in the {tl.state.value} "
-            "order, then in every other order)")
+            "order, then in the other orders it tries)")
 
 
 def _realisable(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:

@@ -127,7 +127,7 @@ def hand_built(rng: random.Random) -> tuple[list, dict, int, bool]:
     each plane of a kind whose value a pause reads), more pauses at random where no pause
     is yet, approach pieces at random between and a last one at the end."""
     approach = rng.random() < 0.75
-    episodes = [t for t in MOTIONS for _ in range(rng.choice((0, 0, 1, 2)))]
+    episodes = [t for t in MOTIONS for _ in range(rng.choice((0, 0, 1, 2, 3)))]
     rng.shuffle(episodes)
     out: list = []
     ended: set = set()
@@ -146,7 +146,7 @@ def hand_built(rng: random.Random) -> tuple[list, dict, int, bool]:
         if needs.followed_by == PAUSE and (_every(t) or t not in ended):
             pause()
             ended.add(t)
-        elif rng.random() < 0.3:
+        elif rng.random() < 0.2:
             pause()
     if approach:
         if A not in out or any(_away(t) for t in out[len(out) - out[::-1].index(A):]):
@@ -175,9 +175,25 @@ def _shows_its_descriptors(text: str) -> None:
 # --- the generator: hand-built arrangements ---------------------------------------------
 
 
+#: Arrangements written out by hand, with the state whose file they show: three vertical
+#: gazes, the last ending at the pause that starts the retreats (the layout once turned
+#: one gaze to where the one before it stood and refused the file).
+BY_HAND = [
+    ("curious", [GV, A, GV, A, GV, P, R, P, R, P, A]),
+    ("inactive", [GV, A, GV, A, GV, P, R, P, R, P, A, T, A]),
+]
+
+
+def _from_arrangement(state: str, arrangement: list, rng: random.Random) -> str:
+    motions = {t: arrangement.count(t) for t in MOTIONS if t in arrangement}
+    assert arrangement_exists(motions, arrangement.count(P), A in arrangement)
+    return _file(motions, arrangement.count(P), A in arrangement, state, rng)
+
+
 def _hand_built_files(n: int, seed: int) -> list[tuple[str, list]]:
     rng = random.Random(seed)
-    out = []
+    out = [(_from_arrangement(state, arrangement, rng), arrangement)
+           for state, arrangement in BY_HAND]
     for i in range(n):
         arrangement, motions, n_pauses, approach = hand_built(rng)
         assert arrangement_exists(motions, n_pauses, approach), arrangement
