@@ -171,8 +171,11 @@ def test_the_descriptor_form_without_an_approach_is_refused_by_its_needs(env, tm
     src.write_text(DESCRIPTOR_FORM.replace("approach a=0.1\n", ""), encoding="utf-8")
     code, out = _lint(src, env)
     assert code == 1
-    (d,) = [d for d in out["diagnostics"] if d["severity"] == "error"]
-    assert d["code"] == "V121" and "approach" in d["message"], d
+    errors = [d for d in out["diagnostics"] if d["severity"] == "error"]
+    assert {d["code"] for d in errors} == {"V121"}, errors
+    (d,) = [d for d in errors if d["line"] == 5]  # the anticipation's statement
+    assert "anticipate_count" in d["message"] and "directly before an approach" in \
+        d["message"], d
 
 
 def test_compile_times_the_kind_by_its_law_and_checks_it(compiled):
