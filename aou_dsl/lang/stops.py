@@ -182,6 +182,8 @@ def _motion(b: Behaviour, approach: Approach | None, stops: list[_Stop]
     barred: set[int] = set()
     ends: dict[tuple[str, str | None], list[int]] = {}  # per kind and plane, the gaps after
     stop_gaps: list[int] = []
+    # a need the file cannot meet (no episode of the kind needed) bars no gap: it is V121's
+    has = {p.kind for p in b.primitives if p.count} - ({APPROACH} if approach is None else set())
     for j, stop in enumerate(stops):
         target = s.standoff + net * (k - j) / (k + 1)
         if approach is not None and pose.d > target + 1e-12:
@@ -192,13 +194,13 @@ def _motion(b: Behaviour, approach: Approach | None, stops: list[_Stop]
         for node, arg in stop.items:
             ep = KINDS[node.kind].episode(node, pose, arg)
             needs = KINDS[ep.kind].needs
-            if needs.preceded_by is not None:
+            if needs.preceded_by is not None and needs.preceded_by in has:
                 (required if needs.preceded_by == PAUSE else barred).add(len(out))
             out.append(ep)
             pose = ep.end
             if needs.followed_by == PAUSE and not every_counts(ep.kind):
                 ends.setdefault((ep.kind, ep.plane), []).append(len(out))
-            elif needs.followed_by is not None:
+            elif needs.followed_by is not None and needs.followed_by in has:
                 (required if needs.followed_by == PAUSE else barred).add(len(out))
     if approach is not None and pose.d > s.standoff + 1e-12:
         out.append(KINDS[APPROACH].episode(approach, pose, s.standoff))

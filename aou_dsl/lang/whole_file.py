@@ -8,12 +8,12 @@ from typing import Any
 
 from ..core.codes import V110, V119, V120, V121, V123, V124, V125
 from .declared import source_of, written
-from .descriptors import REGISTRY, compare, derive
+from .descriptors import compare, derive
 from .ir import Behaviour
-from .kind_needs import why_not
+from .kind_needs import descriptor_table, why_not
 from .layout import Laid, episode_values, layout
-from .primitives import APPROACH, GAZE, KINDS, MIN_RETREAT, PAUSE, RETREAT
-from .timeline import Timeline
+from .primitives import APPROACH, GAZE, KINDS, MIN_RETREAT, PAUSE
+from .timeline import Pose, Timeline
 from .values import Ctx
 
 __all__ = ["MAX_EPISODES", "MAX_MOTION_TIME", "MAX_REACH_DISTANCE", "check_whole"]
@@ -47,18 +47,21 @@ def _time(ctx: Ctx, b: Behaviour, tl: Timeline) -> bool:
 
 
 def _standoff(ctx: Ctx, b: Behaviour) -> bool:
-    """A sequence's moves toward the goal stop at the standoff (V120)."""
+    """A sequence's moves toward the goal stop at the standoff (V120). A move along the
+    line of sight of another kind (a retreat, a plugin's draw-back) goes where its kind's
+    episode goes."""
     s = b.settings
     dist = s.start
     for node in b.primitives:
         p: Any = node
-        if p.kind not in (APPROACH, RETREAT):
+        if p.kind not in KINDS or not KINDS[p.kind].translation:
             continue
         for _ in range(p.count):
             if p.kind == APPROACH and p.length is None:
                 dist = s.standoff
                 continue
-            new = dist - p.length if p.kind == APPROACH else dist + p.length
+            new = dist - p.length if p.kind == APPROACH else \
+                KINDS[p.kind].episode(p, Pose(dist)).end.d
             if new < s.standoff - 1e-9:
                 left = max(dist - s.standoff, 0.0)
                 ctx.error(V120, f"this {p.kind} would end {s.standoff - new:.3g} m inside "
@@ -175,7 +178,7 @@ def _count(b: Behaviour, kind: str) -> int:
 
 def _shown(name: str, value: float | int | None) -> str:
     """A descriptor's value with its unit, as the file would write it."""
-    unit = REGISTRY[name].unit
+    unit = descriptor_table()[name].unit
     return f"{value:.3g} {unit}" if isinstance(value, float) and unit else f"{value}"
 
 
@@ -194,16 +197,17 @@ def _realisable(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
     episode of a statement counts, one diagnostic says why: its values are absent for
     that one reason."""
     said: set[int] = set()
+    table = descriptor_table()
     for m in compare(written(b), derive(episode_values(tl.episodes))):
         node = source_of(b, m.name)
         if m.measured is None and id(node) in said:
             continue  # its statement is already said to show no episode that counts
         said.add(id(node))
-        kind = REGISTRY[m.name].kind
-        none = m.measured is None or (REGISTRY[m.name].is_count and m.measured == 0)
+        kind = table[m.name].kind
+        none = m.measured is None or (table[m.name].is_count and m.measured == 0)
         shows = _none_shown(b, kind, tl) if none else \
             f"its layout shows {_shown(m.name, m.measured)}: {_stopped_by(b, tl)}" \
-            if REGISTRY[m.name].is_count else \
+            if table[m.name].is_count else \
             f"its layout shows {_shown(m.name, m.measured)}"
         ctx.error(V121, f"{m.name} is declared {_shown(m.name, m.declared)} but {shows}",
                   node.span if node else b.span,

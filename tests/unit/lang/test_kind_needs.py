@@ -10,6 +10,8 @@ from typing import Literal
 import pytest
 
 from aou_dsl import api
+from aou_dsl.lang import kind_needs, primitives, stops
+from aou_dsl.lang import layout as layout_module
 from aou_dsl.lang.descriptors import EpisodeValues, qualify
 from aou_dsl.lang.ir import Node
 from aou_dsl.lang.kind_needs import episode_values, shows_all, why_not
@@ -57,7 +59,11 @@ class WindupKind(Kind):
 
 @pytest.fixture
 def windup(monkeypatch):
-    monkeypatch.setitem(KINDS, WIND, WindupKind())
+    """The kinds with the test kind added, as the modules of the layout and the
+    descriptors read them (whatever holds the kinds, a dict or a live view of plugins)."""
+    kinds = {**KINDS, WIND: WindupKind()}
+    for module in (primitives, stops, kind_needs, layout_module):
+        monkeypatch.setattr(module, "KINDS", kinds)
 
 
 def test_the_built_in_kinds_say_their_needs():
@@ -102,9 +108,15 @@ def test_a_new_kind_is_laid_out_by_its_needs(windup, state):
 
 
 def test_a_new_kind_whose_neighbour_the_file_lacks_is_named(windup):
-    b = _behaviour("pause 1s\ntilt 10deg\n", Windup(span=_span()))
+    """The need no layout can meet is said once; it bars no gap from the pauses, which
+    still show (a second V121 for them would blame the pauses for the kind's need)."""
+    b = _behaviour("pause 1s x3\ntilt 10deg x2\n", Windup(span=_span(), count=2))
+    b = b.replace(primitives=tuple(p.replace(count=4) if p.kind == PAUSE else p
+                                   for p in b.primitives))  # 4 motions, room for 5
     assert why_not(b) == ("a windup counts only directly before an approach, nothing "
                           "between, and this file has no approach")
+    values = qualify(episode_values(layout(b).episodes))
+    assert sum(1 for e in values if e.kind == PAUSE) == 4
 
 
 def _span():
