@@ -14,9 +14,10 @@ import pytest
 
 from tests.conftest import ROOT
 
-#: The texts a reader follows: the pages, the README and the grammar's comments.
+#: The texts a reader follows: the pages, the README and the grammar's comments (not the
+#: pages of the npm packages a test installs under editors/).
 TEXTS = sorted([*ROOT.glob("docs/**/*.md"), ROOT / "README.md", ROOT / "grammar" / "aou.lark",
-                *ROOT.glob("editors/**/*.md")])
+                *(p for p in ROOT.glob("editors/**/*.md") if "node_modules" not in p.parts)])
 PATH = re.compile(r"\b(?:aou_dsl|tests)(?:/[\w.*-]+)+/?")
 DOTTED = re.compile(r"(?<![\w/.])aou_dsl(?:\.\w+)+")
 MODULE_RUN = re.compile(r"python -m (tests(?:\.\w+)+)")
