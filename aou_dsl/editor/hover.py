@@ -9,7 +9,7 @@ import re
 from lsprotocol import types
 
 from ..core.rule_model import Category
-from ..lang.descriptors import DEFINITIONS, Descriptor
+from ..lang.descriptors import DEFINITIONS, REGISTRY, Descriptor
 from ..lang.ir import State
 from ..lang.primitives import KINDS
 from ..synth.kind_recipes import all_descriptors
@@ -72,8 +72,11 @@ def describe(d: Descriptor) -> str:
             up, down = _WAYS.get(d.unit, ("higher", "lower"))
             way = up if d.stronger[s] > 0 else down
             found.append(f"- {s}: looks more {s} as it is {way}")
-    study = "\n".join(found) or "- the study found no effect of it on any state"
     meaning = DEFINITIONS.get(d.name) or definition(d.name, d.kind)
+    if d.name not in REGISTRY:  # a plugin's: the study never showed it to anyone
+        return (f"**{d.name}** ({unit}): {meaning}.\n\nNot one of the eleven descriptors "
+                "the study varied: no perceived effect is known.")
+    study = "\n".join(found) or "- the study found no effect of it on any state"
     return (f"**{d.name}** ({unit}): {meaning}.\n\n"
             f"What the study found (one descriptor varied at a time):\n\n{study}")
 

@@ -152,6 +152,31 @@ def _touching(ctx: Ctx, tl: Timeline) -> None:
                        hint="put a motion between them, or write one longer pause")
 
 
+def _beside(ctx: Ctx, tl: Timeline) -> None:
+    """V121 in a sequence: a statement whose kind needs a motion of another kind right
+    beside it (:attr:`~.primitives.kind.Kind.needs`, e.g. a counter-movement directly
+    before an approach) where the sequence puts none. It would not count as declared,
+    yet be measured as some other kind. (A kind that needs a pause beside it is not
+    held to it here: a sequence may move without holds, and its episodes then do not
+    count, on paper and measured alike.)"""
+    eps, said = tl.episodes, set()
+    for i, e in enumerate(eps):
+        needs = KINDS[e.kind].needs if e.kind in KINDS else None
+        if needs is None or e.span in said:
+            continue
+        for other, where, j in ((needs.preceded_by, "before", i - 1),
+                                (needs.followed_by, "after", i + 1)):
+            if other is None or other == PAUSE or (0 <= j < len(eps) and eps[j].kind == other):
+                continue
+            said.add(e.span)
+            ctx.error(V121, f"this {e.kind} has no {other} directly {where} it: "
+                      f"{needs.words(e.kind, PAUSE)}; here it would be measured as "
+                      "another kind", e.span,
+                      hint=f"put {'an' if other[0] in 'aeiou' else 'a'} {other} "
+                      f"directly {where} it")
+            break
+
+
 def _none_shown(b: Behaviour, kind: str, tl: Timeline) -> str:
     """Why no episode of ``kind`` counts in the layout, in words: what the kind needs
     around it (:attr:`~.primitives.kind.Kind.needs`), and what of that the file lacks or
@@ -236,4 +261,6 @@ def check_whole(ctx: Ctx, b: Behaviour, laid: Laid | None = None) -> Timeline | 
     _touching(ctx, tl)
     if b.form == "descriptor":
         _realisable(ctx, b, tl)
+    else:
+        _beside(ctx, tl)
     return tl

@@ -104,9 +104,6 @@ def test_lint_reports_the_plugin_kinds_own_checks(env, tmp_path):
     assert got == [(7, "V123"), (8, "V130"), (9, "V102"), (10, "V113")], got
 
 
-@pytest.mark.xfail(strict=True, reason="a kind's needs are read by the descriptors' "
-                   "qualifying and by V121 in the descriptor form; nothing yet checks a "
-                   "sequence's statements against them")
 def test_lint_refuses_an_anticipation_no_approach_follows(env, tmp_path):
     """What the kind needs around it (an approach, directly after) is checked: an
     anticipation followed by a pause is refused, naming the kind. Accepted, it would not
@@ -119,6 +116,8 @@ def test_lint_refuses_an_anticipation_no_approach_follows(env, tmp_path):
     errors = [d for d in out["diagnostics"] if d["severity"] == "error"]
     assert errors and all(d["code"].startswith("V") for d in errors), errors
     assert any("anticipat" in d["message"] for d in errors), errors
+    assert [d["code"] for d in errors] == ["V121"], errors
+    assert "no approach directly after it" in errors[0]["message"], errors
 
 
 @pytest.mark.parametrize(("drawn", "ok"), [(40, True), (10, False)])
@@ -310,6 +309,19 @@ def test_a_plugin_without_a_measure_part_gets_k802(files, compiled, tmp_path):
     no_traceback(run)
     assert run.returncode != 0
     assert "K802" in run.stdout + run.stderr and "measure" in run.stdout + run.stderr
+
+
+def test_compile_says_k802_when_no_measure_part_can_check_the_motion(files, tmp_path):
+    """Compile checks its own trajectory by measuring it; with no pass that reads the
+    plugin's kind back, that check cannot be done, and the compile says so (not a C310
+    that blames the motion, nor a pass)."""
+    inst = for_commands(tmp_path, "aou_anticipate.partial:without_measure")
+    run = aouc("compile", str(files / "wind_up.aou"), "-o", str(tmp_path / "w.json"),
+               env=inst.env)
+    no_traceback(run)
+    out = run.stdout + run.stderr
+    assert run.returncode == 1, out
+    assert "K802" in out and "measure" in out and "C310" not in out, out
 
 
 def test_a_plugin_that_gives_no_kind_is_reported_k801(files, tmp_path):
