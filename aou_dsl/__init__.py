@@ -42,7 +42,7 @@ _LAZY = {
     "REGISTRY": "lang.descriptors", "Descriptors": "lang.descriptors",
     "AouError": "core.diagnostics", "Diagnostic": "core.diagnostics",
     "BuildOptions": "core.options", "Trajectory": "core.trajectory",
-    "BuildResult": "build.builder", "Session": "build.session", "FileResult": "lang.linter",
+    "BuildResult": "driver.builder", "Session": "driver.session", "FileResult": "lang.linter",
     "CheckReport": "safety.replay", "Measured": "measuring.measured",
     "check": "api", "compile": "api", "lint": "api", "lint_paths": "api",
     "measure": "api", "read_trajectory": "api",

@@ -22,9 +22,9 @@ import os
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
-from .build.builder import BuildResult, build_file, build_source
 from .core.options import BuildOptions, SceneOptions
 from .core.options import package_dirs as package_dirs_of
+from .driver.builder import BuildResult, build_file, build_source
 from .lang.linter import FileResult, lint_file, lint_paths, lint_source
 
 if TYPE_CHECKING:
@@ -72,7 +72,7 @@ def compile(path: Source | None = None, *, source: str | None = None,  # noqa: A
             (when given, the other keywords are not read).
 
     Returns:
-        A :class:`~aou_dsl.build.builder.BuildResult`: ``ok``, ``diagnostics``, ``trajectory``,
+        A :class:`~aou_dsl.driver.builder.BuildResult`: ``ok``, ``diagnostics``, ``trajectory``,
         ``declared`` and ``measured`` descriptors, the output ``document``.
     """
     if options is None:
@@ -98,7 +98,7 @@ def read_trajectory(path: Source, *, robot: str | None = None,
     last position) and ``ee_frame`` override the file's; ``angle_unit="deg"`` and
     ``time_unit="ms"`` read a recording in those units (docs/measure.md); ``package_dirs``
     are the folders of the robot's ``package://`` meshes, kept with the trajectory."""
-    from .build.builder import load_motion
+    from .driver.builder import load_motion
 
     return load_motion(os.fspath(path), robot=robot, goal=goal, ee_frame=ee_frame,
                        angle_unit=angle_unit, time_unit=time_unit,

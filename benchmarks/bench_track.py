@@ -51,8 +51,8 @@ def _process_cpu(argv: list[str], repeat: int = 3) -> float:
 def bench_track() -> None:
     from pathlib import Path
 
-    from aou_dsl.build.builder import build_file
     from aou_dsl.core.servo_specs import MODES
+    from aou_dsl.driver.builder import build_file
     from aou_dsl.lang.linter import lint_file
     from aou_dsl.safety.track import track
     from aou_dsl.safety.track_report import track_modes

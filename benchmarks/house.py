@@ -1,6 +1,6 @@
 """Benchmarks of the warm session and of batches (``python benchmarks/bench.py house``).
 
-- re-lint of a changed 200-line file in a warm :class:`~aou_dsl.build.session.Session`
+- re-lint of a changed 200-line file in a warm :class:`~aou_dsl.driver.session.Session`
   (each text new: warm);
 - rebuild of a new motion in the session (every primitive's values changed: warm), and
   after one descriptor changes (the other primitives' results reused: cached), hesitant
@@ -45,7 +45,7 @@ def _long_file(lines: int = 200) -> str:
 
 
 def _session_figures(repeat: int = 40) -> None:
-    from aou_dsl.build.session import Session
+    from aou_dsl.driver.session import Session
 
     session = Session()
     session.warm()

@@ -198,8 +198,8 @@ def _aouc_compile(path: str, out: str) -> None:
 
 def bench_build(repeat: int = 15) -> None:
     import aou_dsl
-    from aou_dsl.build.builder import CHECK_RATE
     from aou_dsl.compiler.pipeline import DEFAULT_RATE, compile_behaviour, sample
+    from aou_dsl.driver.builder import CHECK_RATE
     from aou_dsl.lang.linter import lint_file
     from aou_dsl.measuring.measured import measure
     from aou_dsl.safety.replay import replay
@@ -440,8 +440,8 @@ def _ceiling(cores: int) -> float:
 
 
 def bench_jobs(per: int = 3, rounds: int = 5) -> None:
-    from aou_dsl.build.parallel import BuildPool, build_many, default_jobs
     from aou_dsl.compiler.output import encode
+    from aou_dsl.driver.parallel import BuildPool, build_many, default_jobs
 
     cores = default_jobs()
     shipped = sorted((ROOT / "behaviours").glob("*.aou"))
@@ -566,7 +566,7 @@ def bench_sweep(files: int = 40, rounds: int = 3) -> None:
 def bench_render() -> None:
     import resource
 
-    from aou_dsl.build.builder import build_file
+    from aou_dsl.driver.builder import build_file
     from aou_dsl.media.render import render_video
 
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()

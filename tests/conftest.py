@@ -22,16 +22,6 @@ def pytest_configure(config: pytest.Config) -> None:
         signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
-def find_chromium() -> str | None:
-    """The Chromium the browser tests drive: the one ``AOU_CHROMIUM`` names, else
-    Debian's (None: none is installed)."""
-    import os
-    import shutil
-
-    return next((p for p in (os.environ.get("AOU_CHROMIUM"), shutil.which("chromium"),
-                             "/usr/bin/chromium") if p and os.path.exists(p)), None)
-
-
 @pytest.fixture
 def behaviours_dir() -> Path:
     return BEHAVIOURS
@@ -47,21 +37,6 @@ def fails_with(code: str, fn, *args, **kw):
     (d,) = err.value.diagnostics
     assert d.code == code, d.message
     return d
-
-
-def wait_for(what, timeout: float = 90.0, every: float = 0.1):
-    """Poll ``what()`` until it is truthy and give its value; the test fails on timeout
-    (a page, a server or a loop that never gets there). Tests of live things wait on a
-    condition this way, never on a fixed sleep."""
-    import time
-
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        got = what()
-        if got:
-            return got
-        time.sleep(every)
-    raise AssertionError("timed out waiting for the page")
 
 
 # --- Running on several workers (pytest-xdist, `--dist loadgroup` in pyproject.toml) ---------

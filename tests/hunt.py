@@ -29,7 +29,7 @@ if __package__ in (None, ""):  # run as a script: the generator and oracle sit b
     import langgen
     import oracle
 else:
-    from . import langgen, oracle
+    from tests import langgen, oracle
 
 CODE = re.compile(r"\b([SVMCRI]\d{3})\b")
 ERROR = re.compile(r"\b([SVMCRI]\d{3}) \[error\]")

@@ -44,7 +44,7 @@ ALL_FORMATS_CASES = 10
 
 def write_sources(src: Path, cases: int, seed: int) -> None:
     """The inputs: shipped behaviours, the valid test files, ``cases`` generated files."""
-    from .langgen import random_cases
+    from tests.langgen import random_cases
 
     src.mkdir(parents=True, exist_ok=True)
     for folder in (ROOT / "behaviours", ROOT / "tests" / "valid"):
@@ -78,8 +78,8 @@ def compile_all(tree: Path, src: Path, out: Path) -> dict[str, int]:
 def write_recordings(docs: Path, rec: Path) -> list[list[str]]:
     """Recordings of the compiled documents by every logger preset, written as the
     tests write them; the ``aouc measure`` arguments of each (compiled documents too)."""
-    from .recsim import PRESETS, record, to_csv_text, to_json_doc
-    from .recsim import _signal as replay
+    from tests.recsim import PRESETS, record, to_csv_text, to_json_doc
+    from tests.recsim import _signal as replay
 
     rec.mkdir(parents=True, exist_ok=True)
     jobs = [[str(p)] for p in sorted(docs.glob("*.json"))]

@@ -5,7 +5,7 @@ docs/robots.md (the part between the report markers; the rest of the page is pro
     python tools/robots_report.py --check    # exit 1 if the page differs from a new run
     python tools/robots_report.py --stdout   # print the report only
 
-Each behaviour goes through ``aou_dsl.build.builder.build_file(path, robot=NAME)``: lint, compile,
+Each behaviour goes through ``aou_dsl.driver.builder.build_file(path, robot=NAME)``: lint, compile,
 the safety replay, the measurement. Per arm and behaviour the report says whether it
 compiled, whether the checks passed, whether the measured descriptors equal the
 declared ones, and for what does not fit, the limit that binds and what the user can
@@ -73,7 +73,7 @@ def _advice(d, arm) -> tuple[str, str]:
 
 def _row(path: Path, robot: str) -> tuple[str, bool, list[str]]:
     """A table row for one behaviour on one arm, whether all is well, and notes."""
-    from aou_dsl.build.builder import build_file
+    from aou_dsl.driver.builder import build_file
     from aou_dsl.robot.load import load_arm
 
     arm = load_arm(robot)
@@ -108,7 +108,7 @@ def _row(path: Path, robot: str) -> tuple[str, bool, list[str]]:
 def _fitted(path: Path, robot: str, notes: list[str]) -> str:
     """``yes`` when ``--fit`` makes the behaviour compile, pass the checks and measure as
     its fitted file declares, in the same state; the changes go to ``notes``."""
-    from aou_dsl.build.builder import build_file
+    from aou_dsl.driver.builder import build_file
 
     res = build_file(str(path), robot=robot, fit=True)
     changes = [d for d in res.diagnostics if d.code == "C314"]

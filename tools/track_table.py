@@ -58,7 +58,7 @@ def track(path: Path, robot: str):
     """``path`` compiled for ``robot`` (fitted when the arm refuses it as written) and
     tracked in every mode: the :class:`~aou_dsl.safety.track_report.TrackReport`, or
     :class:`Refused` when the fit cannot keep the behaviour's look on this arm."""
-    from aou_dsl.build.builder import build_file
+    from aou_dsl.driver.builder import build_file
     from aou_dsl.lang.linter import lint_file, lint_source
     from aou_dsl.safety.track_report import track_modes
 

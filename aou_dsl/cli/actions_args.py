@@ -68,7 +68,9 @@ def dmp_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                      metavar="K", help="durations times K, accelerations over K^2 (default 1)")
     dmp.add_argument("--intensity", type=number(0.0, 1.0, what="an intensity"),
                      metavar="I", help="in [0, 1] (default: the behaviour's own)")
-    dmp.add_argument("--pin", action="append", default=[], choices=("approach", "retreat"),
+    from ..dmp.parts import pinnable
+
+    dmp.add_argument("--pin", action="append", default=[], choices=pinnable(),
                      help="keep the peak acceleration of these motions whatever the goal "
                      "(repeatable)")
     dmp.add_argument("-o", "--output", metavar="FILE",

@@ -103,9 +103,9 @@ def _cmd_explain(args: argparse.Namespace) -> int:
 
 
 def _cmd_compile(args: argparse.Namespace) -> int:
-    from ..build.parallel import build_many, default_jobs
     from ..core.diagnostics import has_errors
     from ..core.options import BuildOptions, SceneOptions
+    from ..driver.parallel import build_many, default_jobs
     from ..lang.linter import collect_inputs
     from .ci_cmd import keep_changed, no_output_misused, write_sarif
     from .dmp_cmd import write_compiled

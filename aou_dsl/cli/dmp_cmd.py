@@ -128,10 +128,10 @@ def _num(v: Any) -> str:
 
 def write_compiled(path: str, res: Any, fmt: str, inputs: Any = ()) -> None:
     """Write a build's output: DMPs for ``dmp`` (this layer knows them), else as
-    :func:`~aou_dsl.build.parallel.write_result` writes every other format."""
+    :func:`~aou_dsl.driver.parallel.write_result` writes every other format."""
     if fmt == "dmp":
         write_document(path, res.document, inputs=inputs)
         return
-    from ..build.parallel import write_result
+    from ..driver.parallel import write_result
 
     write_result(path, res, fmt, inputs=inputs)

@@ -80,8 +80,8 @@ def write_fitted(path: str, res, inputs: list[str]) -> int:
 def check_fitted(args: argparse.Namespace, read_kw: dict) -> int:
     """``aouc check FILE.aou --fit``: the behaviour fitted to the arm, then replayed."""
     from ..api import check
-    from ..build.builder import build_file
     from ..core.options import BuildOptions
+    from ..driver.builder import build_file
     from ..robot.files_read import files_read
 
     if not args.path.endswith(".aou") or (args.write_fitted and not args.fit):

@@ -97,30 +97,66 @@ def format_json(payload: object) -> str:
     return json.dumps(payload, indent=2, sort_keys=False)
 
 
+def _along(e) -> str:
+    return f"distance {e.start.d:.3f} -> {e.end.d:.3f} m (a={e.a:g} m/s^2)"
+
+
+def _bearing(e) -> str:
+    a0, a1 = (e.start.h, e.end.h) if e.plane == "horizontal" else (e.start.v, e.end.v)
+    return (f"{e.plane} bearing {math.degrees(a0):+.1f} -> {math.degrees(a1):+.1f} "
+            f"deg at {e.start.d:.3f} m")
+
+
+def _roll(e) -> str:
+    return f"roll {math.degrees(e.start.roll):+.1f} -> {math.degrees(e.end.roll):+.1f} deg"
+
+
+def _oscillation(e) -> str:
+    return f"shiver {math.degrees(e.amplitude):g} deg peak to peak at {e.f:g} Hz"
+
+
+def _hold(e) -> str:
+    return f"hold at {e.start.d:.3f} m"
+
+
+def _generic(e) -> str:
+    """A plugin kind's episode: where it goes, and the values it shows (its kind's
+    ``episode_values``), each as the kind names it."""
+    from ..lang.primitives import KINDS
+
+    what = (f"distance {e.start.d:.3f} -> {e.end.d:.3f} m" if e.moving
+            else f"at {e.start.d:.3f} m")
+    try:
+        shown = KINDS[e.kind].episode_values(e)
+    except Exception:  # a plugin's kind may fail in any way: show where it goes only
+        shown = {}
+    values = ", ".join(f"{k}={v:.4g}" for k, v in shown.items() if isinstance(v, int | float))
+    return f"{what} ({values})" if values else what
+
+
+@cached(maxsize=1)
+def _what_moves() -> dict:
+    """What ``aouc explain`` says moves in an episode, by kind (the built-ins; a plugin's
+    kind is described by :func:`_generic`)."""
+    from ..lang.primitives import APPROACH, GAZE, PAUSE, RETREAT, SHIVER, TILT
+
+    return {APPROACH: _along, RETREAT: _along, GAZE: _bearing, TILT: _roll,
+            SHIVER: _oscillation, PAUSE: _hold}
+
+
 def format_timeline(behaviour, cv, timeline) -> str:
     """``aouc explain``: the behaviour, its C-V point, and one line per episode."""
     b = behaviour
     declared = f"declared {b.state}" if b.state else "no state declared"
+    w = max([9, *(len(e.kind) + 1 for e in timeline.episodes)])  # a plugin's longer name
     lines = [f"behaviour {b.name} ({declared}; {b.form} form) on {b.settings.robot}",
              f"C-V point: C={cv.C:+.2f} V={cv.V:+.2f} -> {cv.state}; laid out as "
              f"{timeline.state}",
-             f"{'#':>3}  {'episode':<9}{'start':>8}{'dur':>8}  what moves"]
+             f"{'#':>3}  {'episode':<{w}}{'start':>8}{'dur':>8}  what moves"]
     t = 0.0
     for i, e in enumerate(timeline.episodes, 1):
-        if e.kind in ("approach", "retreat"):
-            what = f"distance {e.start.d:.3f} -> {e.end.d:.3f} m (a={e.a:g} m/s^2)"
-        elif e.kind == "gaze":
-            a0, a1 = (e.start.h, e.end.h) if e.plane == "horizontal" else (e.start.v, e.end.v)
-            what = (f"{e.plane} bearing {math.degrees(a0):+.1f} -> {math.degrees(a1):+.1f} "
-                    f"deg at {e.start.d:.3f} m")
-        elif e.kind == "tilt":
-            what = (f"roll {math.degrees(e.start.roll):+.1f} -> "
-                    f"{math.degrees(e.end.roll):+.1f} deg")
-        elif e.kind == "shiver":
-            what = f"shiver {math.degrees(e.amplitude):g} deg peak to peak at {e.f:g} Hz"
-        else:
-            what = f"hold at {e.start.d:.3f} m"
-        lines.append(f"{i:>3}  {e.kind:<9}{t:>7.2f}s{e.duration:>7.2f}s  {what}  "
+        what = _what_moves().get(e.kind, _generic)(e)
+        lines.append(f"{i:>3}  {e.kind:<{w}}{t:>7.2f}s{e.duration:>7.2f}s  {what}  "
                      f"(line {e.span.line})")
         t += e.duration
     lines.append(f"planned duration {t:.2f} s (moving episodes at the declared limits; "
@@ -195,11 +231,14 @@ def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = 
     n = len(m.episodes)
     lines = [f"{path}: {robot}, {m.duration:.2f} s, {n} episode{'' if n == 1 else 's'}"]
     from ..lang.descriptors import REGISTRY
+    from ..measuring.recognisers import extra_descriptors
 
-    for k, v in m.descriptors.items():
+    units = {k: d.unit for k, d in REGISTRY.items()}
+    units |= {d.name: d.unit for d in extra_descriptors() if d.name in m.extra}
+    for k, v in (dict(m.descriptors) | m.extra).items():  # the plugins' after the eleven
         val = "null" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
         lines.append(f"  {k:<22} {val:>10} {_interval(v, m.uncertainty.get(k)):<14} "
-                     f"{REGISTRY[k].unit}".rstrip())
+                     f"{units.get(k, '')}".rstrip())
     los, inf = m.line_of_sight, m.inferred
     if los is not None and len(los.angle):
         # The model assumes the hand looks at the goal throughout: how far it did not.

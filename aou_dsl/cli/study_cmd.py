@@ -69,7 +69,7 @@ def _analyze(args: argparse.Namespace, study) -> int:
 def _build(args: argparse.Namespace, study) -> int:
     import time
 
-    from ..build.parallel import default_jobs
+    from ..driver.parallel import default_jobs
     from ..study.build import build_study, manifest_path
 
     start = time.perf_counter()

@@ -12,7 +12,7 @@ from ..version import __version__
 from .args import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, usage_error
 from .report import format_json, format_text
 
-__all__ = ["cmd_robot", "cmd_rules", "cmd_synth"]
+__all__ = ["cmd_robot", "cmd_rules", "cmd_synth", "plugin_lines"]
 
 
 #: Names people call the built-in arms by: ``aouc robot franka`` suggests ``panda``.
@@ -61,6 +61,7 @@ def cmd_robot(args: argparse.Namespace) -> int:
             return usage_error("robot", "give a robot name or path, or --list")
         for name, spec in ROBOTS.items():
             print(f"{name:14s} {len(spec.arm_joints)} joints, end-effector {spec.ee_frame}")
+        _print_plugins()
         return EXIT_OK
     from ..core.files import check_output, write_atomic
     from ..core.options import package_dirs
@@ -118,6 +119,35 @@ def cmd_synth(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def plugin_lines() -> list[str]:
+    """The installed plugins' primitive kinds in words: each one loaded (its keyword, its
+    distribution and the layers it gives parts for), then each that cannot be used as it
+    is, with its code and why. Empty when none is installed (or ``AOU_NO_PLUGINS=1``)."""
+    from ..core.plugins import GROUP, LAYERS, plugins
+    from ..lang.descriptors import descriptor_problems
+    from ..lang.primitives import BUILTIN_KINDS, KINDS, plugin_problems
+
+    problems = (*plugin_problems(), *descriptor_problems())
+    used = [p for p in plugins() if p.name not in BUILTIN_KINDS and KINDS.get(p.name) is
+            p.part("kind")]
+    if not used and not problems:
+        return []
+    out = [f"plugins (entry point group {GROUP}): {len(used)} loaded"]
+    for p in used:
+        parts = ", ".join(layer for layer in LAYERS if p.part(layer) is not None)
+        out.append(f"  {p.name:<14} {p.source:<28} gives: {parts}")
+    if problems:
+        out.append(f"plugins that cannot be used as they are: {len(problems)}")
+        out += [f"  {p.code} {p.name:<14} {p.source:<28} {p.why}" for p in problems]
+    return out
+
+
+def _print_plugins() -> None:
+    lines = plugin_lines()
+    if lines:
+        print("\n" + "\n".join(lines))
+
+
 def cmd_rules(args: argparse.Namespace) -> int:
     """``aouc rules [CODE...]``: the registry, or some of its rules in full."""
     wanted = [c.upper() for c in args.codes]
@@ -138,4 +168,6 @@ def cmd_rules(args: argparse.Namespace) -> int:
                   f"  example:\n" + "\n".join(f"    {ln}" for ln in r.example.splitlines()))
         else:
             print(f"{r.code}  {r.name:<28} {r.severity:<8} {r.what}")
+    if not wanted or any(r.name.startswith("plugin-") for r in rules):
+        _print_plugins()
     return EXIT_OK

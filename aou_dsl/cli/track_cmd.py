@@ -69,8 +69,8 @@ def _refusal_note(args: argparse.Namespace, diagnostics) -> str | None:
 def _fit_refusal(args: argparse.Namespace) -> Diagnostic | None:
     """The first error of ``--fit`` on the same file and arm, or None when the fit gives
     a motion: the note points to ``--fit --track`` only where that command tracks."""
-    from ..build.builder import build_file
     from ..core.diagnostics import Severity
+    from ..driver.builder import build_file
     from ..fit.plan import FITTED
 
     res = build_file(args.path, robot=getattr(args, "robot", None), check=False, fit=True)

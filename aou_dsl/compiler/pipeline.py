@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.codes import C303, C304, C305, C308, C309, V124
+from ..core.codes import C303, C304, C305, C308, C309, K802, V124
 from ..core.diagnostics import AouError, Diagnostic, Fix, diag, has_errors, refused
 from ..core.memo import Keyed, cached
 from ..core.trajectory import Trajectory
@@ -24,13 +24,14 @@ from ..fit.plan import hint_edit
 from ..fit.refusals import AccelerationShort, ShiverTooFast, TiltTooFast, Unreachable
 from ..lang.ir import Behaviour
 from ..lang.layout import layout
-from ..lang.primitives import KINDS, LOOK_SHIVER_F, Shiver, Timing
+from ..lang.primitives import LOOK_SHIVER_F, Shiver, Timing
 from ..lang.timeline import Episode, Pose, Timeline
 from ..robot.geometry import ReachFrame, reach_frame
 from ..robot.identity import frame_definition
 from ..robot.ik import IKStatus, solve_path
 from ..robot.kinematics import ArmModel
 from ..robot.load import load_arm
+from .kind_timing import missing, timing_of
 from .reuse import solved_path, timed_path
 from .start import CODES, start_diagnostic
 from .timing import (
@@ -96,7 +97,7 @@ def _waypoints(ep: Episode, frame: ReachFrame, opts: CompileOptions
                ) -> tuple[np.ndarray, list[tuple[np.ndarray, np.ndarray]]]:
     """Path coordinate samples (K,) and end-effector targets of a moving episode; kept
     for recompilations by what they depend on (neither is changed by their users)."""
-    step = opts.step_length if KINDS[ep.kind].translation else opts.step_angle
+    step = timing_of(ep.kind).step(opts.step_length, opts.step_angle)
     key = (frame.goal.tobytes(), frame.R0.tobytes(), ep.start, ep.end, ep.path_length, step)
     return _kept_waypoints(Keyed(key, (ep, frame, step)))
 
@@ -160,7 +161,7 @@ def _follows(arm: ArmModel, frame: ReachFrame, options: CompileOptions, tl: Time
         return False
     q = ik.q[0]
     for ep in tl.episodes:
-        if KINDS[ep.kind].timing not in (Timing.HOLD, Timing.OSCILLATION):
+        if not timing_of(ep.kind).still:
             ik = solve_path(arm, _waypoints(ep, frame, options)[1], q)
             if ik.failure is not None:
                 return False
@@ -178,7 +179,7 @@ def _siblings(arm: ArmModel, frame: ReachFrame, episodes: tuple[Episode, ...],
         return []
     out = []
     for e in later:
-        if KINDS[e.kind].timing in (Timing.HOLD, Timing.OSCILLATION):
+        if timing_of(e.kind).still:
             continue
         s, targets = _waypoints(e, frame, options)
         ik = solve_path(arm, targets, q)
@@ -219,6 +220,11 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
     tl = timeline if timeline is not None else layout(b)
     res.timeline = tl
     lap("layout")
+    untimed = missing({ep.kind for ep in tl.episodes})
+    if untimed is not None:
+        at = next(ep.span for ep in tl.episodes if ep.kind == untimed[0])
+        res.diagnostics.append(diag(K802, untimed[1], at))
+        return res
     arm: ArmModel = load_arm(b.settings.robot, None, options.package_dirs)
     spec = arm.spec
     frame = reach_frame(b.settings.goal or spec.goal,
@@ -238,7 +244,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
     lap("ik")
     for i, ep in enumerate(tl.episodes):
         seg: PathSegment | JointSegment | None
-        timing = KINDS[ep.kind].timing
+        timing = timing_of(ep.kind).timing
         if timing is Timing.HOLD:
             segments.append(JointSegment(q, ep.duration))
         elif timing is Timing.OSCILLATION:
@@ -287,12 +293,12 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
                     res.diagnostics.append(diag(C305, f"{ep.kind}: {reason}", ep.span))
                     return res
                 if fail is not None:
-                    unit = "m/s^2" if KINDS[ep.kind].translation else "rad/s^2"
+                    kt = timing_of(ep.kind)
                     res.diagnostics.append(refused(
-                        C304, f"{ep.kind} reaches {fail.achieved:.3g} {unit}, not the "
-                        f"declared {fail.wanted:.3g} {unit}: {fail.reason}", ep.span,
+                        C304, f"{ep.kind} reaches {fail.achieved:.3g} {kt.unit}, not the "
+                        f"declared {fail.wanted:.3g} {kt.unit}: {fail.reason}", ep.span,
                         AccelerationShort(fail.joint, fail.achieved, fail.wanted,
-                                          f"{ep.kind}_acceleration")))
+                                          kt.acceleration)))
             lap("timing")
             segments.append(seg)
             q = ik.q[-1]

@@ -3,7 +3,7 @@ on (the arm, the reach, the episode's path and bounds, where it starts; not its 
 the file). A changed pause, or any other statement, leaves the other episodes' solutions
 as they were, so recompiling after one value changes re-solves only what it changed.
 The results are the same objects a first compile makes: the output is byte for byte the
-same (tests/test_session.py compares). The arm is known by its key
+same (tests/integration/test_session.py compares). The arm is known by its key
 (:attr:`~aou_dsl.robot.kinematics.ArmModel.key`), which holds the content of its robot's
 files: an edited robot file is solved again.
 """
@@ -15,8 +15,8 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 
 from ..core.memo import Keyed, cached
-from ..lang.primitives import KINDS
 from ..robot.ik import solve_path
+from .kind_timing import timing_of
 from .timing import time_path
 
 if TYPE_CHECKING:
@@ -73,4 +73,4 @@ def _timed(probe: Keyed):
 
 
 def _time(arm, s, q_path, ep):
-    return time_path(arm, s, q_path, ep.a, ep.vmax, cartesian=KINDS[ep.kind].translation)
+    return time_path(arm, s, q_path, ep.a, ep.vmax, cartesian=timing_of(ep.kind).translation)

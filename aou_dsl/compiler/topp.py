@@ -110,7 +110,7 @@ def _lean_toppra():
     set, the forward pass's greedy step) skip their per-call allocations and checks: the
     same solver calls with the same arguments in the same order (the seidel solver
     warm-starts from its previous call), so the same law to the last bit, about a sixth
-    faster on aou's paths. ``tests/test_speed_props.py`` compares the two."""
+    faster on aou's paths. ``tests/integration/test_speed_props.py`` compares the two."""
     stock: Any = import_toppra().algorithm.TOPPRA  # an untyped library's class
     nan = float("nan")
 

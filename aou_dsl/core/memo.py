@@ -1,12 +1,12 @@
 """Every cache of the process, in one registry: what a warm tool keeps between builds.
 
-A warm tool (the language server, the studio, a :class:`~aou_dsl.build.session.Session`,
+A warm tool (the language server, the studio, a :class:`~aou_dsl.driver.session.Session`,
 a pool worker) builds again and again in one process, and keeps what is slow to make: the
 parser, loaded arms, each motion episode's IK and time law, the checks' scenes. Each such
 cache is made here, by :func:`cached` (a function's results, least recently used first
 out) or :func:`table` (a bounded map a module fills itself), and registered by name, so
 that every one can be found, measured (:func:`stats`) and emptied (:func:`clear`);
-``tests/test_layers.py`` fails on a ``functools`` cache anywhere else in the package.
+``tests/unit/test_layers.py`` fails on a ``functools`` cache anywhere else in the package.
 
 Every cache has a size: memory stays bounded by the sizes given where each is made
 (:func:`stats` gives each one's bytes, about; the largest hold arms, scenes and per-row

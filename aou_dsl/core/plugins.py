@@ -15,11 +15,16 @@ environment the user chose, like a ``pip install``.
 from __future__ import annotations
 
 import os
+import re
+import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from importlib import metadata
+from typing import TYPE_CHECKING
 
 from .memo import cached
+
+if TYPE_CHECKING:
+    from importlib import metadata
 
 __all__ = ["GROUP", "LAYERS", "Broken", "Plugin", "loaded", "part", "plugins"]
 
@@ -61,12 +66,69 @@ def _source(ep: metadata.EntryPoint) -> str:
     return f"{dist.name} {dist.version}" if dist is not None else ep.value
 
 
-@cached(maxsize=1)
 def loaded() -> tuple[tuple[Plugin, ...], tuple[Broken, ...]]:
     """Every plugin of :data:`GROUP` that loads, in the order of their names, and the
-    entry points that do not."""
-    if os.environ.get("AOU_NO_PLUGINS", "") not in ("", "0"):
+    entry points that do not. Kept by what it depends on: ``AOU_NO_PLUGINS`` and the
+    import path (where installed distributions are found); ``loaded.cache_clear()``
+    forgets it (after installing a package in the same process)."""
+    off = os.environ.get("AOU_NO_PLUGINS", "") not in ("", "0")
+    return _load(off, tuple(sys.path))
+
+
+#: A section header of :data:`GROUP` in an ``entry_points.txt``.
+_SECTION = re.compile(r"^\s*\[\s*" + re.escape(GROUP) + r"\s*\]", re.MULTILINE)
+
+
+def _declared(path: tuple[str, ...]) -> bool:
+    """Whether a distribution on ``path`` may declare an entry point of :data:`GROUP`:
+    its ``*.dist-info`` or ``*.egg-info`` folder's ``entry_points.txt`` has the section.
+    A few milliseconds, where importing :mod:`importlib.metadata` (email, zipfile, csv)
+    and reading every distribution costs tens: ``aouc lint`` pays that only when a
+    plugin is installed. A path entry that is a zip is looked into the same way."""
+    for entry in path:
+        folder = entry or "."
+        try:
+            with os.scandir(folder) as found:
+                infos = [e.path for e in found if e.name.endswith((".dist-info", ".egg-info"))]
+        except NotADirectoryError:
+            if _zip_declares(folder):
+                return True
+            continue
+        except OSError:  # a path entry that does not exist (yet)
+            continue
+        for info in infos:
+            try:
+                with open(os.path.join(info, "entry_points.txt"), encoding="utf-8",
+                          errors="replace") as f:
+                    if _SECTION.search(f.read()):
+                        return True
+            except OSError:  # no entry points, or an egg-info that is a file
+                continue
+    return False
+
+
+def _zip_declares(archive: str) -> bool:
+    """:func:`_declared` for a zip on the import path (True when it cannot be read: then
+    :mod:`importlib.metadata` decides)."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(archive) as z:
+            for name in z.namelist():
+                if name.endswith("-info/entry_points.txt") and name.count("/") == 1 and \
+                        _SECTION.search(z.read(name).decode("utf-8", "replace")):
+                    return True
+    except (OSError, zipfile.BadZipFile):
+        return True
+    return False
+
+
+@cached(maxsize=4)
+def _load(off: bool, path: tuple[str, ...]) -> tuple[tuple[Plugin, ...], tuple[Broken, ...]]:
+    if off or not _declared(path):
         return (), ()
+    from importlib import metadata  # here: `import aou_dsl` and `aouc lint` stay light
+
     good: list[Plugin] = []
     bad: list[Broken] = []
     for ep in sorted(metadata.entry_points(group=GROUP), key=lambda e: (e.name, e.value)):
@@ -82,6 +144,9 @@ def loaded() -> tuple[tuple[Plugin, ...], tuple[Broken, ...]]:
             continue
         good.append(Plugin(ep.name, _source(ep), parts))
     return tuple(good), tuple(bad)
+
+
+loaded.cache_clear = _load.cache_clear  # type: ignore[attr-defined]
 
 
 def plugins() -> tuple[Plugin, ...]:

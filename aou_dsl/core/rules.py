@@ -130,9 +130,9 @@ _RULE_LIST = [
          "The reach never gets closer to the goal than the standoff.",
          "start 0.3m\nsequence { approach 0.5m }"),
     Rule("V121", "unrealisable-descriptors", _E,
-         "The descriptor form declares pauses, retreats or gazes that no layout can show: "
-         "a retreat starts and ends at a pause, a gaze ends at one, and two pauses with "
-         "nothing moving between them read as one.",
+         "Episodes cannot count as declared: no arrangement the state allows shows them all "
+         "(a retreat needs a pause before and after it, a gaze one after it, pauses motion "
+         "between them), or a sequence lacks the kind a statement needs beside it.",
          "The compiled motion would not have the descriptors the file declares.",
          "pause 1s x3   # and nothing else: three pauses in a row are one pause"),
     Rule("V122", "goal-out-of-range", _E,

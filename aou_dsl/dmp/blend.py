@@ -23,7 +23,8 @@ import numpy as np
 
 from ..core.codes import D606, I504
 from ..core.diagnostics import AouError, Span, diag
-from .export import MOVES, DmpSequence
+from .export import DmpSequence
+from .parts import moves
 from .rollout import Rollout, roll
 from .solve import Solved
 
@@ -35,8 +36,9 @@ BLEND_MARGIN = 0.10
 
 def _carrier(ro: Rollout, at: float) -> int:
     """The motion running at ``at``, else the next one; -1 when none is left."""
+    motions = moves()
     for k, (kind, _t0, t1) in enumerate(ro.parts):
-        if kind in MOVES and t1 > at:
+        if kind in motions and t1 > at:
             return k
     return -1
 

@@ -2,11 +2,15 @@
 
 One part per episode of the compiler's timeline (``Trajectory.episodes``):
 
-- approach, retreat, gaze, tilt: a ``CartesianDMP`` of the hand's pose from rest to rest
-  (:mod:`.fit`);
-- pause: a hold of the pose for its duration;
-- shiver: an oscillation of the roll about the hand's forward axis, made by the robot's
-  shiver joint as the compiler makes it: peak-to-peak amplitude, frequency, whole cycles.
+- a move (approach, retreat, gaze, tilt): a ``CartesianDMP`` of the hand's pose from rest
+  to rest (:mod:`.fit`);
+- a hold (pause): a hold of the pose for its duration;
+- an oscillation (shiver): an oscillation of the roll about the hand's forward axis, made
+  by the robot's shiver joint as the compiler makes it: peak-to-peak amplitude,
+  frequency, whole cycles.
+
+Which kind becomes which is the registry of :mod:`.parts` (a plugin kind's ``dmp`` part;
+a plugin kind without one is refused with K802).
 
 Each part carries the values it shows (distance, peak acceleration, turn, duration,
 amplitude); the sequence carries the descriptors measured on the whole trajectory, which
@@ -23,11 +27,9 @@ import numpy as np
 
 from ..core.codes import D601
 from ..core.diagnostics import AouError, Span, diag
+from ..lang.primitives import PAUSE
 
-__all__ = ["MOVES", "DmpPart", "DmpSequence", "to_dmp"]
-
-#: Episode kinds made by a CartesianDMP.
-MOVES = ("approach", "retreat", "gaze", "tilt")
+__all__ = ["DmpPart", "DmpSequence", "to_dmp"]
 
 
 @dataclass
@@ -131,11 +133,13 @@ def to_dmp(trajectory: Any, *, intensity: float = 0.5, behaviour: str | None = N
         descriptors: the trajectory's measured descriptors, when known (else measured).
 
     Raises:
-        AouError: D601 when the trajectory has no episodes or no goal (a recording).
+        AouError: D601 when the trajectory has no episodes or no goal (a recording);
+            K802 when an episode is of a plugin kind whose plugin gives no DMP part.
     """
     from ..measuring.measured import measure
     from ..robot.load import load_arm
     from .fit import fit_pose_dmp, quaternions
+    from .parts import Shape, dmp_kind
 
     tr = trajectory
     if not tr.episodes or tr.goal is None:
@@ -143,6 +147,8 @@ def to_dmp(trajectory: Any, *, intensity: float = 0.5, behaviour: str | None = N
                             "compiler: only a compiled trajectory can become DMPs",
                             _span(tr), hint="compile the .aou file, or give the .json "
                             "`aouc compile` wrote"))
+    shapes = {kind: (entry.shape if (entry := dmp_kind(kind, _span(tr))) else None)
+              for kind in dict.fromkeys(k for k, _a, _e in tr.episodes)}
     arm = load_arm(tr.robot, tr.ee_frame)
     cols = tr.columns(arm.joint_names)
     q = np.asarray(tr.q[:, cols], dtype=float)
@@ -161,16 +167,19 @@ def to_dmp(trajectory: Any, *, intensity: float = 0.5, behaviour: str | None = N
         pose0 = np.concatenate([pos[i0], quat[i0]])
         pose1 = np.concatenate([pos[i1], quat[i1]])
         part = DmpPart(kind, float(e - a), pose0, pose1)
-        if kind in MOVES and i1 - i0 >= 3:
+        shape = shapes[kind]
+        if shape is Shape.MOVE and i1 - i0 >= 3:
             t = tr.t[i0:i1 + 1] - tr.t[i0]
             part.dmp, lead = fit_pose_dmp(t, pos[i0:i1 + 1], quat[i0:i1 + 1])
             part.lead = lead - float(tr.t[i0] - a)
             part.values = _move_values(pos[i0:i1 + 1], quat[i0:i1 + 1], acc[i0:i1 + 1])
-        elif kind == "shiver":
+        elif shape is Shape.OSCILLATION:
             part.end = pose0
             part.values = _shiver_values(q[i0:i1 + 1, j] - q[i0, j], part.duration)
         else:
-            part.kind = "pause" if kind not in MOVES else kind
+            # a hold (or a move too short to fit) keeps the pose; a kind no DMP folder
+            # holds is written as a pause
+            part.kind = kind if shape in (Shape.MOVE, Shape.HOLD) else PAUSE
             part.end = pose0
         parts.append(part)
     measured = descriptors or measure(tr).descriptors.to_json()

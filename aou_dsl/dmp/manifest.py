@@ -22,26 +22,9 @@ from ..core.codes import I502
 from ..core.diagnostics import AouError, Span, diag
 from .export import DmpPart, DmpSequence
 
-__all__ = ["FORMAT", "PARAMETERS", "manifest", "read_dmp", "write_dmp"]
+__all__ = ["FORMAT", "manifest", "read_dmp", "write_dmp"]
 
 FORMAT = "aou-dmp/1"
-
-#: Which DMP parameter controls each descriptor (docs/dmp.md, the scaling rules).
-#: By the descriptor's kind and episode key ("" for a count).
-PARAMETERS = {
-    ("approach", "peak_acceleration"): "execution_time_ of each approach (peak ~ amplitude "
-                                       "/ time^2); forcing weights scaled with the amplitude",
-    ("retreat", "peak_acceleration"): "execution_time_ of each retreat, as above",
-    ("retreat", "distance"): "start_y/goal_y and forcing weights (amplitude scaling)",
-    ("pause", "duration"): "the hold's duration",
-    ("pause", ""): "the parts (fixed)",
-    ("retreat", ""): "the parts (fixed)",
-    ("gaze", "horizontal"): "rotation of start_y/goal_y and weights about the goal (kept)",
-    ("gaze", "vertical"): "rotation of start_y/goal_y and weights about the goal (kept)",
-    ("tilt", "angle"): "the orientation goal_y (kept)",
-    ("tilt", "velocity"): "execution_time_ of each tilt",
-    ("shiver", "amplitude"): "the oscillation's amplitude",
-}
 
 
 def _where(path: str) -> Span:
@@ -67,9 +50,12 @@ def manifest(seq: DmpSequence) -> dict[str, Any]:
 
 
 def _parameters() -> dict[str, str]:
+    """Which DMP parameter controls each descriptor (docs/dmp.md, the scaling rules): the
+    registry's lines (:func:`.parts.parameter_lines`), by descriptor name."""
     from ..synth.recipe import descriptor
+    from .parts import parameter_lines
 
-    return {descriptor(kind, key).name: text for (kind, key), text in PARAMETERS.items()}
+    return {descriptor(kind, key).name: text for (kind, key), text in parameter_lines()}
 
 
 def write_dmp(path: str, seq: DmpSequence, *, inputs: Any = ()) -> None:

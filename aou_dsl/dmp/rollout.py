@@ -39,23 +39,21 @@ import numpy as np
 
 from ..core.codes import D602
 from ..core.diagnostics import AouError, Span, diag
+from ..lang.primitives import PAUSE
 from .allowed import DIVERGED, Diverged, check_goal, check_options
 from .export import DmpSequence
+from .parts import Scaling, Shape, descriptor_name, dmp_kinds, scaled, shape_of
 
 __all__ = ["Rollout", "predict", "roll", "similarity"]
 
 _WHERE = Span.whole_file("<dmp>")
 
 
-def _name(kind: str, key: str) -> str:
-    """The descriptor read from ``kind`` episodes by ``key`` (the registry's name)."""
-    from ..synth.recipe import descriptor
+def _accel() -> dict[str, str]:
+    """The moving kinds whose peak acceleration is a descriptor (a rollout may pin it),
+    and its name."""
+    return {kind: name for kind, name, how in scaled() if how is Scaling.PEAK}
 
-    return descriptor(kind, key).name
-
-
-#: The moving kinds whose peak acceleration is a descriptor, and its name.
-_ACCEL = {kind: _name(kind, "peak_acceleration") for kind in ("approach", "retreat")}
 #: Step of the DMPs' rollouts [s] (the library integrates orientation every millisecond
 #: within it); the rollout is then sampled at the sequence's rate through a cubic spline.
 ROLL_DT = 0.002
@@ -121,13 +119,13 @@ def _factors(seq: DmpSequence, intensity: float | None) -> dict[str, float]:
     if intensity is None or seq.state is None:
         return {}
     state = State(seq.state)
+    kinds = dmp_kinds()
     out = {}
     for d in REGISTRY.values():
         span = SPANS.get(state, {}).get((d.kind, d.key))
-        if span is None or d.is_count or d.kind == "retreat" and d.key == "distance":
-            continue
-        if d.kind == "gaze" or d.kind == "tilt":
-            continue  # an angle is the parts' geometry: a re-plan
+        entry = kinds.get(d.kind)
+        if span is None or d.is_count or entry is None or d.key not in entry.intensity:
+            continue  # an angle or a distance is the parts' geometry: a re-plan
         out[d.name] = span ** (d.stronger[state] * 2.0 * (intensity - seq.intensity))
     return out
 
@@ -141,14 +139,18 @@ def predict(seq: DmpSequence, s: float, k: float, factors: dict[str, float],
         if out.get(name) is not None:
             out[name] = out[name] * f
 
-    for name in _ACCEL.values():
+    for _kind, name, how in scaled():
         f = factors.get(name, 1.0)
-        times(name, f if name in pinned else s * f / k ** 2)
-    hold, shake = _name("pause", "duration"), _name("shiver", "amplitude")
-    times(hold, k * factors.get(hold, 1.0))
-    times(_name("retreat", "distance"), s)
-    times(_name("tilt", "velocity"), 1.0 / k)
-    times(shake, factors.get(shake, 1.0))
+        if how is Scaling.PEAK:
+            times(name, f if name in pinned else s * f / k ** 2)
+        elif how is Scaling.TIME:
+            times(name, k * f)
+        elif how is Scaling.SPACE:
+            times(name, s)
+        elif how is Scaling.RATE:
+            times(name, 1.0 / k)
+        else:
+            times(name, f)
     return out
 
 
@@ -250,7 +252,7 @@ def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
         AouError: I504 for a value out of range.
     """
     for level in (intensity, *(later for _, later in schedule)):
-        check_options(time_scale, level, pinned, tuple(_ACCEL.values()))
+        check_options(time_scale, level, pinned, tuple(_accel().values()))
     p0 = seq.parts[0].start[:3]
     new_goal = tuple(float(x) for x in (goal if goal is not None else seq.goal))
     check_goal(new_goal, p0)
@@ -281,7 +283,7 @@ def roll(seq: DmpSequence, *, goal: tuple[float, float, float] | None = None,
         t1 = plan.t0 + plan.duration
         which[t >= plan.t0] = k
         spans.append((plan.kind, plan.t0, t1))
-        if plan.kind == "shiver":
+        if shape_of(plan.kind) is Shape.OSCILLATION:
             sel = (t >= plan.t0) & (t <= t1)
             shiver[:, sel] = _shiver(t[sel] - plan.t0, plan.amplitude, plan.freq,
                                      plan.duration)
@@ -360,14 +362,15 @@ def _plans(seq: DmpSequence, p0: np.ndarray, s: float, r: np.ndarray, time_scale
             runs, spline = _rolled(cache, i, p, start, end, s, r, k, retime)
             plans.append(_Plan(p.kind, t0, k * p.duration, t0 - k * p.lead, runs, spline,
                                start))
-        elif p.kind == "shiver":
+        elif shape_of(p.kind) is Shape.OSCILLATION:
             cycles = max(3, int(round(p.values["cycles"] * time_scale)))
             freq = p.values["frequency"]
             amp = math.radians(p.values["amplitude"]) * factors.get(
-                _name("shiver", "amplitude"), 1.0)
-            plans.append(_Plan("shiver", t0, cycles / freq, amplitude=amp, freq=freq))
+                descriptor_name(p.kind, "amplitude") or "", 1.0)
+            plans.append(_Plan(p.kind, t0, cycles / freq, amplitude=amp, freq=freq))
         else:
-            dur = p.duration * time_scale * factors.get(_name("pause", "duration"), 1.0)
+            hold = descriptor_name(PAUSE, "duration") or ""
+            dur = p.duration * time_scale * factors.get(hold, 1.0)
             # A motion's fitted tails reach into a hold by about half its margin, and
             # stretch with its time scale: the hold gives back what the stretch adds.
             dur += sum(0.5 * seq.parts[j].lead * (ks[j] - 1.0) for j in (i - 1, i + 1)
@@ -382,7 +385,7 @@ def _time_scale(p: Any, s: float, time_scale: float, factors: dict[str, float],
     """The time scale of part ``p``'s DMP (1 for a part without one)."""
     if p.dmp is None:
         return 1.0
-    name = _ACCEL.get(p.kind)
+    name = _accel().get(p.kind)
     f = factors.get(name, 1.0) if name else 1.0
     return math.sqrt(s / f) if name in pinned else time_scale / math.sqrt(f)
 

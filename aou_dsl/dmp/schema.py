@@ -38,6 +38,7 @@ from .allowed import (
     MIN_INT_DT,
     MIN_RATE,
 )
+from .parts import Shape, dmp_kinds
 
 __all__ = ["ALLOWED", "Where", "build_dmp", "check_manifest", "check_part", "kind_of"]
 
@@ -50,7 +51,6 @@ ALLOWED = {("movement_primitives.dmp._cartesian_dmp", _CARTESIAN): _CARTESIAN,
            ("movement_primitives.dmp._forcing_term", _TERM): _TERM}
 
 _FORMAT = "aou-dmp/1"
-_KINDS = ("approach", "retreat", "gaze", "tilt", "pause", "shiver")
 _MANIFEST_KEYS = {"format", "behaviour", "state", "intensity", "robot", "ee_frame",
                   "joint_names", "goal", "q_start", "shiver_joint", "rate", "duration",
                   "quaternion_order", "descriptors", "parameters", "parts"}
@@ -275,15 +275,17 @@ def _descriptors(x: Any, w: Where, registry: dict) -> dict[str, Any]:
 def _entry(e: Any, w: Where, field: str) -> dict[str, Any]:
     e = _object(e, w, field, _PART_KEYS, _PART_KEYS - {"lead"})
     kind = e["kind"]
-    if kind not in _KINDS:
+    kinds = dmp_kinds()  # looked up by name: nothing named in a file is imported
+    if not isinstance(kind, str) or kind not in kinds:
         shown = repr(kind) if isinstance(kind, str) else kind_of(kind)
-        raise w.fail(f"{field}.kind", f"must be one of {', '.join(_KINDS)}, found {shown}")
+        raise w.fail(f"{field}.kind", f"must be one of {', '.join(kinds)}, found {shown}")
+    shape = kinds[kind].shape
     out = {"kind": kind,
            "duration": _number(e["duration"], w, f"{field}.duration", 0.0, MAX_DURATION),
            "lead": _number(e.get("lead", 0.0), w, f"{field}.lead", -MAX_LEAD, MAX_LEAD),
            "start": _pose(e["start"], w, f"{field}.start"),
            "end": _pose(e["end"], w, f"{field}.end"), "file": e["file"]}
-    if e["file"] is not None and kind in ("pause", "shiver"):
+    if e["file"] is not None and shape is not Shape.MOVE:
         raise w.fail(f"{field}.file", f"must be null for a {kind} (only a motion has a "
                      "part file)")
     if e["file"] is not None and not isinstance(e["file"], str):
@@ -294,7 +296,7 @@ def _entry(e: Any, w: Where, field: str) -> dict[str, Any]:
                      f"{kind_of(values)}")
     out["values"] = {str(k): _number(v, w, f"{field}.values.{k}", -1e6, 1e6)
                      for k, v in values.items()}
-    if kind == "shiver":
+    if shape is Shape.OSCILLATION:
         _shiver(out["values"], w, f"{field}.values")
     return out
 

@@ -8,16 +8,20 @@ import re
 
 from lsprotocol import types
 
+from ..core.rule_model import Category
 from ..lang.descriptors import DEFINITIONS, REGISTRY, Descriptor
 from ..lang.ir import State
 from ..lang.primitives import KINDS
+from ..synth.kind_recipes import all_descriptors
 from . import lsp_engine as engine
+from .kind_texts import definition, texts_of
 from .state import Document
 from .text import Tok, at, statement_at, tokens_of
 
 __all__ = ["descriptor_for", "describe", "hover"]
 
-_CODE = re.compile(r"\b[SVMCRI]\d{3}\b")
+#: A rule code named in a comment: any category's letter and three digits.
+_CODE = re.compile(rf"\b[{''.join(c.value for c in Category)}]\d{{3}}\b")
 _WAYS = {"": ("more", "fewer"), "s": ("longer", "shorter"), "m": ("longer", "shorter"),
          "deg": ("larger", "smaller")}
 _STATES = (State.CONFIDENT, State.CURIOUS, State.HESITANT, State.FEARFUL)
@@ -43,8 +47,10 @@ def descriptor_for(keyword: str, slot: str, plane: str | None = None) -> Descrip
     kind = KINDS.get(keyword)
     if kind is None:
         return None
-    for d in REGISTRY.values():
-        if d.kind != keyword or (keyword == "gaze" and d.key != plane):
+    texts = texts_of(keyword)
+    by_plane = texts is not None and bool(texts.planes)
+    for d in all_descriptors():
+        if d.kind != keyword or (by_plane and d.key != plane):
             continue
         if slot == "x" and d.is_count:
             return d
@@ -66,8 +72,12 @@ def describe(d: Descriptor) -> str:
             up, down = _WAYS.get(d.unit, ("higher", "lower"))
             way = up if d.stronger[s] > 0 else down
             found.append(f"- {s}: looks more {s} as it is {way}")
+    meaning = DEFINITIONS.get(d.name) or definition(d.name, d.kind)
+    if d.name not in REGISTRY:  # a plugin's: the study never showed it to anyone
+        return (f"**{d.name}** ({unit}): {meaning}.\n\nNot one of the eleven descriptors "
+                "the study varied: no perceived effect is known.")
     study = "\n".join(found) or "- the study found no effect of it on any state"
-    return (f"**{d.name}** ({unit}): {DEFINITIONS[d.name]}.\n\n"
+    return (f"**{d.name}** ({unit}): {meaning}.\n\n"
             f"What the study found (one descriptor varied at a time):\n\n{study}")
 
 
@@ -83,7 +93,9 @@ def _key_text(keyword: str, key: str) -> str | None:
 def _argument(stmt: list[Tok], tok: Tok) -> str | None:
     """Hover on an argument: the descriptor it sets, or its key's meaning."""
     keyword = stmt[0].text
-    plane = next((t.text for t in stmt if t.text in ("horizontal", "vertical")), None)
+    texts = texts_of(keyword)
+    planes = texts.planes if texts is not None else ()
+    plane = next((t.text for t in stmt if t.text in planes), None)
     i = stmt.index(tok)
     if tok.text == "=" and i >= 1:
         tok, i = stmt[i - 1], i - 1
@@ -146,9 +158,11 @@ def _episodes(doc: Document, line: int, stmt: list[Tok]) -> str | None:
 
 
 def _planned(ep) -> str:
-    if not ep.moving or ep.kind == "shiver":
-        return f": {math.degrees(ep.amplitude):.3g} deg at {ep.f:g} Hz" \
-            if ep.kind == "shiver" else ""
+    texts = texts_of(ep.kind)
+    if texts is not None and texts.planned is not None:
+        return texts.planned(ep)
+    if not ep.moving:
+        return ""
     peak = min(ep.vmax, math.sqrt(ep.a * ep.path_length)) if ep.a > 0 else ep.vmax
     if KINDS[ep.kind].translation:
         return f": peak speed {peak:.3f} m/s, acceleration {ep.a:.3g} m/s^2"

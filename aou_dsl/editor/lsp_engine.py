@@ -10,7 +10,7 @@ its path (for relative robot files and the diagnostics' spans):
   those of the whole ``aouc compile`` (checks and measuring too), for the compile
   diagnostics (C-codes); :func:`shown` then adds the compiled episodes' figures.
 
-Lints and builds go through warm sessions (:class:`~aou_dsl.build.session.Session`): the
+Lints and builds go through warm sessions (:class:`~aou_dsl.driver.session.Session`): the
 robot models stay loaded, an unchanged text is not linted again, and a build after an
 edit re-solves only the episodes the edit changed. Typing and compiling run on different
 threads, so each has a session of its own;
@@ -28,7 +28,7 @@ from ..core.diagnostics import RULES, AouError, Diagnostic, Rule
 from ..core.memo import cached
 
 if TYPE_CHECKING:
-    from ..build.session import Session
+    from ..driver.session import Session
     from ..lang.linter import FileResult
     from ..lang.parse import SyntaxTree
     from ..lang.relint import Relinter
@@ -65,7 +65,7 @@ class Built:
 def _session(thread: str) -> Session:
     """The warm session of the typing thread (``"typing"``) or of the compile worker
     (``"compile"``)."""
-    from ..build.session import Session
+    from ..driver.session import Session
 
     return Session()
 
@@ -137,7 +137,7 @@ def build(text: str, path: str, robot: str | None = None, first: Built | None = 
     with the safety checks; nothing is written. ``first`` is :func:`compile_only`'s
     result for the same text and robot, whose compile is used. Raises nothing for a bad
     file: what went wrong is in the diagnostics."""
-    from ..build.builder import build_lint
+    from ..driver.builder import build_lint
 
     if first is not None and first._lint is not None:
         res = build_lint(first._lint, robot=robot)  # its IK and timing are kept: not solved again

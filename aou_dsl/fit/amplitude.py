@@ -25,6 +25,7 @@ from typing import Any
 
 from ..core.diagnostics import Diagnostic, Severity
 from ..lang.linter import lint_source
+from ..lang.primitives import SHIVER
 from .reach import Statement, offered
 from .refusals import ShiverTooFast, answered
 
@@ -50,9 +51,9 @@ def with_amplitude_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...
               and x.span.path == lint.path), None)
     if d is None or b is None or lint.source is None or lint.timeline is None:
         return res
-    ep = next((e for e in lint.timeline.episodes if e.kind == "shiver" and e.span == d.span),
+    ep = next((e for e in lint.timeline.episodes if e.kind == SHIVER and e.span == d.span),
               None)
-    st = Statement(lint.source, d.span.line, d.span.col, d.span.end_col, ("shiver",))
+    st = Statement(lint.source, d.span.line, d.span.col, d.span.end_col, (SHIVER,))
     if ep is None or not st.ok or st.dim != "angle":
         return res
     from ..compiler.oscillation import shiver_ratios
@@ -73,7 +74,7 @@ def with_amplitude_fit(res: Any, robot: str | None, package_dirs: tuple[str, ...
         if not math.isfinite(bound):
             return res
         stmt, text = st.with_value(compress(abs(st.value), bound))
-        fitted = Statement(stmt, 1, 1, len(stmt) + 1, ("shiver",))
+        fitted = Statement(stmt, 1, 1, len(stmt) + 1, (SHIVER,))
         if not fitted.ok or abs(fitted.value) < VISIBLE_SHIVER * (1.0 - 1e-9):
             why = (f"at {fa:g} Hz the arm follows a shiver of {math.degrees(bound):.3g} deg "
                    f"at most, under the {least:g} deg a person sees; a slower one than "

@@ -29,9 +29,14 @@ from __future__ import annotations
 
 from ..core.codes import C301, C302, C303, C304, C308, C309
 from ..core.diagnostics import Diagnostic, Span
+from ..lang.descriptors import REGISTRY
+from ..lang.primitives import TILT
 from .refusals import AccelerationShort, ShiverTooFast, TiltTooFast, answer_of
 from .rounding import written
 from .text_edits import Change, value_text
+
+#: The descriptor a tilt's ``v=`` sets.
+_TILT_VELOCITY = next(d.name for d in REGISTRY.values() if d.kind == TILT and d.ir_field == "v")
 
 __all__ = ["FITTED", "KNEE", "compress", "hint_edit", "plan", "shiver_keys"]
 
@@ -100,7 +105,7 @@ def plan(diagnostics: list[Diagnostic], declared: dict[tuple, float]) -> list[Ch
             v = declared.get(_at(d, "v"), r.declared_velocity)
             fitted = written(compress(float(v), r.max_velocity) if v else r.max_velocity, 4)
             out.append(Change(d.span, "v", "" if v is None else f"{v:g}", fitted, "deg/s",
-                              r.joint, r.limit, "tilt_velocity"))
+                              r.joint, r.limit, _TILT_VELOCITY))
         # the changes the builder found (a reach, a shiver's amplitude: field ``reach``)
         out += [Change(Span(d.span.path, c["line"], c["col"], c["line"], c["end_col"]),
                        c["key"], c["declared"], c["fitted"], c["unit"], c["joint"],

@@ -32,7 +32,9 @@ from typing import Any
 from ..core.codes import C301, C302, C303
 from ..core.diagnostics import Diagnostic, Severity, Span, refused
 from ..core.memo import cached
+from ..lang.descriptors import REGISTRY
 from ..lang.linter import FileResult, lint_source
+from ..lang.primitives import APPROACH, GAZE, KINDS, RETREAT, TILT
 from .quantity import UNITS, first
 from .refusals import Unreachable, answered, first_error
 from .rounding import written
@@ -52,19 +54,29 @@ MOST = 4
 _LIMIT = {C301: "reach", C302: "position", C303: "singularity"}
 
 
+#: The units of the descriptors a positional value that moves the hand sets.
+_PLACE_UNITS = ("m", "deg")
+
+
 def _descriptor(words: list[str]) -> str | None:
-    """The descriptor a statement's positional value sets (None: none)."""
-    if words[0] == "gaze" and len(words) > 1 and words[1] in ("horizontal", "vertical"):
-        return f"{words[1]}_gaze"
-    return {"retreat": "retreat_distance", "tilt": "tilt_angle",
-            "shiver": "shiver_amplitude"}.get(words[0])
+    """The descriptor a statement's positional value sets (None: none): the one of its
+    kind, in a unit of length or angle, that no ``key=`` argument sets; of several (a
+    gaze's planes), the one whose episode value the next word names."""
+    kind = KINDS.get(words[0]) if words else None
+    if kind is None:
+        return None
+    found = [d for d in REGISTRY.values() if d.kind == kind.name and not d.is_count
+             and d.unit in _PLACE_UNITS and d.ir_field not in kind.keys]
+    if len(found) > 1:
+        found = [d for d in found if d.key in words[1:2]]
+    return found[0].name if len(found) == 1 else None
 
 
 class Statement:
     """One statement's positional value, and the file's text with another value there."""
 
     def __init__(self, text: str, line: int, col: int, end_col: int,
-                 kinds: tuple[str, ...] = ("gaze", "retreat", "tilt", "approach")) -> None:
+                 kinds: tuple[str, ...] = (GAZE, RETREAT, TILT, APPROACH)) -> None:
         self.text, self.line, self.col = text, line, col
         self.stmt, self.stop = statement(text, line, col, end_col)
         self.match = first(self.stmt)

@@ -14,6 +14,7 @@ import re
 from dataclasses import dataclass
 
 from ..core.diagnostics import Span
+from ..lang.primitives import GAZE
 from .quantity import first, keyed
 
 __all__ = ["POSITIONAL", "Change", "apply", "apply_edit", "set_value", "splice",
@@ -95,9 +96,9 @@ def set_value(stmt: str, key: str, value: str) -> str:
     if at is not None:
         return stmt[:at[0]] + value + stmt[at[1]:]
     words = stmt.split(" ")
-    n = 1 if len(words) > 1 and re.match(r"^[-+.\d]", words[1]) and words[0] != "gaze" \
+    n = 1 if len(words) > 1 and re.match(r"^[-+.\d]", words[1]) and words[0] != GAZE \
         else 0
-    if words[0] == "gaze":
+    if words[0] == GAZE:
         n = 2
     return " ".join([*words[:n + 1], value, *words[n + 1:]])
 

@@ -21,6 +21,11 @@ Three things live here:
    Every term is monotone in its evidence, so more or longer retreats never raise C,
    a higher approach acceleration never lowers C, and adding pauses, gaze, tilt or
    shiver never lowers V.
+
+A kind from a plugin takes part the same way, with no change here: its ``evidence``
+table names channels of :data:`CHANNELS` (and the episode value that feeds each, added
+up or the largest), and :func:`evidence_problem` refuses a table that names anything
+else (the plugin is then not loaded: K801).
 """
 
 from __future__ import annotations
@@ -29,10 +34,13 @@ import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 
+from .evidence import CHANNELS, evidence_problem
 from .ir import Effort, State
+from .primitives import APPROACH, GAZE, PAUSE, RETREAT, SHIVER, TILT
 
 __all__ = [
     "CANONICAL",
+    "CHANNELS",
     "Composition",
     "Contribution",
     "CVPoint",
@@ -42,6 +50,7 @@ __all__ = [
     "classify",
     "composition",
     "effort_to_cv",
+    "evidence_problem",
     "infer",
     "missing_descriptors",
 ]
@@ -139,6 +148,8 @@ class Composition:
     tremor: float = 0.0
 
 
+
+
 @dataclass(frozen=True, slots=True)
 class InferenceParams:
     """Reference scales and gains of the inference (docs/cv-model.md). Chosen so the five
@@ -185,12 +196,13 @@ def infer(comp: Composition, params: InferenceParams = INFERENCE
     """The (C, V) point a composition expresses, and each channel's pull on it."""
     p = params
     terms = (
-        ("approach", comp.drive, p.k_drive * _ratio(comp.drive, p.a_ref), 0.0),
-        ("retreat extent", comp.extent, -p.k_extent * _sat(comp.extent, p.d_ref), 0.0),
-        ("retreat vigour", comp.vigour, -p.k_vigour * _ratio(comp.vigour, p.ar_ref), 0.0),
-        ("pause", comp.stillness, 0.0, p.k_still * _sat(comp.stillness, p.p_ref)),
-        ("gaze/tilt", comp.exploration, 0.0, p.k_explore * _sat(comp.exploration, p.e_ref)),
-        ("shiver", comp.tremor, 0.0, p.k_tremor * _sat(comp.tremor, p.s_ref)),
+        (APPROACH, comp.drive, p.k_drive * _ratio(comp.drive, p.a_ref), 0.0),
+        (f"{RETREAT} extent", comp.extent, -p.k_extent * _sat(comp.extent, p.d_ref), 0.0),
+        (f"{RETREAT} vigour", comp.vigour, -p.k_vigour * _ratio(comp.vigour, p.ar_ref), 0.0),
+        (PAUSE, comp.stillness, 0.0, p.k_still * _sat(comp.stillness, p.p_ref)),
+        (f"{GAZE}/{TILT}", comp.exploration, 0.0,
+         p.k_explore * _sat(comp.exploration, p.e_ref)),
+        (SHIVER, comp.tremor, 0.0, p.k_tremor * _sat(comp.tremor, p.s_ref)),
     )
     contrib = [Contribution(name, dc, dv) for name, x, dc, dv in terms if x > 0]
     c = p.bias + sum(x.dC for x in contrib)
@@ -201,8 +213,9 @@ def infer(comp: Composition, params: InferenceParams = INFERENCE
 def composition(episodes: Iterable) -> Composition:
     """The evidence of a list of :class:`~aou_dsl.lang.descriptors.EpisodeValues` (declared or
     measured): each kind's ``evidence`` table says which value feeds which channel and
-    whether its episodes add up or the largest counts. An episode is read by what it
-    does: a negative approach is a retreat."""
+    whether its episodes add up or the largest counts (a plugin kind's table too: its
+    channels were checked when it loaded). An episode is read by what it does: a
+    negative approach is a retreat."""
     from .primitives import KINDS
 
     amounts: dict[str, float] = {}
@@ -222,6 +235,6 @@ def missing_descriptors(goal: object) -> tuple[str, ...]:
     complete measurement."""
     if goal is not None:
         return ()
-    from .descriptors import REGISTRY
+    from .descriptors import every_descriptor
 
-    return tuple(name for name, d in REGISTRY.items() if d.kind == "gaze")
+    return tuple(name for name, d in every_descriptor().items() if d.kind == GAZE)

@@ -9,25 +9,27 @@ from __future__ import annotations
 
 from typing import Any
 
-from .descriptors import REGISTRY, Descriptors, derive
+from .descriptors import Descriptors, derive, every_descriptor
 from .ir import Behaviour
 from .layout import episode_values
-from .primitives import KINDS
+from .primitives import GAZE, KINDS
 from .timeline import Timeline
 
 __all__ = ["declared", "source_of", "written"]
 
 
 def source_of(b: Behaviour, name: str) -> Any:
-    """The descriptor-form statement that sets descriptor ``name`` (None when absent)."""
-    d = REGISTRY[name]
-    return b.first(d.kind, d.key if d.kind == "gaze" else None)
+    """The descriptor-form statement that sets descriptor ``name`` (None when absent): a
+    gaze's descriptors are one per plane, every other kind's one per kind."""
+    d = every_descriptor()[name]
+    return b.first(d.kind, d.key if d.kind == GAZE else None)
 
 
 def written(b: Behaviour) -> Descriptors:
-    """The descriptor form's values as written; counts of absent kinds are zero."""
+    """The descriptor form's values as written; counts of absent kinds are zero. Every
+    descriptor (a plugin kind's too) is read from its kind's node by the kind itself."""
     out: dict[str, float | int | None] = {}
-    for name, d in REGISTRY.items():
+    for name, d in every_descriptor().items():
         node = source_of(b, name)
         if node is None or node.count == 0:
             out[name] = 0 if d.is_count else None

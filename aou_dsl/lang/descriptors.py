@@ -25,6 +25,9 @@ import enum
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 
+from ..core import plugins as _plugins
+from ..core.codes import K801, K803
+from ..core.memo import table
 from .ir import State
 
 __all__ = [
@@ -37,6 +40,8 @@ __all__ = [
     "Mismatch",
     "compare",
     "derive",
+    "descriptor_problems",
+    "every_descriptor",
     "qualify",
 ]
 
@@ -151,37 +156,96 @@ DEFINITIONS = {
     "joint (one the rest of the motion does not use) about its axis",
 }
 
-_INDEX = {name: i for i, name in enumerate(REGISTRY)}
+#: The last table made, with the plugins it was made from (as in ``primitives.KINDS``).
+_KEPT = table("aou_dsl.lang.descriptors.every", 1)
+
+
+def _every() -> tuple[Mapping[str, Descriptor], Mapping[str, int], tuple]:
+    """Every descriptor by name, each one's index, and the plugin problems; made again
+    when the loaded plugins change (see :func:`aou_dsl.lang.primitives.plugin_problems`)."""
+    from .primitives import BUILTIN_KINDS, KINDS, PluginProblem  # they import no descriptor
+
+    got = _plugins.loaded()
+    kept = _KEPT.get("every")
+    if kept is not None and kept[0] is got:
+        return kept[1], kept[2], kept[3]
+    table = dict(REGISTRY)
+    problems = []
+    for p in _plugins.plugins():
+        given = p.part("descriptors")
+        if given is None or p.name not in KINDS or p.name in BUILTIN_KINDS:
+            continue  # no descriptors, or its kind is not used (said by the kinds)
+        try:
+            rows = list(given)  # type: ignore[call-overload]
+        except TypeError:
+            rows = [given]
+        for d in rows:
+            why = _problem_of(d, p.name, table)
+            if why is not None:
+                problems.append(PluginProblem(why[0], p.name, p.source, why[1]))
+            else:
+                table[d.name] = d
+    out = (table, {name: i for i, name in enumerate(table)}, tuple(problems))
+    _KEPT.put("every", (got, *out))
+    return out
+
+
+def _problem_of(d: object, kind: str, taken: Mapping[str, Descriptor]) -> tuple[str, str] | None:
+    """Why ``d`` (one of plugin ``kind``'s descriptors) cannot be used: (code, why)."""
+    if not isinstance(d, Descriptor):
+        return K801, f"its `descriptors` part holds a {type(d).__name__}, not a Descriptor"
+    if d.kind != kind:
+        return K801, f"its descriptor `{d.name}` is read from `{d.kind}`, not from `{kind}`"
+    if not d.is_count and not d.key:
+        return K801, f"its descriptor `{d.name}` names no episode value"
+    if d.name in taken:
+        return K803, f"its descriptor `{d.name}` is already aou's or an earlier plugin's"
+    return None
+
+
+def every_descriptor() -> Mapping[str, Descriptor]:
+    """Every descriptor by name: :data:`REGISTRY`'s eleven, then those of each loaded
+    plugin (its ``descriptors`` part, :class:`Descriptor` records read from its own
+    kind). A plugin's descriptor that is malformed (K801) or whose name is taken (K803)
+    is left out; :func:`descriptor_problems` says which and why."""
+    return _every()[0]
+
+
+def descriptor_problems() -> tuple:
+    """Why plugins' descriptors are left out (``PluginProblem`` records, K801/K803)."""
+    return _every()[2]
 
 
 class Descriptors(Mapping[str, float | int | None]):
-    """The eleven values of one behaviour or trajectory, frozen; ``None`` for an absent
-    primitive. A mapping from name to value, in :data:`REGISTRY`'s order."""
+    """The values of one behaviour or trajectory, frozen; ``None`` for an absent
+    primitive. A mapping from name to value, in :func:`every_descriptor`'s order (the
+    eleven of :data:`REGISTRY`, then the plugins')."""
 
-    __slots__ = ("_values",)
+    __slots__ = ("_index", "_values")
 
     def __init__(self, values: Mapping[str, float | int | None] | None = None, **kw):
         given = dict(values or {}, **kw)
-        unknown = set(given) - set(REGISTRY)
+        every, self._index, _ = _every()
+        unknown = set(given) - set(every)
         if unknown:
             raise KeyError(f"unknown descriptor(s): {', '.join(sorted(unknown))}")
-        self._values = tuple(given.get(name) for name in REGISTRY)
+        self._values = tuple(given.get(name) for name in every)
 
     def __getitem__(self, name: str) -> float | int | None:
-        return self._values[_INDEX[name]]
+        return self._values[self._index[name]]
 
     def __iter__(self) -> Iterator[str]:
-        return iter(REGISTRY)
+        return iter(self._index)
 
     def __len__(self) -> int:
-        return len(REGISTRY)
+        return len(self._index)
 
     def __hash__(self) -> int:
         return hash(self._values)
 
     def __eq__(self, other: object) -> bool:
         if isinstance(other, Descriptors):
-            return self._values == other._values
+            return list(self._index) == list(other._index) and self._values == other._values
         return isinstance(other, Mapping) and dict(self) == dict(other)
 
     def __repr__(self) -> str:
@@ -218,31 +282,29 @@ class EpisodeValues:
                 **{k: round(v, 6) for k, v in self.values.items()}}
 
 
-#: Kinds that must sit between two pauses (before and after) to count, and kinds that
-#: must be followed by one.
-_BETWEEN_PAUSES = frozenset({"retreat"})
-_ENDS_AT_PAUSE = frozenset({"gaze"})
-
-
 def qualify(episodes: Iterable[EpisodeValues]) -> list[EpisodeValues]:
     """The episodes as the definitions read them: touching pauses merged into one (their
-    durations added), and every episode marked whether it counts."""
+    durations added), and every episode marked whether it counts: whether the episodes
+    next to it are those its kind needs (:attr:`~.primitives.kind.Kind.needs`; none for
+    a kind no registry knows)."""
+    # imported here: a plugin's kinds, loaded with the registry, may read this module
+    from .primitives import KINDS, PAUSE
+
     merged: list[EpisodeValues] = []
     for e in episodes:
         last = merged[-1] if merged else None
-        if e.kind == "pause" and last is not None and last.kind == "pause":
+        if e.kind == PAUSE and last is not None and last.kind == PAUSE:
             duration = last.values.get("duration", 0.0) + e.values.get("duration", 0.0)
             merged[-1] = replace(last, t_end=e.t_end, values={"duration": duration})
         else:
             merged.append(e)
     out = []
     for i, e in enumerate(merged):
-        before = i > 0 and merged[i - 1].kind == "pause"
-        after = i + 1 < len(merged) and merged[i + 1].kind == "pause"
-        if e.kind in _BETWEEN_PAUSES:
-            e = replace(e, counts=before and after)
-        elif e.kind in _ENDS_AT_PAUSE:
-            e = replace(e, counts=after)
+        kind = KINDS.get(e.kind)
+        if kind is not None and kind.needs.around:
+            before = merged[i - 1].kind if i > 0 else None
+            after = merged[i + 1].kind if i + 1 < len(merged) else None
+            e = replace(e, counts=kind.needs.met(before, after))
         out.append(e)
     return out
 
@@ -265,7 +327,7 @@ def derive(episodes: Iterable[EpisodeValues]) -> Descriptors:
     """The eleven descriptors of a list of episodes, in time order: declared (a laid-out
     timeline) and measured (episodes found in a trajectory) alike."""
     eps = qualify(episodes)
-    return Descriptors({name: _aggregate(d, eps) for name, d in REGISTRY.items()})
+    return Descriptors({name: _aggregate(d, eps) for name, d in every_descriptor().items()})
 
 
 def spread(episodes: Iterable[EpisodeValues]) -> dict[str, list[float]]:
@@ -273,7 +335,7 @@ def spread(episodes: Iterable[EpisodeValues]) -> dict[str, list[float]]:
     of unequal episodes)."""
     eps = qualify(episodes)
     out: dict[str, list[float]] = {}
-    for name, d in REGISTRY.items():
+    for name, d in every_descriptor().items():
         if not d.is_count:
             vals = [e.values[d.key] for e in eps
                     if e.kind == d.kind and e.counts and d.key in e.values]
@@ -297,7 +359,7 @@ def compare(declared: Mapping[str, float | int | None],
     tolerance. Absent must be measured absent, and present present; a count of zero and
     an absent count are the same."""
     out = []
-    for name, d in REGISTRY.items():
+    for name, d in every_descriptor().items():
         want, got = declared.get(name), measured.get(name)
         if d.is_count:
             want, got = want or 0, got or 0

@@ -14,10 +14,11 @@ from ..core.diagnostics import AouError, Diagnostic, Severity, Span, diag, has_e
 from ..core.inputs import read_input_text
 from ..core.rules import Category, category
 from .cv import CANONICAL, DEFAULT_WEIGHTS, CVPoint, CVWeights, composition, effort_to_cv, infer
-from .descriptors import REGISTRY
+from .descriptors import descriptor_problems, every_descriptor
 from .ir import Behaviour
 from .layout import episode_values, nominal_values
-from .parse import parse
+from .parse import SequenceBlock, parse
+from .primitives import plugin_problems
 from .timeline import Timeline
 from .validate import Validated, validate_tree
 
@@ -123,7 +124,7 @@ def _model_checks(b: Behaviour, timeline: Timeline | None, weights: CVWeights
             ))
     state = b.state or inferred
     kinds = {p.kind for p in b.primitives if p.count}
-    for name, d in REGISTRY.items():
+    for name, d in every_descriptor().items():
         if state in d.no_effect and d.kind in kinds:
             p = next(p for p in b.primitives if p.kind == d.kind)
             out.append(diag(M203, f"the study found no clear perceived effect of {name} on "
@@ -159,6 +160,7 @@ def judge(text: str, path: str, v: Validated, weights: CVWeights = DEFAULT_WEIGH
     """The lint of ``text`` (no byte-order mark) from its validation ``v``: the model's
     judgement added, the diagnostics capped and in file order."""
     result = FileResult(path, list(v.diagnostics), source=text)
+    result.diagnostics += plugin_warnings(text, path)
     b = v.behaviour
     if b is not None and not has_errors(result.diagnostics):
         point, model_diags = _model_checks(b, v.timeline, weights)
@@ -166,6 +168,31 @@ def judge(text: str, path: str, v: Validated, weights: CVWeights = DEFAULT_WEIGH
         result.diagnostics.extend(model_diags)
     _cap(result)
     return result
+
+
+def plugin_warnings(text: str, path: str) -> list[Diagnostic]:
+    """K801 and K803 for the plugins that cannot be used as they are (one did not load,
+    gives something malformed, or takes a name already taken), each said once at the
+    first statement of ``text`` that uses the plugin's keyword: a file that does not
+    use it is not told about it."""
+    problems = (*plugin_problems(), *descriptor_problems())
+    if not problems:
+        return []
+    try:
+        tree = parse(text, path)
+    except AouError:  # the syntax error is said already
+        return []
+    first: dict[str, Span] = {}
+    for item in tree.items:
+        for st in item.statements if isinstance(item, SequenceBlock) else (item,):
+            first.setdefault(st.keyword, st.keyword_span)
+    out, said = [], set()
+    for p in problems:
+        if p.name in first and (p.code, p.name, p.why) not in said:
+            said.add((p.code, p.name, p.why))
+            out.append(diag(p.code, p.message(), first[p.name], plugin=p.name,
+                            source=p.source))
+    return out
 
 
 def read_source(path: str) -> str:

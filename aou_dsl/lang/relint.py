@@ -1,5 +1,5 @@
 """Linting again after an edit, for tools that lint the same files on every change (the
-language server, the warm :class:`~aou_dsl.build.session.Session`).
+language server, the warm :class:`~aou_dsl.driver.session.Session`).
 
 :class:`Relinter` gives exactly what :func:`~aou_dsl.lang.linter.lint_source` gives for
 the same text (the same diagnostics, behaviour, timeline and C-V point), but keeps each

@@ -62,7 +62,12 @@ class Episode:
 
     @property
     def moving(self) -> bool:
-        return self.kind != "pause"
+        """Whether anything moves in it. An episode that keeps its pose, with no
+        acceleration and no oscillation, is held still (a pause, or a plugin kind's
+        held episode); every other kind's episode moves (its acceleration, its roll or
+        its swing is never zero: validation refuses zero)."""
+        return not (self.start == self.end and self.a == 0.0 and self.amplitude == 0.0
+                    and self.f == 0.0)
 
     @property
     def path_length(self) -> float:

@@ -9,15 +9,16 @@ kind's ``read``), settings (:mod:`.settings`), then the behaviour as a whole
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
+from typing import overload
 
 from ..core.codes import V101, V107, V108, V111, V113, V114, V115
 from ..core.diagnostics import Diagnostic, Span
 from .ir import Behaviour, Node, State
 from .layout import Laid
 from .parse import Colon, SequenceBlock, Statement, SyntaxTree, Word
-from .primitives import KINDS
+from .primitives import GAZE, KINDS, Timing, plugin_problems
 from .settings import SETTINGS, read_settings
 from .timeline import Timeline
 from .values import Ctx, Reader, did_you_mean, fix_word
@@ -26,7 +27,36 @@ from .whole_file import MAX_EPISODES, MAX_MOTION_TIME, check_whole
 __all__ = ["KEYWORDS", "MAX_EPISODES", "MAX_MOTION_TIME", "Validated", "primitive", "validate",
            "validate_tree"]
 
-KEYWORDS = ("behaviour", *SETTINGS, *KINDS, "sequence")
+
+
+class _Keywords(Sequence[str]):
+    """Every statement keyword: the header, the settings, every kind (the plugins' too,
+    as :data:`KINDS` holds them now) and ``sequence``."""
+
+    __slots__ = ()
+
+    def _now(self) -> tuple[str, ...]:
+        return ("behaviour", *SETTINGS, *KINDS, "sequence")
+
+    @overload
+    def __getitem__(self, i: int) -> str: ...
+    @overload
+    def __getitem__(self, i: slice) -> Sequence[str]: ...
+
+    def __getitem__(self, i):
+        return self._now()[i]
+
+    def __len__(self) -> int:
+        return len(self._now())
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._now())
+
+    def __contains__(self, word: object) -> bool:
+        return word in self._now()
+
+
+KEYWORDS: Sequence[str] = _Keywords()
 
 
 @dataclass(frozen=True)
@@ -41,7 +71,9 @@ class Validated:
 def primitive(ctx: Ctx, st: Statement, in_sequence: bool) -> Node | None:
     """A primitive statement as IR, or None (with diagnostics) when it does not fit."""
     kind = KINDS[st.keyword]
-    return kind.read(Reader(ctx, st, kind, in_sequence))
+    # an oscillation lasts a number of swings, or `for DURATION`
+    return kind.read(Reader(ctx, st, kind, in_sequence,
+                            takes_for=kind.timing is Timing.OSCILLATION))
 
 
 def _header(ctx: Ctx, st: Statement) -> tuple[str | None, State | None]:
@@ -93,7 +125,7 @@ def _block(ctx: Ctx, f: _File, item: SequenceBlock) -> None:
         if st.keyword not in KINDS:
             ctx.error(V101 if st.keyword not in KEYWORDS else V113,
                       f"`{st.keyword}` is not a primitive; a sequence holds only "
-                      f"{', '.join(KINDS)}", st.keyword_span,
+                      f"{', '.join(KINDS)}{_no_plugin(st.keyword)}", st.keyword_span,
                       hint=did_you_mean(st.keyword, KINDS),
                       fix=fix_word(st.keyword_span, st.keyword, KINDS))
             continue
@@ -105,7 +137,7 @@ def _block(ctx: Ctx, f: _File, item: SequenceBlock) -> None:
 def _descriptor_statement(ctx: Ctx, f: _File, st: Statement) -> None:
     f.first_primitive = f.first_primitive or st.span
     p = f.read(ctx, st, False)
-    key = f"gaze {getattr(p, 'plane', '')}" if p is not None and p.kind == "gaze" \
+    key = f"{GAZE} {getattr(p, 'plane', '')}" if p is not None and p.kind == GAZE \
         else st.keyword
     if key in f.seen:
         ctx.error(V107, f"`{key}` appears twice in the descriptor form (first at "
@@ -116,6 +148,17 @@ def _descriptor_statement(ctx: Ctx, f: _File, st: Statement) -> None:
     f.seen[key] = st.span
     if p is not None:
         f.descriptor.append(p)
+
+
+def _no_plugin(word: str) -> str:
+    """Why no kind is called ``word``, for V101: no installed plugin gives it, or the one
+    that does could not be used."""
+    if word in KEYWORDS:
+        return ""
+    for p in plugin_problems():
+        if p.name == word:
+            return f" (the plugin that gives it cannot be used: {p.why})"
+    return " (and no installed plugin gives it)"
 
 
 def _statement(ctx: Ctx, f: _File, st: Statement, first: bool) -> None:
@@ -134,7 +177,8 @@ def _statement(ctx: Ctx, f: _File, st: Statement, first: bool) -> None:
     elif st.keyword in KINDS:
         _descriptor_statement(ctx, f, st)
     else:
-        ctx.error(V101, f"unknown statement `{st.keyword}`", st.keyword_span,
+        ctx.error(V101, f"unknown statement `{st.keyword}`{_no_plugin(st.keyword)}",
+                  st.keyword_span,
                   hint=did_you_mean(st.keyword, KEYWORDS) or
                   f"statements are {', '.join(KEYWORDS)}", found=st.keyword,
                   fix=fix_word(st.keyword_span, st.keyword, KEYWORDS))

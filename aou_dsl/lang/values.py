@@ -144,8 +144,11 @@ class Args:
     for_: Quantity | None = None
 
 
-def split_args(ctx: Ctx, st: Statement, allowed: Iterable[str], repeat: bool) -> Args:
-    """Sort ``st``'s arguments; unknown or repeated keys and counts are diagnostics."""
+def split_args(ctx: Ctx, st: Statement, allowed: Iterable[str], repeat: bool,
+               takes_for: bool = False) -> Args:
+    """Sort ``st``'s arguments; unknown or repeated keys and counts are diagnostics.
+    ``takes_for``: the statement's kind takes a duration as ``for DURATION`` (a shiver's
+    oscillation)."""
     allowed = list(allowed)
     out = Args()
     args = list(st.args)
@@ -164,7 +167,7 @@ def split_args(ctx: Ctx, st: Statement, allowed: Iterable[str], repeat: bool) ->
                           "1000 episodes are allowed", a.span, found=a.text[:12] + "...")
             else:
                 out.count = int(a.text[1:])
-        elif isinstance(a, Word) and a.text == "for" and st.keyword == "shiver":
+        elif isinstance(a, Word) and a.text == "for" and takes_for:
             nxt = args[i + 1] if i + 1 < len(args) else None
             if not isinstance(nxt, Quantity):
                 ctx.error(V113, "`for` must be followed by a duration, e.g. `for 1s`",
@@ -178,7 +181,7 @@ def split_args(ctx: Ctx, st: Statement, allowed: Iterable[str], repeat: bool) ->
                 out.for_ = nxt
                 i += 1
         elif isinstance(a, KeyVal):
-            _key(ctx, st, a, allowed, out)
+            _key(ctx, st, a, allowed, out, takes_for)
         else:
             out.positional.append(a)
         i += 1
@@ -229,14 +232,15 @@ def _bad_count(ctx: Ctx, text: str, span: Span, _: int) -> None:
               f"`{text}`", span, hint=hint, found=text, fix=fix)
 
 
-def _key(ctx: Ctx, st: Statement, a: KeyVal, allowed: list[str], out: Args) -> None:
+def _key(ctx: Ctx, st: Statement, a: KeyVal, allowed: list[str], out: Args,
+         takes_for: bool) -> None:
     if a.key not in allowed:
         keys = ", ".join(f"{k}=" for k in allowed) or "no keys"
         hint = did_you_mean(a.key, allowed)
         at = a.span
         fix = fix_word(Span(at.path, at.line, at.col, at.line, at.col + len(a.key)), a.key,
                        allowed)
-        if a.key == "for" and st.keyword == "shiver":  # `for` is a word, not a key
+        if a.key == "for" and takes_for:  # `for` is a word, not a key
             keys += " and `for DURATION`"
             hint = f"write `for {a.value.text}`, with a space, not `=`"
             fix = Fix(a.span, f"for {a.value.text}")
@@ -256,11 +260,12 @@ class Reader:
         count: its ``xN`` (1 when absent); ``args``: its arguments by shape.
     """
 
-    def __init__(self, ctx: Ctx, st: Statement, kind: Any, in_sequence: bool):
+    def __init__(self, ctx: Ctx, st: Statement, kind: Any, in_sequence: bool,
+                 takes_for: bool = False):
         self.ctx, self.st, self.kind, self.in_sequence = ctx, st, kind, in_sequence
         self.n_before = len(ctx.diags)
         keys: Mapping = kind.keys
-        self.args = split_args(ctx, st, keys, repeat=True)
+        self.args = split_args(ctx, st, keys, repeat=True, takes_for=takes_for)
         self.pos = self.args.positional
         self.count = 1 if self.args.count is None else self.args.count
         self._index: dict[int, int] | None = None

@@ -8,11 +8,12 @@ from typing import Any
 
 from ..core.codes import V110, V119, V120, V121, V123, V124, V125
 from .declared import source_of, written
-from .descriptors import REGISTRY, compare, derive
+from .descriptors import compare, derive
 from .ir import Behaviour
+from .kind_needs import descriptor_table, why_not
 from .layout import Laid, episode_values, layout
-from .primitives import KINDS, MIN_RETREAT
-from .timeline import Timeline
+from .primitives import APPROACH, GAZE, KINDS, MIN_RETREAT, PAUSE
+from .timeline import Pose, Timeline
 from .values import Ctx
 
 __all__ = ["MAX_EPISODES", "MAX_MOTION_TIME", "MAX_REACH_DISTANCE", "check_whole"]
@@ -46,18 +47,21 @@ def _time(ctx: Ctx, b: Behaviour, tl: Timeline) -> bool:
 
 
 def _standoff(ctx: Ctx, b: Behaviour) -> bool:
-    """A sequence's moves toward the goal stop at the standoff (V120)."""
+    """A sequence's moves toward the goal stop at the standoff (V120). A move along the
+    line of sight of another kind (a retreat, a plugin's draw-back) goes where its kind's
+    episode goes."""
     s = b.settings
     dist = s.start
     for node in b.primitives:
         p: Any = node
-        if p.kind not in ("approach", "retreat"):
+        if p.kind not in KINDS or not KINDS[p.kind].translation:
             continue
         for _ in range(p.count):
-            if p.kind == "approach" and p.length is None:
+            if p.kind == APPROACH and p.length is None:
                 dist = s.standoff
                 continue
-            new = dist - p.length if p.kind == "approach" else dist + p.length
+            new = dist - p.length if p.kind == APPROACH else \
+                KINDS[p.kind].episode(p, Pose(dist)).end.d
             if new < s.standoff - 1e-9:
                 left = max(dist - s.standoff, 0.0)
                 ctx.error(V120, f"this {p.kind} would end {s.standoff - new:.3g} m inside "
@@ -84,7 +88,7 @@ def _swept(ctx: Ctx, tl: Timeline) -> None:
     """V123: a gaze moves the end-effector around the goal; an arc shorter than the
     smallest visible motion cannot be seen, whatever its angle."""
     for e in tl.episodes:
-        if e.kind != "gaze":
+        if e.kind != GAZE:
             continue
         turn = math.hypot(e.end.h - e.start.h, e.end.v - e.start.v)
         arc = 2.0 * e.start.d * math.sin(turn / 2.0)
@@ -117,7 +121,7 @@ def _short_moves(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
                   f"least {least_mm} from it, or leave this approach out",
                   moved=e.path_length, least=MIN_RETREAT)
         return
-    pieces = sum(1 for x in tl.episodes if x.kind == "approach")
+    pieces = sum(1 for x in tl.episodes if x.kind == APPROACH)
     ctx.error(V123, f"the layout splits the approach into {pieces} pieces (one to each "
               f"stop, the last to the standoff) and the shortest moves {mm}, too little to "
               f"be seen or measured; {least}", e.span,
@@ -133,7 +137,7 @@ def _further_start(b: Behaviour, pieces: int) -> str:
     for cm in range(math.ceil(first * 100 - 1e-9), round(MAX_REACH_DISTANCE * 100) + 1):
         tl = layout(b.replace(settings=s.replace(start=cm / 100)))
         if all(e.path_length >= MIN_RETREAT for e in tl.episodes
-               if e.kind == "approach"):
+               if e.kind == APPROACH):
             return f"start further from the goal, e.g. `start {cm}cm`, or {fewer}"
     return f"{fewer}, or a start further from the goal (`start`)"
 
@@ -141,49 +145,94 @@ def _further_start(b: Behaviour, pieces: int) -> str:
 def _touching(ctx: Ctx, tl: Timeline) -> None:
     """V125: two pauses in a row are one hold."""
     for a, b in zip(tl.episodes, tl.episodes[1:], strict=False):
-        if a.kind == b.kind == "pause":
+        if a.kind == b.kind == PAUSE:
             ctx.report(V125, f"this pause follows another with no motion between them: "
                        f"they are seen and measured as one hold of "
                        f"{a.duration + b.duration:.3g} s", b.span,
                        hint="put a motion between them, or write one longer pause")
 
 
-_NEEDS = {"retreat": "a retreat counts only between two pauses, one before and one after it",
-          "gaze": "a gaze counts only when a pause ends it"}
+def _beside(ctx: Ctx, tl: Timeline) -> None:
+    """V121 in a sequence: a statement whose kind needs a motion of another kind right
+    beside it (:attr:`~.primitives.kind.Kind.needs`, e.g. a counter-movement directly
+    before an approach) where the sequence puts none. It would not count as declared,
+    yet be measured as some other kind. (A kind that needs a pause beside it is not
+    held to it here: a sequence may move without holds, and its episodes then do not
+    count, on paper and measured alike.)"""
+    eps, said = tl.episodes, set()
+    for i, e in enumerate(eps):
+        needs = KINDS[e.kind].needs if e.kind in KINDS else None
+        if needs is None or e.span in said:
+            continue
+        for other, where, j in ((needs.preceded_by, "before", i - 1),
+                                (needs.followed_by, "after", i + 1)):
+            if other is None or other == PAUSE or (0 <= j < len(eps) and eps[j].kind == other):
+                continue
+            said.add(e.span)
+            ctx.error(V121, f"this {e.kind} has no {other} directly {where} it: "
+                      f"{needs.words(e.kind, PAUSE)}; here it would be measured as "
+                      "another kind", e.span,
+                      hint=f"put {'an' if other[0] in 'aeiou' else 'a'} {other} "
+                      f"directly {where} it")
+            break
 
 
-def _none_shown(kind: str, n_pauses: int) -> str:
-    """Why no episode of ``kind`` counts in the layout, in words."""
+def _none_shown(b: Behaviour, kind: str, tl: Timeline) -> str:
+    """Why no episode of ``kind`` counts in the layout, in words: what the kind needs
+    around it (:attr:`~.primitives.kind.Kind.needs`), and what of that the file lacks or
+    else the rule that stops the layout."""
     article = "an" if kind[0] in "aeiou" else "a"
-    why = _NEEDS.get(kind, f"no {kind} of its layout counts")
-    if kind in _NEEDS and n_pauses < (2 if kind == "retreat" else 1):
-        why += f", and this file has {('no pause', 'only one pause')[n_pauses]}"
-    return f"no layout of this file can show {article} {kind}: {why}"
+    needs = KINDS[kind].needs if kind in KINDS else None
+    why = needs.words(kind, PAUSE) if needs is not None else None
+    if needs is None or why is None:
+        return f"the layout cannot show {article} {kind}: no {kind} of it counts"
+    n_pauses = _count(b, PAUSE)
+    wanted = needs.around.count(PAUSE)
+    lacks = [f"this file has {('no pause', 'only one pause')[n_pauses]}"] \
+        if wanted and n_pauses < wanted else []
+    lacks += [f"this file has no {other}" for other in dict.fromkeys(needs.around)
+              if other != PAUSE and not _count(b, other)]
+    why += f", and {lacks[0]}" if lacks else f"; {_stopped_by(b, tl)}"
+    return f"the layout cannot show {article} {kind}: {why}"
+
+
+def _count(b: Behaviour, kind: str) -> int:
+    node = b.first(kind)
+    return node.count if node is not None else 0
 
 
 def _shown(name: str, value: float | int | None) -> str:
     """A descriptor's value with its unit, as the file would write it."""
-    unit = REGISTRY[name].unit
+    unit = descriptor_table()[name].unit
     return f"{value:.3g} {unit}" if isinstance(value, float) and unit else f"{value}"
+
+
+def _stopped_by(b: Behaviour, tl: Timeline) -> str:
+    """The rule that keeps the layout from showing more, in words: a need of the kinds
+    counting finds, else the bounds of the search (the orders of stops it tries)."""
+    why = why_not(b)
+    if why is not None:
+        return why
+    return (f"no arrangement the layout tries shows more (its stops in the {tl.state.value} "
+            "order, then in the other orders it tries)")
 
 
 def _realisable(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
     """V121: the laid-out descriptor form must show the values the file writes. When no
     episode of a statement counts, one diagnostic says why: its values are absent for
     that one reason."""
-    pause = b.first("pause")
-    n_pauses = pause.count if pause is not None else 0
     said: set[int] = set()
+    table = descriptor_table()
     for m in compare(written(b), derive(episode_values(tl.episodes))):
         node = source_of(b, m.name)
         if m.measured is None and id(node) in said:
             continue  # its statement is already said to show no episode that counts
         said.add(id(node))
-        kind = REGISTRY[m.name].kind
-        none = m.measured is None or (REGISTRY[m.name].is_count and m.measured == 0)
-        shows = _none_shown(kind, n_pauses) if none else \
-            f"no layout of this file can show more than {_shown(m.name, m.measured)}" \
-            if REGISTRY[m.name].is_count else \
+        kind = table[m.name].kind
+        none = m.measured is None or (table[m.name].is_count and m.measured == 0)
+        shows = _none_shown(b, kind, tl) if none else \
+            f"its layout shows {_shown(m.name, m.measured)}: {_stopped_by(b, tl)}" \
+            if table[m.name].is_count else \
             f"its layout shows {_shown(m.name, m.measured)}"
         ctx.error(V121, f"{m.name} is declared {_shown(m.name, m.declared)} but {shows}",
                   node.span if node else b.span,
@@ -212,4 +261,6 @@ def check_whole(ctx: Ctx, b: Behaviour, laid: Laid | None = None) -> Timeline | 
     _touching(ctx, tl)
     if b.form == "descriptor":
         _realisable(ctx, b, tl)
+    else:
+        _beside(ctx, tl)
     return tl

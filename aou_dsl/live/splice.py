@@ -23,6 +23,7 @@ import numpy as np
 
 from ..core.codes import C306
 from ..core.diagnostics import AouError, Span, diag
+from ..lang.primitives import PAUSE
 
 if TYPE_CHECKING:
     from ..core.trajectory import Trajectory
@@ -268,7 +269,7 @@ def brake_and_hold(reg: Regulator, x: State3, timings: dict[str, float]
     from ..lang.ir import State
     from ..synth.synthesis import study
 
-    hold_for = study(State.INACTIVE).node("pause").duration
+    hold_for = study(State.INACTIVE).node(PAUSE).duration
     clock = time.perf_counter()
     rate = 250.0
     got = transition(reg, x, None, rate)
@@ -289,5 +290,5 @@ def brake_and_hold(reg: Regulator, x: State3, timings: dict[str, float]
     tr = Trajectory(np.concatenate([t, hold]), np.vstack([q, np.tile(q[-1], (n, 1))]),
                     reg.arm.joint_names, reg.arm.spec.name, reg.arm.spec.ee_frame,
                     tuple(goal), np.vstack([qd, zeros]), np.vstack([qdd, zeros]),
-                    (("pause", T, T + hold_for),))
+                    ((PAUSE, T, T + hold_for),))
     return tr, 0.0, T

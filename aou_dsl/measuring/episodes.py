@@ -23,10 +23,12 @@ import numpy as np
 from ..core.codes import R406
 from ..core.diagnostics import AouError, Span, diag
 from ..lang.descriptors import EpisodeValues
+from ..lang.primitives import GAZE
 from ..robot.batch_fk import classical_acceleration, linear_jacobian
 from ..robot.kinematics import ArmModel
 from .holds import Boundary, Rest
 from .peaks import episode_peak, path_travel, phase_peak
+from .recognisers import moved_along
 from .signal import curvature_gain, filter_at, odd, smooth
 
 __all__ = ["COMPUTED_NOISE", "STILL_TRANSLATION", "Context", "Piece", "Samples",
@@ -179,7 +181,7 @@ def translation(c: Context, p: Piece, g0: np.ndarray | None) -> EpisodeValues | 
     else:
         along = float(d @ c.rot[p.i0][:, 2])  # along the forward axis
     if abs(along) >= 0.7 * travel:
-        kind = "approach" if along > 0 else "retreat"
+        kind = moved_along(along > 0)
         u = d / max(float(np.linalg.norm(d)), 1e-12)
         peak, sd = peak_acceleration(c, p, u)
         return EpisodeValues(kind, p.t0, p.t1, {
@@ -193,7 +195,7 @@ def translation(c: Context, p: Piece, g0: np.ndarray | None) -> EpisodeValues | 
             if abs(end - start) > MIN_GAZE_SWEEP:
                 values[plane] = abs(end)
         values["angle"] = max(values.values(), default=0.0)
-    return EpisodeValues("gaze", p.t0, p.t1, values)
+    return EpisodeValues(GAZE, p.t0, p.t1, values)
 
 
 def _phases(c: Context, p: Piece, speed: np.ndarray) -> list[tuple[int, int, int, int]]:

@@ -12,9 +12,11 @@ The steps (docs/measure.md explains the choices):
 3. :mod:`.holds`: pauses (every joint still, within its noise) with their edges refined
    to where the motion stops, and the instants between two episodes.
 4. :mod:`.episodes` and :mod:`.roll`: the motion between them, classified by what
-   moved: approach, retreat, gaze, tilt, shiver.
+   moved: approach, retreat, gaze, tilt, shiver; then each plugin kind's pass claims its
+   own episodes (:mod:`.recognisers`).
 5. The descriptors, from those episodes by :func:`aou_dsl.lang.descriptors.derive`: the
-   same function that derives what a file declares.
+   same function that derives what a file declares; the plugins' descriptors after the
+   eleven, aggregated the same way (:func:`.recognisers.extra_values`).
 """
 
 from __future__ import annotations
@@ -30,7 +32,15 @@ from ..core.codes import R401, R403, R405, R407
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..core.trajectory import Trajectory
 from ..lang.cv import CVPoint, composition, infer
-from ..lang.descriptors import REGISTRY, Descriptors, EpisodeValues, derive, qualify, spread
+from ..lang.descriptors import (
+    Descriptor,
+    Descriptors,
+    EpisodeValues,
+    derive,
+    qualify,
+    spread,
+)
+from ..lang.primitives import PAUSE
 from ..robot.batch_fk import batch_fk
 from ..robot.load import load_arm
 from .episodes import (
@@ -43,6 +53,7 @@ from .episodes import (
     translation,
 )
 from .holds import MIN_PAUSE, REST_SPEED, Boundary, Rest, boundaries, rest_at_end, rest_signals
+from .recognisers import claimed, every_named, extra_descriptors, extra_values
 from .roll import MIN_TILT, SHAPED_CYCLE, Lobe, lobe, roll_angle, rotations
 from .signal import Grid, JointNoise, joint_noise, short_window, smooth, to_grid, unwrap
 
@@ -103,6 +114,8 @@ class Measured:
     #: The C-V point's and the line of sight's spread (:class:`.uncertainty.Inferred`;
     #: None when not computed).
     inferred: Any = None
+    #: The plugins' descriptors, by name, after the eleven (empty without plugins).
+    extra: dict[str, float | int | None] = field(default_factory=dict)
 
     def to_json(self) -> dict:
         eps = [{"kind": e.kind, "start": round(e.t_start + self.t_origin, 4),
@@ -111,7 +124,9 @@ class Measured:
                for e in qualify(self.episodes)]
         los = self.line_of_sight
         return {
-            "descriptors": self.descriptors.to_json(),
+            "descriptors": {**self.descriptors.to_json(), **{
+                k: (round(v, 6) if isinstance(v, float) else v)
+                for k, v in self.extra.items()}},
             "episodes": eps,
             "cv": self.cv.to_json(),
             "noise": self.noise,
@@ -254,9 +269,9 @@ def _episodes(ctx: Context, parts: list[Piece | Boundary],
         if isinstance(part, Boundary):
             flush()
             t0 = part.t0
-            if out and out[-1].kind == "pause":  # nothing moved since the last pause
+            if out and out[-1].kind == PAUSE:  # nothing moved since the last pause
                 t0 = out.pop().t_start
-            out.append(EpisodeValues("pause", t0, part.t1, {"duration": part.t1 - t0}))
+            out.append(EpisodeValues(PAUSE, t0, part.t1, {"duration": part.t1 - t0}))
             continue
         moved = translation(ctx, part, g0)
         if moved is not None:
@@ -292,8 +307,21 @@ def _undersampled(where: Span, t0: float, t1: float, per_cycle: float, h: float
                 frequency=f, samples_per_cycle=per_cycle)
 
 
-def _unequal(name: str, vals: list[float]) -> bool:
-    return max(vals) - min(vals) > REGISTRY[name].tolerance(float(np.median(vals)))
+def _unequal(table: dict[str, Descriptor], name: str, vals: list[float]) -> bool:
+    return max(vals) - min(vals) > table[name].tolerance(float(np.median(vals)))
+
+
+def _spread(episodes: list[EpisodeValues]) -> dict[str, list[float]]:
+    """Per non-count descriptor, the eleven's and the plugins', the values of the
+    episodes it aggregates."""
+    out = spread(episodes)
+    eps = qualify(episodes)
+    for d in extra_descriptors():
+        vals = [float(e.values[d.key]) for e in eps
+                if e.kind == d.kind and e.counts and d.key in e.values]
+        if vals and not d.is_count:
+            out[d.name] = vals
+    return out
 
 
 def measure(rec: Trajectory, *, uncertainty: bool = True) -> Measured:
@@ -323,9 +351,11 @@ def _measure(rec: Trajectory, pinned: JointNoise | None = None, fk: Kinematics |
     ctx, bounds, jn = _context(rec, pinned, fk)
     quantum = jn.quantum
     coarse: list[tuple[float, float, float]] = []
-    episodes = _episodes(ctx, pieces(ctx, bounds), coarse)
-    descriptors = derive(episodes)
     where = Span.whole_file(rec.path)
+    episodes, unclaimed = claimed(_episodes(ctx, pieces(ctx, bounds), coarse), where)
+    descriptors = derive(episodes)
+    extra = extra_values(episodes)
+    values = {**descriptors, **extra}
     diags = [_undersampled(where, t0 + float(rec.t[0]), t1 + float(rec.t[0]), per_cycle,
                            ctx.rest.h) for t0, t1, per_cycle in coarse]
     if ctx.goal is None:
@@ -333,14 +363,16 @@ def _measure(rec: Trajectory, pinned: JointNoise | None = None, fk: Kinematics |
                           "of sight are not measured; approach and retreat are read along "
                           "the hand's forward axis", where,
                           hint="give it with --goal X,Y,Z, or --goal final"))
+    table = every_named()
     diags += [diag(R403, f"{name} differs between episodes: "
                    f"{', '.join(f'{v:.4g}' for v in vals)}; reporting the "
-                   f"{REGISTRY[name].aggregate} {descriptors[name]:.4g}", where,
+                   f"{table[name].aggregate} {values[name]:.4g}", where,
                    descriptor=name, values=vals)
-              for name, vals in spread(episodes).items() if _unequal(name, vals)]
+              for name, vals in _spread(episodes).items() if _unequal(table, name, vals)]
+    diags += unclaimed
     point, _ = infer(composition(episodes))
     los = _line_of_sight(ctx)
     return Measured(descriptors, episodes, point, diags, float(ctx.noise.max()),
                     los.max if los is not None and len(los.angle) else math.nan,
                     float(ctx.rest.t_last), tuple(float(x) for x in ctx.noise), los,
-                    float(rec.t[0]), tuple(float(x) for x in quantum)), jn
+                    float(rec.t[0]), tuple(float(x) for x in quantum), extra=extra), jn

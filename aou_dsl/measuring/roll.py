@@ -19,6 +19,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..lang.descriptors import EpisodeValues
+from ..lang.primitives import SHIVER, TILT
 from .episodes import Context, Piece
 
 __all__ = ["MIN_TILT", "SHAPED_CYCLE", "Lobe", "lobe", "roll_angle", "rotations"]
@@ -226,7 +227,7 @@ def _shiver(c: Context, lobes: list[Lobe]) -> EpisodeValues:
     y = seg[:, j]
     top = _extreme(y, int(np.argmax(y)), 1.0, most)
     bottom = _extreme(y, int(np.argmin(y)), -1.0, most)
-    return EpisodeValues("shiver", t0, t1, {
+    return EpisodeValues(SHIVER, t0, t1, {
         "amplitude": math.degrees(top - bottom), "joint": float(j),
         "cycles": len(lobes) / 2.0, "frequency": _frequency(lobes)})
 
@@ -244,7 +245,7 @@ def _tilt(lb: Lobe) -> EpisodeValues | None:
     angle = abs(lb.roll)
     if angle < MIN_TILT:
         return None
-    return EpisodeValues("tilt", lb.piece.t0, lb.piece.t1, {
+    return EpisodeValues(TILT, lb.piece.t0, lb.piece.t1, {
         "angle": angle, "signed": lb.roll, "velocity": angle / max(lb.duration, 1e-9),
         "joint": float(lb.joint)})
 

@@ -7,7 +7,7 @@ order, the order of the library routine the measurement was first calibrated wit
 weights from a least-squares solve; a symmetric or antisymmetric set of weights applied
 to mirrored pairs of samples, outermost pair first; the ends fitted with their own
 polynomial). It needs only NumPy: importing SciPy's signal package costs a cold command
-about a second (tests/test_savgol.py holds the two to the same bits).
+about a second (tests/unit/measuring/test_savgol.py holds the two to the same bits).
 """
 
 from __future__ import annotations

@@ -30,8 +30,8 @@ import numpy as np
 from ..core.codes import R411
 from ..core.diagnostics import AouError, Span, diag
 from ..core.trajectory import Trajectory
-from ..lang.descriptors import REGISTRY
 from .episodes import COMPUTED_NOISE
+from .recognisers import every_named
 from .signal import JointNoise, short_window, smooth, to_grid, unwrap
 
 __all__ = ["REPLICATES", "Inferred", "Spread", "attach"]
@@ -115,7 +115,7 @@ def _spread(name: str, value: float | int | None, base: float | int | None,
     """The spread of descriptor ``name`` read ``value`` in the recording, ``base`` in
     its smoothed base and ``reads`` in the re-noised copies; ``step`` the sampling
     step [s]."""
-    d = REGISTRY[name]
+    d = every_named()[name]
     if d.is_count:
         counts = [int(c or 0) for c in reads]
         n, b = int(value or 0), int(base or 0)
@@ -194,14 +194,20 @@ def _cross(w: np.ndarray, r: np.ndarray) -> np.ndarray:
     return out
 
 
+def _values(m) -> dict:
+    """A measurement's descriptors, the eleven then the plugins'."""
+    return {**m.descriptors, **m.extra}
+
+
 def attach(m, rec: Trajectory, jn: JointNoise,
            measure_once: Callable[[Trajectory, JointNoise | None, Linearised], tuple]
            ) -> None:
     """Give ``m`` (a :class:`.measured.Measured` of ``rec``, whose joints' noise is
     ``jn``) its uncertainty, and R411 when a count or a presence is not stable."""
-    value = m.descriptors
+    value = _values(m)
+    table = every_named()
     if float(jn.effective.max(initial=0.0)) <= COMPUTED_NOISE:
-        m.uncertainty = {k: exact(value[k]) for k in REGISTRY}
+        m.uncertainty = {k: exact(value[k]) for k in table}
         m.inferred = _inferred(m, m, [])
         return
     from ..robot.load import load_arm
@@ -221,15 +227,15 @@ def attach(m, rec: Trajectory, jn: JointNoise,
             read_m.append(measure_once(copy, jn, fk)[0])
         except AouError:  # a copy the noise made unreadable adds nothing
             continue
-    reads = [r.descriptors for r in read_m]
-    smooth_read = None if smooth_m is None else smooth_m.descriptors
+    reads = [_values(r) for r in read_m]
+    smooth_read = None if smooth_m is None else _values(smooth_m)
     m.inferred = _inferred(m, smooth_m, read_m)
     if len(reads) < 2 or smooth_read is None:
-        m.uncertainty = {k: Spread(None, value[k], value[k], False) for k in REGISTRY}
+        m.uncertainty = {k: Spread(None, value[k], value[k], False) for k in table}
     else:
         step = float(np.median(np.diff(np.asarray(rec.t, float))))
         m.uncertainty = {k: _spread(k, value[k], smooth_read[k], [r[k] for r in reads],
-                                    step) for k in REGISTRY}
+                                    step) for k in table}
     vague = [k for k, s in m.uncertainty.items() if _vague(k, value[k], s)]
     for k in vague:  # not to be trusted: a verdict on it is inconclusive
         m.uncertainty[k] = replace(m.uncertainty[k], stable=False)
@@ -316,19 +322,21 @@ VAGUE_TOLERANCES = 3.0
 
 def _vague(name: str, value: float | int | None, s: Spread) -> bool:
     half = half_width(s, value)
-    if half is None or REGISTRY[name].is_count or value is None:
+    d = every_named()[name]
+    if half is None or d.is_count or value is None:
         return False
-    return half > max(VAGUE * abs(float(value)), VAGUE_TOLERANCES * REGISTRY[name].abs_tol)
+    return half > max(VAGUE * abs(float(value)), VAGUE_TOLERANCES * d.abs_tol)
 
 
 def _shaky_text(name: str, value, s: Spread, n: int) -> str:
     def v(x) -> str:
         return "absent" if x is None else (f"{x:.4g}" if isinstance(x, float) else str(x))
 
-    if not s.absent_in and value is not None and not REGISTRY[name].is_count:
+    count = every_named()[name].is_count
+    if not s.absent_in and value is not None and not count:
         return f"{name} reads {v(value)}, 95 % interval {v(s.low)} to {v(s.high)}"
 
-    if REGISTRY[name].is_count:
+    if count:
         return f"{name} reads {v(value)}, from {s.low} to {s.high} in {n} re-noised copies"
     if value is None:
         return f"{name} reads absent, present in {n - s.absent_in} of {n} re-noised copies"

@@ -2,6 +2,8 @@
 descriptor declared by the ``.aou`` file beside the one measured, with its tolerance and
 a pass, a fail or an inconclusive (the measured value's interval straddles the
 tolerance's edge), and the C-V point of each (``aouc measure REC --against FILE.aou``).
+The plugins' descriptors follow the eleven, judged the same way; a file that uses a
+plugin kind no ``measure`` part recognises is not judged (K802, :mod:`.recognisers`).
 
 The declared values are the file's own (:func:`aou_dsl.lang.declared.declared`, the same
 the compiler checks its output against), the tolerances those of the descriptor table
@@ -11,6 +13,7 @@ compiled trajectory would.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from ..core.codes import R408, R412, R413
@@ -19,9 +22,11 @@ from ..core.trajectory import Trajectory
 from ..lang.cv import CVPoint
 from ..lang.declared import declared, source_of
 from ..lang.descriptors import REGISTRY, Descriptor
+from ..lang.layout import episode_values
 from ..lang.linter import FileResult, lint_file
 from ..lang.primitives import KINDS
 from .measured import Measured, measure
+from .recognisers import extra_descriptors, extra_values, missing_part
 
 __all__ = ["FAIL", "INCONCLUSIVE", "PASS", "Row", "Verdict", "judge"]
 
@@ -179,18 +184,41 @@ def _round(v: float | int | None) -> float | int | None:
     return round(v, 6) if isinstance(v, float) else v
 
 
+def _extra_declared(b, tl) -> dict[str, float | int | None]:
+    """The plugins' descriptors the file declares: written (descriptor form: its
+    statement's count or value, as the eleven are read) or derived from its timeline."""
+    extra = extra_descriptors()
+    if b.form != "descriptor":
+        return extra_values(episode_values(tl.episodes))
+    out: dict[str, float | int | None] = {}
+    for d in extra:
+        node = b.first(d.kind)
+        if node is None or node.count == 0:
+            out[d.name] = 0 if d.is_count else None
+        else:
+            out[d.name] = node.count if d.is_count else KINDS[d.kind].values(node)[d.key]
+    return out
+
+
 def _rows(lint: FileResult, measured: Measured) -> tuple[Row, ...]:
     b, tl = lint.behaviour, lint.timeline
     assert b is not None and tl is not None
-    want = declared(b, tl)
-    got = measured.descriptors
+    want: Mapping[str, float | int | None] = declared(b, tl)
+    got: Mapping[str, float | int | None] = measured.descriptors
+    extra = extra_descriptors()
+    if extra:  # the plugins' after the eleven, unless the declared side has them already
+        mine = _extra_declared(b, tl)
+        want = {**want, **{d.name: want[d.name] if d.name in want else mine.get(d.name)
+                           for d in extra}}
+        got = {**got, **measured.extra}
     rows = []
-    for name, d in REGISTRY.items():
+    for d in (*REGISTRY.values(), *extra):
+        name = d.name
         w, g = want.get(name), got.get(name)
         if d.is_count:
             w, g = w or 0, g or 0
         tol = None if w is None else d.tolerance(float(w))
-        p = source_of(b, name)
+        p = source_of(b, name) if name in REGISTRY else b.first(d.kind)
         spread = measured.uncertainty.get(name)
         lo, hi, stable = (g, g, True) if spread is None else (
             spread.low, spread.high, spread.stable)
@@ -234,12 +262,17 @@ def judge(rec: Trajectory, behaviour: str | FileResult) -> Verdict:
     ``goal`` line, else its robot's default).
 
     Raises:
-        AouError: the file's errors when it does not lint; what measuring raises.
+        AouError: the file's errors when it does not lint; K802 when it uses a plugin
+            kind that no ``measure`` part recognises; what measuring raises.
     """
     lint = lint_file(behaviour) if isinstance(behaviour, str) else behaviour
     if not lint.ok or lint.behaviour is None or lint.timeline is None or lint.cv is None:
         raise AouError([d for d in lint.diagnostics if d.severity is Severity.ERROR]
                        or lint.diagnostics)
+    unread = missing_part({e.kind for e in lint.timeline.episodes},
+                          {e.kind: e.span for e in reversed(lint.timeline.episodes)})
+    if unread:  # its episodes would be measured as other kinds: every verdict wrong
+        raise AouError(unread)
     from_file = rec.goal is None
     if from_file:
         from ..robot.load import load_robot

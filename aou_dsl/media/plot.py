@@ -15,12 +15,11 @@ from ..core.codes import R401, R405
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..core.trajectory import Trajectory
 from ..lang.cv import CANONICAL, CVPoint
+from .kind_labels import DEFAULT_COLOUR, labels
 
 __all__ = ["FORMATS", "ProfileData", "cv_figure", "point_labels", "profile_data", "profile_figure",
            "save"]
 
-_COLOURS = {"approach": "#4c9a2a", "retreat": "#c0392b", "pause": "#95a5a6",
-            "gaze": "#2e86c1", "tilt": "#8e44ad", "shiver": "#e67e22"}
 
 
 @dataclass(frozen=True)
@@ -186,10 +185,14 @@ def profile_figure(d: ProfileData):
         ax_v.plot(d.t, d.speed, color="black", lw=1.2, label="end-effector speed")
     # The filtered speed sets the scale: the raw one's noise may reach far above it.
     top = max(float(d.speed.max()), 1e-3) * 1.25
+    known = labels()
     for kind, a, b in d.episodes[:MAX_SHADED]:
+        shown = known.get(kind)
         for ax in axes:
-            ax.axvspan(a, b, color=_COLOURS.get(kind, "#dddddd"), alpha=0.15, lw=0)
-        ax_v.text((a + b) / 2, top * 0.93, kind, ha="center", va="top", fontsize=7,
+            ax.axvspan(a, b, color=shown.colour if shown else DEFAULT_COLOUR, alpha=0.15,
+                       lw=0)
+        ax_v.text((a + b) / 2, top * 0.93, shown.label if shown else kind, ha="center",
+                  va="top", fontsize=7,
                   rotation=90 if b - a < 0.08 * (d.t[-1] - d.t[0]) else 0)
     ax_v.set_ylim(0, top)
     ax_v.set_ylabel("speed [m/s]")

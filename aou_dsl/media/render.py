@@ -168,7 +168,7 @@ def render_configurations(robot: str, goal: tuple, options, camera: Camera,
 
     The still things are drawn once (:func:`_stage`); each image draws the arm alone and
     lays it over them wherever it is nearer the camera, by depth, as one depth-buffered
-    drawing of the whole scene does (the pixels are the same: ``tests/test_media.py``
+    drawing of the whole scene does (the pixels are the same: ``tests/integration/test_media.py``
     holds it to PyBullet drawing everything at once).
     """
     st = _stage(robot, goal, options, camera)
@@ -399,7 +399,7 @@ def render_video(trajs: list, path: str, *, fps: float = 30.0, camera: Camera = 
 
 
 def _cores() -> int:
-    from ..build.parallel import default_jobs
+    from ..driver.parallel import default_jobs
 
     return default_jobs()
 

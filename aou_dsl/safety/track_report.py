@@ -15,6 +15,7 @@ from ..core.codes import C322, C323
 from ..core.diagnostics import Diagnostic, Span, diag
 from ..core.servo_specs import MODES, ServoTable
 from ..core.trajectory import Trajectory
+from ..lang.primitives import SHIVER as SHIVER_KIND
 from ..measuring.verdict import Verdict, judge
 from .track import Tracked, arm_servo, track
 
@@ -69,7 +70,7 @@ def _shiver_descriptor() -> str:
     """The descriptor of a shiver's amplitude, by its kind in the descriptor table."""
     from ..lang.descriptors import REGISTRY
 
-    return next(d.name for d in REGISTRY.values() if d.kind == "shiver"
+    return next(d.name for d in REGISTRY.values() if d.kind == SHIVER_KIND
                 and d.key == "amplitude")
 
 

@@ -15,19 +15,9 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from ..lang.descriptors import REGISTRY
+from .kind_controls import RANGES, descriptor_of, range_of
 
 __all__ = ["INTENSITY", "RANGES", "Player", "Sliders", "slider_range"]
-
-#: Slider ranges by the descriptor's unit (counts: ""): (low, high, step).
-RANGES: dict[str, tuple[float, float, float]] = {
-    "": (0, 10, 1),
-    "s": (0.2, 5.0, 0.01),
-    "m": (0.005, 0.2, 0.005),
-    "m/s^2": (0.01, 3.0, 0.01),
-    "deg": (1.0, 60.0, 0.5),
-    "deg/s": (5.0, 180.0, 1.0),
-}
 _FPS = 30.0
 #: The time slider follows the clock every this many frames.
 _SLIDER_EVERY = 6
@@ -40,12 +30,13 @@ INTENSITY = "intensity"
 def _hint(name: str) -> str:
     if name == INTENSITY:
         return "write the file again as `aouc synth` would at this intensity"
-    return f"{name} [{REGISTRY[name].unit or 'count'}]"
+    return f"{name} [{descriptor_of(name).unit or 'count'}]"
 
 
 def slider_range(name: str, value: float) -> tuple[float, float, float]:
-    """The range of ``name``'s slider, widened to hold the file's ``value``."""
-    lo, hi, step = (0.0, 1.0, 0.05) if name == INTENSITY else RANGES[REGISTRY[name].unit]
+    """The range of ``name``'s slider (:func:`.kind_controls.range_of`), widened to hold
+    the file's ``value``."""
+    lo, hi, step = (0.0, 1.0, 0.05) if name == INTENSITY else range_of(name)
     return min(lo, value), max(hi, value), step
 
 
@@ -145,7 +136,7 @@ class Sliders:
             with self.folder:
                 for name, v in values.items():
                     lo, hi, step = slider_range(name, v)
-                    count = name != INTENSITY and REGISTRY[name].is_count
+                    count = name != INTENSITY and descriptor_of(name).is_count
                     h = self.server.gui.add_slider(
                         name, int(lo) if count else lo, int(hi) if count else hi,
                         int(step) if count else step, int(v) if count else float(v),
@@ -154,7 +145,7 @@ class Sliders:
                     self.handles[name] = h
             return
         for name, v in values.items():
-            count = name != INTENSITY and REGISTRY[name].is_count
+            count = name != INTENSITY and descriptor_of(name).is_count
             self.handles[name].value = int(v) if count else float(v)
 
     def values(self) -> dict[str, float]:

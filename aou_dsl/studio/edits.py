@@ -27,12 +27,12 @@ from typing import Any, NamedTuple
 from ..core.codes import I504
 from ..core.diagnostics import AouError, Span, diag
 from ..lang.declared import declared, source_of, written
-from ..lang.descriptors import REGISTRY
 from ..lang.ir import Behaviour
 from ..lang.linter import lint_source
 from ..lang.parse import KeyVal, Quantity, Statement, Word, parse
 from ..lang.primitives import KINDS
 from ..lang.timeline import Timeline
+from .kind_controls import descriptor_of, descriptors
 
 __all__ = ["Edit", "Origin", "apply", "settable", "synth_origin"]
 
@@ -70,9 +70,9 @@ def settable(b: Behaviour, timeline: Timeline | None = None) -> dict[str, float 
         return _sequence_values(b, timeline) if timeline is not None else {}
     values = written(b)
     out: dict[str, float | int] = {}
-    for name in REGISTRY:
-        v = values[name]
-        if source_of(b, name) is not None and v is not None:
+    for name in descriptors():
+        v = values.get(name)
+        if v is not None and source_of(b, name) is not None:
             out[name] = v
     return out
 
@@ -80,8 +80,8 @@ def settable(b: Behaviour, timeline: Timeline | None = None) -> dict[str, float 
 def _sequence_values(b: Behaviour, timeline: Timeline) -> dict[str, float | int]:
     values = declared(b, timeline)
     out: dict[str, float | int] = {}
-    for name, d in REGISTRY.items():
-        v = values[name]
+    for name, d in descriptors().items():
+        v = values.get(name)
         if not d.is_count and v and _sources(b, name):
             out[name] = v
     return out
@@ -90,10 +90,11 @@ def _sequence_values(b: Behaviour, timeline: Timeline) -> dict[str, float | int]
 def _sources(b: Behaviour, name: str) -> list[Any]:
     """The statements that set descriptor ``name``: one node per statement (a
     sequence's ``xN`` may repeat a node)."""
-    d = REGISTRY[name]
+    d = descriptor_of(name)
     seen: dict[tuple[int, int], Any] = {}
     for p in b.primitives:
-        if p.kind == d.kind and (d.kind != "gaze" or getattr(p, "plane", None) == d.key):
+        plane = getattr(p, "plane", None)  # a kind with planes: one descriptor each
+        if p.kind == d.kind and (plane is None or plane == d.key):
             seen.setdefault((p.span.line, p.span.col), p)
     return list(seen.values())
 
@@ -164,13 +165,13 @@ def _rescaled(text: str, wanted: Mapping[str, float], path: str) -> str:
 
 def _scaled(text: str, b: Behaviour, name: str, k: float, path: str) -> list[Edit]:
     """Every statement that sets ``name`` in a sequence, its value times ``k``."""
-    d = REGISTRY[name]
+    d = descriptor_of(name)
     return [_edit(text, node, name, getattr(node, d.ir_field) * k / d.scale, path)
             for node in _sources(b, name)]
 
 
 def _same(name: str, old: float, new: float) -> bool:
-    d = REGISTRY[name]
+    d = descriptor_of(name)
     if d.is_count:
         return int(old) == int(round(new))
     return f"{old * d.scale:.6g}" == f"{new * d.scale:.6g}"
@@ -178,7 +179,7 @@ def _same(name: str, old: float, new: float) -> bool:
 
 def _edit(text: str, node: Any, name: str, value: float, path: str) -> Edit:
     """The rewrite of the token of ``node`` (its statement) that sets ``name``."""
-    d = REGISTRY[name]
+    d = descriptor_of(name)
     new_value = int(round(value)) if d.is_count else value * d.scale
     if d.is_count and new_value < 0:
         raise AouError(diag(I504, f"{name} is a count: 0 or more, found {new_value}",

@@ -2,7 +2,7 @@
 
 Everything the studio shows comes from an :class:`Engine`: it lints, compiles, checks
 and measures a ``.aou`` text exactly as ``aouc compile`` does, through a warm
-:class:`~aou_dsl.build.session.Session` (the arms it has loaded stay loaded, and a slider
+:class:`~aou_dsl.driver.session.Session` (the arms it has loaded stay loaded, and a slider
 that changes one value re-solves only the episodes that value changes), or reads and
 measures a recording, and keeps the last good result, so a text that fails leaves the
 motion before it on screen.
@@ -72,8 +72,8 @@ class Engine:
 
     def __init__(self, robot: str | None = None, package_dirs: tuple[str, ...] = (),
                  fit: bool = False) -> None:
-        from ..build.session import Session
         from ..core.options import BuildOptions
+        from ..driver.session import Session
 
         self.robot = robot
         self.fit = fit
@@ -126,7 +126,7 @@ class Engine:
         """A recording (CSV, JSON, NPZ) read for ``robot`` and measured: its episodes are
         the ones measured (not any the file carries); without a goal, the goal is the
         hand's last position."""
-        from ..build.builder import load_motion as read_trajectory
+        from ..driver.builder import load_motion as read_trajectory
         from ..measuring.measured import measure
 
         start = time.perf_counter()

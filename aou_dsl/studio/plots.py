@@ -22,7 +22,7 @@ from ..core.codes import C314
 from ..core.diagnostics import Diagnostic
 from ..lang.cv import CANONICAL, CVPoint
 from ..lang.descriptors import REGISTRY, Descriptors
-from .view3d import EPISODE_COLOURS
+from .kind_controls import colour_of
 
 __all__ = ["cv_map", "descriptor_table", "diagnostics_html", "fitted_html", "timeline",
            "velocity_profile"]
@@ -34,7 +34,7 @@ _FIT_KEYS = {"f": "shiver frequency", "for": "shiver duration", "a": "accelerati
 
 
 def _rgb(kind: str) -> str:
-    r, g, b = EPISODE_COLOURS.get(kind, (180, 180, 180))
+    r, g, b = colour_of(kind)
     return f"rgb({r},{g},{b})"
 
 

@@ -17,14 +17,9 @@ from typing import Any
 import numpy as np
 
 from ..core.trajectory import Trajectory
+from .kind_controls import EPISODE_COLOURS, colour_of
 
 __all__ = ["EPISODE_COLOURS", "Arm", "Track", "track"]
-
-#: One colour per primitive kind (those of ``aouc plot``), as RGB 0-255.
-EPISODE_COLOURS = {"approach": (76, 154, 42), "retreat": (192, 57, 43),
-                   "pause": (149, 165, 166), "gaze": (46, 134, 193),
-                   "tilt": (142, 68, 173), "shiver": (230, 126, 34)}
-_OTHER = (180, 180, 180)
 
 
 @dataclass(frozen=True)
@@ -102,8 +97,8 @@ class Arm:
         pts = tk.hand[::step]
         mids = tk.t[::step]
         seg = np.stack([pts[:-1], pts[1:]], axis=1)
-        colours = np.array([EPISODE_COLOURS.get(_kind_at(tk.episodes, m), _OTHER)
-                            for m in mids[:-1]], dtype=np.uint8)
+        colours = np.array([colour_of(_kind_at(tk.episodes, m)) for m in mids[:-1]],
+                           dtype=np.uint8)
         self._path = self.server.scene.add_line_segments(
             f"{self.root}_path", seg, np.repeat(colours[:, None, :], 2, axis=1),
             thickness=2.0 if self.ghost else 4.0, thickness_units="screen",

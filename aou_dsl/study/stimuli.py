@@ -124,8 +124,8 @@ def motion_key(stim: Stim, robot: str, robot_sha: str, render: dict) -> str:
     does not (a comment, a variant's value equal to its base's) share a video."""
     import numpy as np
 
-    from ..build.builder import build_source
     from ..core.options import BuildOptions
+    from ..driver.builder import build_source
     from ..version import __version__
 
     res = build_source(stim.text, stim.path, BuildOptions(robot=robot, check=False))
@@ -148,8 +148,8 @@ def motion_key(stim: Stim, robot: str, robot_sha: str, render: dict) -> str:
 def render_one(text: str, label: str, robot: str, out: str, render: dict) -> list[str]:
     """Compile ``text`` and draw its video into ``out`` (in a process of its own); the
     error messages, none when it worked."""
-    from ..build.builder import build_source
     from ..core.options import BuildOptions
+    from ..driver.builder import build_source
     from ..media.render import Camera, render_video
 
     try:

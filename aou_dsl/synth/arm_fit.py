@@ -21,7 +21,8 @@ from ..fit.refusals import AccelerationShort
 from ..fit.rounding import significant
 from ..fit.search import DIGITS
 from ..lang.ir import DEFAULTS
-from ..lang.primitives import MIN_SHIVER_F, shiver_duration
+from ..lang.primitives import KINDS, MIN_SHIVER_F, SHIVER, TILT, shiver_duration
+from .kind_recipes import kind_recipes
 from .recipe import Recipe, descriptor
 
 __all__ = ["SHIVER_F", "Limits", "fit", "fit_limits", "goal_line", "robot_line",
@@ -100,7 +101,7 @@ def fit_limits(robot: str, goal: tuple[float, float, float] | None = None) -> Li
 
 @cached(maxsize=16)
 def _fit_limits(robot: str, goal: tuple[float, float, float] | None, key: tuple) -> Limits:
-    from ..build.builder import build_source
+    from ..driver.builder import build_source
     from ..robot.load import load_arm
 
     arm = load_arm(robot)
@@ -123,10 +124,14 @@ def _cap_accel(r: Recipe, kind: str, lim: Limits) -> Recipe:
     node = r.node(kind)
     if node is None or not node.count or node.a <= lim.accel:
         return r
-    name = descriptor(kind, "peak_acceleration").name
+    out = r.with_node(node.replace(a=lim.accel))
+    try:
+        name = descriptor(kind, "peak_acceleration").name
+    except KeyError:  # a plugin kind without an acceleration descriptor: no note
+        return out
     note = (f"{r.notes.get(name, '')}; capped from {node.a:g} at {lim.accel:g} for "
             f"{lim.robot} (its joints reach about {lim.reached:.2g} m/s^2 here)")
-    return r.with_node(node.replace(a=lim.accel)).noted(name, note)
+    return out.noted(name, note)
 
 
 def shiver_max_frequency(amplitude: float, duration: float, lim: Limits) -> float:
@@ -151,7 +156,7 @@ SHIVER_F = "shiver frequency"
 
 
 def _fit_shiver(r: Recipe, lim: Limits) -> Recipe:
-    node = r.node("shiver")
+    node = r.node(SHIVER)
     f_max = shiver_max_frequency(node.amplitude, node.duration, lim)
     if node.f <= f_max:
         return r.noted(SHIVER_F, "the language default (the study gives none)")
@@ -165,7 +170,7 @@ def _fit_shiver(r: Recipe, lim: Limits) -> Recipe:
     while amp > 1.0 and shiver_max_frequency(math.radians(amp), node.duration,
                                              lim) < MIN_SHIVER_F:
         amp = significant(amp * 0.9, DIGITS)
-    name = descriptor("shiver", "amplitude").name
+    name = descriptor(SHIVER, "amplitude").name
     note = (f"{r.notes.get(name, '')}; reduced from {math.degrees(node.amplitude):g} to "
             f"{amp:g} deg: {lim.robot}'s {lim.roll_joint} cannot shiver wider at "
             f"{MIN_SHIVER_F:g} Hz")
@@ -184,8 +189,8 @@ def _whole(duration: float, f: float) -> float:
 def _fit_tilt(r: Recipe, lim: Limits) -> Recipe:
     """A tilt lasts ``angle / v`` and peaks at ``2 v`` and ``4 v^2 / angle`` (rest to
     rest): the velocity is lowered until both fit the rolling joint."""
-    node = r.node("tilt")
-    name = descriptor("tilt", "velocity").name
+    node = r.node(TILT)
+    name = descriptor(TILT, "velocity").name
     v_max = min(lim.roll_v / 2.0,
                 math.sqrt(TILT_MARGIN / MARGIN * lim.roll_a * abs(node.angle) / 4.0))
     if node.v <= v_max:
@@ -200,9 +205,11 @@ def _fit_tilt(r: Recipe, lim: Limits) -> Recipe:
 def fit(r: Recipe, lim: Limits) -> Recipe:
     """``r`` with every value within the arm's limits; the notes say what was lowered and
     why."""
-    r = _cap_accel(_cap_accel(r, "approach", lim), "retreat", lim)
-    if r.count("shiver"):
+    for kind in kind_recipes():  # every translation's acceleration, in the file's order
+        if kind in KINDS and KINDS[kind].translation:
+            r = _cap_accel(r, kind, lim)
+    if r.count(SHIVER):
         r = _fit_shiver(r, lim)
-    if r.count("tilt"):
+    if r.count(TILT):
         r = _fit_tilt(r, lim)
     return r

@@ -14,23 +14,21 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 from ..fit.rounding import significant
-from ..lang.descriptors import REGISTRY, Descriptor
+from ..lang.descriptors import Descriptor
 from ..lang.ir import State
-from ..lang.primitives import KINDS
+from ..lang.primitives import KINDS, PAUSE
+from .kind_recipes import all_descriptors, descriptors, kind_recipes, pauses_needed, slots
 
-__all__ = ["SLOTS", "Recipe", "descriptor", "slot_of"]
+__all__ = ["Recipe", "descriptor", "slot_of"]
 
-#: The statements of a descriptor-form file, by (kind, gaze plane), in the order written.
-SLOTS: tuple[tuple[str, str | None], ...] = (
-    ("approach", None), ("pause", None), ("retreat", None), ("gaze", "horizontal"),
-    ("gaze", "vertical"), ("tilt", None), ("shiver", None))
-
+#: A statement of a descriptor-form file: its kind and its plane (None for a kind
+#: without planes); the registry (:func:`.kind_recipes.slots`) gives them in order.
 Slot = tuple[str, str | None]
 
 
 def descriptor(kind: str, key: str) -> Descriptor:
     """The descriptor read from episodes of ``kind`` by ``key`` ("" for the count)."""
-    for d in REGISTRY.values():
+    for d in all_descriptors():
         if d.kind == kind and (d.key == key or (d.is_count and key == "")):
             return d
     raise KeyError((kind, key))
@@ -38,7 +36,8 @@ def descriptor(kind: str, key: str) -> Descriptor:
 
 def slot_of(d: Descriptor) -> Slot:
     """The statement that sets descriptor ``d``."""
-    return d.kind, (d.key if d.kind == "gaze" else None)
+    r = kind_recipes().get(d.kind)
+    return d.kind, (d.key if r is not None and r.planes != (None,) else None)
 
 
 @dataclass(frozen=True)
@@ -95,7 +94,8 @@ class Recipe:
         rounded weighted mean (absent counts 0); each value the weighted mean over the
         states that have the statement; other parameters are the heaviest state's."""
         nodes: dict[Slot, Any] = {}
-        for slot in SLOTS:
+        every = descriptors()
+        for slot in slots():
             having = {s: r for s, r in recipes.items() if r.count(*slot) > 0}
             n = math.floor(sum(w[s] * r.count(*slot) for s, r in having.items()) + 0.5)
             if not having or n < 1:
@@ -103,20 +103,19 @@ class Recipe:
             top = max(having, key=lambda s: w[s])
             node = having[top].nodes[slot].replace(count=n)
             total = sum(w[s] for s in having)
-            for d in REGISTRY.values():
+            for d in every:
                 if slot_of(d) == slot and not d.is_count:
                     v = sum(w[s] * r.value(d) for s, r in having.items()) / total
                     node = node.replace(
                         **{d.ir_field: significant(v, 3, "nearest") * d.scale})
             nodes[slot] = node
         out = cls(nodes)
-        need = (out.count("retreat") + 1 if out.count("retreat") else 0) + \
-            (1 if out.count("gaze", "horizontal") or out.count("gaze", "vertical") else 0)
-        pause = next(r.node("pause") for r in recipes.values() if r.count("pause"))
-        if out.count("pause") < need:  # a retreat starts and ends at a pause
-            out = out.with_node((out.node("pause") or pause).replace(count=need))
+        need = pauses_needed(out.count)
+        pause = next(r.node(PAUSE) for r in recipes.values() if r.count(PAUSE))
+        if out.count(PAUSE) < need:  # a retreat starts and ends at a pause
+            out = out.with_node((out.node(PAUSE) or pause).replace(count=need))
         shown = ", ".join(f"{s} {x:.2f}" for s, x in sorted(w.items(), key=lambda i: -i[1]))
-        for d in REGISTRY.values():
+        for d in every:
             if out.present(d):
                 how = "rounded weighted mean" if d.is_count else "weighted mean"
                 out = out.noted(d.name, f"{how} of the blend of {shown}")

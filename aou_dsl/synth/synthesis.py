@@ -38,16 +38,18 @@ from ..fit.refusals import AccelerationShort
 from ..fit.rounding import significant
 from ..fit.search import DIGITS
 from ..lang.cv import CANONICAL, classify
-from ..lang.descriptors import REGISTRY, Descriptor
+from ..lang.descriptors import Descriptor
 from ..lang.ir import State
 from ..lang.linter import lint_source
+from ..lang.primitives import PAUSE, RETREAT
 from .arm_fit import Limits, fit, fit_limits
-from .recipe import Recipe, descriptor
+from .kind_recipes import descriptors, kind_recipes, span_of, spans
+from .recipe import Recipe, descriptor, slot_of
 from .writer import render
 
 if TYPE_CHECKING:
-    from ..build.builder import BuildResult
-    from ..build.session import Session
+    from ..driver.builder import BuildResult
+    from ..driver.session import Session
 
 __all__ = ["SPANS", "STUDY_INTENSITY", "STUDY_SOURCE", "blend_weights", "compiled", "recipe",
            "study", "synthesize"]
@@ -76,20 +78,9 @@ STUDY_SOURCE: dict[State, str] = {
 #: How far intensity 1 moves each descriptor of a state's row of the study's perception
 #: results (intensity 0 as far the other way), by the descriptor's (kind, episode key):
 #: a factor for values, episodes added for counts (key ""), the angle reached [deg] for
-#: an exploration the stimulus lacks. Chosen so that every intensity still reads as its
-#: state (tests/test_synth.py checks it).
-SPANS: dict[State, dict[tuple[str, str], float]] = {
-    State.CONFIDENT: {("approach", "peak_acceleration"): 1.5, ("pause", "duration"): 1.5},
-    State.CURIOUS: {("approach", "peak_acceleration"): 1.3, ("gaze", "horizontal"): 1.5,
-                    ("gaze", "vertical"): 20.0, ("tilt", "angle"): 30.0},
-    State.HESITANT: {("approach", "peak_acceleration"): 1.4, ("pause", "duration"): 1.5,
-                     ("retreat", "distance"): 1.5, ("retreat", ""): 2},
-    State.FEARFUL: {("approach", "peak_acceleration"): 1.2, ("pause", "duration"): 1.5,
-                    ("pause", ""): 2, ("retreat", ""): 2},
-}
-
-#: Varied counts never fall below these (a fearful or hesitant reach keeps a withdrawal).
-_MIN_COUNT = {"retreat": 1, "pause": 1}
+#: an exploration the stimulus lacks. The built-in kinds' spans of the registry
+#: (:mod:`.kind_recipes`, which also gives the fewest episodes a varied count keeps).
+SPANS: dict[State, dict[tuple[str, str], float]] = spans()
 
 
 def _check_intensity(intensity: float) -> float:
@@ -110,12 +101,14 @@ def study(state: State) -> Recipe:
 def _vary(state: State, d: Descriptor, r: Recipe, x: float) -> Recipe:
     """``r`` with descriptor ``d`` of ``state`` at ``x = 2 I - 1`` in [-1, 1]."""
     sign = d.stronger[state]
-    span = SPANS[state][(d.kind, d.key)]
+    span = span_of(state, d.kind, d.key)
+    assert span is not None, (state, d.name)
+    least = kind_recipes()[d.kind].min_count
     v0 = study(state).value(d)
     if d.is_count:
-        lo = max(_MIN_COUNT.get(d.kind, 0), int(v0 - sign * span))
+        lo = max(least, int(v0 - sign * span))
         hi = int(v0 + sign * span)
-        n = max(_MIN_COUNT.get(d.kind, 0), int(v0) + sign * math.floor(span * x + 0.5))
+        n = max(least, int(v0) + sign * math.floor(span * x + 0.5))
         note = (f"study {v0:g}; reads more {state} with {'more' if sign > 0 else 'fewer'}: "
                 f"{lo} at intensity 0, {v0:g} at 0.5, {hi} at 1")
         return r.with_value(d, n, note)
@@ -135,21 +128,24 @@ def recipe(state: State, intensity: float = STUDY_INTENSITY) -> Recipe:
     """The composition of ``state`` at ``intensity``, before any robot is considered."""
     x = 2.0 * _check_intensity(intensity) - 1.0
     r = study(state)
-    for d in REGISTRY.values():
-        if state in d.stronger:
+    every = descriptors()
+    for d in every:
+        # a descriptor is varied where it has a span and the stimulus has its statement
+        if state in d.stronger and span_of(state, d.kind, d.key) is not None \
+                and r.node(*slot_of(d)) is not None:
             r = _vary(state, d, r, x)
-    pauses = descriptor("pause", "")
-    extra = r.count("retreat") - study(state).count("retreat")
+    pauses = descriptor(PAUSE, "")
+    extra = r.count(RETREAT) - study(state).count(RETREAT)
     if extra > 0 and state not in pauses.stronger:
-        r = r.with_value(pauses, study(state).count("pause") + extra,
-                         f"study {study(state).count('pause')}; one more per added retreat "
+        r = r.with_value(pauses, study(state).count(PAUSE) + extra,
+                         f"study {study(state).count(PAUSE)}; one more per added retreat "
                          "(a retreat starts and ends at a pause)")
-    for d in REGISTRY.values():
+    for d in every:
         if r.present(d) and d.name not in r.notes:
             r = r.noted(d.name, f"the study's value (no clear perceived effect on {state})"
                         if state in d.no_effect else "the study's value (not varied)")
     if state is State.INACTIVE:
-        r = r.noted(descriptor("pause", "duration").name, "the shipped inactive hold (not a "
+        r = r.noted(descriptor(PAUSE, "duration").name, "the shipped inactive hold (not a "
                     "stimulus of the study; intensity does not change it)")
     return r
 
@@ -289,7 +285,7 @@ _LIMIT_CODES = frozenset({C304, C308, C309, C311})
 def _session() -> Session:
     """The warm session synthesis and the live regulator build in: arms loaded once, the
     last builds kept, a changed text re-solving only the episodes it changed."""
-    from ..build.session import Session
+    from ..driver.session import Session
 
     return Session(keep=32)
 

@@ -7,11 +7,11 @@ from typing import TYPE_CHECKING
 
 from ..fit.rounding import significant
 from ..fit.search import DIGITS
-from ..lang.descriptors import REGISTRY
 from ..lang.ir import State
-from ..lang.primitives import KINDS
+from ..lang.primitives import KINDS, SHIVER
 from .arm_fit import MARGIN, SHIVER_F, goal_line, robot_line
-from .recipe import SLOTS, slot_of
+from .kind_recipes import descriptors, slots
+from .recipe import slot_of
 
 if TYPE_CHECKING:
     from ..core.diagnostics import Diagnostic
@@ -32,12 +32,12 @@ def _statement(r: Recipe, kind: str, plane: str | None) -> list[str]:
     if node is None or not node.count:
         return []
     out = ["", *(_comment(d.name, r.value(d), d.unit, r.notes[d.name])
-                 for d in REGISTRY.values()
+                 for d in descriptors()
                  if slot_of(d) == (kind, plane) and d.name in r.notes)]
     if KINDS[kind].translation:
         out.append(_comment("speed cap", node.v, "m/s", "the language default (the study "
                             "gives none)"))
-    if kind == "shiver" and SHIVER_F in r.notes:
+    if kind == SHIVER and SHIVER_F in r.notes:
         out.append(_comment(SHIVER_F, node.f, "Hz", r.notes[SHIVER_F]))
     return [*out, KINDS[kind].format(node)]
 
@@ -71,6 +71,6 @@ def render(r: Recipe, state: State, intensity: float, limits: Limits, *,
     lines += [f"behaviour {state}_synth : {state}", robot_line(limits.robot)]
     if limits.goal is not None:
         lines.append(goal_line(limits.goal).rstrip("\n"))
-    for kind, plane in SLOTS:
+    for kind, plane in slots():
         lines += _statement(r, kind, plane)
     return "\n".join(lines) + "\n"

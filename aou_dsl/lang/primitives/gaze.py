@@ -9,7 +9,8 @@ from typing import Literal
 from ...core.units import Dim
 from ..ir import DEFAULTS, Node
 from ..timeline import Episode, Pose
-from .kind import MIN_ANGLE, Key, Kind, fmt, given, move, repeat
+from .kind import MIN_ANGLE, Key, Kind, Needs, fmt, given, move, repeat
+from .pause import PauseKind
 
 __all__ = ["GAZE_ANGULAR_ACCEL", "Gaze", "GazeKind"]
 
@@ -44,6 +45,8 @@ class GazeKind(Kind):
     usage = "gaze horizontal|vertical ANGLE [v=ANGSPEED] [xN]"
     keys = {"v": Key(Dim.ANGULAR_SPEED, "deg/s", "angular speed")}
     evidence = {"exploration": ("angle", "sum")}
+    #: Its angle is read at the pause that ends it (a look that comes back is still one).
+    needs = Needs(followed_by=PauseKind.name)
     look = ("holds the goal: the hand turns about it in its plane, its line of sight on the "
             "goal throughout, and ends on the side it declares")
 

@@ -23,8 +23,8 @@ from ..timeline import Episode, Pose
 if TYPE_CHECKING:
     from ..values import Reader
 
-__all__ = ["MIN_ANGLE", "MIN_PAUSE", "MIN_RETREAT", "Key", "Kind", "Timing", "fmt", "given",
-           "move"]
+__all__ = ["MIN_ANGLE", "MIN_PAUSE", "MIN_RETREAT", "Key", "Kind", "Needs", "Timing", "fmt",
+           "given", "move"]
 
 #: How much a measured value may miss an invariant's bound before it counts as broken:
 #: a measurement reads a frequency from a few swings, to a few per cent.
@@ -61,6 +61,59 @@ class Timing(enum.Enum):
     OPTIMAL = "optimal"
 
 
+def _a(word: str) -> str:
+    return f"{'an' if word[:1] in 'aeiou' else 'a'} {word}"
+
+
+@dataclass(frozen=True, slots=True)
+class Needs:
+    """What an episode of a kind needs around it to count (to show its descriptors), and
+    so where a layout may put it. Kinds are named by their keywords.
+
+    Attributes:
+        preceded_by: the kind of the episode that must end right before it (a retreat
+            starts at a pause), or None.
+        followed_by: the kind of the episode that must start right after it, nothing
+            between (a retreat ends at a pause, a gaze's angle is read at the pause that
+            ends it; a counter-movement that anticipates an approach comes directly
+            before one), or None.
+        apart: two of its episodes never touch: motion goes between them (two pauses in
+            a row are seen and measured as one hold).
+    """
+
+    preceded_by: str | None = None
+    followed_by: str | None = None
+    apart: bool = False
+
+    def met(self, before: str | None, after: str | None) -> bool:
+        """Whether an episode counts between an episode of kind ``before`` and one of
+        kind ``after`` (None: the timeline's start or end)."""
+        return ((self.preceded_by is None or before == self.preceded_by)
+                and (self.followed_by is None or after == self.followed_by))
+
+    @property
+    def around(self) -> tuple[str, ...]:
+        """The kinds it needs next to it, one entry per neighbour (before, then after)."""
+        return tuple(k for k in (self.preceded_by, self.followed_by) if k is not None)
+
+    def words(self, name: str, hold: str) -> str | None:
+        """What an episode of kind ``name`` needs, as a sentence after its name (``hold``:
+        the keyword of the kind that ends a motion, whose end reads its value); None
+        when it counts anywhere."""
+        p, f = self.preceded_by, self.followed_by
+        if p is not None and p == f:
+            return f"{_a(name)} counts only between two {p}s, one before and one after it"
+        if p is not None and f is not None:
+            return f"{_a(name)} counts only right after {_a(p)} and right before {_a(f)}"
+        if f == hold:
+            return f"{_a(name)} counts only when {_a(f)} ends it"
+        if f is not None:
+            return f"{_a(name)} counts only directly before {_a(f)}, nothing between"
+        if p is not None:
+            return f"{_a(name)} counts only right after {_a(p)}"
+        return None
+
+
 class Kind(abc.ABC):
     """One primitive kind: the contract a new kind implements. Subclasses set the class
     attributes ``name``, ``node``, ``usage`` and ``evidence`` (checked when the subclass is
@@ -84,6 +137,10 @@ class Kind(abc.ABC):
     #: What makes its episodes look like this kind to a person, in words: the invariant
     #: :meth:`keeps_look` holds a fit to and :meth:`reads_as` reads a measured episode by.
     look: ClassVar[str] = ""
+    #: What its episodes need around them to count, and so where a layout may put them
+    #: (:class:`Needs`): none by default. A plugin kind sets its own, e.g.
+    #: ``needs = Needs(followed_by=APPROACH)`` for a move directly before an approach.
+    needs: ClassVar[Needs] = Needs()
 
     def __init_subclass__(cls, **kw) -> None:
         super().__init_subclass__(**kw)

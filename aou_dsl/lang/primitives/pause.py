@@ -9,7 +9,7 @@ from ...core.codes import V105
 from ...core.units import Dim
 from ..ir import Node
 from ..timeline import Episode, Pose
-from .kind import MIN_PAUSE, Kind, Timing, fmt, repeat
+from .kind import MIN_PAUSE, Kind, Needs, Timing, fmt, repeat
 
 __all__ = ["Pause", "PauseKind"]
 
@@ -29,6 +29,8 @@ class PauseKind(Kind):
     usage = "pause DURATION [xN]"
     timing = Timing.HOLD
     evidence = {"stillness": ("duration", "sum")}
+    #: Two pauses in a row are one hold: motion goes between them.
+    needs = Needs(apart=True)
     look = f"still: every joint at rest, for at least {MIN_PAUSE:g} s"
 
     def read(self, r):

@@ -10,7 +10,8 @@ from ...core.units import Dim
 from ..ir import DEFAULTS, Node
 from ..timeline import Episode, Pose
 from .approach import translation
-from .kind import MIN_RETREAT, Key, Kind, fmt, repeat
+from .kind import MIN_RETREAT, Key, Kind, Needs, fmt, repeat
+from .pause import PauseKind
 
 __all__ = ["Retreat", "RetreatKind"]
 
@@ -35,6 +36,8 @@ class RetreatKind(Kind):
     keys = {"a": Key(Dim.ACCEL, "m/s^2", "acceleration"),
             "v": Key(Dim.SPEED, "m/s", "speed")}
     evidence = {"extent": ("distance", "sum"), "vigour": ("peak_acceleration", "max")}
+    #: A retreat starts and ends at a pause: a withdrawal, not a step of a longer move.
+    needs = Needs(preceded_by=PauseKind.name, followed_by=PauseKind.name)
     look = (f"moves away: the goal distance grows, by at least {MIN_RETREAT * 1000:g} mm "
             "(an approach statement of negative length is a retreat, and the reverse)")
 

@@ -1,0 +1,103 @@
+"""`aouc measure REC --against FILE.aou`: a recording of a real arm (simulated loggers,
+tests/recsim.py) judged against the behaviour it should show, in JSON, CSV and NPZ;
+every descriptor declared vs measured with its tolerance; exit 1 and R408 at the
+declaring statement when one is outside; `--format json|github`."""
+
+from __future__ import annotations
+
+import io
+import json
+import zipfile
+
+import numpy as np
+import pytest
+
+from aou_dsl.cli.commands import main
+from aou_dsl.driver.builder import build_file
+from aou_dsl.lang.descriptors import REGISTRY
+from tests.conftest import BEHAVIOURS
+from tests.recsim import PRESETS, record, to_csv_text, to_json_doc
+
+HESITANT = BEHAVIOURS / "hesitant.aou"
+
+
+@pytest.fixture(scope="module")
+def recording():
+    """The hesitant behaviour performed on the simulated Panda (its own tracking lag) and
+    written by libfranka-like and plain 6-decimal loggers."""
+    res = build_file(str(HESITANT), check=False)
+    assert res.ok
+    doc = res.document
+    return {name: record(doc, PRESETS[name], dynamic=True)
+            for name in ("franka_fci", "csv_6_decimals_250hz")}
+
+
+def _write(tmp_path, rec: dict, fmt: str) -> tuple[str, list[str]]:
+    """The recording in ``fmt``; the extra arguments a reader needs for it."""
+    path = tmp_path / f"run.{fmt}"
+    if fmt == "csv":  # a bare log: no robot, no goal (the behaviour's goal is used)
+        path.write_text(to_csv_text(rec))
+        return str(path), ["--robot", "panda"]
+    doc = to_json_doc(rec)
+    if fmt == "json":
+        path.write_text(json.dumps(doc))
+    else:
+        buf = io.BytesIO()
+        with zipfile.ZipFile(buf, "w") as zf:
+            for key in ("t", "q"):
+                arr = io.BytesIO()
+                np.lib.format.write_array(arr, np.asarray(doc[key], dtype=np.float64))
+                zf.writestr(f"{key}.npy", arr.getvalue())
+            zf.writestr("header.json", json.dumps(
+                {k: v for k, v in doc.items() if k not in ("t", "q")}))
+        path.write_bytes(buf.getvalue())
+    return str(path), []
+
+
+@pytest.mark.parametrize("logger", ["franka_fci", "csv_6_decimals_250hz"])
+@pytest.mark.parametrize("fmt", ["json", "csv", "npz"])
+def test_a_recording_of_the_behaviour_passes_against_it(recording, tmp_path, capsys,
+                                                        fmt, logger):
+    path, extra = _write(tmp_path, recording[logger], fmt)
+    code = main(["measure", path, "--against", str(HESITANT), *extra, "--format", "json"])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0, out
+    rows = {r["descriptor"]: r for r in out["descriptors"]}
+    assert list(rows) == list(REGISTRY)
+    assert all(r["ok"] for r in rows.values())
+    assert rows["pause_count"]["declared"] == 5 and rows["pause_count"]["measured"] == 5
+    assert rows["pause_duration"]["tolerance"] == pytest.approx(0.0334)
+    assert rows["horizontal_gaze"]["declared"] is None
+    assert out["cv"]["declared"]["state"] == out["cv"]["measured"]["state"] == "hesitant"
+    assert out["goal_from_behaviour"] is (fmt == "csv")
+
+
+def test_a_descriptor_outside_its_tolerance_fails_the_run_at_its_statement(
+        recording, tmp_path, capsys):
+    """The same run judged against a file declaring 2 s pauses: exit 1, one R408 at the
+    pause statement, the rest pass."""
+    other = tmp_path / "longer.aou"
+    other.write_text(HESITANT.read_text().replace("pause 1.67s", "pause 2s"))
+    path, extra = _write(tmp_path, recording["franka_fci"], "json")
+    assert main(["measure", path, "--against", str(other), *extra]) == 1
+    out, err = capsys.readouterr()
+    fails = [ln for ln in out.splitlines() if ln.rstrip().endswith("FAIL")]
+    assert len(fails) == 1 and fails[0].split()[0] == "pause_duration"
+    assert "10 of 11 descriptors within tolerance" in out
+    (line,) = [ln for ln in err.splitlines() if " R408 " in ln]
+    pause_line = next(i for i, ln in enumerate(other.read_text().splitlines(), 1)
+                      if ln.startswith("pause"))
+    assert line.startswith(f"{other}:{pause_line}:1: R408")
+    assert main(["measure", path, "--against", str(other), "--format", "github"]) == 1
+    (ann,) = capsys.readouterr().out.splitlines()
+    assert ann.startswith(f"::error file={other},line={pause_line},")
+    assert "pause_duration: declared 2 s, measured 1.6" in ann
+
+
+def test_a_behaviour_file_with_errors_is_said_and_nothing_judged(recording, tmp_path, capsys):
+    bad = tmp_path / "bad.aou"
+    bad.write_text("pause 3m\n")
+    path, _ = _write(tmp_path, recording["franka_fci"], "json")
+    assert main(["measure", path, "--against", str(bad)]) == 1
+    out, err = capsys.readouterr()
+    assert "descriptor" not in out and "bad.aou:1:" in err
