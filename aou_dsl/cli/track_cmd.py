@@ -37,7 +37,7 @@ def nothing_to_track(args: argparse.Namespace) -> Iterator[None]:
         if getattr(args, "track", False) and args.path.endswith(".aou"):
             from .track_whatif import what_if_tracking
 
-            shown = what_if_tracking(args, list(err.diagnostics))
+            shown = what_if_tracking(args, list(err.diagnostics), format_tracking)
             note = _refusal_note(args, err.diagnostics, what_if=shown)
             if note:
                 print(note, file=sys.stderr)

@@ -8,9 +8,14 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from ..core.codes import C323
 from ..core.diagnostics import Diagnostic, Span
+
+if TYPE_CHECKING:
+    from ..safety.track_report import TrackReport
 
 __all__ = ["WHAT_IF", "what_if_tracking"]
 
@@ -18,14 +23,15 @@ __all__ = ["WHAT_IF", "what_if_tracking"]
 WHAT_IF = "what if"
 
 
-def what_if_tracking(args: argparse.Namespace, diagnostics: list[Diagnostic]) -> bool:
-    """Print the what-if report when every error of ``diagnostics`` is a refusal of the
-    arm's velocity, acceleration or jerk limits and the motion as declared can be
-    planned with them lifted; text output only. Whether it was printed."""
+def what_if_tracking(args: argparse.Namespace, diagnostics: list[Diagnostic],
+                     format_tracking: Callable[[TrackReport], str]) -> bool:
+    """Print the what-if report (as ``format_tracking`` writes a tracked plan's) when
+    every error of ``diagnostics`` is a refusal of the arm's velocity, acceleration or
+    jerk limits and the motion as declared can be planned with them lifted; text
+    output only. Whether it was printed."""
     from ..driver.what_if import LIMIT_REFUSALS, declared_motion, refused_by_limits
     from ..lang.linter import lint_file
     from .report import print_diagnostics
-    from .track_cmd import format_tracking
 
     if args.format == "json" or not refused_by_limits(diagnostics):
         return False
