@@ -51,7 +51,11 @@ def _arm(robot: str) -> str:
 
 
 class Refused(str):
-    """A behaviour the arm refuses even fitted: the refusal's code, as the row shows it."""
+    """A behaviour the arm refuses even fitted: the refusal's code, as the row shows it.
+    ``what_if``: where only the arm's limits refuse it, the report of its motion as
+    declared tracked anyway, as ``aouc check --track`` prints it (else None)."""
+
+    what_if = None
 
 
 def track(path: Path, robot: str):
@@ -59,16 +63,23 @@ def track(path: Path, robot: str):
     tracked in every mode: the :class:`~aou_dsl.safety.track_report.TrackReport`, or
     :class:`Refused` when the fit cannot keep the behaviour's look on this arm."""
     from aou_dsl.driver.builder import build_file
+    from aou_dsl.driver.what_if import declared_motion, refused_by_limits
     from aou_dsl.lang.linter import lint_file, lint_source
     from aou_dsl.safety.track_report import track_modes
 
     res = build_file(str(path), robot=robot, check=False)
     written = None
     if not res.ok:
+        first = res
         res = build_file(str(path), robot=robot, check=False, fit=True)
         if not res.ok:
             codes = sorted({d.code for d in res.diagnostics if str(d.severity) == "error"})
-            return Refused(", ".join(codes))
+            refused = Refused(", ".join(codes))
+            motion = declared_motion(str(path), robot) \
+                if refused_by_limits(first.diagnostics) else None
+            if motion is not None:
+                refused.what_if = track_modes(motion, lint_file(str(path)))
+            return refused
         written = lint_file(str(path))
     lint = (lint_source(res.fitted_source, str(path)) if res.fitted_source is not None
             else res.lint)
@@ -127,8 +138,11 @@ def row(path: Path, robot: str, report=None) -> str:
 
     report = report or track(path, robot)
     if isinstance(report, Refused):
-        return (f"| {_arm(robot)} | {path.stem}, refused even fitted ({report}) | "
-                + " | ".join("not tracked" for _ in MODES) + " |")
+        head = f"| {_arm(robot)} | {path.stem}, refused even fitted ({report})"
+        if report.what_if is None:
+            return head + " | " + " | ".join("not tracked" for _ in MODES) + " |"
+        return (f"{head}; what-if, tracked as declared | "
+                + " | ".join(cell(report.what_if, m) for m in MODES) + " |")
     return (f"| {_arm(robot)} | {behaviour_cell(path, report)} | "
             + " | ".join(cell(report, m) for m in MODES) + " |")
 
@@ -141,6 +155,8 @@ def arm_row(robot: str, reports: dict) -> str:
     from aou_dsl.core.servo_specs import MODES
 
     refused = sorted(f"{p.stem} ({r})" for p, r in reports.items() if isinstance(r, Refused))
+    what_if = {p: r.what_if for p, r in reports.items()
+               if isinstance(r, Refused) and r.what_if is not None}
     reports = {p: r for p, r in reports.items() if not isinstance(r, Refused)}
     table = next(iter(reports.values())).servo
     cells = []
@@ -156,6 +172,10 @@ def arm_row(robot: str, reports: dict) -> str:
             kept += r.verdict.measured_cv.state == rep.plan.declared_cv.state
             lost.update(a.name for a in rep.at_risk() if not a.shown[mode][2])
             shiver += [f"{path.stem}'s shiver {_pct(a.shown[mode][1])}"
+                       for a in rep.at_risk()
+                       if a.name == SHIVER and a.shown[mode][1] is not None]
+        for path, rep in what_if.items():  # refused: its motion as declared, a what-if
+            shiver += [f"{path.stem}'s shiver {_pct(a.shown[mode][1])} (what-if)"
                        for a in rep.at_risk()
                        if a.name == SHIVER and a.shown[mode][1] is not None]
         what = ", ".join(f"{n} in {k}" for n, k in sorted(lost.items(),

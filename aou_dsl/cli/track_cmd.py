@@ -24,7 +24,9 @@ __all__ = ["check_tracking", "compile_tracked", "format_tracking", "nothing_to_t
 @contextlib.contextmanager
 def nothing_to_track(args: argparse.Namespace) -> Iterator[None]:
     """Around the compile of ``aouc check FILE.aou --track``: when the arm refuses the
-    file there is no motion to track. Say so before its errors, and what gives one: the
+    file, the motion as declared is tracked as a what-if where only the arm's limits
+    refuse it (:mod:`.track_whatif`); else there is no motion to track. Say which
+    before its errors, and what gives one: the
     command with ``--fit`` when every error is one the fit changes (a value the arm
     cannot give), else that the errors must be mended first (``--fit`` would refuse
     too). Errors that are not the arm's refusal (the file's own, a missing file) speak
@@ -33,13 +35,17 @@ def nothing_to_track(args: argparse.Namespace) -> Iterator[None]:
         yield
     except AouError as err:
         if getattr(args, "track", False) and args.path.endswith(".aou"):
-            note = _refusal_note(args, err.diagnostics)
+            from .track_whatif import what_if_tracking
+
+            shown = what_if_tracking(args, list(err.diagnostics), format_tracking)
+            note = _refusal_note(args, err.diagnostics, what_if=shown)
             if note:
                 print(note, file=sys.stderr)
         raise
 
 
-def _refusal_note(args: argparse.Namespace, diagnostics) -> str | None:
+def _refusal_note(args: argparse.Namespace, diagnostics, what_if: bool = False
+                  ) -> str | None:
     import shlex
 
     from ..core.diagnostics import Severity
@@ -48,7 +54,9 @@ def _refusal_note(args: argparse.Namespace, diagnostics) -> str | None:
     errors = [d for d in diagnostics if d.severity is Severity.ERROR]
     if not errors or not any(d.code.startswith("C") for d in errors):
         return None
-    head = "aouc check --track: nothing to track, the arm refuses the behaviour as written"
+    head = ("aouc check --track: the tracking above is a what-if, the arm refuses the "
+            "behaviour as written" if what_if else
+            "aouc check --track: nothing to track, the arm refuses the behaviour as written")
     other = sorted({d.code for d in errors if d.code not in FITTED})
     if other:
         return (f"{head} (below), and --fit cannot change what {', '.join(other)} "

@@ -29,7 +29,7 @@ from ..lang.timeline import Episode, Pose, Timeline
 from ..robot.geometry import ReachFrame, reach_frame
 from ..robot.identity import frame_definition
 from ..robot.ik import IKStatus, solve_path
-from ..robot.kinematics import ArmModel
+from ..robot.kinematics import ArmModel, lifted
 from ..robot.load import load_arm
 from .kind_timing import missing, timing_of
 from .reuse import solved_path, timed_path
@@ -64,13 +64,14 @@ class CompileOptions:
     """Options of ``aouc compile``: sample ``rate`` [Hz], IK ``step_*`` sizes, the folders
     of the robot's ``package://`` meshes; ``start_seed``, a joint configuration [rad] the
     start pose is solved from instead of the robot's posture (another IK branch,
-    :mod:`.branches`)."""
-
+    :mod:`.branches`); ``lift``, a factor on the arm's velocity, acceleration and jerk
+    x of the motion as declared)."""
     rate: float = DEFAULT_RATE
     step_length: float = STEP_LENGTH
     step_angle: float = STEP_ANGLE
     package_dirs: tuple[str, ...] = ()
     start_seed: tuple[float, ...] | None = None
+    lift: float = 1.0
 
 
 @dataclass
@@ -194,11 +195,11 @@ def _siblings(arm: ArmModel, frame: ReachFrame, episodes: tuple[Episode, ...],
 def _too_fast(code: str, fail: TimingFailure, ep: Episode, edit: str | None,
               refusal: ShiverTooFast | TiltTooFast) -> Diagnostic:
     """C308 or C309: the limit a shiver or a tilt exceeds; the hint is the edit that
-    fits (the value the message gives), when there is one."""
+    fits (the value the message gives), when there is one; a fix when it sets one key."""
     one_key = edit is not None and len(re.findall(r"\w+=|\bfor\s", edit)) == 1
-    return refused(code, fail.reason, ep.span, refusal,
-                   hint=f"write `{edit}`" if edit else None,  # a fix sets one key:
-                   fix=Fix(ep.span, edit, edit.split("=")[0]) if edit and one_key else None)
+    fix = Fix(ep.span, edit, edit.split("=")[0]) if edit and one_key else None
+    return refused(code, fail.reason, ep.span, refusal, fix=fix,
+                   hint=f"write `{edit}`" if edit else None)
 
 
 def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
@@ -226,6 +227,7 @@ def compile_behaviour(b: Behaviour, options: CompileOptions = CompileOptions(),
         res.diagnostics.append(diag(K802, untimed[1], at))
         return res
     arm: ArmModel = load_arm(b.settings.robot, None, options.package_dirs)
+    arm = arm if options.lift == 1.0 else lifted(arm, options.lift)
     spec = arm.spec
     frame = reach_frame(b.settings.goal or spec.goal,
                         b.settings.start_direction or spec.start_direction)
@@ -335,8 +337,7 @@ def target_path(res: CompileResult) -> tuple[np.ndarray, np.ndarray]:
 
 
 def sample(res: CompileResult, rate: float) -> Trajectory:
-    """The compiled motion sampled at ``rate`` [Hz] (the checks use a dense clock
-    whatever the output rate)."""
+    """The compiled motion sampled at ``rate`` [Hz] (the checks' dense clock)."""
     if res.trajectory is None or res.timeline is None:
         raise AouError(diag(C305, "the compilation failed: there is nothing to sample",
                             res.behaviour.span))
@@ -370,9 +371,8 @@ def evaluate(res: CompileResult, t: np.ndarray
 
 
 def positions(res: CompileResult, t: np.ndarray) -> np.ndarray:
-    """Joint positions of the compiled motion at any times ``t`` [s], shape (N,): (N, n);
-    the same as ``evaluate(res, t)[0]``, without the velocities and accelerations (a
-    controller's view of the motion reads positions only)."""
+    """``evaluate(res, t)[0]`` without the velocities and accelerations: the positions
+    [rad], (N, n), a controller's view of the motion reads."""
     if res.trajectory is None or not res.segments:
         raise AouError(diag(C305, "the compilation failed: there is nothing to sample",
                             res.behaviour.span))

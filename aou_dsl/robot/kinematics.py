@@ -9,14 +9,14 @@ commands that need kinematics pay for it.
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
 from ..core.robot_specs import DEFAULT_JOINT_JERK, RobotSpec
 
-__all__ = ["ArmModel", "arm_model", "frame_id"]
+__all__ = ["ArmModel", "arm_model", "frame_id", "lifted"]
 
 
 @dataclass(frozen=True)
@@ -251,3 +251,13 @@ def arm_model(spec: RobotSpec, model: Any, *, no_effort: tuple[str, ...] = ()) -
         effort=effort,
         jmax=np.array(spec.joint_jerk or (DEFAULT_JOINT_JERK,) * n, dtype=float),
     )
+
+
+def lifted(arm: ArmModel, factor: float) -> ArmModel:
+    """``arm`` with its velocity, acceleration and jerk limits ``factor`` times higher
+    (position and effort limits as they are): the plan of a motion as declared where
+    the arm's limits refuse it, for a what-if (``aouc check --track``). Its key says
+    so, so that no cache gives the arm's own plan for it, nor this one for the arm."""
+    return replace(arm, vmax=arm.vmax * factor, amax=arm.amax * factor,
+                   jmax=arm.jmax * factor, key=(*arm.key, ("lifted", factor))
+                   if arm.key else ())

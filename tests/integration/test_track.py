@@ -259,10 +259,14 @@ def test_the_vendor_gen3_with_its_published_servos_keeps_the_shiver_with_feedfor
     assert not shiver["position"]["ok"] and shiver["feedforward"]["ok"]
 
 
-def test_a_behaviour_the_arm_refuses_is_not_tracked_and_the_user_is_told_why(capsys):
-    """Fearful's shiver is too fast for the Kinova as written (C308): --track says there
-    is no motion to track, and that --fit cannot give one that stays a fearful tremor."""
+def test_a_behaviour_the_arm_refuses_is_tracked_as_a_what_if_and_the_user_is_told_why(
+        capsys):
+    """Fearful's shiver is too fast for the Kinova as written (C308): --track tracks the
+    motion as declared as a what-if (tests/integration/test_track_what_if.py), says the
+    file still fails, and that --fit cannot give one that stays a fearful tremor."""
     assert main(["check", str(BEHAVIOURS / "fearful.aou"), "--robot", "kinova",
                  "--track"]) == 1
-    err = capsys.readouterr().err
-    assert " C308 " in err and "nothing to track" in err and "C315" in err
+    captured = capsys.readouterr()
+    err = captured.err
+    assert " C308 " in err and "nothing to track" not in err and "C315" in err
+    assert captured.out.startswith("what if:")

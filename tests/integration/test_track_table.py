@@ -21,19 +21,25 @@ def _table(path) -> list[str]:
     return [ln for ln in body.splitlines() if ln.startswith("| `")]
 
 
-@pytest.mark.parametrize(("robot", "name"), [("panda", "fearful"), ("ur5", "inactive")])
+@pytest.mark.parametrize(("robot", "name"), [("panda", "fearful"), ("ur5", "inactive"),
+                                             ("kinova", "fearful")])
 def test_a_row_of_the_checks_page_is_its_recomputation(robot, name):
-    """Fearful on the Panda (its shiver shrinks under plain set-points) and inactive on
-    the UR5 (a 500 Hz controller without computed torque): the page's row is the row
+    """Fearful on the Panda (its shiver shrinks under plain set-points), inactive on
+    the UR5 (a 500 Hz controller without computed torque) and fearful on the Kinova
+    (refused even fitted: its motion as declared, a what-if): the page's row is the row
     the script writes from a new tracking."""
     path = BEHAVIOURS / f"{name}.aou"
     report = track_table.track(path, robot)
     new = track_table.row(path, robot, report)
     rows = [ln for ln in _table(ROOT / "docs" / "checks.md")
-            if ln.startswith(f"| `{robot}` | {name}")]
+            if ln.split(" | ")[0] in (f"| `{robot}`", f"| `{robot}` (generic servo)")
+            and ln.split(" | ")[1].split(",")[0].split(" (")[0] == name]
     assert rows == [new]
     if robot == "panda":  # the figure the page's prose quotes
         assert "shiver 54 %" in track_table.cell(report, "position")
+    if robot == "kinova":  # refused: tracked as declared, and labelled so
+        assert "what-if" in new and report.what_if is not None
+        assert "shiver 54 %" in track_table.cell(report.what_if, "position")
 
 
 def test_the_tables_cover_every_shipped_behaviour_on_every_arm_with_a_servo_table():
