@@ -22,10 +22,11 @@ from typing import Any
 from ..core.codes import C314, C315
 from ..core.diagnostics import Diagnostic, diag
 from ..core.repeats import said_once
-from ..lang.linter import FileResult, lint_source
+from ..lang.linter import FileResult
 from ..lang.primitives import look_changed
+from .guard import guarded, refusal
 from .plan import FITTED, Kinds, fixed, plan
-from .refusals import answer_of, first_error
+from .refusals import answer_of
 from .text_edits import Change, apply
 
 __all__ = ["MAX_ROUNDS", "fit_loop"]
@@ -80,7 +81,7 @@ def fit_loop(lint: FileResult, build: Callable[[FileResult], Any]) -> Any:
     res = _rounds(lint, build, last)
     todo = [d for d in said_once(res.diagnostics) if d.code in FITTED]
     res.diagnostics += fixed(todo, _kinds(last[-1]))
-    return res
+    return guarded(res)
 
 
 def _rounds(lint: FileResult, build: Callable[[FileResult], Any],
@@ -99,12 +100,11 @@ def _rounds(lint: FileResult, build: Callable[[FileResult], Any],
             res.diagnostics += _not_fitted(todo, b.span)
             break
         new_text = apply(text, changes)
-        new_lint = lint_source(new_text, lint.path)
-        if not new_lint.ok:
+        new_lint, bad = refusal(new_text, lint.path)  # never a text the language refuses
+        if bad is not None:
             res.diagnostics.append(diag(
                 C314, f"not fitted: the changes ({', '.join(c.text for c in changes)}) "
-                f"are values the language does not take: "
-                f"{first_error(new_lint.diagnostics)}", b.span))
+                f"are values the language does not take: {bad}", b.span))
             return res
         if (state is not None and (
                 new_lint.cv is None or new_lint.cv.state != state)):
