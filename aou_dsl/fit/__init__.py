@@ -8,8 +8,9 @@
 :mod:`~aou_dsl.fit.plan` (which values to change, and by how much),
 :mod:`~aou_dsl.fit.reach` (a pose brought within reach),
 :mod:`~aou_dsl.fit.amplitude` (a shiver narrowed to what the wrist follows),
-:mod:`~aou_dsl.fit.rounds` (``--fit``: build, change, build again) and
-:mod:`~aou_dsl.fit.every_change` (a refusal's hint with every change the file needs).
+:mod:`~aou_dsl.fit.rounds` (``--fit``: build, change, build again),
+:mod:`~aou_dsl.fit.every_change` (a refusal's hint with every change the file needs) and
+:mod:`~aou_dsl.fit.guard` (no text or edit offered that the language refuses).
 
 It sits in the compiler's layer: the compiler reads its rounding, search, refusals and
 edits to word its hints, and the reach and amplitude fits follow the compiler's own path.

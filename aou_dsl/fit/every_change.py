@@ -22,32 +22,29 @@ from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
-from ..core.codes import C308, C309
 from ..core.diagnostics import Diagnostic, Fix, Severity, Span, has_errors
 from ..lang.linter import FileResult, lint_source
-from .refusals import answer_of, answered, first_error
-from .text_edits import Change, apply, apply_edit, splice
+from .guard import KEYED as _KEYED
+from .guard import guarded, own_edit
+from .refusals import answered, first_error
 
 __all__ = ["statement_edits", "with_every_change"]
-
-#: The start distance a start pose refusal's hint gives.
-_START = re.compile(r"`(start \d+cm)`")
-#: A hint that is an edit of keyed values (``write `f=1.3Hz for 2.31s```).
-_SAID = re.compile(r"write `([^`]+)`")
-#: The refusals whose edit sets keyed values of their statement.
-_KEYED = frozenset({C308, C309})
-
 
 def with_every_change(res: Any, build: Callable[[FileResult], Any]) -> Any:
     """``res`` (a build result) with the hint of its first refusal that has an edit
     completed by every other change the file needs to compile (see the module).
     ``build`` builds a linted file as ``res`` was built (the reach and amplitude hints
-    included, not this completion)."""
+    included, not this completion). No edit that would not lint is offered
+    (:func:`~aou_dsl.fit.guard.guarded`)."""
+    return guarded(_with_every_change(res, build))
+
+
+def _with_every_change(res: Any, build: Callable[[FileResult], Any]) -> Any:
     lint = res.lint
     if lint.source is None or lint.behaviour is None or not has_errors(res.diagnostics):
         return res
     for d in res.diagnostics:
-        own = _own(lint, d) if d.severity is Severity.ERROR else None
+        own = own_edit(lint, d) if d.severity is Severity.ERROR else None
         if own is not None:
             break
     else:
@@ -68,37 +65,6 @@ def with_every_change(res: Any, build: Callable[[FileResult], Any]) -> Any:
     res.diagnostics = [replace(answered(x, hint, edits=edits, edits_complete=left is None),
                                fix=fix) if x is d else x for x in res.diagnostics]
     return res
-
-
-def _own(lint: FileResult, d: Diagnostic) -> str | None:
-    """The file's text with ``d``'s own hint applied (None: the hint is no edit)."""
-    text = lint.source
-    assert text is not None
-    if d.span.path != lint.path or d.span.line < 1:
-        return None
-    if d.fix is not None and d.fix.key is not None and (d.hint or "").startswith("write `"):
-        return apply_edit(text, d.fix.span, d.fix.text)
-    said = _SAID.match(d.hint or "")
-    if d.fix is None and said and d.code in _KEYED:  # `f=1.3Hz for 2.31s`: two keys
-        return apply_edit(text, d.span, said[1])
-    offered = answer_of(d).offered
-    if offered:
-        return apply(text, [Change(Span(d.span.path, r["line"], r["col"], r["line"],
-                                        r["end_col"]), r["key"], r["declared"], r["fitted"],
-                                   r["unit"]) for r in offered])
-    start = _START.search(d.hint or "")
-    spans = lint.behaviour.settings.spans if lint.behaviour is not None else {}
-    if not (start and d.span in spans.values() and d.span.line == d.span.end_line):
-        return None
-    # the `start` line changed, or, in a file without one, written after the setting
-    # the refusal points at (`goal (0.3, 0, 0.6); start 21cm`)
-    if spans.get("start") == d.span:
-        now = start[1]
-    elif "start" not in spans:
-        now = f"{_text(text, d.span)}; {start[1]}"
-    else:
-        return None
-    return splice(text, d.span.line, d.span.col, d.span.end_col - 1, now)
 
 
 def _complete(lint: FileResult, own: str, build: Callable[[FileResult], Any]

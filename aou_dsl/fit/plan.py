@@ -17,6 +17,9 @@ text, by this rule:
   value is above ``k``). Two files
   that differ only in that value are fitted to values in the same order (the map is
   strictly increasing), so a Part B variant pair keeps its contrast.
+- A value no key of the statement's kind sets (a gaze's acceleration: the language
+  fixes it, and ``gaze`` takes no ``a=``) is never written: :func:`fixed` says so
+  instead, as a typed refusal (:class:`~aou_dsl.fit.refusals.FixedByLanguage`).
 - Fitted descriptors are written with 4 significant digits, a shiver's frequency with 3,
   rounded toward what fits.
 
@@ -27,18 +30,20 @@ peak) and keeps the fit only when the file still expresses its declared state.
 
 from __future__ import annotations
 
-from ..core.codes import C301, C302, C303, C304, C308, C309
-from ..core.diagnostics import Diagnostic, Span
+from collections.abc import Mapping
+
+from ..core.codes import C301, C302, C303, C304, C308, C309, C314
+from ..core.diagnostics import Diagnostic, Span, refused
 from ..lang.descriptors import REGISTRY
-from ..lang.primitives import TILT
-from .refusals import AccelerationShort, ShiverTooFast, TiltTooFast, answer_of
+from ..lang.primitives import KINDS, TILT
+from .refusals import AccelerationShort, FixedByLanguage, ShiverTooFast, TiltTooFast, answer_of
 from .rounding import written
 from .text_edits import Change, value_text
 
 #: The descriptor a tilt's ``v=`` sets.
 _TILT_VELOCITY = next(d.name for d in REGISTRY.values() if d.kind == TILT and d.ir_field == "v")
 
-__all__ = ["FITTED", "KNEE", "compress", "hint_edit", "plan", "shiver_keys"]
+__all__ = ["FITTED", "KNEE", "compress", "fixed", "hint_edit", "plan", "shiver_keys"]
 
 #: Fraction of the arm's peak below which a declared value is never changed.
 KNEE = 0.9
@@ -82,14 +87,53 @@ def hint_edit(r: ShiverTooFast) -> str | None:
     return " ".join(value_text(k, v, u) for k, v, u, _ in _shiver(r)) or None
 
 
-def plan(diagnostics: list[Diagnostic], declared: dict[tuple, float]) -> list[Change]:
+#: The kind of each statement, by its ``(line, col)``.
+Kinds = Mapping[tuple[int, int], str]
+
+
+def _fixed(d: Diagnostic, kinds: Kinds) -> FixedByLanguage | None:
+    """The record of ``d`` when it refuses a value its statement's kind takes no key for."""
+    r, kind = d.refusal, kinds.get((d.span.line, d.span.col))
+    if not isinstance(r, AccelerationShort) or kind is None or kind not in KINDS \
+            or "a" in KINDS[kind].keys:
+        return None
+    unit = "m/s^2" if KINDS[kind].translation else "rad/s^2"
+    return FixedByLanguage(kind, "a", tuple(KINDS[kind].keys), r.declared, r.achieved, unit,
+                           r.joint)
+
+
+def fixed(diagnostics: list[Diagnostic], kinds: Kinds) -> list[Diagnostic]:
+    """A C314 for each value ``diagnostics`` refuse that the language fixes (no key of
+    the statement's kind sets it, ``kinds`` by ``(line, col)``): why the fit leaves it."""
+    out = []
+    for d in diagnostics:
+        r = _fixed(d, kinds)
+        if r is None:
+            continue
+        takes = ", ".join(f"`{k}=`" for k in r.takes) or "no key"
+        gives = "" if r.achieved is None else f"; the arm gives {r.achieved:.3g} {r.unit}" + (
+            f" ({r.joint} binds)" if r.joint else "")
+        value = "" if r.declared is None else f" ({r.declared:.3g} {r.unit})"
+        out.append(refused(
+            C314, f"not fitted: a {r.kind}'s acceleration is fixed by the language"
+            f"{value}: `{r.kind}` takes {takes}, no `{r.key}=`, so the "
+            f"fit writes none{gives}", d.span, r))
+    return out
+
+
+def plan(diagnostics: list[Diagnostic], declared: dict[tuple, float],
+         kinds: Kinds | None = None) -> list[Change]:
     """The changes that fit what ``diagnostics`` refuse (their typed refusals, and the
     changes the reach and amplitude fits found). ``declared`` holds, by ``(line, col,
     key)`` of the statement, the value first declared where an earlier round changed it
-    (the rule is applied from it, not from the fitted value)."""
+    (the rule is applied from it, not from the fitted value). ``kinds`` gives each
+    statement's kind by ``(line, col)``: a value its kind takes no key for is not
+    changed (:func:`fixed`)."""
     out = []
     for d in diagnostics:
         r = d.refusal
+        if _fixed(d, kinds or {}) is not None:
+            continue
         if isinstance(r, AccelerationShort) and r.achieved and r.declared is not None:
             x = declared.get(_at(d, "a"), float(r.declared))
             fitted = written(compress(x, float(r.achieved)), 4)

@@ -15,8 +15,9 @@ from typing import Any
 
 from ..core.diagnostics import Diagnostic, Severity
 
-__all__ = ["AccelerationShort", "Answer", "ShiverTooFast", "StartUnreachable", "TiltTooFast",
-           "TimingFailure", "Unreachable", "answered", "answer_of", "first_error"]
+__all__ = ["AccelerationShort", "Answer", "FixedByLanguage", "ShiverTooFast",
+           "StartUnreachable", "TiltTooFast", "TimingFailure", "Unreachable", "answered",
+           "answer_of", "first_error"]
 
 
 @dataclass(frozen=True)
@@ -82,6 +83,22 @@ class AccelerationShort:
     achieved: float | None
     declared: float | None
     descriptor: str
+
+
+@dataclass(frozen=True)
+class FixedByLanguage:
+    """C314: the fit's own refusal of a value the arm cannot give but no statement of
+    ``kind`` may set: ``key`` is none of the kind's keys (``takes``), the language fixes
+    the value (``declared``, in ``unit``), so the fit writes nothing there and the arm
+    gives ``achieved``, ``joint`` the joint that binds (a gaze's acceleration)."""
+
+    kind: str
+    key: str
+    takes: tuple[str, ...]
+    declared: float | None
+    achieved: float | None
+    unit: str
+    joint: str | None
 
 
 def first_error(diagnostics: list[Diagnostic]) -> str:

@@ -22,10 +22,11 @@ from typing import Any
 from ..core.codes import C314, C315
 from ..core.diagnostics import Diagnostic, diag
 from ..core.repeats import said_once
-from ..lang.linter import FileResult, lint_source
+from ..lang.linter import FileResult
 from ..lang.primitives import look_changed
-from .plan import FITTED, plan
-from .refusals import answer_of, first_error
+from .guard import guarded, refusal
+from .plan import FITTED, Kinds, fixed, plan
+from .refusals import answer_of
 from .text_edits import Change, apply
 
 __all__ = ["MAX_ROUNDS", "fit_loop"]
@@ -65,9 +66,26 @@ def _not_fitted(todo: list[Diagnostic], where: Any) -> list[Diagnostic]:
         for d in todo if answer_of(d).look]
 
 
+def _kinds(lint: FileResult) -> Kinds:
+    """The kind of each statement of ``lint``, by its ``(line, col)``."""
+    eps = lint.timeline.episodes if lint.timeline is not None else ()
+    return {(ep.span.line, ep.span.col): ep.kind for ep in eps}
+
+
 def fit_loop(lint: FileResult, build: Callable[[FileResult], Any]) -> Any:
     """``build(lint)``, then rounds of :func:`~aou_dsl.fit.plan.plan` and
-    ``build`` of the changed text (at most :data:`MAX_ROUNDS` builds)."""
+    ``build`` of the changed text (at most :data:`MAX_ROUNDS` builds). A value the
+    language fixes (a gaze's acceleration) is never changed: a C314 says why
+    (:func:`~aou_dsl.fit.plan.fixed`)."""
+    last = [lint]  # the lint of the last build
+    res = _rounds(lint, build, last)
+    todo = [d for d in said_once(res.diagnostics) if d.code in FITTED]
+    res.diagnostics += fixed(todo, _kinds(last[-1]))
+    return guarded(res)
+
+
+def _rounds(lint: FileResult, build: Callable[[FileResult], Any],
+            last: list[FileResult]) -> Any:
     res = build(lint)
     text, b = lint.source, lint.behaviour
     if text is None or b is None:
@@ -77,17 +95,16 @@ def fit_loop(lint: FileResult, build: Callable[[FileResult], Any]) -> Any:
     made: dict[tuple, Change] = {}
     for _ in range(MAX_ROUNDS - 1):
         todo = [d for d in said_once(res.diagnostics) if d.code in FITTED]
-        changes = plan(todo, first)
+        changes = plan(todo, first, _kinds(last[-1]))
         if not changes:
             res.diagnostics += _not_fitted(todo, b.span)
             break
         new_text = apply(text, changes)
-        new_lint = lint_source(new_text, lint.path)
-        if not new_lint.ok:
+        new_lint, bad = refusal(new_text, lint.path)  # never a text the language refuses
+        if bad is not None:
             res.diagnostics.append(diag(
                 C314, f"not fitted: the changes ({', '.join(c.text for c in changes)}) "
-                f"are values the language does not take: "
-                f"{first_error(new_lint.diagnostics)}", b.span))
+                f"are values the language does not take: {bad}", b.span))
             return res
         if (state is not None and (
                 new_lint.cv is None or new_lint.cv.state != state)):
@@ -111,6 +128,7 @@ def fit_loop(lint: FileResult, build: Callable[[FileResult], Any]) -> Any:
             except ValueError:
                 first.setdefault(key, math.nan)
             made[key] = replace(c, declared=made[key].declared) if key in made else c
+        last.append(new_lint)
         text, res = new_text, build(new_lint)
     if made:
         res.diagnostics += [_warning(c) for c in made.values()]
