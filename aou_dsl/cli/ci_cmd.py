@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 from ..core.diagnostics import AouError, Diagnostic, Severity, Span
 from ..core.rules import category
@@ -74,7 +74,7 @@ def keep_changed(inputs: list[tuple[str, str | None]], ref: str,
     return kept
 
 
-def write_sarif(path: str, found: list[Diagnostic], reads: list[str]) -> int:
+def write_sarif(path: str, found: list[Diagnostic], reads: Sequence[str]) -> int:
     """``--sarif FILE``: the batch's diagnostics as a SARIF log, written whole, never over
     an input (I502); the exit status of the writing."""
     from ..core.files import write_atomic

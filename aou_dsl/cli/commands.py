@@ -120,9 +120,8 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     if args.changed_since:
         inputs = keep_changed(inputs, args.changed_since)
     sources = [src for src, _ in inputs]
-    reads = _reads(args, sources)
-    try:
-        dests, fmt = guard_outputs(args, inputs, reads)  # before any work: the output rule
+    try:  # before any work: the output rule; reads comes back indexed for every write
+        dests, fmt, reads = guard_outputs(args, inputs, _reads(args, sources))
     except AouError as err:
         return _fail(err)
     if args.csv_derivatives:

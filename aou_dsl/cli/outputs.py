@@ -3,15 +3,21 @@
 from __future__ import annotations
 
 import argparse
+from collections.abc import Sequence
+
+from ..core.read_set import ReadSet
 
 __all__ = ["guard_outputs"]
 
 
 def guard_outputs(args: argparse.Namespace, inputs: list[tuple[str, str | None]],
-                  reads: list[str]) -> tuple[list[str | None], str]:
+                  reads: Sequence[str]) -> tuple[list[str | None], str, ReadSet]:
     """Where each input's trajectory goes (None each with ``--no-output``) and in which
     format, after every output (``-o``'s files, ``--write-fitted``, ``--sarif``) is
-    checked against the files the command reads and against each other.
+    checked against the files the command reads and against each other; and those
+    files as a :class:`~aou_dsl.core.read_set.ReadSet`, indexed once, so that the rule
+    of each output (here, and again when it is written) is a look-up, not a pass over
+    every input.
 
     Raises:
         AouError: I502 (or I506) naming the clash.
@@ -19,6 +25,7 @@ def guard_outputs(args: argparse.Namespace, inputs: list[tuple[str, str | None]]
     from ..compiler.output import FOLDER_FORMATS, FORMATS, output_paths
     from ..core.files import check_format, guard_output
 
+    reads = ReadSet(reads)
     if args.no_output:
         dests: list[str | None] = [None] * len(inputs)
         fmt = "json"
@@ -36,4 +43,4 @@ def guard_outputs(args: argparse.Namespace, inputs: list[tuple[str, str | None]]
         written.append(args.write_fitted)
     if args.sarif:
         guard_output(args.sarif, [*reads, *written])
-    return dests, fmt
+    return dests, fmt, reads

@@ -9,7 +9,7 @@ import argparse
 import contextlib
 import json
 import sys
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from typing import IO
 
 import numpy as np
@@ -215,7 +215,7 @@ def tracked_document(report, mode: str) -> dict:
             "t": [float(x) for x in tr.t], "q": tr.q.tolist()}
 
 
-def run_tracking(args: argparse.Namespace, tr, behaviour, *, reads: list[str],
+def run_tracking(args: argparse.Namespace, tr, behaviour, *, reads: Sequence[str],
                  out: IO[str] | None, written=None, fitted=()
                  ) -> tuple[list[Diagnostic], dict | None]:
     """Track ``tr`` (judged against ``behaviour``, a lint or None), print the report on
@@ -251,7 +251,7 @@ def run_tracking(args: argparse.Namespace, tr, behaviour, *, reads: list[str],
 
 
 
-def check_tracking(args: argparse.Namespace, tr, reads: list[str]
+def check_tracking(args: argparse.Namespace, tr, reads: Sequence[str]
                    ) -> tuple[list[Diagnostic], dict | None]:
     """``aouc check --track``: a ``.aou`` file's motion judged against it, a trajectory
     file's tracking error alone; the report on standard output (text) or returned (JSON).
@@ -266,7 +266,7 @@ def check_tracking(args: argparse.Namespace, tr, reads: list[str]
                         out=None if args.format == "json" else sys.stdout)
 
 
-def compile_tracked(args: argparse.Namespace, res, reads: list[str]):
+def compile_tracked(args: argparse.Namespace, res, reads: Sequence[str]):
     """``compile --track``: the report on standard error, its warnings (C322, C323); a
     file whose tracking cannot be simulated fails (nothing written)."""
     from dataclasses import replace

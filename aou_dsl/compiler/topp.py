@@ -107,11 +107,14 @@ def _described(what: str, lim: np.ndarray) -> str:
 @cached(maxsize=1)
 def _lean_toppra():
     """toppra's ``TOPPRA`` whose two per-stage steps (the backward pass's controllable
-    set, the forward pass's greedy step) skip their per-call allocations and checks: the
-    same solver calls with the same arguments in the same order (the seidel solver
-    warm-starts from its previous call), so the same law to the last bit, about a sixth
+    set, the forward pass's greedy step) skip their per-call allocations and checks, and
+    whose two passes keep their running values in Python floats instead of reading and
+    writing array elements one at a time: the same solver calls with the same arguments
+    in the same order (the seidel solver warm-starts from its previous call), the same
+    arithmetic, so the same law to the last bit, and the same refusals; about a third
     faster on aou's paths. ``tests/integration/test_speed_props.py`` compares the two."""
     stock: Any = import_toppra().algorithm.TOPPRA  # an untyped library's class
+    ra: Any = sys.modules[stock.__mro__[1].__module__]  # its passes' constants
     nan = float("nan")
 
     class LeanTOPPRA(stock):
@@ -140,6 +143,89 @@ def _lean_toppra():
             if i < 0 or i > self._N or x is None or x != x:
                 return np.array([nan, nan])
             return self._solve(i, None, self._forward[i], x, x, K_next[0], K_next[1])
+
+        def compute_controllable_sets(self, sdmin, sdmax):
+            # toppra's backward pass, its set kept in floats while it runs (not read
+            # and written an element at a time in an array): the same calls, the same
+            # numbers. Stops at a NaN set as toppra does, the rows after it left 0.
+            assert sdmin <= sdmax and 0 <= sdmin
+            n = self._N
+            K = np.zeros((n + 1, 2))
+            K[n] = [sdmin ** 2, sdmax ** 2]
+            lo, hi = K[n, 0], K[n, 1]
+            solve, upper, lower = self._solve, self._upper, self._lower
+            self.solver_wrapper.setup_solver()
+            rows = []
+            for i in range(n - 1, -1, -1):
+                if lo != lo or hi != hi:
+                    lo = hi = nan
+                else:
+                    x_upper = solve(i, None, upper, nan, nan, lo, hi)[1]
+                    lo, hi = solve(i, None, lower, nan, nan, lo, hi)[1], x_upper
+                if lo < 0:
+                    lo = 0.0
+                rows.append((lo, hi))
+                if lo != lo or hi != hi:
+                    K[i:n] = rows[::-1]
+                    return K
+            self.solver_wrapper.close_solver()
+            K[:n] = rows[::-1]
+            return K
+
+        def compute_parameterization(self, sd_start, sd_end, return_data=False):
+            # toppra's, with the forward pass's velocities and accelerations kept in
+            # floats while it runs: the same steps, the same numbers.
+            if sd_end < 0 or sd_start < 0:
+                return super().compute_parameterization(sd_start, sd_end, return_data)
+            K = self.compute_controllable_sets(sd_end, sd_end)
+            codes = ra.ParameterizationReturnCode
+            if np.isnan(K).any():  # not controllable: toppra's failure, as it gives it
+                self._problem_data.return_code = codes.FailUncontrollable
+                return (None, None, None, K) if return_data else (None, None, None)
+            self._problem_data.K = K
+            x_start = sd_start ** 2
+            if x_start + ra.SMALL < K[0, 0] or K[0, 1] + ra.SMALL < x_start:
+                self._problem_data.return_code = codes.FailUncontrollable
+                return (None, None, None, K) if return_data else (None, None, None)
+            sw = self.solver_wrapper
+            n, deltas, forward = sw.get_no_stages(), sw.get_deltas().tolist(), self._forward
+            extra = sw.get_no_vars() - 2
+            v_vec = np.zeros((n, extra))
+            k_lo, k_hi = K[:, 0].tolist(), K[:, 1].tolist()
+            xs, us = [x_start] + [0.0] * n, [0.0] * n
+            tries = 0
+            sw.setup_solver()
+            i = 0
+            while i < self._N:
+                x = xs[i]
+                res = (np.array([nan, nan]) if x is None or x != x else
+                       self._solve(i, None, forward[i], x, x, k_lo[i + 1], k_hi[i + 1]))
+                if res[0] != res[0]:
+                    if tries < ra.MAX_TRIES:
+                        xs[i] = max(x - ra.TINY, 0.999 * x)
+                        tries += 1
+                    else:
+                        xs[i + 1:] = [nan] * (n - i)
+                        break
+                else:
+                    tries = 0
+                    us[i] = u = float(res[0])
+                    x_next = x + 2 * deltas[i] * u
+                    x_next = max(x_next - ra.TINY, 0.9999 * x_next)
+                    xs[i + 1] = min(k_hi[i + 1], max(k_lo[i + 1], x_next))
+                    if extra:
+                        v_vec[i] = res[2:]
+                    i += 1
+            sw.close_solver()
+            sd_vec = np.sqrt(np.array(xs, dtype=float))
+            sdd_vec = np.array(us, dtype=float)
+            self._problem_data.sd_vec = sd_vec
+            self._problem_data.sdd_vec = sdd_vec
+            self._problem_data.return_code = (codes.ErrUnknown if np.isnan(sd_vec).any()
+                                              else codes.Ok)
+            if return_data:
+                return sdd_vec, sd_vec, v_vec, K
+            return sdd_vec, sd_vec, v_vec
 
     return LeanTOPPRA
 

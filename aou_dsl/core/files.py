@@ -31,6 +31,7 @@ from typing import Any
 from .codes import I501, I502, I506
 from .diagnostics import AouError, Span, diag
 from .output_folders import is_aou_bag, is_aou_dmp
+from .read_set import ReadSet
 
 __all__ = ["atomic", "check_format", "check_output", "decode", "guard_output", "is_own_output",
            "make_folders", "read_bytes", "read_text", "same_file", "sweep_stale", "temp_prefix",
@@ -93,14 +94,8 @@ def same_file(path: str, other: str) -> bool:
 
 def _clash(path: str, read: str) -> str | None:
     """How ``path`` would write over the input ``read`` (None: it would not)."""
-    try:
-        if os.path.realpath(path) == os.path.realpath(read):
-            return "is" if os.path.abspath(path) == os.path.abspath(read) else "links to"
-        if os.path.exists(path) and os.path.exists(read) and os.path.samefile(path, read):
-            return "is a hard link of"
-    except (OSError, ValueError):
-        return None
-    return None
+    found = ReadSet((read,)).clash(path)
+    return None if found is None else found[0]
 
 
 def _special(mode: int) -> str | None:
@@ -125,12 +120,13 @@ def guard_output(path: str, reads: Sequence[str] = (), *, force: bool = True,
             file aou did not write (without ``force``).
     """
     where = Span.whole_file(path)
-    for read in reads:
-        how = _clash(path, read)
-        if how is not None:
-            raise AouError(diag(I502, f"refusing to write `{path}`: it {how} `{read}`, "
-                                "which this command reads", where,
-                                hint="choose another output with -o", input=read))
+    known = reads if isinstance(reads, ReadSet) else ReadSet(reads)
+    found = known.clash(path)
+    if found is not None:
+        how, read = found
+        raise AouError(diag(I502, f"refusing to write `{path}`: it {how} `{read}`, "
+                            "which this command reads", where,
+                            hint="choose another output with -o", input=read))
     try:
         mode = os.stat(path).st_mode
     except (OSError, ValueError):
@@ -140,7 +136,7 @@ def guard_output(path: str, reads: Sequence[str] = (), *, force: bool = True,
         raise AouError(diag(I502, f"refusing to write `{path}`: it is a {kind}, not a "
                             "regular file", where, hint="choose a file name with -o"))
     if bag:
-        _guard_bag(path, reads, where, stat.S_ISDIR(mode))
+        _guard_bag(path, known, where, stat.S_ISDIR(mode))
     elif stat.S_ISDIR(mode):
         raise AouError(diag(I502, f"cannot write `{path}`: it is a folder", where))
     elif not force and not is_own_output(path):
@@ -149,16 +145,16 @@ def guard_output(path: str, reads: Sequence[str] = (), *, force: bool = True,
                             "to replace it"))
 
 
-def _guard_bag(path: str, reads: Sequence[str], where: Span, folder: bool) -> None:
+def _guard_bag(path: str, reads: ReadSet, where: Span, folder: bool) -> None:
     if not folder:
         raise AouError(diag(I502, f"cannot write the bag `{path}`: it is a file, and a "
                             "bag is a folder", where, hint="choose another output with -o"))
     real = os.path.realpath(path)
-    for read in reads:
-        if os.path.realpath(read).startswith(real + os.sep):
-            raise AouError(diag(I502, f"refusing to write the bag `{path}`: it holds "
-                                f"`{read}`, which this command reads", where,
-                                hint="choose another output with -o", input=read))
+    read = reads.held_by(real)
+    if read is not None:
+        raise AouError(diag(I502, f"refusing to write the bag `{path}`: it holds "
+                            f"`{read}`, which this command reads", where,
+                            hint="choose another output with -o", input=read))
     if os.listdir(real) and not (is_aou_bag(real) or is_aou_dmp(real)):
         raise AouError(diag(I502, f"refusing to write the bag `{path}`: the folder holds "
                             "files other than a bag aou wrote", where,

@@ -188,15 +188,16 @@ class Sweep:
         cum = self._bounds[p]
         if cum is None:
             cum = self.bound(p)
-        last = len(cum) - 1
-        if k < 0 or k + 1 >= len(it.js):  # an open end: the bound is lowest at the end
-            j, x = (it.js[0], 0) if k < 0 else (it.js[-1], last)
+        js = it.js
+        if k < 0 or k + 1 >= len(js):  # an open end: the bound is lowest at the end
+            j, x = (js[0], 0) if k < 0 else (js[-1], len(cum) - 1)
             if j == x:
                 return None
             return float(it.ds[k + 1 if k < 0 else k] - abs(cum[x] - cum[j])), x
-        ja, jb = it.js[k], it.js[k + 1]
+        ja, jb = js[k], js[k + 1]
         if jb - ja <= 1:
             return None
+        last = len(cum) - 1
         da, db = it.ds[k], it.ds[k + 1]
         ca, cb = cum[ja], cum[jb]
         meet = (da - db + ca + cb) / 2
@@ -226,21 +227,22 @@ class Sweep:
                                                   strict=True)
                     if j % members == 0 or j == last), default=math.inf)
         heap: list[tuple[float, int, int]] = []
-
-        def push(p: int, k: int) -> None:
-            lo = self._lowest(p, k, members)
-            if lo is not None:
-                heapq.heappush(heap, (lo[0], p, lo[1]))
-
+        lowest, heappush, heappop, measure = (self._lowest, heapq.heappush, heapq.heappop,
+                                              self.measure)
         for p in ps:
             for k in range(-1, len(self.items[p].js)):
-                push(p, k)
+                lo = lowest(p, k, members)
+                if lo is not None:
+                    heappush(heap, (lo[0], p, lo[1]))
         while heap and heap[0][0] < best - CLEARANCE_TOL:
-            _, p, j = heapq.heappop(heap)
-            best = min(best, self.measure(p, j))
+            _, p, j = heappop(heap)
+            d = measure(p, j)
+            if d < best:
+                best = d
             k = bisect_left(self.items[p].js, j)
-            push(p, k - 1)
-            push(p, k)
+            for lo in (lowest(p, k - 1, members), lowest(p, k, members)):
+                if lo is not None:
+                    heappush(heap, (lo[0], p, lo[1]))
         return best
 
     def first_contact(self, kind: str, touching) -> tuple[int, int] | None:

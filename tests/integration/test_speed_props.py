@@ -292,13 +292,21 @@ def test_the_lean_toppra_gives_the_stock_law():
         jv, ja = arm.plan_vmax * (0.05 if k % 3 == 0 else 1.0), arm.plan_amax
         path = toppra.SplineInterpolator(s_way, np.column_stack([q_way, s_way]))
         grid = topp.grid(s_way, 80, a, vmax)
-        outs = []
-        for cls in (toppra.algorithm.TOPPRA, topp._lean_toppra()):
-            inst = cls(list(topp._constraints(tuple(jv), tuple(ja), a, vmax)), path,
-                       gridpoints=grid, solver_wrapper="seidel")
-            outs.append(inst.compute_parameterization(0.0, 0.0, return_data=True))
-        for stock, lean in zip(*outs, strict=True):
-            assert np.array_equal(stock, lean, equal_nan=True)
+        # at rest at both ends (aou's case); and ends no law can reach, so that both
+        # refusals (a final speed beyond control, a start speed beyond it) are compared
+        for ends in ((0.0, 0.0), (0.0, 1e3), (1e3, 0.0)):
+            outs, codes = [], []
+            for cls in (toppra.algorithm.TOPPRA, topp._lean_toppra()):
+                inst = cls(list(topp._constraints(tuple(jv), tuple(ja), a, vmax)), path,
+                           gridpoints=grid, solver_wrapper="seidel")
+                outs.append(inst.compute_parameterization(*ends, return_data=True))
+                codes.append(inst.problem_data.return_code)
+            assert codes[0] == codes[1], ends
+            assert (codes[0] == toppra.algorithm.ParameterizationReturnCode.Ok) == (
+                ends == (0.0, 0.0)), (ends, codes)
+            for stock, lean in zip(*outs, strict=True):
+                assert (stock is None) == (lean is None), ends
+                assert stock is None or np.array_equal(stock, lean, equal_nan=True), ends
 
 
 # --- lint: long files, the cap on diagnostics, the parser's cache ---------------------------
