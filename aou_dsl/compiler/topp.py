@@ -114,7 +114,7 @@ def _lean_toppra():
     arithmetic, so the same law to the last bit, and the same refusals; about a third
     faster on aou's paths. ``tests/integration/test_speed_props.py`` compares the two."""
     stock: Any = import_toppra().algorithm.TOPPRA  # an untyped library's class
-    ra: Any = sys.modules[stock.__mro__[1].__module__]  # its passes' constants
+    ra: types.ModuleType = sys.modules[stock.__mro__[1].__module__]  # its passes' constants
     nan = float("nan")
 
     class LeanTOPPRA(stock):
