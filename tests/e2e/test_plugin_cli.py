@@ -13,26 +13,14 @@ from pathlib import Path
 
 import pytest
 
-from tests.plugins.install import ROOT, for_commands, without_plugins
+from tests.plugins.install import ROOT, for_commands, wind_up, without_plugins
 
 AOUC = [sys.executable, "-m", "aou_dsl"]
 
 #: A sequence whose anticipation draws back 10 mm at 0.4 m/s^2 before approaches at a
 #: tenth of that: its drive (the largest peak acceleration of an approach or an
 #: anticipation) comes from the anticipation alone.
-SEQUENCE = """\
-behaviour wind_up
-robot panda
-start 0.30m
-standoff 0.10m
-sequence {
-  pause 1s
-  anticipate 10mm a=0.4
-  approach 0.1m a=0.01
-  pause 1s
-  approach a=0.01
-}
-"""
+SEQUENCE = wind_up()
 D, A = 0.010, 0.4
 
 

@@ -9,21 +9,9 @@ from types import SimpleNamespace
 import pytest
 
 from aou_dsl.lang.descriptors import EpisodeValues
-from tests.plugins.install import installed
+from tests.plugins.install import installed, wind_up
 
-SEQUENCE = """\
-behaviour wind_up
-robot panda
-start 0.30m
-standoff 0.10m
-sequence {
-  pause 1s
-  anticipate 12mm a=0.3
-  approach 0.1m a=0.05
-  pause 1s
-  approach a=0.05
-}
-"""
+SEQUENCE = wind_up("12mm", 0.3, 0.05)
 
 
 @pytest.fixture

@@ -90,3 +90,11 @@ def installed(tmp: Path, entry: str = "aou_anticipate:plugin") -> Iterator[Insta
 def without_plugins() -> dict[str, str]:
     """The environment of an ``aouc`` subprocess that sees no plugin (none installed)."""
     return _env([])
+
+
+def wind_up(draw: str = "10mm", a: float = 0.4, approach_a: float = 0.01) -> str:
+    """The plugin's example: a sequence whose anticipation draws back ``draw`` at peak
+    acceleration ``a`` [m/s^2] right before an approach at ``approach_a``."""
+    return (f"behaviour wind_up\nrobot panda\nstart 0.30m\nstandoff 0.10m\nsequence {{\n"
+            f"  pause 1s\n  anticipate {draw} a={a:g}\n  approach 0.1m a={approach_a:g}\n"
+            f"  pause 1s\n  approach a={approach_a:g}\n}}\n")
