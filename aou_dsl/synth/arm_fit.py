@@ -21,7 +21,7 @@ from ..fit.refusals import AccelerationShort
 from ..fit.rounding import significant
 from ..fit.search import DIGITS
 from ..lang.ir import DEFAULTS
-from ..lang.primitives import KINDS, MIN_SHIVER_F, SHIVER, TILT, shiver_duration
+from ..lang.primitives import KINDS, LOOK_SHIVER_F, SHIVER, TILT, VISIBLE_SHIVER, shiver_duration
 from .kind_recipes import kind_recipes
 from .recipe import Recipe, descriptor
 
@@ -160,23 +160,25 @@ def _fit_shiver(r: Recipe, lim: Limits) -> Recipe:
     f_max = shiver_max_frequency(node.amplitude, node.duration, lim)
     if node.f <= f_max:
         return r.noted(SHIVER_F, "the language default (the study gives none)")
-    if f_max >= MIN_SHIVER_F:
+    floor = min(LOOK_SHIVER_F, node.f)  # a tremor's least frequency: slower is a roll
+    if f_max >= floor:
         f = significant(f_max, DIGITS)
         return r.with_node(node.replace(f=f, duration=_whole(node.duration, f))).noted(
             SHIVER_F, f"the language default {node.f:g} Hz, lowered to {f:g} Hz for "
             f"{lim.robot}'s {lim.roll_joint} (the amplitude stays)")
     # the peaks are proportional to the amplitude at a fixed frequency
-    amp = significant(math.degrees(node.amplitude) * (f_max / MIN_SHIVER_F) ** 2, DIGITS)
-    while amp > 1.0 and shiver_max_frequency(math.radians(amp), node.duration,
-                                             lim) < MIN_SHIVER_F:
-        amp = significant(amp * 0.9, DIGITS)
+    least = math.degrees(VISIBLE_SHIVER)
+    amp = significant(math.degrees(node.amplitude) * (f_max / floor) ** 2, DIGITS)
+    while amp > least and shiver_max_frequency(math.radians(amp), node.duration,
+                                               lim) < floor:
+        amp = significant(max(amp * 0.9, least), DIGITS)
     name = descriptor(SHIVER, "amplitude").name
     note = (f"{r.notes.get(name, '')}; reduced from {math.degrees(node.amplitude):g} to "
             f"{amp:g} deg: {lim.robot}'s {lim.roll_joint} cannot shiver wider at "
-            f"{MIN_SHIVER_F:g} Hz")
-    return (r.with_node(node.replace(f=MIN_SHIVER_F, amplitude=math.radians(amp),
-                                     duration=_whole(node.duration, MIN_SHIVER_F)))
-            .noted(SHIVER_F, f"lowered to {MIN_SHIVER_F:g} Hz for {lim.robot}'s "
+            f"{floor:g} Hz, and a slower shiver would read as slow rolls, not a tremor")
+    return (r.with_node(node.replace(f=floor, amplitude=math.radians(amp),
+                                     duration=_whole(node.duration, floor)))
+            .noted(SHIVER_F, f"lowered to {floor:g} Hz for {lim.robot}'s "
                    f"{lim.roll_joint}").noted(name, note))
 
 

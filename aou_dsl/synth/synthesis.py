@@ -205,8 +205,11 @@ def _floor(state: State, limits: Limits) -> float:
         return 0.0
     lo, hi = 0.0, 1.0
     if not ok(hi):
+        fitted = fit(recipe(state, hi), limits)
+        why = [note[note.index("reduced from"):] for note in fitted.notes.values()
+               if "reduced from" in note]  # what the arm narrowed, if that is why
         raise AouError(diag(I504, f"no intensity of `{state}` reads as {state} on "
-                            f"{limits.robot}", _WHERE))
+                            f"{limits.robot}" + (f": {why[0]}" if why else ""), _WHERE))
     while hi - lo > 0.01:
         mid = (lo + hi) / 2
         lo, hi = (lo, mid) if ok(mid) else (mid, hi)

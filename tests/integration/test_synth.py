@@ -21,6 +21,7 @@ from aou_dsl.lang.cv import CANONICAL, classify
 from aou_dsl.lang.declared import written
 from aou_dsl.lang.descriptors import REGISTRY
 from aou_dsl.lang.ir import State
+from aou_dsl.lang.primitives import LOOK_SHIVER_F
 from aou_dsl.synth.synthesis import SPANS, STUDY_INTENSITY, blend_weights, compiled, synthesize
 from tests.conftest import BEHAVIOURS
 
@@ -66,8 +67,10 @@ def test_study_intensity_reproduces_the_shipped_behaviour(state, robot):
     # on another arm, only what the arm cannot do may differ, and its comment says so
     other_text = fitted(state, intensity=STUDY_INTENSITY, robot=robot)
     other = _values(other_text)
+    # an arm that cannot give the state's weaker end raises the intensity, and says so
+    raised = f"on {robot} a weaker {state}" in other_text
     for name, value in _values(text).items():
-        if other[name] != value:
+        if other[name] != value and not raised:
             note = [ln for ln in other_text.splitlines() if ln.startswith(f"# {name} ")]
             assert note and f"for {robot}" in note[0], name
 
@@ -98,11 +101,15 @@ def test_descriptors_move_the_perceived_way(state, a, b, robot):
 @pytest.mark.parametrize("robot", ARMS)
 def test_intensity_spans_a_visible_range(state, robot):
     """From intensity 0 to 1 every perceived descriptor of the state really moves."""
-    v0 = _values(fitted(state, intensity=0.0, robot=robot))
+    t0 = fitted(state, intensity=0.0, robot=robot)
+    v0 = _values(t0)
     v1 = _values(fitted(state, intensity=1.0, robot=robot))
+    # where the arm raised the weak end (it says so), a count may not find room to move
+    raised = f"on {robot} a weaker {state}" in t0
     for name, d in REGISTRY.items():
         if state in d.stronger:
-            assert d.stronger[state] * (v1[name] - v0[name]) > 0, name
+            change = d.stronger[state] * (v1[name] - v0[name])
+            assert change >= 0 if raised and d.is_count else change > 0, name
 
 
 @pytest.mark.parametrize("state", STUDY_STATES)
@@ -242,10 +249,23 @@ def test_every_arm_gets_files_that_compile_and_keep_the_properties(state):
     clean, reads as its state, compiles within the arm's limits and passes the checks, and
     its perceived descriptors still move the perceived way (an arm may cap a value or
     lower an intensity, never reverse a direction)."""
+    kept = 0
     for robot in _loadable():
         previous = None
         for i in (0.0, 0.25, 0.5, 0.75, 1.0):
-            text = synthesize(state, intensity=i, robot=robot)
+            try:
+                text = synthesize(state, intensity=i, robot=robot)
+            except AouError as err:
+                # Only a tremor the arm cannot give wide enough at a tremor's frequency
+                # may stop a state, and the refusal says so (a slower shiver would be
+                # slow rolls: another state's look).
+                assert state is State.FEARFUL and i == 0.0, (robot, i, err)
+                assert "I504" in str(err) and "cannot shiver wider at 2.5 Hz" in str(err)
+                break
+            kept += 1
+            shiver = [w for w in text.splitlines() if w.startswith("shiver ")]
+            assert all(float(w.split("f=")[1].split("Hz")[0]) >= LOOK_SHIVER_F
+                       for w in shiver if "f=" in w), (robot, i, shiver)
             assert _clean(text).cv.state is state, (robot, i)
             _compiles(text, robot, round_trip=False)
             values = _values(text)
@@ -254,6 +274,7 @@ def test_every_arm_gets_files_that_compile_and_keep_the_properties(state):
                     assert d.stronger[state] * (values[name] - previous[name]) >= 0, \
                         (robot, i, name)
             previous = values
+    assert kept >= 5  # the Panda, at least, keeps every state at every intensity
 
 
 @pytest.mark.slow
