@@ -239,9 +239,9 @@ def shape_of(kind: str) -> Shape | None:
 def descriptor_name(kind: str, key: str) -> str | None:
     """The name of the descriptor read from ``kind`` episodes by ``key`` (``""``: the
     count), or None when there is none (a plugin's scaling of a key it does not report)."""
-    from ..synth.kind_recipes import all_descriptors
+    from ..lang.descriptors import every_descriptor
 
-    return next((d.name for d in all_descriptors() if d.kind == kind
+    return next((d.name for d in every_descriptor().values() if d.kind == kind
                  and (d.key == key or (d.is_count and key == ""))), None)
 
 

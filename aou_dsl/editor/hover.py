@@ -9,10 +9,9 @@ import re
 from lsprotocol import types
 
 from ..core.rule_model import Category
-from ..lang.descriptors import DEFINITIONS, REGISTRY, Descriptor
+from ..lang.descriptors import DEFINITIONS, REGISTRY, Descriptor, every_descriptor
 from ..lang.ir import State
 from ..lang.primitives import KINDS
-from ..synth.kind_recipes import all_descriptors
 from . import lsp_engine as engine
 from .kind_texts import definition, texts_of
 from .state import Document
@@ -49,7 +48,7 @@ def descriptor_for(keyword: str, slot: str, plane: str | None = None) -> Descrip
         return None
     texts = texts_of(keyword)
     by_plane = texts is not None and bool(texts.planes)
-    for d in all_descriptors():
+    for d in every_descriptor().values():
         if d.kind != keyword or (by_plane and d.key != plane):
             continue
         if slot == "x" and d.is_count:

@@ -10,7 +10,7 @@ shows the file (:func:`shows_all`). Pure Python.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 
 from . import descriptors
 from .descriptors import Descriptor, EpisodeValues, qualify
@@ -18,21 +18,15 @@ from .ir import Behaviour
 from .primitives import APPROACH, KINDS, PAUSE
 from .timeline import Episode
 
-__all__ = ["descriptor_table", "episode_values", "episodes_of", "every_counts", "shows_all",
+__all__ = ["episode_values", "episodes_of", "every_counts", "shows_all",
            "why_not"]
-
-
-def descriptor_table() -> Mapping[str, Descriptor]:
-    """Every descriptor by name: the registry's eleven and, where the registry gives
-    them (its ``every_descriptor``), the loaded plugins' too."""
-    return descriptors.every_descriptor()
 
 
 def every_counts(kind: str) -> bool:
     """Whether every episode of ``kind`` must count for its descriptors to show: a kind
     with a count (a retreat) or one no descriptor table knows (a plugin's, to be safe);
     not a kind whose descriptors are values one counting episode shows (a gaze's angle)."""
-    mine = [d for d in descriptor_table().values() if d.kind == kind]
+    mine = [d for d in descriptors.every_descriptor().values() if d.kind == kind]
     return not mine or any(d.is_count for d in mine)
 
 
@@ -65,7 +59,7 @@ def shows_all(b: Behaviour, episodes: Sequence[Episode]) -> bool:
     for e in eps:
         if not e.counts and every_counts(e.kind):
             return False
-    for d in descriptor_table().values():
+    for d in descriptors.every_descriptor().values():
         if d.is_count or d.kind not in KINDS:
             continue
         want = any(p.count for p in b.primitives if _sets(p, d))

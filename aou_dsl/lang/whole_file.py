@@ -8,9 +8,9 @@ from typing import Any
 
 from ..core.codes import V110, V119, V120, V121, V123, V124, V125
 from .declared import source_of, written
-from .descriptors import compare, derive
+from .descriptors import compare, derive, every_descriptor
 from .ir import Behaviour
-from .kind_needs import descriptor_table, why_not
+from .kind_needs import why_not
 from .layout import Laid, episode_values, layout
 from .primitives import APPROACH, GAZE, KINDS, MIN_RETREAT, PAUSE
 from .timeline import Pose, Timeline
@@ -203,7 +203,7 @@ def _count(b: Behaviour, kind: str) -> int:
 
 def _shown(name: str, value: float | int | None) -> str:
     """A descriptor's value with its unit, as the file would write it."""
-    unit = descriptor_table()[name].unit
+    unit = every_descriptor()[name].unit
     return f"{value:.3g} {unit}" if isinstance(value, float) and unit else f"{value}"
 
 
@@ -222,7 +222,7 @@ def _realisable(ctx: Ctx, b: Behaviour, tl: Timeline) -> None:
     episode of a statement counts, one diagnostic says why: its values are absent for
     that one reason."""
     said: set[int] = set()
-    table = descriptor_table()
+    table = every_descriptor()
     for m in compare(written(b), derive(episode_values(tl.episodes))):
         node = source_of(b, m.name)
         if m.measured is None and id(node) in said:

@@ -22,7 +22,7 @@ The steps (docs/measure.md explains the choices):
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -307,7 +307,7 @@ def _undersampled(where: Span, t0: float, t1: float, per_cycle: float, h: float
                 frequency=f, samples_per_cycle=per_cycle)
 
 
-def _unequal(table: dict[str, Descriptor], name: str, vals: list[float]) -> bool:
+def _unequal(table: Mapping[str, Descriptor], name: str, vals: list[float]) -> bool:
     return max(vals) - min(vals) > table[name].tolerance(float(np.median(vals)))
 
 

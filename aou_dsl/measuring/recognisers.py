@@ -167,40 +167,17 @@ def _malformed(got: list[object]) -> str | None:
 
 
 def extra_descriptors() -> tuple[Descriptor, ...]:
-    """The plugins' descriptors (after the eleven of
-    :data:`~aou_dsl.lang.descriptors.REGISTRY`), each a
-    :class:`~aou_dsl.lang.descriptors.Descriptor` whose name is not taken."""
-    every = getattr(_descriptors, "every_descriptor", None)
-    if every is not None:  # the registry's own reading: by name, or as records
-        got = every()
-        found: Iterable[object] = got.values() if isinstance(got, Mapping) else got
-    else:  # the plugins' own parts, read the way every_descriptor reads them
-        found = [d for p in _plugins.plugins()
-                 for d in _as_list(p.part("descriptors"))]
-    out: list[Descriptor] = []
-    seen = set(REGISTRY)
-    for d in found:
-        if isinstance(d, Descriptor) and d.name not in seen:
-            seen.add(d.name)
-            out.append(d)
-    return tuple(out)
+    """The plugins' descriptors, after the eleven of
+    :data:`~aou_dsl.lang.descriptors.REGISTRY` (the registry's ``every_descriptor``, which
+    has already left out the malformed and the taken)."""
+    return tuple(d for name, d in _descriptors.every_descriptor().items()
+                 if name not in REGISTRY)
 
 
-def every_named() -> dict[str, Descriptor]:
+def every_named() -> Mapping[str, Descriptor]:
     """The eleven then the plugins' descriptors, by name, in the order they are
     reported."""
-    return {**REGISTRY, **{d.name: d for d in extra_descriptors()}}
-
-
-def _as_list(part: object) -> list[object]:
-    if part is None or isinstance(part, str | bytes):
-        return []
-    if isinstance(part, Mapping):
-        return list(part.values())
-    try:
-        return list(part)  # type: ignore[call-overload]
-    except TypeError:
-        return []
+    return _descriptors.every_descriptor()
 
 
 def aggregate(d: Descriptor, episodes: Sequence[EpisodeValues]) -> float | int | None:

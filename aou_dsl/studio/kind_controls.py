@@ -19,9 +19,8 @@ from dataclasses import dataclass, field
 from typing import Protocol, runtime_checkable
 
 from ..core import plugins as _plugins
-from ..lang.descriptors import REGISTRY, Descriptor
+from ..lang.descriptors import REGISTRY, Descriptor, every_descriptor
 from ..lang.primitives import APPROACH, GAZE, KINDS, PAUSE, RETREAT, SHIVER, TILT
-from ..synth.kind_recipes import all_descriptors
 
 __all__ = ["DEFAULT_COLOUR", "DEFAULT_RANGE", "EPISODE_COLOURS", "LAYER", "RANGES",
            "KindControls", "StudioKindPart", "colour_of", "descriptor_of", "descriptors",
@@ -130,7 +129,7 @@ def colour_of(kind: str) -> RGB:
 
 def descriptors() -> dict[str, Descriptor]:
     """Every descriptor a slider may set: the registry's, then the loaded plugins'."""
-    return {d.name: d for d in all_descriptors()}
+    return {d.name: d for d in every_descriptor().values()}
 
 
 def descriptor_of(name: str) -> Descriptor:

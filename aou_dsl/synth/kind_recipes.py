@@ -21,11 +21,11 @@ from dataclasses import dataclass, field
 from typing import Protocol, runtime_checkable
 
 from ..core import plugins as _plugins
-from ..lang.descriptors import REGISTRY, Descriptor
+from ..lang.descriptors import Descriptor, every_descriptor
 from ..lang.ir import State
 from ..lang.primitives import APPROACH, GAZE, PAUSE, RETREAT, SHIVER, TILT
 
-__all__ = ["LAYER", "KindRecipe", "SynthKindPart", "all_descriptors", "descriptors",
+__all__ = ["LAYER", "KindRecipe", "SynthKindPart", "descriptors",
            "kind_recipes", "pauses_needed", "slots", "span_of", "spans"]
 
 #: The plugin part this registry reads.
@@ -120,20 +120,11 @@ def slots() -> tuple[Slot, ...]:
     return tuple((k, plane) for k, r in kind_recipes().items() for plane in r.planes)
 
 
-def all_descriptors() -> tuple[Descriptor, ...]:
-    """Every descriptor: the registry's, then the loaded plugins' (the descriptor table's
-    ``every_descriptor()``, by name, where it offers one)."""
-    from ..lang import descriptors as table
-
-    every = getattr(table, "every_descriptor", None)
-    return tuple(every().values()) if every is not None else tuple(REGISTRY.values())
-
-
 def descriptors() -> tuple[Descriptor, ...]:
     """The descriptors synthesis reads and writes: the registry's, then the plugin
     kinds' that take part (those of a kind left out are not)."""
     kinds = kind_recipes()
-    return tuple(d for d in all_descriptors() if d.kind in kinds)
+    return tuple(d for d in every_descriptor().values() if d.kind in kinds)
 
 
 def spans() -> dict[State, dict[tuple[str, str], float]]:

@@ -14,10 +14,10 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 from ..fit.rounding import significant
-from ..lang.descriptors import Descriptor
+from ..lang.descriptors import Descriptor, every_descriptor
 from ..lang.ir import State
 from ..lang.primitives import KINDS, PAUSE
-from .kind_recipes import all_descriptors, descriptors, kind_recipes, pauses_needed, slots
+from .kind_recipes import descriptors, kind_recipes, pauses_needed, slots
 
 __all__ = ["Recipe", "descriptor", "slot_of"]
 
@@ -28,7 +28,7 @@ Slot = tuple[str, str | None]
 
 def descriptor(kind: str, key: str) -> Descriptor:
     """The descriptor read from episodes of ``kind`` by ``key`` ("" for the count)."""
-    for d in all_descriptors():
+    for d in every_descriptor().values():
         if d.kind == kind and (d.key == key or (d.is_count and key == "")):
             return d
     raise KeyError((kind, key))
