@@ -37,6 +37,11 @@ class JointSegment:
     def duration(self) -> float:
         return self._duration
 
+    @property
+    def n(self) -> int:
+        """The number of joints."""
+        return len(self.q_hold)
+
     def sample(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         n = len(tau)
         q = np.tile(self.q_hold, (n, 1))

@@ -383,7 +383,7 @@ def _evaluate(segments: list[PathSegment | JointSegment], t: np.ndarray,
               positions: bool = False) -> tuple[np.ndarray, ...]:
     """``q, qd, qdd`` at times ``t`` (``q`` alone with ``positions``)."""
     bounds = np.concatenate([[0.0], np.cumsum([s.duration for s in segments])])
-    n = segments[0].sample(np.zeros(1))[0].shape[1]
+    n = segments[0].n  # the joints (a segment's samples have as many columns)
     out = tuple(np.empty((len(t), n)) for _ in range(1 if positions else 3))
     idx = np.clip(np.searchsorted(bounds, t, side="right") - 1, 0, len(segments) - 1)
     if len(t) > 1 and np.all(t[1:] >= t[:-1]):  # a clock: each segment's times in a row

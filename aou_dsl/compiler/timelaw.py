@@ -183,7 +183,11 @@ class SmoothLaw:
 
     def peak_acceleration(self) -> float:
         """The exact peak of ``|s''|`` (a piecewise linear function: its extremes are at
-        the breakpoints)."""
+        the breakpoints); computed once per law (timing reads it twice)."""
+        return self._peak
+
+    @functools.cached_property
+    def _peak(self) -> float:
         return float(np.max(np.abs(self(self.breakpoints())[2])))
 
     def probe_times(self) -> np.ndarray:

@@ -139,23 +139,67 @@ def _chain_fk(arm: ArmModel, chain: list, q: np.ndarray, jacobian: bool
 
 def rows_fk(arm: ArmModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """:func:`batch_fk` of the rows of ``q`` (N, n), each row's values those of any batch
-    of two rows or more holding it (:func:`.rows.by_rows`). A build asks it twice of
-    the same samples (its checks, then its measurement): the last few answers are kept
-    by the arm and the samples' bytes, and given back as copies."""
+    of two rows or more holding it (:func:`.rows.by_rows`), but for the last few rows of
+    a batch (below). A build asks it twice of the same samples: its checks, then its
+    measurement, whose grid holds them all but the last. The last few answers are kept
+    by the arm and the samples' bytes; an ask for the first rows of a kept batch is
+    answered from it (:func:`_first_rows`); every answer is given back as copies."""
     from .rows import by_rows, content_key
 
     q = np.asarray(q, float)
     key = (Keyed(id(arm), arm), content_key(q))
-    kept = _ROWS_FK.get(key)
+    found = _ROWS_FK.get(key)
+    kept = found[1] if found is not None else _first_rows(arm, q, key)
     if kept is None:
         kept = by_rows(q, lambda rows: batch_fk(arm, rows))
-        _ROWS_FK.put(key, kept)
+    if found is None:
+        _ROWS_FK.put(key, (key, kept))
     pos, rot = (np.array(x, order="K") for x in kept)
     return pos, rot
 
 
+#: A batch's last rows that are computed again when a batch is answered from the first
+#: rows of a kept one, and the alignment of the batch that computes them.
+_TAIL, _ALIGN = 64, 64
+
+
+def _first_rows(arm: ArmModel, q: np.ndarray, key: tuple) -> tuple[np.ndarray, ...] | None:
+    """The answer for the rows ``q`` (keyed ``key``) when they are the first rows of a
+    kept batch of the same arm (its bytes from the start, as many columns); None when
+    they are not.
+
+    A row's values do not depend on the rows beside it, except in the last few rows of a
+    batch: the matrix products of :func:`batch_fk` run their last columns through
+    another kernel, whose rounding can differ (seen up to three rows from the end, and
+    only there). So the last :data:`_TAIL` rows are computed again, as the last rows of
+    a batch of their own whose length is that of ``q`` modulo :data:`_ALIGN` (each
+    column then falls where it falls in ``q``'s own product); the rows before them in
+    that batch must equal the kept ones, or ``q`` is computed whole."""
+    from .rows import by_rows
+
+    arm_key, ((dtype, shape, content),) = key
+    m = shape[0]
+    r = 2 * _TAIL + m % _ALIGN
+    if m <= r:
+        return None
+    for (kept_arm, ((kdtype, kshape, kcontent),)), answer in _ROWS_FK.values():
+        if not (kept_arm == arm_key and kdtype == dtype and kshape[1:] == shape[1:]
+                and kshape[0] > m and kcontent.data.startswith(content.data)):
+            continue
+        tail = by_rows(q[m - r:], lambda rows: batch_fk(arm, rows))
+        if not all(np.array_equal(t[:r - _TAIL], a[m - r:m - _TAIL])
+                   for t, a in zip(tail, answer, strict=True)):
+            return None
+        out = tuple(np.array(a[:m], order="K") for a in answer)
+        for o, t in zip(out, tail, strict=True):
+            o[m - _TAIL:] = t[r - _TAIL:]
+        return out
+    return None
+
+
 #: The last answers of :func:`rows_fk`, by arm (the key holds it, so its id stays its
-#: own) and samples: a motion's 5,000 samples and their poses are under a megabyte.
+#: own) and samples, each with its key (for :func:`_first_rows`): a motion's 5,000
+#: samples and their poses are under a megabyte.
 _ROWS_FK = table("aou_dsl.robot.batch_fk.rows_fk", 4)
 
 

@@ -58,9 +58,10 @@ def content_key(*arrays: np.ndarray) -> tuple:
 def by_rows(q: np.ndarray, fn: Callable[[np.ndarray], tuple[np.ndarray, ...]]
             ) -> tuple[np.ndarray, ...]:
     """``fn(q)`` of the rows of ``q`` (N, n), whose outputs have one row per row of
-    ``q``: each row's values are those of any batch of two rows or more holding it. One
-    row alone is computed as two, and given back laid out as ``fn`` lays out its outputs
-    (C or Fortran order)."""
+    ``q``: each row's values are those of any batch of two rows or more holding it (but
+    the last few rows of a batch, where a matrix product may round otherwise: see
+    :func:`.batch_fk.rows_fk`). One row alone is computed as two, and given back laid
+    out as ``fn`` lays out its outputs (C or Fortran order)."""
     q = np.ascontiguousarray(np.atleast_2d(q), dtype=float)
     if len(q) != 1:
         return tuple(fn(q))

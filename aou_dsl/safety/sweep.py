@@ -147,31 +147,44 @@ class Sweep:
 
     def measure(self, p: int, j: int) -> float:
         """The distance of item ``p`` at sample ``j`` (at most :data:`QUERY_RANGE`)."""
+        return self._take(p, j)[0]
+
+    def _take(self, p: int, j: int) -> tuple[float, int]:
+        """:meth:`measure`, and where ``j`` is among the item's measured samples."""
         it = self.items[p]
-        k = bisect_left(it.js, j)
-        if k < len(it.js) and it.js[k] == j:
-            return it.ds[k]
-        self.visit(j)
-        key = (self.planned[p], self.key(j))
-        d = self.memo.distances.get(key)
+        js = it.js
+        k = bisect_left(js, j)
+        if k < len(js) and js[k] == j:
+            return it.ds[k], k
+        if j not in self.visited:
+            self.visit(j)
+        key = (self.planned[p], self._keys[j] if self._keys is not None else self.key(j))
+        memo = self.memo.distances
+        d = memo.get(key)
         if d is None:
-            d = self.memo.distances[key] = self._query(it, j)
-        it.js.insert(k, j)
+            d = memo[key] = self._query(it, j)
+        js.insert(k, j)
         it.ds.insert(k, d)
-        return d
+        return d, k
 
     def _query(self, it: _Item, j: int) -> float:
-        """PyBullet's distance of ``it`` at sample ``j``."""
-        self._put(j)
-        pb, c, body = self.scene.pb, self.scene.client, self.scene.body
+        """PyBullet's distance of ``it`` at sample ``j`` (the nearest of its points, at
+        most :data:`QUERY_RANGE`)."""
+        if j != self.at:
+            self._put(j)
+        scene = self.scene
         if it.kind == "self":
-            pts = pb.getClosestPoints(body, body, QUERY_RANGE, it.a, it.b, physicsClientId=c)
+            pts = scene.pb.getClosestPoints(scene.body, scene.body, QUERY_RANGE, it.a, it.b,
+                                            physicsClientId=scene.client)
         else:
-            pts = pb.getClosestPoints(body, it.b, QUERY_RANGE, linkIndexA=it.a,
-                                      physicsClientId=c)
-        d = min((pt[8] for pt in pts), default=QUERY_RANGE)
+            pts = scene.pb.getClosestPoints(scene.body, it.b, QUERY_RANGE, linkIndexA=it.a,
+                                            physicsClientId=scene.client)
+        d = QUERY_RANGE
+        for pt in pts:
+            if pt[8] < d:
+                d = pt[8]
         self.queries += 1
-        return min(d, QUERY_RANGE)
+        return d
 
     def seed(self, samples: list[int]) -> None:
         for j in samples:
@@ -193,26 +206,39 @@ class Sweep:
             j, x = (js[0], 0) if k < 0 else (js[-1], len(cum) - 1)
             if j == x:
                 return None
-            return float(it.ds[k + 1 if k < 0 else k] - abs(cum[x] - cum[j])), x
+            return it.ds[k + 1 if k < 0 else k] - abs(cum[x] - cum[j]), x
         ja, jb = js[k], js[k + 1]
         if jb - ja <= 1:
             return None
-        last = len(cum) - 1
-        da, db = it.ds[k], it.ds[k + 1]
+        ds = it.ds
+        da, db = ds[k], ds[k + 1]
         ca, cb = cum[ja], cum[jb]
-        meet = (da - db + ca + cb) / 2
-        j = bisect_left(cum, meet, ja, jb + 1)
-        cands: tuple[int, ...] = (j - 1, j)  # the cones meet between j - 1 and j
-        if members > 1:
-            cands = (min(j // members * members, last), min(-(-j // members) * members, last),
-                     (j - 1) // members * members)
+        j = bisect_left(cum, (da - db + ca + cb) / 2, ja, jb + 1)
+        # the cones meet between j - 1 and j: the lower bound there, the larger of the
+        # two cones' (each a float of the same arithmetic as ``max`` would compare)
+        if members == 1:
+            best = None
+            for x in (j - 1, j):
+                if ja < x < jb:
+                    cx = cum[x]
+                    lb, other = da - (cx - ca), db - (cb - cx)
+                    if other > lb:
+                        lb = other
+                    if best is None or lb < best[0]:
+                        best = (lb, x)
+            return best
+        last = len(cum) - 1
+        down, up = j // members * members, -(-j // members) * members
         best = None
-        for x in cands:
+        for x in (down if down < last else last, up if up < last else last,
+                  (j - 1) // members * members):
             if ja < x < jb:
                 cx = cum[x]
-                lb = max(da - (cx - ca), db - (cb - cx))
+                lb, other = da - (cx - ca), db - (cb - cx)
+                if other > lb:
+                    lb = other
                 if best is None or lb < best[0]:
-                    best = (float(lb), x)
+                    best = (lb, x)
         return best
 
     def _of(self, kind: str) -> list[int]:
@@ -227,8 +253,8 @@ class Sweep:
                                                   strict=True)
                     if j % members == 0 or j == last), default=math.inf)
         heap: list[tuple[float, int, int]] = []
-        lowest, heappush, heappop, measure = (self._lowest, heapq.heappush, heapq.heappop,
-                                              self.measure)
+        lowest, heappush, heappop, take = (self._lowest, heapq.heappush, heapq.heappop,
+                                           self._take)
         for p in ps:
             for k in range(-1, len(self.items[p].js)):
                 lo = lowest(p, k, members)
@@ -236,13 +262,14 @@ class Sweep:
                     heappush(heap, (lo[0], p, lo[1]))
         while heap and heap[0][0] < best - CLEARANCE_TOL:
             _, p, j = heappop(heap)
-            d = measure(p, j)
+            d, k = take(p, j)
             if d < best:
                 best = d
-            k = bisect_left(self.items[p].js, j)
-            for lo in (lowest(p, k - 1, members), lowest(p, k, members)):
-                if lo is not None:
-                    heappush(heap, (lo[0], p, lo[1]))
+            left, right = lowest(p, k - 1, members), lowest(p, k, members)
+            if left is not None:
+                heappush(heap, (left[0], p, left[1]))
+            if right is not None:
+                heappush(heap, (right[0], p, right[1]))
         return best
 
     def first_contact(self, kind: str, touching) -> tuple[int, int] | None:
