@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.codes import R401, R403, R405, R407, R411
+from ..core.codes import R401, R403, R405, R407
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..core.trajectory import Trajectory
 from ..lang.cv import CVPoint, composition, infer
@@ -56,6 +56,7 @@ from .holds import MIN_PAUSE, REST_SPEED, Boundary, Rest, boundaries, rest_at_en
 from .recognisers import claimed, every_named, extra_descriptors, extra_values
 from .roll import MIN_TILT, SHAPED_CYCLE, Lobe, lobe, roll_angle, rotations
 from .signal import Grid, JointNoise, joint_noise, short_window, smooth, to_grid, unwrap
+from .stamps import judge_stamps
 
 __all__ = ["MIN_PAUSE", "MIN_TILT", "STILL_TRANSLATION", "LineOfSight", "Measured",
            "measure"]
@@ -346,113 +347,16 @@ def measure(rec: Trajectory, *, uncertainty: bool = True) -> Measured:
     return m
 
 
-#: Fewest steps of clear motion on which the clock's stamps are judged.
-STAMP_STEPS = 80
-#: Least spread of the clock's steps (their std over their median) worth judging: a
-#: clock steadier than this moves no reading.
-STAMP_JITTER = 0.1
-#: The stamps follow the samples when the positions' steps follow the clock's by at
-#: least this share (1 when each stamp is its sample's time; 0 when the stamps are taken
-#: on arrival and the samples were made at their own steady pace).
-STAMP_FOLLOW = 0.7
-#: Samples over which a clock that does not follow its samples is evened out.
-STAMP_WINDOW = 21
-
-
-def stamp_share(t: np.ndarray, q: np.ndarray, noise: np.ndarray) -> float | None:
-    """How much of the clock's jitter the positions follow: the slope of each step of
-    the joint that moved most, over its local pace, against the clock's step over its
-    median (1 when each stamp is the time its sample was taken, 0 when the stamps are
-    taken on arrival and the samples came at a steady pace). None when the clock is
-    steady (its steps vary less than :data:`STAMP_JITTER`) or the motion too short or
-    too slow to judge (fewer than :data:`STAMP_STEPS` steps each more than 3 times the
-    joint's noise)."""
-    dt = np.diff(t)
-    h = float(np.median(dt))
-    if len(dt) < STAMP_STEPS or float(np.std(dt)) < STAMP_JITTER * h:
-        return None
-    j = int(np.argmax(np.ptp(q, axis=0)))
-    k = 5
-    dq = np.diff(q[:, j])
-    pace = (q[2 * k:, j] - q[:-2 * k, j]) / (t[2 * k:] - t[:-2 * k])  # over 10 steps
-    step, gap = dq[k:len(dq) - k + 1], dt[k:len(dt) - k + 1]
-    n = min(len(step), len(pace))
-    step, gap, pace = step[:n], gap[:n], pace[:n]
-    clear = (np.abs(step) > 3 * max(float(noise[j]), 1e-12)) & \
-        (np.abs(pace) * h > 3 * max(float(noise[j]), 1e-12))
-    if int(clear.sum()) < STAMP_STEPS:
-        return None
-    x = gap[clear] / h - 1.0
-    y = step[clear] / (pace[clear] * h) - 1.0
-    if float(np.dot(x, x)) <= 0.0:
-        return None
-    return float(np.dot(x, y) / np.dot(x, x))
-
-
-def evened(t: np.ndarray, window: int = STAMP_WINDOW) -> np.ndarray:
-    """A clock's stamps averaged over ``window`` samples (fewer, symmetric, at its ends):
-    it still increases strictly, keeps a logging gap's time (spread over the window)
-    and loses the stamps' jitter."""
-    half = window // 2
-    c = np.concatenate([[0.0], np.cumsum(t - t[0])])
-    i = np.arange(len(t))
-    r = np.minimum(np.minimum(i, len(t) - 1 - i), half)
-    return t[0] + (c[i + r + 1] - c[i - r]) / (2 * r + 1)
-
-
 def _stamps(m: Measured, rec: Trajectory, jn: JointNoise) -> None:
-    """A recording whose stamps do not follow its samples (taken on arrival: the
-    positions advance at a steady pace while the stamps jitter) moves every reading of
-    a rate by the stamps' error, the same in every re-noised copy (they keep the clock).
-    The recording is then read again on its clock evened out (:func:`evened`): each
-    interval is widened to take in that reading, and a value whose interval then
-    reaches more than 20 % of itself from it (as for the noise, :mod:`.uncertainty`)
-    is not to be trusted (R411, with both readings)."""
+    """Judge the recording's clock (:mod:`.stamps`): only a noisy recording's, read
+    again on its clock evened out when the stamps do not follow the samples."""
     if float(jn.effective.max(initial=0.0)) <= COMPUTED_NOISE or not m.uncertainty:
         return
     arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
     t, q = _checked(rec, rec.columns(arm.joint_names))
     q, _ = unwrap(q)
-    share = stamp_share(t, q, jn.effective)
-    if share is None or share >= STAMP_FOLLOW:
-        return
-    try:
-        again, _ = _measure(rec.with_(t=evened(t)), jn)
-    except AouError:
-        return
-    from dataclasses import replace
-
-    from .uncertainty import VAGUE, VAGUE_TOLERANCES, half_width
-
-    def vague(name: str, value: float, s: Any) -> bool:  # as the noise's rule
-        half, d = half_width(s, value), every_named()[name]
-        return half is not None and not d.is_count and \
-            half > max(VAGUE * abs(value), VAGUE_TOLERANCES * d.abs_tol)
-
-    moved = []
-    for name, sp in m.uncertainty.items():
-        value, other = m.descriptors.get(name), again.descriptors.get(name)
-        if not (isinstance(value, float) and isinstance(other, float)) or \
-                sp.low is None or sp.high is None or sp.low <= other <= sp.high:
-            continue
-        wide = replace(sp, low=min(sp.low, other), high=max(sp.high, other))
-        if sp.stable and vague(name, value, wide):
-            wide = replace(wide, stable=False)
-            moved.append((name, value, other))
-        m.uncertainty[name] = wide
-    if moved:
-        h = float(np.median(np.diff(t)))
-        jitter = float(np.std(np.diff(t)))
-        m.diagnostics.append(diag(
-            R411, f"the clock's stamps do not follow the samples (their steps vary by "
-            f"{jitter * 1e3:.2g} ms about {h * 1e3:.2g} ms, the positions' steps follow "
-            f"{max(share, 0.0):.0%} of that: stamps taken on arrival): read on the clock "
-            "evened out, " + "; ".join(f"{n} reads {o:.4g} instead of {v:.4g}"
-                                        for n, v, o in moved)
-            + f". {'These are' if len(moved) > 1 else 'This is'} not to be trusted",
-            Span.whole_file(rec.path),
-            hint="log the time each sample was taken (the controller's own stamp), not "
-            "the time it arrived", descriptors=[n for n, _, _ in moved], share=share))
+    judge_stamps(m, rec.path, t, q, jn.effective,
+                 lambda even: _measure(rec.with_(t=even), jn)[0])
 
 
 def _measure(rec: Trajectory, pinned: JointNoise | None = None, fk: Kinematics | None = None

@@ -13,10 +13,11 @@ import numpy as np
 import pytest
 
 from aou_dsl.core.trajectory import Trajectory
-from aou_dsl.measuring import measured
-from aou_dsl.measuring.measured import STAMP_FOLLOW, evened, measure, stamp_share
+from aou_dsl.measuring import stamps
+from aou_dsl.measuring.measured import measure
 from aou_dsl.measuring.recording import final_goal
 from aou_dsl.measuring.signal import joint_noise
+from aou_dsl.measuring.stamps import STAMP_FOLLOW, evened, stamp_share
 
 URDF = str(Path(__file__).resolve().parents[2] / "vendor" / "kinova_gen3_description"
            / "urdf" / "gen3.urdf")
@@ -92,7 +93,7 @@ def test_stamps_on_arrival_widen_the_interval_to_the_true_clocks_reading(seed, m
     assert s.low <= 1.03 * truth, (s, truth)
     rec, _ = take(seed, False)
     s = measure(rec).uncertainty["approach_acceleration"]
-    monkeypatch.setattr(measured, "STAMP_FOLLOW", -1.0)  # every clock follows
+    monkeypatch.setattr(stamps, "STAMP_FOLLOW", -1.0)  # every clock follows
     assert s == measure(rec).uncertainty["approach_acceleration"]
     rec, _ = take(seed, True)
     assert measure(rec).uncertainty["approach_acceleration"].low > 1.04 * truth  # before
