@@ -56,6 +56,7 @@ from .holds import MIN_PAUSE, REST_SPEED, Boundary, Rest, boundaries, rest_at_en
 from .recognisers import claimed, every_named, extra_descriptors, extra_values
 from .roll import MIN_TILT, SHAPED_CYCLE, Lobe, lobe, roll_angle, rotations
 from .signal import Grid, JointNoise, joint_noise, short_window, smooth, to_grid, unwrap
+from .stamps import judge_stamps
 
 __all__ = ["MIN_PAUSE", "MIN_TILT", "STILL_TRANSLATION", "LineOfSight", "Measured",
            "measure"]
@@ -342,7 +343,20 @@ def measure(rec: Trajectory, *, uncertainty: bool = True) -> Measured:
         from .uncertainty import attach
 
         attach(m, rec, jn, _measure)
+        _stamps(m, rec, jn)
     return m
+
+
+def _stamps(m: Measured, rec: Trajectory, jn: JointNoise) -> None:
+    """Judge the recording's clock (:mod:`.stamps`): only a noisy recording's, read
+    again on its clock evened out when the stamps do not follow the samples."""
+    if float(jn.effective.max(initial=0.0)) <= COMPUTED_NOISE or not m.uncertainty:
+        return
+    arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
+    t, q = _checked(rec, rec.columns(arm.joint_names))
+    q, _ = unwrap(q)
+    judge_stamps(m, rec.path, t, q, jn.effective,
+                 lambda even: _measure(rec.with_(t=even), jn)[0])
 
 
 def _measure(rec: Trajectory, pinned: JointNoise | None = None, fk: Kinematics | None = None
