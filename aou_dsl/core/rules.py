@@ -339,12 +339,12 @@ _RULE_LIST = [
          "AOU_MAX_SAMPLES to read larger ones.",
          "aouc measure huge.npz   # its q.npy claims 1,000,000,000 samples"),
     Rule("R411", "noise-beyond-segmentation", _W,
-         "A recording's joint noise is more than its segmentation bears: copies of it "
-         "re-noised at the noise level aou estimated read a different count, or find a "
-         "descriptor present that the recording reads absent (or the reverse).",
-         "A count or a presence that the noise can flip is a guess, not a measurement; the "
-         "warning names the noise level and the descriptors it affects, and a judgement "
-         "against a behaviour file reads them as inconclusive.",
+         "A recording is noisier than its measurement bears: re-noised copies read another "
+         "count or presence, a value's interval reaches a fifth of it away, or its "
+         "clock's stamps were taken on arrival and the value moves on the clock evened out.",
+         "A value the noise or the clock can move that far is a guess, not a measurement; "
+         "the warning names the noise level (or the clock) and the descriptors it affects, "
+         "and a judgement against a behaviour file reads them as inconclusive.",
          "a 250 Hz recording of the hesitant behaviour with 1e-3 rad of joint noise"),
     Rule("R412", "inconclusive", _W,
          "A recording measured against a behaviour file shows a descriptor whose 95 % "
