@@ -1,11 +1,15 @@
 """Real recordings of another arm: the Laban motion-based arm trajectories, a Kinova Gen3
 moved by hand by its participants in a sustained (slow) and a sudden take each
 (tests/vendor/laban_gen3/README.md: the source, how the copy was reduced, the joint
-order), measured with the vendor-style Gen3 URDF in tests/vendor/.
+order), measured on the Gen3 URDF as Kinova ships it (tests/vendor/kortex_description/,
+unchanged: joints ``Actuator1``..``Actuator7``, the hand ``EndEffector_Link``).
 
-Each take's approach acceleration is read by aou (the API ``aouc measure`` uses, with
-``--goal final``: the hand ends at what it reached for) and by an independent
-measurement written here from first principles (below). Claimed:
+Each take's approach acceleration is read by aou through its command line (``aouc
+measure TAKE --robot GEN3_URDF_V12.urdf --goal final --map MAP``: the converted takes
+name their columns ``joint_1``..``joint_7``, and the map file renames them to the
+vendor's joints; ``--goal final``: the hand ends at what it reached for) and by an
+independent measurement written here from first principles (below), which reads the
+same URDF with its own parser. Claimed:
 
 - aou never gives a confident number far from the independent one: every value it
   trusts (no R411 naming it) lies within a factor :data:`FACTOR` of the independent
@@ -22,8 +26,12 @@ the table and the counts.
 
 from __future__ import annotations
 
+import contextlib
 import gzip
+import io
+import json
 import math
+import re
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -34,12 +42,19 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from aou_dsl.core.diagnostics import AouError
-
 ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "tests" / "vendor" / "laban_gen3"
-URDF = ROOT / "tests" / "vendor" / "kinova_gen3_description" / "urdf" / "gen3.urdf"
+#: Kinova's own file, as its package ships it (tests/vendor/kortex_description/README.md).
+URDF = (ROOT / "tests" / "vendor" / "kortex_description" / "arms" / "gen3" / "7dof" / "urdf"
+        / "GEN3_URDF_V12.urdf")
+#: The hand: the last link of the vendor's chain (a fixed joint 61.5 mm beyond the
+#: bracelet), which aou takes as the end-effector when no frame is given.
+HAND = "EndEffector_Link"
 JOINTS = tuple(f"joint_{k}" for k in range(1, 8))
+#: The recordings' columns onto the vendor's joints (the dataset's arrays run joint 1
+#: to 7 from the base: tests/vendor/laban_gen3/README.md).
+MAP = {f"joint_{k}": f"Actuator{k}" for k in range(1, 8)}
+MAP_ARG = ",".join(f"{c}={j}" for c, j in MAP.items())
 PARTICIPANTS = sorted({p.name.split("_")[0] for p in DATA.glob("P*_G.csv.gz")},
                       key=lambda s: int(s[1:]))
 #: Cut-offs [Hz] of the independent low-pass: the reading's range over them is its
@@ -92,10 +107,11 @@ def _rpy(r: float, p: float, y: float) -> np.ndarray:
 
 
 @cache
-def _chain(tip: str = "end_effector_link") -> tuple[tuple[str, np.ndarray], ...]:
-    """The URDF's joints from the root to ``tip``: (type, origin transform); every
-    moving joint of this URDF turns about its own z."""
-    root = ET.parse(URDF).getroot()
+def _chain(urdf: Path = URDF, tip: str = HAND) -> tuple[tuple[str, str, np.ndarray], ...]:
+    """The joints of ``urdf`` from its root to ``tip``: (name, type, origin transform).
+    Read here with the standard library's XML parser, not aou's loader; every moving
+    joint of the Gen3's URDFs turns about its own z (asserted)."""
+    root = ET.parse(urdf).getroot()
     by_child = {j.find("child").get("link"): j for j in root.iter("joint")}  # type: ignore[union-attr]
     out = []
     link = tip
@@ -105,27 +121,34 @@ def _chain(tip: str = "end_effector_link") -> tuple[tuple[str, np.ndarray], ...]
         m = np.eye(4)
         m[:3, :3] = _rpy(*map(float, o.get("rpy", "0 0 0").split()))  # type: ignore[union-attr]
         m[:3, 3] = [float(x) for x in o.get("xyz").split()]  # type: ignore[union-attr]
-        axis = j.find("axis")
-        assert axis is None or axis.get("xyz") == "0 0 1"
-        out.append((j.get("type"), m))
+        kind = j.get("type")
+        if kind != "fixed":
+            axis = j.find("axis")
+            assert axis is not None and [float(x) for x in axis.get("xyz").split()] == [0, 0, 1]  # type: ignore[union-attr]
+        out.append((j.get("name"), kind, m))
         link = j.find("parent").get("link")  # type: ignore[union-attr]
     return tuple(out[::-1])
 
 
-def hand(q: np.ndarray) -> np.ndarray:
-    """The end-effector link's position [m] for each row of joint_1..7."""
+def hand(q: np.ndarray, urdf: Path = URDF, tip: str = HAND,
+         names: dict[str, str] = MAP) -> np.ndarray:
+    """The position [m] of ``tip`` for each row of ``q`` (columns :data:`JOINTS`), each
+    column turning the joint of ``urdf`` that ``names`` maps it to."""
+    column = {j: JOINTS.index(c) for c, j in names.items()}
     m = np.tile(np.eye(4), (len(q), 1, 1))
-    k = 0
-    for kind, origin in _chain():
+    moved = []
+    for name, kind, origin in _chain(urdf, tip):
         m = m @ origin
         if kind in ("revolute", "continuous"):
-            c, s = np.cos(q[:, k]), np.sin(q[:, k])
+            c, s = np.cos(q[:, column[name]]), np.sin(q[:, column[name]])
             turn = np.zeros_like(m)
             turn[:, 0, 0], turn[:, 0, 1], turn[:, 1, 0], turn[:, 1, 1] = c, -s, s, c
             turn[:, 2, 2] = turn[:, 3, 3] = 1.0
             m = m @ turn
-            k += 1
-    assert k == 7
+            moved.append(name)
+        else:
+            assert kind == "fixed", kind
+    assert sorted(moved) == sorted(names.values())
     return m[:, :3, 3]
 
 
@@ -173,28 +196,42 @@ class Reading:
         return hi >= self.ind_low / FACTOR and lo <= self.ind_high * FACTOR
 
 
+def aouc_measure(csv: Path, map_file: Path) -> tuple[int, str, str]:
+    """``aouc measure CSV --robot URDF --goal final --map MAP_FILE --format json``, run
+    in this process (the command's own argument parsing and output; a process per take
+    would spend more time starting than measuring): exit code, stdout, stderr."""
+    from aou_dsl.cli.commands import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(["measure", str(csv), "--robot", str(URDF), "--goal", "final",
+                     "--map", str(map_file), "--format", "json"])
+    return code, out.getvalue(), err.getvalue()
+
+
 @cache
 def read(take: str) -> Reading:
     import tempfile
 
-    from aou_dsl.measuring.measured import measure
-    from aou_dsl.measuring.recording import read_recording
-
     t, q = load(take)
     ind = [independent(t - t[0], q, c) for c in CUTOFFS]
     with tempfile.TemporaryDirectory() as d:
-        try:
-            m = measure(read_recording(str(recording(take, Path(d))), robot=str(URDF),
-                                       goal="final"))
-        except AouError as e:
-            return Reading(take, None, None, None, False, e.diagnostics[0].code, min(ind),
-                           max(ind))
-    v = m.descriptors[DESCRIPTOR]
-    s = m.uncertainty[DESCRIPTOR]
-    named = any(d.code == "R411" and DESCRIPTOR in (d.fields.get("descriptors") or ())
-                for d in m.diagnostics)
-    return Reading(take, None if v is None else float(v), s.low, s.high,
-                   bool(s.stable) and not named and v is not None, None, min(ind), max(ind))
+        map_file = Path(d) / "gen3.map"
+        map_file.write_text("# the converter's columns -> Kinova's joints\n" + "".join(
+            f"{c}={j}\n" for c, j in MAP.items()))
+        code, out, err = aouc_measure(recording(take, Path(d)), map_file)
+    if code != 0:
+        errors = re.findall(r" ([A-Z]\d{3}) \[error\]", err)
+        assert errors, err  # a failure is a coded diagnostic, never a traceback
+        return Reading(take, None, None, None, False, errors[0], min(ind), max(ind))
+    m = json.loads(out)
+    v = m["descriptors"][DESCRIPTOR]
+    s = m["uncertainty"][DESCRIPTOR]
+    named = any(d["code"] == "R411" and DESCRIPTOR in (d["fields"].get("descriptors") or ())
+                for d in m["diagnostics"])
+    return Reading(take, None if v is None else float(v), s["low"], s["high"],
+                   bool(s["stable"]) and not named and v is not None, None, min(ind),
+                   max(ind))
 
 
 def order(g: Reading, h: Reading) -> str:
@@ -306,10 +343,62 @@ def test_the_converter_reads_the_dataset_format(tmp_path):
     r = subprocess.run([sys.executable, str(tool), str(bad), "-o", str(tmp_path / "x.csv")],
                        capture_output=True, text=True)
     assert r.returncode == 2 and "line 2" in r.stderr and not (tmp_path / "x.csv").exists()
-    r = subprocess.run(["aouc", "measure", str(out),
-                        "--robot", str(URDF), "--goal", "final", "--format", "json"],
+    r = subprocess.run(["aouc", "measure", str(out), "--robot", str(URDF), "--goal", "final",
+                        "--map", MAP_ARG, "--format", "json"],
                        capture_output=True, text=True, cwd=ROOT)
     assert r.returncode == 0, r.stderr
+
+
+#: Kinova's file as its package ships it (tests/vendor/kortex_description/README.md).
+URDF_SHA256 = "6e955097a5cb3136c4f927b78ddbef512ee84094ce0cac3669450be62595d1f1"
+#: The Gen3 URDF written here by hand (other tests use it), and where it puts the base.
+HAND_WRITTEN = ROOT / "tests" / "vendor" / "kinova_gen3_description" / "urdf" / "gen3.urdf"
+
+
+def test_the_urdf_is_kinovas_file_unchanged():
+    import hashlib
+
+    assert hashlib.sha256(URDF.read_bytes()).hexdigest() == URDF_SHA256
+    assert (URDF.parents[4] / "LICENSE").read_text().startswith(
+        "Copyright (c) 2018, Kinova inc.")
+
+
+def test_aou_measures_the_hand_the_test_measures():
+    """With no ``--ee-frame``, aou takes the vendor's ``EndEffector_Link`` as the hand
+    and places it where the test's own reading of the file does, at every 40th sample
+    of a take; the hand-written Gen3 URDF the other tests use places its hand there too
+    (its base raised onto a 5 cm, 2 cm offset), so their figures stand for this arm."""
+    from aou_dsl.robot.load import load_arm
+
+    _, q = load("P10_H")
+    q = q[::40]
+    arm = load_arm(str(URDF))
+    assert arm.model.frames[arm.frame_id].name == HAND
+    assert arm.joint_names == tuple(MAP.values())
+    ours = hand(q)
+    pos, _ = arm.fk(q)
+    assert np.abs(pos - ours).max() < 1e-9
+    other = hand(q, HAND_WRITTEN, "end_effector_link", {c: c for c in JOINTS})
+    assert np.abs(other - ours - [0.05, 0.0, 0.02]).max() < 1e-9
+
+
+def test_the_map_is_what_names_the_joints(tmp_path):
+    """Without ``--map`` the converted take's columns are no joints of Kinova's file: a
+    coded refusal naming both. With two joints swapped in the map the reading moves."""
+    from aou_dsl.cli.commands import main
+
+    csv = recording("P10_H", tmp_path)
+    err = io.StringIO()
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
+        code = main(["measure", str(csv), "--robot", str(URDF), "--goal", "final"])
+    assert code != 0 and "R402" in err.getvalue() and "Actuator1" in err.getvalue() \
+        and "joint_1" in err.getvalue(), err.getvalue()
+    swapped = tmp_path / "swapped.map"
+    swapped.write_text("".join(f"{c}={MAP[d]}\n" for c, d in zip(
+        JOINTS, ("joint_2", "joint_1", *JOINTS[2:]), strict=True)))
+    code, out, err_text = aouc_measure(csv, swapped)
+    assert code == 0, err_text
+    assert json.loads(out)["descriptors"][DESCRIPTOR] != read("P10_H").value
 
 
 if __name__ == "__main__":

@@ -19,9 +19,10 @@ from aou_dsl.measuring.recording import final_goal
 from aou_dsl.measuring.signal import joint_noise
 from aou_dsl.measuring.stamps import STAMP_FOLLOW, evened, stamp_share
 
-URDF = str(Path(__file__).resolve().parents[2] / "vendor" / "kinova_gen3_description"
-           / "urdf" / "gen3.urdf")
-JOINTS = tuple(f"joint_{k}" for k in range(1, 8))
+#: Kinova's own Gen3 URDF, unchanged (tests/vendor/kortex_description/README.md).
+URDF = str(Path(__file__).resolve().parents[2] / "vendor" / "kortex_description" / "arms"
+           / "gen3" / "7dof" / "urdf" / "GEN3_URDF_V12.urdf")
+JOINTS = tuple(f"Actuator{k}" for k in range(1, 8))
 RATE = 570.0
 HOME = np.array([0.0, 0.26, np.pi, -2.27, 0.0, 0.96, 1.5708])
 MOVE = np.array([0.3, 0.5, 0.0, 0.6, 0.0, -0.4, 0.0])
