@@ -4,8 +4,12 @@ Automatically Label Expressive Robot Arm Motion Qualities? Open Dataset and Mach
 Learning Results") into a recording ``aouc measure`` reads.
 
     python tools/laban_to_recording.py raw_data/P10_H1.csv -o p10_h1.csv
-    aouc measure p10_h1.csv --robot tests/vendor/kinova_gen3_description/urdf/gen3.urdf \\
-        --goal final
+    printf 'joint_%s=Actuator%s\\n' 1 1 2 2 3 3 4 4 5 5 6 6 7 7 > gen3.map
+    aouc measure p10_h1.csv --goal final --map gen3.map \\
+        --robot tests/vendor/kortex_description/arms/gen3/7dof/urdf/GEN3_URDF_V12.urdf
+
+(Kinova's own file names the joints ``Actuator1`` to ``Actuator7``; the map tells aou
+which column is which.)
 
 The dataset's files (``raw_data/P<n>_<cond><take>.csv``) have a header
 ``Time,Position,Velocity,Effort``: ``Time`` in Unix seconds, then three quoted,
