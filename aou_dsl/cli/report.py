@@ -235,10 +235,13 @@ def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = 
 
     units = {k: d.unit for k, d in REGISTRY.items()}
     units |= {d.name: d.unit for d in extra_descriptors() if d.name in m.extra}
+    untrusted = [k for k, v in (dict(m.descriptors) | m.extra).items()
+                 if v is not None and k in m.uncertainty and not m.uncertainty[k].stable]
     for k, v in (dict(m.descriptors) | m.extra).items():  # the plugins' after the eleven
         val = "null" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
         lines.append(f"  {k:<22} {val:>10} {_interval(v, m.uncertainty.get(k)):<14} "
-                     f"{units.get(k, '')}".rstrip())
+                     f"{units.get(k, '')}{'  not to be trusted' if k in untrusted else ''}"
+                     .rstrip())
     los, inf = m.line_of_sight, m.inferred
     if los is not None and len(los.angle):
         # The model assumes the hand looks at the goal throughout: how far it did not.
@@ -249,6 +252,8 @@ def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = 
              f"V={m.cv.V:+.2f}{_around(m.cv.V, inf and inf.V)} -> {m.cv.state}")
     if inf is not None and len(inf.states) > 1:  # the noise can flip the state
         point += f" (the re-noised copies read {', '.join(inf.states)})"
+    if untrusted:  # a point read from a guess is a guess, however narrow its interval
+        point += f"; read from values not to be trusted ({', '.join(untrusted)})"
     if missing:  # no state named: a point without the gazes would mislead
         point = (f"  C-V: not placed: without a goal the gaze descriptors "
                  f"{', '.join(missing)} are unknown, and the point needs them (give "
