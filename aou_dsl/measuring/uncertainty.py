@@ -36,10 +36,15 @@ from .signal import JointNoise, short_window, smooth, to_grid, unwrap
 
 __all__ = ["REPLICATES", "Inferred", "Spread", "attach"]
 
-#: Re-noised copies measured per recording.
+#: Re-noised copies measured first; when they all read the recording's segmentation
+#: (every count, every presence and the inferred state), that is all.
+FIRST = 4
+#: Copies measured in all when the first ones do not agree (a segmentation the noise
+#: may flip is looked at more closely).
 REPLICATES = 10
-#: Two-sided 95 % quantile of Student's t with ``REPLICATES - 1`` degrees of freedom.
-T95 = 2.262
+#: Two-sided 95 % quantiles of Student's t by degrees of freedom (copies less one).
+T95 = {1: 12.706, 2: 4.303, 3: 3.182, 4: 2.776, 5: 2.571, 6: 2.447, 7: 2.365, 8: 2.306,
+       9: 2.262}
 #: The seed of the copies' noise: the same file gives the same intervals.
 SEED = 20240
 #: The error of placing a pause's edges where the motion beside it stops, as a fraction
@@ -84,10 +89,11 @@ def exact(value: float | int | None) -> Spread:
 
 
 def _copies(rec: Trajectory, cols: np.ndarray, jn: JointNoise, rng: np.random.Generator
-            ) -> list[Trajectory]:
-    """``rec`` with its arm joints smoothed (the base), then :data:`REPLICATES` copies
-    of the base with fresh noise at each moving joint's level; other columns as they
-    are."""
+            ) -> tuple[Trajectory, Callable[[], Trajectory], dict[str, np.ndarray]]:
+    """``rec`` with its arm joints smoothed (the base); a maker of copies of the base
+    with fresh noise at each moving joint's level (other columns as they are); and the
+    recording's own arm joints on the measurement's uniform clock (``"grid"``) and on
+    its own (``"raw"``), which the copies' kinematics are expanded about."""
     t = np.asarray(rec.t, float)
     q_all = np.asarray(rec.q, float)
     q, _ = unwrap(q_all[:, cols])
@@ -102,12 +108,13 @@ def _copies(rec: Trajectory, cols: np.ndarray, jn: JointNoise, rng: np.random.Ge
     smooth_q[:, ~moving] = q[:, ~moving]
     base_q = q_all.copy()
     base_q[:, cols] = smooth_q
-    out = [rec.with_(q=base_q)]
-    for _ in range(REPLICATES):
+
+    def copy() -> Trajectory:
         qc = q_all.copy()
         qc[:, cols] = smooth_q + rng.standard_normal(q.shape) * level
-        out.append(rec.with_(q=qc))
-    return out
+        return rec.with_(q=qc)
+
+    return rec.with_(q=base_q), copy, {"grid": grid.q, "raw": q}
 
 
 def _spread(name: str, value: float | int | None, base: float | int | None,
@@ -139,42 +146,51 @@ def _spread(name: str, value: float | int | None, base: float | int | None,
     # Each of a duration's two edges falls on a sample (known to a step at best), and
     # is placed by following the motion beside it back to rest (its own error).
     timed = d.unit == "s" or d.unit.endswith("/s")  # a duration, or a speed over one
-    half = T95 * sd + (2 * step if d.unit == "s" else 0.0) + (EDGES * abs(v) if timed else 0.0)
+    half = (T95[len(present) - 1] * sd + (2 * step if d.unit == "s" else 0.0)
+            + (EDGES * abs(v) if timed else 0.0))
     return Spread(sd, min(v, corrected) - half, max(v, corrected) + half, absent == 0,
                   absent)
 
 
 class Linearised:
-    """The forward kinematics of the copies, to first order about the smoothed base's.
+    """The forward kinematics of the copies, to first order about the recording's own.
 
-    A copy differs from the base by noise of 1e-4 to 1e-3 rad; the hand's pose moves
-    with it by the Jacobian times that noise, and the terms this leaves out are of the
-    noise squared (about 1e-6 m on an arm half a metre long, a thousandth of what the
-    noise itself moves the hand). The first call on each clock (``"grid"`` or ``"raw"``)
-    is the base's: it is computed exactly, with the Jacobian at every sample; later
-    calls on that clock are the copies'. A rotation turns by the angular part,
-    ``exp(W) R ~ (I + W + W^2/2) R``. An arm with joints other than revolute and
-    prismatic, or a clock of another length, is computed exactly every time."""
+    A copy differs from the recording by noise of 1e-4 to 1e-3 rad (the smoothed base
+    by what its filter took out, each copy by that and its fresh noise); the hand's
+    pose moves with it by the Jacobian times that difference, and the terms this leaves
+    out are of the noise squared (about 1e-6 m on an arm half a metre long, a thousandth
+    of what the noise itself moves the hand). The recording's own poses on each clock
+    (``"grid"`` or ``"raw"``) are its measurement's (kept by the samples' bytes, so not
+    computed again); the Jacobian is computed at every :data:`JACOBIAN_STEP`-th sample
+    and interpolated linearly between (over a few milliseconds it changes by far less
+    than the noise changes it). Without the recording's samples (``about`` None), the
+    first call on each clock is the point expanded about, computed exactly. A rotation
+    turns by the angular part, ``exp(W) R ~ (I + W + W^2/2) R``. An arm with joints
+    other than revolute and prismatic, or a clock of another length, is computed exactly
+    every time."""
 
-    def __init__(self, arm) -> None:
+    def __init__(self, arm, about: dict[str, np.ndarray] | None = None) -> None:
         self.arm = arm
-        # Per clock: the base's joints, hand positions and rotations, and the Jacobian's
-        # linear and angular parts joint by joint, (n, N, 3) each.
+        self.about = about or {}
+        # Per clock: the expansion point's joints, hand positions and rotations, and the
+        # Jacobian's linear and angular parts joint by joint, (n, N, 3) each.
         self.at: dict[str, tuple[np.ndarray, ...]] = {}
 
     def __call__(self, q: np.ndarray, clock: str) -> tuple[np.ndarray, np.ndarray]:
-        from ..robot.batch_fk import batch_fk, batch_fk_jacobian
+        from ..robot.batch_fk import batch_fk
 
         about = self.at.get(clock)
-        if about is None or about[0].shape != q.shape:
-            got = batch_fk_jacobian(self.arm, q) if about is None else None
+        if about is None:
+            q0 = self.about.get(clock)
+            first = q0 is None
+            got = _expansion(self.arm, q if q0 is None else q0, exact_rows=first)
             if got is None:
                 return batch_fk(self.arm, q)
-            pos, rot, jac = got
-            self.at[clock] = (np.array(q, float), pos, rot,
-                              np.ascontiguousarray(jac[:, :3].transpose(2, 0, 1)),
-                              np.ascontiguousarray(jac[:, 3:].transpose(2, 0, 1)))
-            return pos, rot
+            about = self.at[clock] = got
+            if first:
+                return about[1], about[2]
+        if about[0].shape != q.shape:
+            return batch_fk(self.arm, q)
         q0, pos0, rot0, lin, ang = about
         dq = q - q0
         pos, w = pos0.copy(), np.zeros_like(pos0)
@@ -183,6 +199,39 @@ class Linearised:
             w += ang[j] * dq[:, j, None]
         turned = _cross(w, rot0)
         return pos, rot0 + turned + 0.5 * _cross(w, turned)
+
+
+#: The copies' Jacobian is computed at every this many samples, and interpolated.
+JACOBIAN_STEP = 8
+
+
+def _expansion(arm, q: np.ndarray, exact_rows: bool) -> tuple[np.ndarray, ...] | None:
+    """The point the copies' kinematics are expanded about: ``q`` (N, n), its hand
+    positions and rotations (``exact_rows``: computed here; else the measurement's own,
+    kept by the samples' bytes) and the Jacobian's linear and angular parts, (n, N, 3)
+    each, from every :data:`JACOBIAN_STEP`-th row. None for an arm whose joints are not
+    all revolute or prismatic."""
+    from ..robot.batch_fk import batch_fk_jacobian, rows_fk
+
+    q = np.array(q, float)
+    n = len(q)
+    if exact_rows or n < 2 * JACOBIAN_STEP:
+        got = batch_fk_jacobian(arm, q)
+        if got is None:
+            return None
+        pos, rot, jac = got
+    else:
+        knots = np.unique(np.append(np.arange(0, n, JACOBIAN_STEP), n - 1))
+        got = batch_fk_jacobian(arm, q[knots])
+        if got is None:
+            return None
+        at = np.searchsorted(knots, np.arange(n), "right") - 1
+        at = np.minimum(at, len(knots) - 2)
+        frac = ((np.arange(n) - knots[at]) / (knots[at + 1] - knots[at]))[:, None, None]
+        jac = got[2][at] * (1.0 - frac) + got[2][at + 1] * frac
+        pos, rot = rows_fk(arm, q)
+    return (q, pos, rot, np.ascontiguousarray(jac[:, :3].transpose(2, 0, 1)),
+            np.ascontiguousarray(jac[:, 3:].transpose(2, 0, 1)))
 
 
 def _cross(w: np.ndarray, r: np.ndarray) -> np.ndarray:
@@ -215,16 +264,18 @@ def attach(m, rec: Trajectory, jn: JointNoise,
     arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
     cols = rec.columns(arm.joint_names)
     rng = np.random.default_rng(SEED)
-    base, *copies = _copies(rec, cols, jn, rng)
-    fk = Linearised(arm)
+    base, copy, about = _copies(rec, cols, jn, rng)
+    fk = Linearised(arm, about)
     try:
         smooth_m = measure_once(base, jn, fk)[0]
     except AouError:
         smooth_m = None
-    read_m = []
-    for copy in copies:
+    read_m: list = []
+    for k in range(REPLICATES):
+        if k == FIRST and _agree([m, smooth_m, *read_m]):
+            break
         try:
-            read_m.append(measure_once(copy, jn, fk)[0])
+            read_m.append(measure_once(copy(), jn, fk)[0])
         except AouError:  # a copy the noise made unreadable adds nothing
             continue
     reads = [_values(r) for r in read_m]
@@ -255,6 +306,21 @@ def attach(m, rec: Trajectory, jn: JointNoise,
             hint="log at a higher rate or with less noise; a longer pause or a slower "
             "motion stands out of the noise better",
             noise=noise, descriptors=shaky, states=list(states)))
+
+
+def _agree(ms: list) -> bool:
+    """Whether the measurements (None: unreadable) read one segmentation: every count,
+    every presence and the inferred state the same."""
+    if any(x is None for x in ms):
+        return False
+    table = every_named()
+
+    def shape(x) -> tuple:
+        v = _values(x)
+        return (x.cv.state.value, *((int(v[k] or 0) if d.is_count else v[k] is None)
+                                    for k, d in table.items()))
+
+    return len({shape(x) for x in ms}) == 1
 
 
 @dataclass(frozen=True)
@@ -299,7 +365,8 @@ def _inferred(m, base, copies: list) -> Inferred:
             return Spread(None, value, value, False)
         sd = float(np.std(reads, ddof=1))
         corrected = value - (float(np.mean(reads)) - b)
-        return Spread(sd, min(value, corrected) - T95 * sd, max(value, corrected) + T95 * sd,
+        t95 = T95[len(reads) - 1]
+        return Spread(sd, min(value, corrected) - t95 * sd, max(value, corrected) + t95 * sd,
                       len(states) == 1)
 
     def sight(attr: str):
