@@ -40,8 +40,9 @@ from .signal import JointNoise, short_window, smooth, to_grid, unwrap
 
 __all__ = ["REPLICATES", "Inferred", "Spread", "attach"]
 
-#: Re-noised copies measured first; when they all read the recording's segmentation
-#: (every count, every presence and the inferred state), that is all.
+#: Re-noised copies measured first; when they are all readable and read the
+#: recording's segmentation (every count, every presence and the inferred state), as
+#: the smoothed base does, that is all.
 FIRST = 4
 #: Copies measured in all when the first ones do not agree (a segmentation the noise
 #: may flip is looked at more closely).
@@ -303,7 +304,7 @@ def attach(m, rec: Trajectory, jn: JointNoise,
         smooth_m = None
     read_m: list = []
     for k in range(REPLICATES):
-        if k == FIRST and _agree([m, smooth_m, *read_m]):
+        if k == FIRST and len(read_m) == FIRST and _agree([m, smooth_m, *read_m]):
             break
         try:
             read_m.append(measure_once(copy(), jn, fk)[0])
