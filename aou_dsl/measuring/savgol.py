@@ -23,6 +23,8 @@ __all__ = ["savgol", "savgol_weights"]
 #: How far two mirrored weights may differ and still count as equal (or opposite), so
 #: that the pair is summed before it is weighted.
 _MIRROR_TOLERANCE = float(np.finfo(float).eps)
+#: Values filtered at a time (rows times columns): a few hundred kilobytes.
+_BLOCK = 1 << 15
 
 
 @cached(maxsize=256)
@@ -68,7 +70,12 @@ def savgol(x: np.ndarray, window: int, order: int, deriv: int = 0,
     out = np.empty_like(x)
     half = window // 2
     n = len(x)
-    _correlate(x, weights, mirror, out[half:n - half])
+    # A block of rows at a time, so that each pass over the samples (one per pair of
+    # weights) stays in the processor's cache: the same operations on each sample.
+    rows = max(1, _BLOCK // max(1, x[:1].size))
+    for s in range(half, n - half, rows):
+        e = min(n - half, s + rows)
+        _correlate(x[s - half:e + half], weights, mirror, out[s:e])
     _fit_end(x, out, slice(0, window), slice(0, half), order, deriv, delta)
     _fit_end(x, out, slice(n - window, n), slice(n - half, n), order, deriv, delta)
     return out

@@ -6,12 +6,15 @@ medians: no closed formula carries that noise through all of it. So it is carrie
 doing it again. The recording is smoothed (the measurement's own velocity filter, as a
 position filter), fresh noise at each joint's estimated level is added, and the copy is
 measured with the recording's own filters and thresholds (its noise pinned, not
-re-estimated). :data:`REPLICATES` copies give each descriptor a std; its 95 % interval is
-the value +- Student's t of that many copies times the std, widened to take in the value
-less what the noise adds on average (the copies' mean beside the smoothed recording's
-own reading: the larger of noisy readings is biased up), and for a duration a sampling
-step at each edge and the edges' own placement error (:data:`EDGES`). docs/measure.md
-gives the coverage measured over simulated recordings.
+re-estimated). :data:`FIRST` copies are measured, :data:`REPLICATES` when they or
+the base do not all read the recording's segmentation; they give each descriptor a
+std, and its 95 % interval is the value +- Student's t of that many copies times the
+std, widened to take in the value less what the noise adds on average (the copies'
+mean beside the smoothed recording's own reading, times :data:`BIAS`: the larger of
+noisy readings is biased up), for a duration a sampling step at each edge and the
+edges' own placement error (:data:`EDGES`), and for a peak acceleration what its
+reading cannot resolve above it (:data:`PEAK_SHAPE`). docs/measure.md gives the
+coverage measured over simulated recordings.
 
 A count or a presence that differs between the copies is a segmentation the noise can
 flip: its interval spans what the copies read, and R411 names it with the noise level;
@@ -22,6 +25,7 @@ every interval is the value itself.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
@@ -36,10 +40,16 @@ from .signal import JointNoise, short_window, smooth, to_grid, unwrap
 
 __all__ = ["REPLICATES", "Inferred", "Spread", "attach"]
 
-#: Re-noised copies measured per recording.
+#: Re-noised copies measured first; when they are all readable and read the
+#: recording's segmentation (every count, every presence and the inferred state), as
+#: the smoothed base does, that is all.
+FIRST = 4
+#: Copies measured in all when the first ones do not agree (a segmentation the noise
+#: may flip is looked at more closely).
 REPLICATES = 10
-#: Two-sided 95 % quantile of Student's t with ``REPLICATES - 1`` degrees of freedom.
-T95 = 2.262
+#: Two-sided 95 % quantiles of Student's t by degrees of freedom (copies less one).
+T95 = {1: 12.706, 2: 4.303, 3: 3.182, 4: 2.776, 5: 2.571, 6: 2.447, 7: 2.365, 8: 2.306,
+       9: 2.262}
 #: The seed of the copies' noise: the same file gives the same intervals.
 SEED = 20240
 #: The error of placing a pause's edges where the motion beside it stops, as a fraction
@@ -47,6 +57,26 @@ SEED = 20240
 #: about 1 % of the duration over the generated recordings of the tests, whatever the
 #: noise: not something re-noised copies show).
 EDGES = 0.01
+#: What the noise adds to a reading on average (the larger of noisy readings is biased
+#: up, a peak-to-peak range grows with the noise) is read as the copies' mean less the
+#: smoothed base's reading, times this. The base keeps part of the noise a reading sees
+#: (its filter passes what is slower than its window; a reading over a phase sees just
+#: that), so the copies, the base's noise and their own, show only part of the bias:
+#: for a bias in proportion to the noise level ``s``, the copies show
+#: ``(sqrt(1 + r^2) - r) s`` of the recording's ``s`` when the base keeps ``r`` of it,
+#: at least ``sqrt(2) - 1`` of it (``r`` = 1): the bias is at most ``1 + sqrt(2)`` times
+#: what they show. (A bias in the noise squared they show whole; this only widens it.)
+BIAS = 1.0 + math.sqrt(2.0)
+#: The unit of a hand's peak acceleration, and how far above its reading the peak may
+#: lie without any noise, as a fraction of it: the reading is a mean of the
+#: acceleration over a phase, or over a run of it, with positive weights, so never
+#: above the peak; a profile that rises less than an arm's transients above the
+#: phase's level is read as the level (aou_dsl/measuring/peaks.py). Over the shipped
+#: and 100 generated behaviours logged with 1e-6 rad of noise, approaches read up to
+#: 0.71 % low (five of 88 more than 0.29 %), at 250 Hz as at 1 kHz, retreats up to
+#: 0.19 %: not something re-noised copies show, since no noise makes it.
+ACCELERATION = "m/s^2"
+PEAK_SHAPE = 0.01
 
 
 @dataclass(frozen=True)
@@ -84,10 +114,11 @@ def exact(value: float | int | None) -> Spread:
 
 
 def _copies(rec: Trajectory, cols: np.ndarray, jn: JointNoise, rng: np.random.Generator
-            ) -> list[Trajectory]:
-    """``rec`` with its arm joints smoothed (the base), then :data:`REPLICATES` copies
-    of the base with fresh noise at each moving joint's level; other columns as they
-    are."""
+            ) -> tuple[Trajectory, Callable[[], Trajectory], dict[str, np.ndarray]]:
+    """``rec`` with its arm joints smoothed (the base); a maker of copies of the base
+    with fresh noise at each moving joint's level (other columns as they are); and the
+    recording's own arm joints on the measurement's uniform clock (``"grid"``) and on
+    its own (``"raw"``), which the copies' kinematics are expanded about."""
     t = np.asarray(rec.t, float)
     q_all = np.asarray(rec.q, float)
     q, _ = unwrap(q_all[:, cols])
@@ -102,12 +133,13 @@ def _copies(rec: Trajectory, cols: np.ndarray, jn: JointNoise, rng: np.random.Ge
     smooth_q[:, ~moving] = q[:, ~moving]
     base_q = q_all.copy()
     base_q[:, cols] = smooth_q
-    out = [rec.with_(q=base_q)]
-    for _ in range(REPLICATES):
+
+    def copy() -> Trajectory:
         qc = q_all.copy()
         qc[:, cols] = smooth_q + rng.standard_normal(q.shape) * level
-        out.append(rec.with_(q=qc))
-    return out
+        return rec.with_(q=qc)
+
+    return rec.with_(q=base_q), copy, {"grid": grid.q, "raw": q}
 
 
 def _spread(name: str, value: float | int | None, base: float | int | None,
@@ -133,65 +165,114 @@ def _spread(name: str, value: float | int | None, base: float | int | None,
     if len(present) < 2 or base is None:
         return Spread(None, v, v, False, absent)
     sd = float(np.std(present, ddof=1))
-    # What the noise adds on average (the larger of noisy readings is biased up, a
-    # peak-to-peak range grows with the noise): the copies' mean beside the base's.
-    corrected = v - (float(np.mean(present)) - float(base))
+    corrected = v - BIAS * (float(np.mean(present)) - float(base))
     # Each of a duration's two edges falls on a sample (known to a step at best), and
     # is placed by following the motion beside it back to rest (its own error).
     timed = d.unit == "s" or d.unit.endswith("/s")  # a duration, or a speed over one
-    half = T95 * sd + (2 * step if d.unit == "s" else 0.0) + (EDGES * abs(v) if timed else 0.0)
-    return Spread(sd, min(v, corrected) - half, max(v, corrected) + half, absent == 0,
-                  absent)
+    half = (T95[len(present) - 1] * sd + (2 * step if d.unit == "s" else 0.0)
+            + (EDGES * abs(v) if timed else 0.0))
+    # A peak acceleration is a mean of the acceleration over what it is read from:
+    # never above the peak, and below it by what the reading did not resolve.
+    above = PEAK_SHAPE * abs(v) if d.unit == ACCELERATION else 0.0
+    return Spread(sd, min(v, corrected) - half, max(v, corrected) + half + above,
+                  absent == 0, absent)
 
 
 class Linearised:
-    """The forward kinematics of the copies, to first order about the smoothed base's.
+    """The forward kinematics of the copies, to first order about the recording's own.
 
-    A copy differs from the base by noise of 1e-4 to 1e-3 rad; the hand's pose moves
-    with it by the Jacobian times that noise, and the terms this leaves out are of the
-    noise squared (about 1e-6 m on an arm half a metre long, a thousandth of what the
-    noise itself moves the hand). The first call on each clock (``"grid"`` or ``"raw"``)
-    is the base's: it is computed exactly, with the Jacobian at every sample; later
-    calls on that clock are the copies'. A rotation turns by the angular part,
-    ``exp(W) R ~ (I + W + W^2/2) R``. An arm with joints other than revolute and
-    prismatic, or a clock of another length, is computed exactly every time."""
+    A copy differs from the recording by noise of 1e-4 to 1e-3 rad (the smoothed base
+    by what its filter took out, each copy by that and its fresh noise); the hand's
+    pose moves with it by the Jacobian times that difference, and the terms this leaves
+    out are of the noise squared (about 1e-6 m on an arm half a metre long, a thousandth
+    of what the noise itself moves the hand). The recording's own poses on each clock
+    (``"grid"`` or ``"raw"``) are its measurement's (kept by the samples' bytes, so not
+    computed again); the Jacobian is computed at every :data:`JACOBIAN_STEP`-th sample
+    and interpolated linearly between (over a few milliseconds it changes by far less
+    than the noise changes it). Without the recording's samples (``about`` None), the
+    first call on each clock is the point expanded about, computed exactly. A rotation
+    turns by the angular part, ``exp(W) R ~ (I + W + W^2/2) R``. An arm with joints
+    other than revolute and prismatic, or a clock of another length, is computed exactly
+    every time."""
 
-    def __init__(self, arm) -> None:
+    def __init__(self, arm, about: dict[str, np.ndarray] | None = None) -> None:
         self.arm = arm
-        # Per clock: the base's joints, hand positions and rotations, and the Jacobian's
-        # linear and angular parts joint by joint, (n, N, 3) each.
+        self.about = about or {}
+        # Per clock: the expansion point's joints, hand positions and rotations, and the
+        # Jacobian's linear and angular parts joint by joint, (n, N, 3) each.
         self.at: dict[str, tuple[np.ndarray, ...]] = {}
 
     def __call__(self, q: np.ndarray, clock: str) -> tuple[np.ndarray, np.ndarray]:
-        from ..robot.batch_fk import batch_fk, batch_fk_jacobian
+        from ..robot.batch_fk import batch_fk
 
         about = self.at.get(clock)
-        if about is None or about[0].shape != q.shape:
-            got = batch_fk_jacobian(self.arm, q) if about is None else None
+        if about is None:
+            q0 = self.about.get(clock)
+            first = q0 is None
+            got = _expansion(self.arm, q if q0 is None else q0, exact_rows=first)
             if got is None:
                 return batch_fk(self.arm, q)
-            pos, rot, jac = got
-            self.at[clock] = (np.array(q, float), pos, rot,
-                              np.ascontiguousarray(jac[:, :3].transpose(2, 0, 1)),
-                              np.ascontiguousarray(jac[:, 3:].transpose(2, 0, 1)))
-            return pos, rot
+            about = self.at[clock] = got
+            if first:
+                return about[1], about[2]
+        if about[0].shape != q.shape:
+            return batch_fk(self.arm, q)
         q0, pos0, rot0, lin, ang = about
         dq = q - q0
         pos, w = pos0.copy(), np.zeros_like(pos0)
         for j in range(dq.shape[1]):
             pos += lin[j] * dq[:, j, None]
             w += ang[j] * dq[:, j, None]
-        turned = _cross(w, rot0)
-        return pos, rot0 + turned + 0.5 * _cross(w, turned)
+        return pos, np.matmul(_turn(w), rot0)
 
 
-def _cross(w: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """``w x`` each column of ``r``: ``skew(w) @ r`` for ``w`` (N, 3), ``r`` (N, 3, 3)."""
-    out = np.empty_like(r)
-    out[:, 0] = w[:, 1, None] * r[:, 2] - w[:, 2, None] * r[:, 1]
-    out[:, 1] = w[:, 2, None] * r[:, 0] - w[:, 0, None] * r[:, 2]
-    out[:, 2] = w[:, 0, None] * r[:, 1] - w[:, 1, None] * r[:, 0]
-    return out
+#: The copies' Jacobian is computed at every this many samples, and interpolated.
+JACOBIAN_STEP = 8
+
+
+def _expansion(arm, q: np.ndarray, exact_rows: bool) -> tuple[np.ndarray, ...] | None:
+    """The point the copies' kinematics are expanded about: ``q`` (N, n), its hand
+    positions and rotations (``exact_rows``: computed here; else the measurement's own,
+    kept by the samples' bytes) and the Jacobian's linear and angular parts, (n, N, 3)
+    each, from every :data:`JACOBIAN_STEP`-th row. None for an arm whose joints are not
+    all revolute or prismatic."""
+    from ..robot.batch_fk import batch_fk_jacobian, rows_fk
+
+    q = np.array(q, float)
+    n = len(q)
+    if exact_rows or n < 2 * JACOBIAN_STEP:
+        got = batch_fk_jacobian(arm, q)
+        if got is None:
+            return None
+        pos, rot, jac = got
+    else:
+        knots = np.unique(np.append(np.arange(0, n, JACOBIAN_STEP), n - 1))
+        got = batch_fk_jacobian(arm, q[knots])
+        if got is None:
+            return None
+        rows = np.arange(n, dtype=float)
+        parts = np.empty((2, q.shape[1], n, 3))  # linear, angular; joint; sample; axis
+        for r in range(6):
+            for j in range(q.shape[1]):
+                parts[r // 3, j, :, r % 3] = np.interp(rows, knots, got[2][:, r, j])
+        pos, rot = rows_fk(arm, q)
+        return q, pos, rot, parts[0], parts[1]
+    return (q, pos, rot, np.ascontiguousarray(jac[:, :3].transpose(2, 0, 1)),
+            np.ascontiguousarray(jac[:, 3:].transpose(2, 0, 1)))
+
+
+def _turn(w: np.ndarray) -> np.ndarray:
+    """``exp(W) ~ I + W + W^2 / 2`` for ``W`` the skew matrix of each row of ``w`` (N, 3),
+    (N, 3, 3); ``W^2 = w w^T - |w|^2 I``."""
+    x, y, z = w[:, 0], w[:, 1], w[:, 2]
+    m = np.empty((len(w), 3, 3))
+    m[:, 0, 0] = 1.0 - 0.5 * (y * y + z * z)
+    m[:, 1, 1] = 1.0 - 0.5 * (x * x + z * z)
+    m[:, 2, 2] = 1.0 - 0.5 * (x * x + y * y)
+    m[:, 0, 1], m[:, 1, 0] = 0.5 * x * y - z, 0.5 * x * y + z
+    m[:, 0, 2], m[:, 2, 0] = 0.5 * x * z + y, 0.5 * x * z - y
+    m[:, 1, 2], m[:, 2, 1] = 0.5 * y * z - x, 0.5 * y * z + x
+    return m
 
 
 def _values(m) -> dict:
@@ -215,16 +296,18 @@ def attach(m, rec: Trajectory, jn: JointNoise,
     arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
     cols = rec.columns(arm.joint_names)
     rng = np.random.default_rng(SEED)
-    base, *copies = _copies(rec, cols, jn, rng)
-    fk = Linearised(arm)
+    base, copy, about = _copies(rec, cols, jn, rng)
+    fk = Linearised(arm, about)
     try:
         smooth_m = measure_once(base, jn, fk)[0]
     except AouError:
         smooth_m = None
-    read_m = []
-    for copy in copies:
+    read_m: list = []
+    for k in range(REPLICATES):
+        if k == FIRST and len(read_m) == FIRST and _agree([m, smooth_m, *read_m]):
+            break
         try:
-            read_m.append(measure_once(copy, jn, fk)[0])
+            read_m.append(measure_once(copy(), jn, fk)[0])
         except AouError:  # a copy the noise made unreadable adds nothing
             continue
     reads = [_values(r) for r in read_m]
@@ -255,6 +338,21 @@ def attach(m, rec: Trajectory, jn: JointNoise,
             hint="log at a higher rate or with less noise; a longer pause or a slower "
             "motion stands out of the noise better",
             noise=noise, descriptors=shaky, states=list(states)))
+
+
+def _agree(ms: list) -> bool:
+    """Whether the measurements (None: unreadable) read one segmentation: every count,
+    every presence and the inferred state the same."""
+    if any(x is None for x in ms):
+        return False
+    table = every_named()
+
+    def shape(x) -> tuple:
+        v = _values(x)
+        return (x.cv.state.value, *((int(v[k] or 0) if d.is_count else v[k] is None)
+                                    for k, d in table.items()))
+
+    return len({shape(x) for x in ms}) == 1
 
 
 @dataclass(frozen=True)
@@ -298,8 +396,9 @@ def _inferred(m, base, copies: list) -> Inferred:
         if len(reads) < 2 or b is None:
             return Spread(None, value, value, False)
         sd = float(np.std(reads, ddof=1))
-        corrected = value - (float(np.mean(reads)) - b)
-        return Spread(sd, min(value, corrected) - T95 * sd, max(value, corrected) + T95 * sd,
+        corrected = value - BIAS * (float(np.mean(reads)) - b)
+        t95 = T95[len(reads) - 1]
+        return Spread(sd, min(value, corrected) - t95 * sd, max(value, corrected) + t95 * sd,
                       len(states) == 1)
 
     def sight(attr: str):
