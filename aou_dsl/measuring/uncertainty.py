@@ -41,8 +41,8 @@ from .signal import JointNoise, short_window, smooth, to_grid, unwrap
 __all__ = ["REPLICATES", "Inferred", "Spread", "attach"]
 
 #: Re-noised copies measured first; when they are all readable and read the
-#: recording's segmentation (every count, every presence and the inferred state), as
-#: the smoothed base does, that is all.
+#: recording's segmentation (every count and every presence), as the smoothed base
+#: does, that is all.
 FIRST = 4
 #: Copies measured in all when the first ones do not agree (a segmentation the noise
 #: may flip is looked at more closely).
@@ -341,16 +341,19 @@ def attach(m, rec: Trajectory, jn: JointNoise,
 
 
 def _agree(ms: list) -> bool:
-    """Whether the measurements (None: unreadable) read one segmentation: every count,
-    every presence and the inferred state the same."""
+    """Whether the measurements (None: unreadable) read one segmentation: every count and
+    every presence the same. The inferred state is left out: a state the first copies
+    flip is already not to be trusted (R411 names it), and more copies would only add
+    to the states listed, where a count's or a presence's interval is what the copies
+    read, and needs them."""
     if any(x is None for x in ms):
         return False
     table = every_named()
 
     def shape(x) -> tuple:
         v = _values(x)
-        return (x.cv.state.value, *((int(v[k] or 0) if d.is_count else v[k] is None)
-                                    for k, d in table.items()))
+        return tuple((int(v[k] or 0) if d.is_count else v[k] is None)
+                     for k, d in table.items())
 
     return len({shape(x) for x in ms}) == 1
 
