@@ -185,7 +185,7 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False) -> Zero
             return Zero(edge, False)
     return Zero(float(min(max(t0, bounds[0]), bounds[1])), True, t0,
                 1.0 / slope if slope > 0 else math.inf,
-                step * (r.held[seg[min(up + window, len(seg) - 1)]] - r.held[i]) / r.thr[i])
+                step * (r.q[seg[min(up + window, len(seg) - 1)]] - r.q[i]) / r.thr[i])
 
 
 def _zero(t: np.ndarray, v: np.ndarray, straight: bool = False) -> float | None:
