@@ -11,7 +11,9 @@ for most of it, is a pause; a shorter one is the boundary between two episodes (
 rest-to-rest boundary, or a reversal). Motion that reverses or stops without ever
 looking still (a fast shiver, coarse sampling) is found from the speed's dips to zero,
 also between two samples: sampled a few times per cycle, a shiver's samples can all
-miss its reversals, where its leading joint's velocity changes sign.
+miss its reversals, where its leading joint's velocity changes sign. A short rest inside
+a slow motion's start or end, which the noise hid and let out again, is no boundary
+when the motion on both sides moves the same way and points at a stop beyond it.
 A pause beside an oscillation, whose envelope fades in and out, has its edges placed by
 :mod:`.onset`.
 """
