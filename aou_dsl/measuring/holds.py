@@ -98,10 +98,12 @@ def _rest_runs(r: Rest) -> tuple[list[tuple[int, int]], set[int]]:
     return runs(rest), slow_edges
 
 
-def _lead(r: Rest, seg: np.ndarray, slow: bool) -> tuple[np.ndarray, int] | None:
+def _lead(r: Rest, seg: np.ndarray, slow: bool) -> tuple[np.ndarray, int, float] | None:
     """The velocity of the joint that leads the motion over ``seg`` (the samples beside
-    a rest, away from it), signed positive and in units of its rest threshold; and the
-    filter's window. Of the short and the long filter, the one that sees the motion
+    a rest, away from it), signed positive and in units of its rest threshold; the
+    filter's window; and that threshold in units of the rest test's own (the long
+    filter's is lower: its ramp crosses the rest test's threshold later). Of the short
+    and the long filter, the one that sees the motion
     first (the long one sees it half its window early, which is allowed for), or the
     long one for an edge that slow motion made (``slow``)."""
     found = []
@@ -120,11 +122,12 @@ def _lead(r: Rest, seg: np.ndarray, slow: bool) -> tuple[np.ndarray, int] | None
         up = np.flatnonzero(vj > CLEARLY)
         if len(up):
             # A filter sees motion half its window before it starts.
-            found.append((int(up[0]) + width // 2, vj, width, window == 0))
+            found.append((int(up[0]) + width // 2, vj, width, window == 0,
+                          float(thr[seg[0], j] / r.thr[seg[0], j])))
     if not found:
         return None
     found.sort(key=lambda f: (not f[3]) if slow else f[0])
-    return found[0][1], found[0][2]
+    return found[0][1], found[0][2], found[0][4]
 
 
 class Zero(NamedTuple):
@@ -155,7 +158,7 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False) -> Zero
     lead = _lead(r, seg, slow) if len(seg) >= 2 else None
     if lead is None:
         return Zero(float(t[i]), False)
-    vj, window = lead
+    vj, window, unit = lead
     up = int(np.argmax(vj > CLEARLY))
     # The first peak: after the velocity is clearly up, where it falls back under 80 %
     # of its running maximum. The ramp runs from the last sample at or under zero (a
@@ -171,7 +174,7 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False) -> Zero
     # rest (give or take a step), and no further into the rest than its ramp takes to
     # fall through the threshold (twice that, plus the filter's reach).
     slope = abs(float(np.polyfit(ramp - ramp[0], vr, 1)[0])) if len(ramp) >= 2 else 0.0
-    reach_in = 2.0 / slope + (window // 2 + 1) * r.h if slope > 0 else math.inf
+    reach_in = 2.0 / (slope * unit) + (window // 2 + 1) * r.h if slope > 0 else math.inf
     edge = float(t[i])
     far_t = edge - step * min(abs(float(t[far]) - edge) + r.h, reach_in)
     bounds = sorted((far_t, float(t[seg[up]])))

@@ -175,3 +175,22 @@ def test_a_shivers_hidden_first_swing_is_no_pause():
     shiver = next((a, b) for kind, a, b in timeline if kind == "shiver")
     assert not [e for e in m.episodes if e.kind == "pause"
                 and e.t_start < shiver[1] and e.t_end > shiver[0]]
+
+
+def test_a_pause_beside_a_slow_approach_ends_where_the_approach_starts():
+    """The hesitant's approaches at 0.05 m/s^2 logged at 250 Hz with 6e-4 rad: their
+    last and first 0.3 s hide under the short filter's threshold and are found by the
+    0.3 s one. Each pause's edge beside them is followed down the approach's ramp to
+    where it stops or starts, as far as that ramp takes to cross the rest test's own
+    threshold (the long filter's is ten times lower: read in its units, the edge was
+    held 0.1 s short, and every pause beside a slow approach read 0.1 s long). Each
+    pause read within 30 ms of the declared one at both edges."""
+    from tests.conftest import BEHAVIOURS
+
+    doc, _, timeline = build((BEHAVIOURS / "hesitant.aou").read_text(), "hesitant")
+    _, m = logged(doc, logger(6e-4, 250.0, 4))
+    read = [(e.t_start, e.t_end) for e in m.episodes if e.kind == "pause"]
+    declared = [(a, b) for kind, a, b in timeline if kind == "pause"]
+    assert len(read) == len(declared) == 5
+    for (a, b), (t0, t1) in zip(read, declared, strict=True):
+        assert abs(a - t0) < 0.03 and abs(b - t1) < 0.03, ((a, b), (t0, t1))
