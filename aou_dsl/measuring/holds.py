@@ -45,7 +45,7 @@ CLEARLY = 3.0
 #: The velocity ramp beside a stop is followed up to this fraction of its peak.
 RAMP_TOP = 0.6
 #: The joints move the same way on both sides of a rest when the cosine between their
-#: velocities (in units of their thresholds) is over this.
+#: ways along the two ramps (each joint's in units of its threshold) is over this.
 PASSING = 0.5
 #: The ramps on both sides of a rest the motion passes through point at one stop when
 #: they meet zero within this many velocity filter spans of each other; the stop is a
@@ -100,12 +100,12 @@ def _rest_runs(r: Rest) -> tuple[list[tuple[int, int]], set[int]]:
 
 def _lead(r: Rest, seg: np.ndarray, slow: bool) -> tuple[np.ndarray, int, float] | None:
     """The velocity of the joint that leads the motion over ``seg`` (the samples beside
-    a rest, away from it), signed positive and in units of its rest threshold; the
+    a rest, away from it), signed positive and in units of its filter's threshold; the
     filter's window; and that threshold in units of the rest test's own (the long
     filter's is lower: its ramp crosses the rest test's threshold later). Of the short
-    and the long filter, the one that sees the motion
-    first (the long one sees it half its window early, which is allowed for), or the
-    long one for an edge that slow motion made (``slow``)."""
+    and the long filter, the one that sees the motion first (the long one sees it half
+    its window early, which is allowed for), or the long one for an edge that slow
+    motion made (``slow``)."""
     found = []
     for v, thr, window in ((r.v, r.thr, r.window), (r.v_long, r.thr_long, 0)):
         if v is None or thr is None:
@@ -136,7 +136,6 @@ class Zero(NamedTuple):
     at: float  # the edge, within the rest and the motion's first clearly moving sample
     firm: bool  # a straight ramp was followed
     raw: float | None = None  # where the ramp followed back meets zero, anywhere
-    rise: float = math.inf  # how long the ramp takes to climb one rest threshold [s]
     heading: np.ndarray | None = None  # the joints' way along the ramp, in thresholds
 
 
@@ -189,7 +188,6 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False) -> Zero
         if t0 is None:
             return Zero(edge, False)
     return Zero(float(min(max(t0, bounds[0]), bounds[1])), True, t0,
-                1.0 / slope if slope > 0 else math.inf,
                 step * (r.q[seg[min(up + window, len(seg) - 1)]] - r.q[i]) / r.thr[i])
 
 
