@@ -11,7 +11,9 @@ for most of it, is a pause; a shorter one is the boundary between two episodes (
 rest-to-rest boundary, or a reversal). Motion that reverses or stops without ever
 looking still (a fast shiver, coarse sampling) is found from the speed's dips to zero,
 also between two samples: sampled a few times per cycle, a shiver's samples can all
-miss its reversals, where its leading joint's velocity changes sign.
+miss its reversals, where its leading joint's velocity changes sign. A short rest inside
+a slow motion's start or end, which the noise hid and let out again, is no boundary
+when the motion on both sides moves the same way and points at a stop beyond it.
 A pause beside an oscillation, whose envelope fades in and out, has its edges placed by
 :mod:`.onset`.
 """
@@ -20,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -41,6 +44,14 @@ STILL_ANGLE = 2e-5
 CLEARLY = 3.0
 #: The velocity ramp beside a stop is followed up to this fraction of its peak.
 RAMP_TOP = 0.6
+#: The joints move the same way on both sides of a rest when the cosine between their
+#: ways along the two ramps (each joint's in units of its threshold) is over this.
+PASSING = 0.5
+#: The ramps on both sides of a rest the motion passes through point at one stop when
+#: they meet zero within this many velocity filter spans of each other; the stop is a
+#: boundary of its own when no other lies within :data:`AWAY` spans of it.
+AGREE = 2.0
+AWAY = 4.0
 
 
 @dataclass(frozen=True)
@@ -87,12 +98,14 @@ def _rest_runs(r: Rest) -> tuple[list[tuple[int, int]], set[int]]:
     return runs(rest), slow_edges
 
 
-def _lead(r: Rest, seg: np.ndarray, slow: bool) -> tuple[np.ndarray, int] | None:
+def _lead(r: Rest, seg: np.ndarray, slow: bool) -> tuple[np.ndarray, int, float] | None:
     """The velocity of the joint that leads the motion over ``seg`` (the samples beside
-    a rest, away from it), signed positive and in units of its rest threshold; and the
-    filter's window. Of the short and the long filter, the one that sees the motion
-    first (the long one sees it half its window early, which is allowed for), or the
-    long one for an edge that slow motion made (``slow``)."""
+    a rest, away from it), signed positive and in units of its filter's threshold; the
+    filter's window; and that threshold in units of the rest test's own (the long
+    filter's is lower: its ramp crosses the rest test's threshold later). Of the short
+    and the long filter, the one that sees the motion first (the long one sees it half
+    its window early, which is allowed for), or the long one for an edge that slow
+    motion made (``slow``)."""
     found = []
     for v, thr, window in ((r.v, r.thr, r.window), (r.v_long, r.thr_long, 0)):
         if v is None or thr is None:
@@ -109,15 +122,24 @@ def _lead(r: Rest, seg: np.ndarray, slow: bool) -> tuple[np.ndarray, int] | None
         up = np.flatnonzero(vj > CLEARLY)
         if len(up):
             # A filter sees motion half its window before it starts.
-            found.append((int(up[0]) + width // 2, vj, width, window == 0))
+            found.append((int(up[0]) + width // 2, vj, width, window == 0,
+                          float(thr[seg[0], j] / r.thr[seg[0], j])))
     if not found:
         return None
     found.sort(key=lambda f: (not f[3]) if slow else f[0])
-    return found[0][1], found[0][2]
+    return found[0][1], found[0][2], found[0][4]
 
 
-def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False
-               ) -> tuple[float, bool]:
+class Zero(NamedTuple):
+    """Where the motion beside a rest meets zero velocity (:func:`_ramp_zero`)."""
+
+    at: float  # the edge, within the rest and the motion's first clearly moving sample
+    firm: bool  # a straight ramp was followed
+    raw: float | None = None  # where the ramp followed back meets zero, anywhere
+    heading: np.ndarray | None = None  # the joints' way along the ramp, in thresholds
+
+
+def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False) -> Zero:
     """Where the motion beside rest sample ``i`` (after it for ``step`` +1, before it for
     -1) is at zero velocity: the signed velocity of its leading joint, a straight line
     near a stop, is fitted from the edge up to :data:`RAMP_TOP` of its first peak and
@@ -127,15 +149,15 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False
     if r.carried is not None:
         exact = carried_edge(r.t, r.q, *r.carried, i, step)
         if exact is not None:
-            return exact, True
+            return Zero(exact, True)
     t, n = r.t, len(r.t)
     reach = max(3, int(round(1.0 / r.h)))
     seg = (np.arange(i + 1, min(i + 1 + reach, n)) if step > 0
            else np.arange(i - 1, max(i - 1 - reach, -1), -1))
     lead = _lead(r, seg, slow) if len(seg) >= 2 else None
     if lead is None:
-        return float(t[i]), False
-    vj, window = lead
+        return Zero(float(t[i]), False)
+    vj, window, unit = lead
     up = int(np.argmax(vj > CLEARLY))
     # The first peak: after the velocity is clearly up, where it falls back under 80 %
     # of its running maximum. The ramp runs from the last sample at or under zero (a
@@ -151,21 +173,22 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False
     # rest (give or take a step), and no further into the rest than its ramp takes to
     # fall through the threshold (twice that, plus the filter's reach).
     slope = abs(float(np.polyfit(ramp - ramp[0], vr, 1)[0])) if len(ramp) >= 2 else 0.0
-    reach_in = 2.0 / slope + (window // 2 + 1) * r.h if slope > 0 else math.inf
+    reach_in = 2.0 / (slope * unit) + (window // 2 + 1) * r.h if slope > 0 else math.inf
     edge = float(t[i])
     far_t = edge - step * min(abs(float(t[far]) - edge) + r.h, reach_in)
     bounds = sorted((far_t, float(t[seg[up]])))
     t0 = _zero(ramp, vr)
     if t0 is None:
-        return edge, False
+        return Zero(edge, False)
     # The filter rounds the corner at the stop: samples whose window reaches across it
     # are left out of a second fit.
     keep = np.abs(ramp - t0) > (window // 2) * r.h
     if keep.sum() >= 2:
         t0 = _zero(ramp[keep], vr[keep], straight=True)
         if t0 is None:
-            return edge, False
-    return float(min(max(t0, bounds[0]), bounds[1])), True
+            return Zero(edge, False)
+    return Zero(float(min(max(t0, bounds[0]), bounds[1])), True, t0,
+                step * (r.q[seg[min(up + window, len(seg) - 1)]] - r.q[i]) / r.thr[i])
 
 
 def _zero(t: np.ndarray, v: np.ndarray, straight: bool = False) -> float | None:
@@ -246,7 +269,7 @@ def _dips(r: Rest, taken: np.ndarray) -> list[tuple[float, float, int]]:
             tk = float(r.t[a] + (r.t[b] - r.t[a]) * va / (va - vb))
             out.append((tk, tk, k))
             continue
-        t0, t1 = _ramp_zero(r, k, -1, k)[0], _ramp_zero(r, k, +1, k)[0]
+        t0, t1 = _ramp_zero(r, k, -1, k).at, _ramp_zero(r, k, +1, k).at
         out.append((t0, t1, k) if t1 > t0 else ((t0 + t1) / 2, (t0 + t1) / 2, k))
     return out
 
@@ -258,12 +281,14 @@ def boundaries(r: Rest) -> list[Boundary]:
     taken = np.zeros(n, bool)
     found, slow = _rest_runs(r)
     edge = r.window // 2  # the filter's reach: a rest that close to an end starts there
+    pointed: list[float] = []
     for i0, i1 in found:
         i0 = 0 if i0 <= edge else i0
         i1 = n - 1 if i1 >= n - 1 - edge else i1
         taken[i0:i1 + 1] = True
-        t0 = float(r.t[0]) if i0 == 0 else _ramp_zero(r, i0, -1, i1, i0 in slow)[0]
-        t1 = r.t_last if i1 == n - 1 else _ramp_zero(r, i1, +1, i0, i1 in slow)[0]
+        z0 = Zero(float(r.t[0]), False) if i0 == 0 else _ramp_zero(r, i0, -1, i1, i0 in slow)
+        z1 = Zero(r.t_last, False) if i1 == n - 1 else _ramp_zero(r, i1, +1, i0, i1 in slow)
+        t0, t1 = z0.at, z1.at
         h0, h1 = _held(r, t0, t1) if t1 - t0 >= MIN_PAUSE else (t0, t0)
         if h1 - h0 >= max(MIN_PAUSE, 0.5 * (t1 - t0)):
             # Motion too slow to see in the speed but not in the positions (the soft
@@ -276,15 +301,51 @@ def boundaries(r: Rest) -> list[Boundary]:
                 continue
             t0, t1 = a, b
         if 0 < i0 and i1 < n - 1:
+            passing = _passing(r, z0, z1, i0, i1)
+            if passing is not None:
+                if passing[1]:
+                    pointed.append(passing[0])
+                continue
             # The instant between two episodes; when motion too slow to see fills the
             # gap between where one stops and the next starts, that gap belongs to
             # neither (it is the soft end of a shiver, or its soft start).
             t0, t1 = (t0, t1) if t1 > t0 else ((t0 + t1) / 2,) * 2
             out.append(Boundary(t0, t1, i0, i1, False))
+    # Where the motion passing through a rest stops, unless a rest is found there: the
+    # noise can hide a stop between two slow motions the same way (the second starts
+    # before the first is seen to stop).
+    near = AWAY * r.window * r.h
+    for stop in pointed:
+        if r.t[0] < stop < r.t_last and not any(b.t0 - near <= stop <= b.t1 + near
+                                                for b in out):
+            k = int(np.clip(np.searchsorted(r.t, stop), 0, n - 1))
+            out.append(Boundary(stop, stop, k, k, False))
     for t0, t1, k in _dips(r, taken):
         out.append(Boundary(t0, t1, k, k, False))
     out.sort(key=lambda b: b.t0)
     return _merged(out)
+
+
+def _passing(r: Rest, z0: Zero, z1: Zero, i0: int, i1: int) -> tuple[float, bool] | None:
+    """Where the motion passing through the rest run ``i0``..``i1`` stops (or starts),
+    and whether its two ramps agree on it; None when it stops in the run. It passes
+    through when the joints move the same way on both sides of the run and both ramps,
+    followed back to zero, meet it beyond the same end of the run (by more than the
+    velocity filter's span): noise hides a slow motion's start or end under the
+    threshold for a while, and may let it out again for a few samples, and the short
+    rest between is no stop. The stop is the nearer of the two zeros; ramps that meet
+    zero more than :data:`AGREE` spans apart give no reading of it."""
+    if z0.raw is None or z1.raw is None or z0.heading is None or z1.heading is None:
+        return None
+    if z0.heading @ z1.heading <= PASSING * np.linalg.norm(z0.heading) * np.linalg.norm(
+            z1.heading):
+        return None
+    margin = r.window * r.h
+    lo, hi = sorted((z0.raw, z1.raw))
+    agree = hi - lo <= AGREE * margin
+    if lo > r.t[i1] + margin:
+        return lo, agree
+    return (hi, agree) if hi < r.t[i0] - margin else None
 
 
 def _held(r: Rest, t0: float, t1: float) -> tuple[float, float]:

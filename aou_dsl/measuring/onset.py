@@ -15,7 +15,10 @@ The fit reaches well up the first lobe, where the oscillation's growth has begun
 slow, so that enough samples stand above the noise; the free power absorbs that. A
 motion that does not swing to both sides of the hold (an approach, a tilt, the ringing
 of an arm that stops) is left to its velocity ramp, and a fit that misses the data by
-more than the noise leaves the edge where it was.
+more than the noise leaves the edge where it was. An oscillation that fades in over a
+cycle may hide its whole first swing under the noise, so that the first lobe standing out
+is its second: a power of time alone misses the hidden swing, and the power times the
+oscillation (at the frequency its first two clear lobes give) is fitted instead.
 
 A file that carries its joints' velocities and accelerations (a compiled trajectory)
 says exactly where any motion leaves rest: :func:`carried_edge`.
@@ -52,6 +55,8 @@ SWING = 0.3
 LOBE = 0.05
 #: A deviation is clearly motion past this many noise stds.
 CLEAR = 6.0
+#: The oscillation's frequency, read from two lobes, is fitted within this much of it.
+RATES = (0.8, 0.9, 1.0, 1.1, 1.2)
 
 
 def soft_edge(t: np.ndarray, q: np.ndarray, noise: np.ndarray, hold: tuple[int, int],
@@ -100,18 +105,51 @@ def soft_edge(t: np.ndarray, q: np.ndarray, noise: np.ndarray, hold: tuple[int, 
     if len(starts) == 0:
         return None
     lag = np.clip(tau[None, :] - starts[:, None], 0.0, None)  # (S, K)
+    limit = len(y) * max(FIT_SIGMAS * float(sig[j]), FIT_SHAPE * top) ** 2
+    best = _best(lag, y, starts, [lag ** p for p in POWERS])
+    if best[0] > limit:
+        # An oscillation that fades in over a cycle can hide its first swings under the
+        # noise: the first clear lobe is not its first, and a power of time alone
+        # misses the hidden ones before it. The power times the oscillation fits them.
+        w = _angular(t[side], d, clear[0], back[0] if len(back) else len(d))
+        if w is not None:
+            best = _best(lag, y, starts, [lag ** p * np.sin(k * w * lag) for p in POWERS
+                                          for k in RATES])
+    if best[0] > limit:
+        return None
+    return float(t[edge]) + step * best[1]
+
+
+def _best(lag: np.ndarray, y: np.ndarray, starts: np.ndarray, shapes: list[np.ndarray]
+          ) -> tuple[float, float]:
+    """The least squared residual of ``y`` fitted with ``c * shape`` over the shapes (each
+    (S, K): one row per candidate start), and the start that gives it."""
     best = (np.inf, 0.0)
-    for p in POWERS:
-        g = lag ** p
+    for g in shapes:
         gg = np.einsum("sk,sk->s", g, g)
         c = np.where(gg > 0, (g @ y) / np.where(gg > 0, gg, 1.0), 0.0)
-        sse = np.einsum("sk,sk->s", y[None, :] - c[:, None] * g, y[None, :] - c[:, None] * g)
+        r = y[None, :] - c[:, None] * g
+        sse = np.einsum("sk,sk->s", r, r)
         k = int(np.argmin(sse))
         if sse[k] < best[0]:
             best = (float(sse[k]), float(starts[k]))
-    if best[0] > len(y) * max(FIT_SIGMAS * float(sig[j]), FIT_SHAPE * top) ** 2:
+    return best
+
+
+def _angular(t: np.ndarray, d: np.ndarray, first: int, back: int) -> float | None:
+    """The oscillation's angular frequency [rad/s] from the deviation ``d`` at times
+    ``t``: pi over the time from the top of its first clear lobe (from ``first``, up to
+    ``back`` samples on, where it swings back) to the bottom of the next; None when the
+    next lobe is not there."""
+    top = first + int(np.argmax(d[first:first + back]))
+    rest = d[first + back:]
+    again = np.flatnonzero(rest > 0.0)
+    lobe = rest[:again[0]] if len(again) else rest
+    if len(lobe) < 2:
         return None
-    return float(t[edge]) + step * best[1]
+    bottom = first + back + int(np.argmin(lobe))
+    half = abs(float(t[bottom] - t[top]))
+    return math.pi / half if half > 0 else None
 
 
 def _swings(d: np.ndarray, level: float) -> int:

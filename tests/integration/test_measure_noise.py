@@ -140,16 +140,17 @@ def test_the_inferred_state_and_the_line_of_sight_carry_their_interval(shipped, 
 
 
 def test_more_noise_than_the_segmentation_bears_is_said_with_its_level(shipped):
-    """1e-3 rad at 250 Hz on the hesitant's slow approaches: the pause count cannot be
-    trusted. R411 gives the noise level and names the descriptors it affects, and the
-    count's interval reaches past one value."""
+    """1e-3 rad at 250 Hz on the hesitant's slow approaches: its retreat count cannot be
+    trusted (its pauses, now read through the slow motion beside them, can). R411 gives
+    the noise level and names the descriptors it affects, and the count's interval
+    reaches past one value."""
     doc = shipped["hesitant"][0]
     _, m = logged(doc, logger(1e-3, 250.0, 3))
     (warn,) = [d for d in m.diagnostics if d.code == "R411"]
     assert "0.001 rad" in warn.message
     shaky = warn.fields["descriptors"]
-    assert "pause_count" in shaky
-    s = m.uncertainty["pause_count"]
+    assert "retreat_count" in shaky
+    s = m.uncertainty["retreat_count"]
     assert s.low < s.high and not s.stable
     # A value whose interval is far wider than itself is named too.
     assert all(k in shaky for k, sp in m.uncertainty.items()
