@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.codes import R401, R403, R405, R407
+from ..core.codes import R401, R403, R405, R406, R407
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..core.trajectory import Trajectory
 from ..lang.cv import CVPoint, composition, infer
@@ -56,7 +56,7 @@ from .holds import MIN_PAUSE, REST_SPEED, Boundary, Rest, boundaries, rest_at_en
 from .recognisers import claimed, every_named, extra_descriptors, extra_values
 from .roll import MIN_TILT, SHAPED_CYCLE, Lobe, lobe, roll_angle, rotations
 from .signal import Grid, JointNoise, joint_noise, short_window, smooth, to_grid, unwrap
-from .stamps import judge_stamps
+from .stamps import evened, judge_stamps, read_on_evened, stamped_on_arrival
 
 __all__ = ["MIN_PAUSE", "MIN_TILT", "STILL_TRANSLATION", "LineOfSight", "Measured",
            "measure"]
@@ -338,13 +338,34 @@ def measure(rec: Trajectory, *, uncertainty: bool = True) -> Measured:
         AouError: R401/R402 when the trajectory cannot be measured; R406 when a
             measured value contradicts the joint motion it came from.
     """
-    m, jn = _measure(rec)
+    try:
+        m, jn = _measure(rec)
+        failed: AouError | None = None
+    except AouError as e:
+        # A clock stamped on arrival can make the hand's reading contradict its joints:
+        # it is read on the clock evened out, and says so.
+        if e.diagnostics[0].code != R406 or (even := _evened_clock(rec)) is None:
+            raise
+        own_t, failed = np.asarray(rec.t, float), e
+        rec = rec.with_(t=even)
+        m, jn = _measure(rec)
     if uncertainty:
         from .uncertainty import attach
 
         attach(m, rec, jn, _measure)
-        _stamps(m, rec, jn)
+        if failed is None:
+            _stamps(m, rec, jn)
+    if failed is not None:
+        read_on_evened(m, rec.path, own_t, failed)
     return m
+
+
+def _evened_clock(rec: Trajectory) -> np.ndarray | None:
+    """The recording's clock evened out when its stamps do not follow its samples."""
+    arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
+    t, q = _checked(rec, rec.columns(arm.joint_names))
+    q, _ = unwrap(q)
+    return evened(t) if stamped_on_arrival(t, q, joint_noise(t, q).effective) else None
 
 
 def _stamps(m: Measured, rec: Trajectory, jn: JointNoise) -> None:

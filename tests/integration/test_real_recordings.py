@@ -310,6 +310,15 @@ def test_a_surging_approach_is_read_at_its_surges():
     assert r.ind_low / 1.25 <= r.value <= r.ind_high * 1.25, r
 
 
+def test_a_take_its_stamps_make_unreadable_is_read_on_the_evened_clock():
+    """P17's slow take, on its own clock (stamped on arrival), reads a peak its joints
+    cannot produce (R406, and no value). It is read on the clock evened out instead, a
+    value with R411 naming it, never trusted; the independent reading is 1.55-2.08."""
+    r = read("P17_G")
+    assert r.error is None and r.value is not None and not r.trusted, r
+    assert r.ind_low / FACTOR <= r.value <= r.ind_high * FACTOR, r
+
+
 def test_the_stamped_slow_take_is_not_ordered_and_the_other_is():
     """P7's slow take read 21 m/s^2 (independent: about 1), trusted, and so 'faster'
     than its sudden take: its clock's stamps, taken on arrival, moved the reading, the
