@@ -14,7 +14,9 @@ with full confidence.
   stds of the filtered speed's noise above the dip (a wobble of the noise is none). The
   speed is first averaged over :data:`SPAN`: a hand's surge lasts longer, a tremor or
   a jittered clock's wobble does not; and a surge lasts at least that long (a dip
-  closer to the piece's ends or to the dip before is none). A motion with one speed-up
+  closer to the piece's ends or to the dip before is none), and the first and the last
+  reach their top at least that far inside the piece (a speed highest at the piece's
+  edge is the filter's edge, or a motion cut there). A motion with one speed-up
   and one slow-down has no dip: it is one surge, read as before.
 - **Phases.** In each surge, from its start to the first sample at 95 % of its own top
   speed (the speed-up), and from the last such sample to its end (the slow-down); each
@@ -89,6 +91,12 @@ def surges(speed: np.ndarray, h: float, noise: float = 0.0) -> list[tuple[int, i
     for d in dips:
         if d - kept[-1] >= least_span and n - 1 - d >= least_span:
             kept.append(d)
+    # A surge at either end of the piece has its top inside it: a speed highest at the
+    # piece's first or last samples is a filter's edge or a cut motion, not a surge.
+    if len(kept) > 1 and int(np.argmax(speed[:kept[1] + 1])) < least_span:
+        kept.pop(1)
+    if len(kept) > 1 and n - 1 - (kept[-1] + int(np.argmax(speed[kept[-1]:]))) < least_span:
+        kept.pop()
     bounds = [*kept, n - 1]
     return list(zip(bounds[:-1], bounds[1:], strict=True))
 
