@@ -43,6 +43,7 @@ from ..lang.descriptors import (
 from ..lang.primitives import PAUSE
 from ..robot.batch_fk import batch_fk
 from ..robot.load import load_arm
+from .cuts import Cut, cut_motion, judge_cuts
 from .episodes import (
     COMPUTED_NOISE,
     STILL_TRANSLATION,
@@ -117,6 +118,8 @@ class Measured:
     inferred: Any = None
     #: The plugins' descriptors, by name, after the eleven (empty without plugins).
     extra: dict[str, float | int | None] = field(default_factory=dict)
+    #: The motions the recording cuts short (:mod:`.cuts`).
+    cuts: tuple[Cut, ...] = ()
 
     def to_json(self) -> dict:
         eps = [{"kind": e.kind, "start": round(e.t_start + self.t_origin, 4),
@@ -248,9 +251,11 @@ def _edge_rest(rec: Trajectory, rest: Rest) -> tuple[bool, bool]:
 
 
 def _episodes(ctx: Context, parts: list[Piece | Boundary],
-              coarse: list[tuple[float, float, float]] | None = None) -> list[EpisodeValues]:
+              coarse: list[tuple[float, float, float]] | None = None,
+              cuts: list[Cut] | None = None) -> list[EpisodeValues]:
     """Pauses, translations and rolls in time order; oscillations sampled too coarsely
-    to tell a shiver from tilts are added to ``coarse`` (see :func:`.roll.rotations`)."""
+    to tell a shiver from tilts are added to ``coarse`` (see :func:`.roll.rotations`),
+    translations the recording cuts short to ``cuts`` (:mod:`.cuts`)."""
     out: list[EpisodeValues] = []
     lobes: list[Lobe] = []
     g0 = None
@@ -276,6 +281,8 @@ def _episodes(ctx: Context, parts: list[Piece | Boundary],
             continue
         moved = translation(ctx, part, g0)
         if moved is not None:
+            if cuts is not None and (cut := cut_motion(ctx, part, moved)) is not None:
+                cuts.append(cut)
             flush()
             out.append(moved)
             continue
@@ -341,13 +348,12 @@ def measure(rec: Trajectory, *, uncertainty: bool = True) -> Measured:
     try:
         m, jn = _measure(rec)
         failed: AouError | None = None
-    except AouError as e:
-        # A clock stamped on arrival can make the hand's reading contradict its joints:
-        # it is read on the clock evened out, and says so.
-        if e.diagnostics[0].code != R406 or (even := _evened_clock(rec)) is None:
+    except AouError as e:  # a clock stamped on arrival can make the hand's reading
+        t, q = _joints(rec)  # contradict the joints: read on it evened out, and said so
+        if e.diagnostics[0].code != R406 or not stamped_on_arrival(
+                t, q, joint_noise(t, q).effective):
             raise
-        own_t, failed = np.asarray(rec.t, float), e
-        rec = rec.with_(t=even)
+        rec, failed = rec.with_(t=evened(t)), e
         m, jn = _measure(rec)
     if uncertainty:
         from .uncertainty import attach
@@ -356,16 +362,16 @@ def measure(rec: Trajectory, *, uncertainty: bool = True) -> Measured:
         if failed is None:
             _stamps(m, rec, jn)
     if failed is not None:
-        read_on_evened(m, rec.path, own_t, failed)
+        read_on_evened(m, rec.path, t, failed)
+    judge_cuts(m, rec.path, list(m.cuts))
     return m
 
 
-def _evened_clock(rec: Trajectory) -> np.ndarray | None:
-    """The recording's clock evened out when its stamps do not follow its samples."""
+def _joints(rec: Trajectory) -> tuple[np.ndarray, np.ndarray]:
+    """The recording's clock and its arm's joints, unwrapped."""
     arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
     t, q = _checked(rec, rec.columns(arm.joint_names))
-    q, _ = unwrap(q)
-    return evened(t) if stamped_on_arrival(t, q, joint_noise(t, q).effective) else None
+    return t, unwrap(q)[0]
 
 
 def _stamps(m: Measured, rec: Trajectory, jn: JointNoise) -> None:
@@ -373,9 +379,7 @@ def _stamps(m: Measured, rec: Trajectory, jn: JointNoise) -> None:
     again on its clock evened out when the stamps do not follow the samples."""
     if float(jn.effective.max(initial=0.0)) <= COMPUTED_NOISE or not m.uncertainty:
         return
-    arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
-    t, q = _checked(rec, rec.columns(arm.joint_names))
-    q, _ = unwrap(q)
+    t, q = _joints(rec)
     judge_stamps(m, rec.path, t, q, jn.effective,
                  lambda even: _measure(rec.with_(t=even), jn)[0])
 
@@ -386,8 +390,9 @@ def _measure(rec: Trajectory, pinned: JointNoise | None = None, fk: Kinematics |
     ctx, bounds, jn = _context(rec, pinned, fk)
     quantum = jn.quantum
     coarse: list[tuple[float, float, float]] = []
+    cuts: list[Cut] = []
     where = Span.whole_file(rec.path)
-    episodes, unclaimed = claimed(_episodes(ctx, pieces(ctx, bounds), coarse), where)
+    episodes, unclaimed = claimed(_episodes(ctx, pieces(ctx, bounds), coarse, cuts), where)
     descriptors = derive(episodes)
     extra = extra_values(episodes)
     values = {**descriptors, **extra}
@@ -410,4 +415,5 @@ def _measure(rec: Trajectory, pinned: JointNoise | None = None, fk: Kinematics |
     return Measured(descriptors, episodes, point, diags, float(ctx.noise.max()),
                     los.max if los is not None and len(los.angle) else math.nan,
                     float(ctx.rest.t_last), tuple(float(x) for x in ctx.noise), los,
-                    float(rec.t[0]), tuple(float(x) for x in quantum), extra=extra), jn
+                    float(rec.t[0]), tuple(float(x) for x in quantum), extra=extra,
+                    cuts=tuple(cuts)), jn
