@@ -81,7 +81,7 @@ def judge_cuts(m: Any, path: str, cuts: list[Cut]) -> None:
         return
     m.diagnostics.append(diag(
         R411, "the recording cuts a motion short: " + "; ".join(
-            f"{name} {m.descriptors.get(name):.4g} is read from a {cut.kind} whose hand "
+            f"{name} {m.descriptors.get(name):.4g} is read from the {cut.kind} whose hand "
             f"still moved at {cut.share:.0%} of its top speed at t="
             f"{cut.at + m.t_origin:.3f}s, where the recording "
             f"{'ends' if cut.at > 0 else 'starts'}: most of that phase, and perhaps the "
