@@ -19,8 +19,10 @@ same URDF with its own parser. Claimed:
   the independent measurement decides.
 
 The default run holds two participants (one whose slow take the stamps of its clock
-made read 21 m/s^2, confidently, before aou judged them; one it orders); the slow run
-all 26 with both takes. ``python -m tests.integration.test_real_recordings`` prints
+made read 21 m/s^2, confidently, before aou judged them; one it orders) and the takes
+each of aou's rules for real hands was made for (a surging approach, takes the log
+cuts mid-motion, one its own stamps make unreadable); the slow run all 26 with both
+takes. ``python -m tests.integration.test_real_recordings`` prints
 the table and the counts.
 """
 
