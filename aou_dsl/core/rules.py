@@ -340,8 +340,10 @@ _RULE_LIST = [
          "aouc measure huge.npz   # its q.npy claims 1,000,000,000 samples"),
     Rule("R411", "noise-beyond-segmentation", _W,
          "A recording is noisier than its measurement bears: re-noised copies read another "
-         "count or presence, a value's interval reaches a fifth of it away, or its "
-         "clock's stamps were taken on arrival and the value moves on the clock evened out.",
+         "count or presence, a value's interval reaches a fifth of it away, its "
+         "clock's stamps were taken on arrival and the value moves on the clock evened out "
+         "(or is read there because its own stamps failed), or the log cuts a motion while "
+         "the hand still moves at 80 % of its top speed.",
          "A value the noise or the clock can move that far is a guess, not a measurement; "
          "the warning names the noise level (or the clock) and the descriptors it affects, "
          "and a judgement against a behaviour file reads them as inconclusive.",

@@ -29,7 +29,8 @@ from ..robot.kinematics import ArmModel
 from .holds import Boundary, Rest
 from .peaks import episode_peak, path_travel, phase_peak
 from .recognisers import moved_along
-from .signal import curvature_gain, filter_at, odd, smooth
+from .signal import curvature_gain, filter_at, odd, slope_gain, smooth
+from .surges import Phase, phases
 
 __all__ = ["COMPUTED_NOISE", "STILL_TRANSLATION", "Context", "Piece", "Samples",
            "peak_acceleration", "pieces", "translation"]
@@ -198,21 +199,13 @@ def translation(c: Context, p: Piece, g0: np.ndarray | None) -> EpisodeValues | 
     return EpisodeValues(GAZE, p.t0, p.t1, values)
 
 
-def _phases(c: Context, p: Piece, speed: np.ndarray) -> list[tuple[int, int, int, int]]:
-    """The speeding-up and slowing-down phases of a piece: the samples of each (from
-    rest to 95 % of the top speed, and back), and those up to or from the top speed
-    (where a peak that grows to the top speed is: a bang-bang law's switch); a phase
-    cut by the recording's start or end is left out, unless nothing else is left."""
-    n = len(speed)
-    fast = np.flatnonzero(speed >= 0.95 * speed.max())
-    a, b = int(fast[0]), int(fast[-1])
-    top = a + int(np.argmax(speed[a:b + 1]))
-    out = []
-    if p.at_rest0:
-        out.append((0, a, 0, top))
-    if p.at_rest1:
-        out.append((b, n - 1, top, n - 1))
-    return out or [(0, n - 1, 0, n - 1)]
+def _phases(c: Context, p: Piece, speed: np.ndarray, noise: float) -> list[Phase]:
+    """The speeding-up and slowing-down phases of a piece (:mod:`.surges`): of each surge
+    the samples from its start to 95 % of its top speed, and back to its end, and those
+    up to or from the top speed (where a peak that grows to the top speed is: a
+    bang-bang law's switch); a phase cut by the recording's start or end is left out,
+    unless nothing else is left. ``noise``: the speed's std."""
+    return phases(speed, c.rest.h, p.at_rest0, p.at_rest1, noise)
 
 
 def peak_acceleration(c: Context, p: Piece, u: np.ndarray) -> tuple[float, float]:
@@ -253,11 +246,13 @@ def peak_acceleration(c: Context, p: Piece, u: np.ndarray) -> tuple[float, float
     # level, where one motion reverses into the next by up to twice it.
     steps = (2.0 if p.at_rest0 and not p.held0 else 1.0,
              2.0 if p.at_rest1 and not p.held1 else 1.0)
-    found = [f for a, b, lo, hi in _phases(c, p, speed)
-             if (f := phase_peak(t, x, own(a, -1), own(b, +1), sigma_x, transient,
+    # At a dip between two surges the acceleration turns from slowing down to speeding up.
+    found = [f for ph in _phases(c, p, speed, sigma_x * slope_gain(r.window, h))
+             if (f := phase_peak(t, x, own(ph.a, -1), own(ph.b, +1), sigma_x, transient,
                                  travel if c.noise.max() > 0 else None,
-                                 steps[0] if a == 0 else steps[1] if b == len(grid) - 1
-                                 else 1.0, (own(lo, -1), own(hi, +1)))) is not None]
+                                 2.0 if ph.at_dip else steps[0] if ph.a == 0
+                                 else steps[1] if ph.b == len(grid) - 1 else 1.0,
+                                 (own(ph.lo, -1), own(ph.hi, +1)))) is not None]
     if not found:
         return 0.0, 0.0
     peak = episode_peak(found)

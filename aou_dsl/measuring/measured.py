@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.codes import R401, R403, R405, R407
+from ..core.codes import R401, R403, R405, R406, R407
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..core.trajectory import Trajectory
 from ..lang.cv import CVPoint, composition, infer
@@ -43,6 +43,7 @@ from ..lang.descriptors import (
 from ..lang.primitives import PAUSE
 from ..robot.batch_fk import batch_fk
 from ..robot.load import load_arm
+from .cuts import Cut, cut_motion, judge_cuts
 from .episodes import (
     COMPUTED_NOISE,
     STILL_TRANSLATION,
@@ -56,7 +57,7 @@ from .holds import MIN_PAUSE, REST_SPEED, Boundary, Rest, boundaries, rest_at_en
 from .recognisers import claimed, every_named, extra_descriptors, extra_values
 from .roll import MIN_TILT, SHAPED_CYCLE, Lobe, lobe, roll_angle, rotations
 from .signal import Grid, JointNoise, joint_noise, short_window, smooth, to_grid, unwrap
-from .stamps import judge_stamps
+from .stamps import evened, judge_stamps, read_on_evened, stamped_on_arrival
 
 __all__ = ["MIN_PAUSE", "MIN_TILT", "STILL_TRANSLATION", "LineOfSight", "Measured",
            "measure"]
@@ -117,6 +118,8 @@ class Measured:
     inferred: Any = None
     #: The plugins' descriptors, by name, after the eleven (empty without plugins).
     extra: dict[str, float | int | None] = field(default_factory=dict)
+    #: The motions the recording cuts short (:mod:`.cuts`).
+    cuts: tuple[Cut, ...] = ()
 
     def to_json(self) -> dict:
         eps = [{"kind": e.kind, "start": round(e.t_start + self.t_origin, 4),
@@ -248,9 +251,11 @@ def _edge_rest(rec: Trajectory, rest: Rest) -> tuple[bool, bool]:
 
 
 def _episodes(ctx: Context, parts: list[Piece | Boundary],
-              coarse: list[tuple[float, float, float]] | None = None) -> list[EpisodeValues]:
+              coarse: list[tuple[float, float, float]] | None = None,
+              cuts: list[Cut] | None = None) -> list[EpisodeValues]:
     """Pauses, translations and rolls in time order; oscillations sampled too coarsely
-    to tell a shiver from tilts are added to ``coarse`` (see :func:`.roll.rotations`)."""
+    to tell a shiver from tilts are added to ``coarse`` (see :func:`.roll.rotations`),
+    translations the recording cuts short to ``cuts`` (:mod:`.cuts`)."""
     out: list[EpisodeValues] = []
     lobes: list[Lobe] = []
     g0 = None
@@ -276,6 +281,8 @@ def _episodes(ctx: Context, parts: list[Piece | Boundary],
             continue
         moved = translation(ctx, part, g0)
         if moved is not None:
+            if cuts is not None and (cut := cut_motion(ctx, part, moved)) is not None:
+                cuts.append(cut)
             flush()
             out.append(moved)
             continue
@@ -338,13 +345,33 @@ def measure(rec: Trajectory, *, uncertainty: bool = True) -> Measured:
         AouError: R401/R402 when the trajectory cannot be measured; R406 when a
             measured value contradicts the joint motion it came from.
     """
-    m, jn = _measure(rec)
+    try:
+        m, jn = _measure(rec)
+        failed: AouError | None = None
+    except AouError as e:  # a clock stamped on arrival can make the hand's reading
+        t, q = _joints(rec)  # contradict the joints: read on it evened out, and said so
+        if e.diagnostics[0].code != R406 or not stamped_on_arrival(
+                t, q, joint_noise(t, q).effective):
+            raise
+        rec, failed = rec.with_(t=evened(t)), e
+        m, jn = _measure(rec)
     if uncertainty:
         from .uncertainty import attach
 
         attach(m, rec, jn, _measure)
-        _stamps(m, rec, jn)
+        if failed is None:
+            _stamps(m, rec, jn)
+    if failed is not None:
+        read_on_evened(m, rec.path, t, failed)
+    judge_cuts(m, rec.path, list(m.cuts))
     return m
+
+
+def _joints(rec: Trajectory) -> tuple[np.ndarray, np.ndarray]:
+    """The recording's clock and its arm's joints, unwrapped."""
+    arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
+    t, q = _checked(rec, rec.columns(arm.joint_names))
+    return t, unwrap(q)[0]
 
 
 def _stamps(m: Measured, rec: Trajectory, jn: JointNoise) -> None:
@@ -352,9 +379,7 @@ def _stamps(m: Measured, rec: Trajectory, jn: JointNoise) -> None:
     again on its clock evened out when the stamps do not follow the samples."""
     if float(jn.effective.max(initial=0.0)) <= COMPUTED_NOISE or not m.uncertainty:
         return
-    arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
-    t, q = _checked(rec, rec.columns(arm.joint_names))
-    q, _ = unwrap(q)
+    t, q = _joints(rec)
     judge_stamps(m, rec.path, t, q, jn.effective,
                  lambda even: _measure(rec.with_(t=even), jn)[0])
 
@@ -365,8 +390,9 @@ def _measure(rec: Trajectory, pinned: JointNoise | None = None, fk: Kinematics |
     ctx, bounds, jn = _context(rec, pinned, fk)
     quantum = jn.quantum
     coarse: list[tuple[float, float, float]] = []
+    cuts: list[Cut] = []
     where = Span.whole_file(rec.path)
-    episodes, unclaimed = claimed(_episodes(ctx, pieces(ctx, bounds), coarse), where)
+    episodes, unclaimed = claimed(_episodes(ctx, pieces(ctx, bounds), coarse, cuts), where)
     descriptors = derive(episodes)
     extra = extra_values(episodes)
     values = {**descriptors, **extra}
@@ -389,4 +415,5 @@ def _measure(rec: Trajectory, pinned: JointNoise | None = None, fk: Kinematics |
     return Measured(descriptors, episodes, point, diags, float(ctx.noise.max()),
                     los.max if los is not None and len(los.angle) else math.nan,
                     float(ctx.rest.t_last), tuple(float(x) for x in ctx.noise), los,
-                    float(rec.t[0]), tuple(float(x) for x in quantum), extra=extra), jn
+                    float(rec.t[0]), tuple(float(x) for x in quantum), extra=extra,
+                    cuts=tuple(cuts)), jn

@@ -5,7 +5,9 @@ The positions then advance at their own steady pace while the stamps jitter, and
 re-noised copy (:mod:`.uncertainty`) keeps the same clock, so the intervals stay narrow
 about a wrong value. :func:`stamp_share` tells such a clock from one whose stamps are
 the samples' own times; :func:`judge_stamps` reads the recording again on its clock
-evened out (:func:`evened`) and widens each interval to take that reading in.
+evened out (:func:`evened`) and widens each interval to take that reading in. When the
+reading on the recording's own clock contradicts its joints (R406), such a recording is
+read on the clock evened out instead, and says so (:func:`read_on_evened`).
 """
 
 from __future__ import annotations
@@ -21,7 +23,8 @@ from ..core.diagnostics import AouError, Span, diag
 from .recognisers import every_named
 from .uncertainty import VAGUE, VAGUE_TOLERANCES, Spread, half_width
 
-__all__ = ["STAMP_FOLLOW", "evened", "judge_stamps", "stamp_share"]
+__all__ = ["STAMP_FOLLOW", "evened", "judge_stamps", "read_on_evened", "stamp_share",
+           "stamped_on_arrival"]
 
 
 #: Fewest steps of clear motion on which the clock's stamps are judged.
@@ -123,3 +126,34 @@ def judge_stamps(m: Any, path: str, t: np.ndarray, q: np.ndarray, noise: np.ndar
             Span.whole_file(path),
             hint="log the time each sample was taken (the controller's own stamp), not "
             "the time it arrived", descriptors=[n for n, _, _ in moved], share=share))
+
+
+def stamped_on_arrival(t: np.ndarray, q: np.ndarray, noise: np.ndarray) -> bool:
+    """Whether a clock's stamps do not follow its samples (:func:`stamp_share`)."""
+    share = stamp_share(t, q, noise)
+    return share is not None and share < STAMP_FOLLOW
+
+
+def read_on_evened(m: Any, path: str, t: np.ndarray, error: AouError) -> None:
+    """Say that ``m`` was read on the clock evened out, because on the recording's own
+    clock, stamped on arrival, the reading contradicted the joints (``error``, an
+    R406): R411 names both, and every peak acceleration ``m`` reads is not to be
+    trusted (its stamps moved it once already)."""
+    names = [n for n, d in every_named().items()
+             if d.key == "peak_acceleration" and not d.is_count
+             and isinstance(m.descriptors.get(n), float)]
+    for n in names:
+        if n in m.uncertainty:
+            m.uncertainty[n] = replace(m.uncertainty[n], stable=False)
+    dt = np.diff(t)
+    first = error.diagnostics[0]
+    m.diagnostics.append(diag(
+        R411, f"the clock's stamps do not follow the samples (their steps vary by "
+        f"{float(np.std(dt)) * 1e3:.2g} ms about {float(np.median(dt)) * 1e3:.2g} ms: "
+        f"stamps taken on arrival), and on them the measurement failed ({first.code}: "
+        f"{first.message}); read on the clock evened out instead: "
+        + "; ".join(f"{n} reads {m.descriptors.get(n):.4g}" for n in names)
+        + ". Values read from the evened clock are not to be trusted",
+        Span.whole_file(path),
+        hint="log the time each sample was taken (the controller's own stamp), not "
+        "the time it arrived", descriptors=names, own_clock_error=first.code))
