@@ -339,14 +339,11 @@ _RULE_LIST = [
          "AOU_MAX_SAMPLES to read larger ones.",
          "aouc measure huge.npz   # its q.npy claims 1,000,000,000 samples"),
     Rule("R411", "noise-beyond-segmentation", _W,
-         "A recording is noisier than its measurement bears: re-noised copies read another "
-         "count or presence, a value's interval reaches a fifth of it away, its "
-         "clock's stamps were taken on arrival and the value moves on the clock evened out "
-         "(or is read there because its own stamps failed), or the log cuts a motion while "
-         "the hand still moves at 80 % of its top speed.",
-         "A value the noise or the clock can move that far is a guess, not a measurement; "
-         "the warning names the noise level (or the clock) and the descriptors it affects, "
-         "and a judgement against a behaviour file reads them as inconclusive.",
+         "A recording's measurement is a guess: re-noised copies read another count or "
+         "presence, an interval reaches a fifth of its value away, stamps taken on arrival "
+         "move it (or it is read on the clock evened out), or the log cuts a fast motion.",
+         "The warning names the noise level, the clock or the cut, and each descriptor it "
+         "affects; a judgement against a behaviour file reads them as inconclusive.",
          "a 250 Hz recording of the hesitant behaviour with 1e-3 rad of joint noise"),
     Rule("R412", "inconclusive", _W,
          "A recording measured against a behaviour file shows a descriptor whose 95 % "

@@ -14,8 +14,9 @@ import pinocchio as pin
 import pytest
 
 from aou_dsl.core.trajectory import Trajectory
+from aou_dsl.measuring.linearised import Linearised
 from aou_dsl.measuring.measured import _measure, measure
-from aou_dsl.measuring.uncertainty import Linearised, attach
+from aou_dsl.measuring.uncertainty import attach
 from aou_dsl.robot.batch_fk import batch_fk, batch_fk_jacobian
 from aou_dsl.robot.load import load_arm
 from tests.conftest import BEHAVIOURS

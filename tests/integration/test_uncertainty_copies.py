@@ -11,8 +11,9 @@ import pytest
 
 from aou_dsl.core.trajectory import Trajectory
 from aou_dsl.measuring import uncertainty
+from aou_dsl.measuring.linearised import JACOBIAN_STEP, Linearised
 from aou_dsl.measuring.measured import _measure
-from aou_dsl.measuring.uncertainty import JACOBIAN_STEP, Linearised, attach
+from aou_dsl.measuring.uncertainty import attach
 from aou_dsl.robot.batch_fk import batch_fk, batch_fk_jacobian
 from aou_dsl.robot.load import load_arm
 from tests.conftest import BEHAVIOURS
