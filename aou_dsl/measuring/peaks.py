@@ -101,7 +101,10 @@ def path_travel(s: np.ndarray, q: np.ndarray, noise: np.ndarray
         # The normal equations: z lies in [-0.5, 0.5], so they lose at most about 1e-8 of
         # a joint's angle, far under its noise; LAPACK's least squares (an SVD) costs a
         # hundred times more on the thousands of samples of an approach at 1 kHz.
-        coef = np.linalg.solve(powers.T @ powers, powers.T @ qm)
+        try:
+            coef = np.linalg.solve(powers.T @ powers, powers.T @ qm)
+        except np.linalg.LinAlgError:  # fewer distinct travels than the terms (rounding)
+            continue
         miss = qm - powers @ coef
         if float(np.mean(miss * miss * w)) > PATH_FIT:
             continue

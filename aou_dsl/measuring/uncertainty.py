@@ -117,7 +117,8 @@ def exact(value: float | int | None) -> Spread:
 def _copies(rec: Trajectory, cols: np.ndarray, jn: JointNoise, rng: np.random.Generator
             ) -> tuple[Trajectory, Callable[[], Trajectory], dict[str, np.ndarray]]:
     """``rec`` with its arm joints smoothed (the base); a maker of copies of the base
-    with fresh noise at each moving joint's level (other columns as they are); and the
+    with fresh noise at each moving joint's level, rounded again where the recording's
+    rounding is coarser than its noise (other columns as they are); and the
     recording's own arm joints on the measurement's uniform clock (``"grid"``) and on
     its own (``"raw"``), which the copies' kinematics are expanded about."""
     t = np.asarray(rec.t, float)
@@ -135,9 +136,21 @@ def _copies(rec: Trajectory, cols: np.ndarray, jn: JointNoise, rng: np.random.Ge
     base_q = q_all.copy()
     base_q[:, cols] = smooth_q
 
+    # A joint whose rounding is coarser than its white noise logs a staircase, which
+    # stays put over a pause where white noise averages out: its copies are rounded to
+    # the same steps, on a grid shifted at random (where the truth lies in a step is
+    # unknown).
+    step = np.where(moving & (jn.quantum / math.sqrt(12.0) > jn.sigma), jn.quantum, 0.0)
+    rounded = step > 0
+
     def copy() -> Trajectory:
         qc = q_all.copy()
-        qc[:, cols] = smooth_q + rng.standard_normal(q.shape) * level
+        x = smooth_q + rng.standard_normal(q.shape) * level
+        if rounded.any():
+            shift = rng.uniform(0.0, 1.0, q.shape[1]) * step
+            x[:, rounded] = (np.round((x[:, rounded] + shift[rounded]) / step[rounded])
+                             * step[rounded] - shift[rounded])
+        qc[:, cols] = x
         return rec.with_(q=qc)
 
     return rec.with_(q=base_q), copy, {"grid": grid.q, "raw": q}
