@@ -217,21 +217,14 @@ class Sweep:
         # the cones meet between j - 1 and j: the lower bound there, the larger of the
         # two cones' (each a float of the same arithmetic as ``max`` would compare)
         if members == 1:
-            best = None
-            for x in (j - 1, j):
-                if ja < x < jb:
-                    cx = cum[x]
-                    lb, other = da - (cx - ca), db - (cb - cx)
-                    if other > lb:
-                        lb = other
-                    if best is None or lb < best[0]:
-                        best = (lb, x)
-            return best
-        last = len(cum) - 1
-        down, up = j // members * members, -(-j // members) * members
+            candidates: tuple[int, ...] = (j - 1, j)
+        else:
+            last = len(cum) - 1
+            down, up = j // members * members, -(-j // members) * members
+            candidates = (down if down < last else last, up if up < last else last,
+                          (j - 1) // members * members)
         best = None
-        for x in (down if down < last else last, up if up < last else last,
-                  (j - 1) // members * members):
+        for x in candidates:
             if ja < x < jb:
                 cx = cum[x]
                 lb, other = da - (cx - ca), db - (cb - cx)

@@ -57,15 +57,9 @@ def _recording(name: str, noise: float, rate: float, seed: int) -> Trajectory:
                       tuple(rec["goal"]["position"]))
 
 
-@pytest.mark.parametrize("name,noise,rate,seed,copies", [
-    ("fearful", 1e-4, 1000.0, 2, uncertainty.FIRST),  # every copy reads one segmentation
-    ("hesitant", 1e-3, 250.0, 3, uncertainty.REPLICATES),  # its pause count flips
-])
-def test_four_copies_where_they_agree_on_the_segmentation_ten_where_not(name, noise, rate,
-                                                                       seed, copies):
-    """The base and the first four copies are measured; when a count or a presence
-    differs among them and the recording, six more copies are."""
-    tr = _recording(name, noise, rate, seed)
+def _attached(tr: Trajectory) -> tuple:
+    """``tr`` measured, and given its uncertainty; with the recordings measured for it
+    (the smoothed base, then each copy)."""
     m, jn = _measure(tr)
     calls = []
 
@@ -74,6 +68,18 @@ def test_four_copies_where_they_agree_on_the_segmentation_ten_where_not(name, no
         return _measure(r, pinned, fk)
 
     attach(m, tr, jn, once)
+    return m, calls
+
+
+@pytest.mark.parametrize("name,noise,rate,seed,copies", [
+    ("fearful", 1e-4, 1000.0, 2, uncertainty.FIRST),  # every copy reads one segmentation
+    ("hesitant", 1e-3, 250.0, 3, uncertainty.REPLICATES),  # its pause count flips
+])
+def test_four_copies_where_they_agree_on_the_segmentation_ten_where_not(name, noise, rate,
+                                                                       seed, copies):
+    """The base and the first four copies are measured; when a count or a presence
+    differs among them and the recording, six more copies are."""
+    m, calls = _attached(_recording(name, noise, rate, seed))
     assert len(calls) == 1 + copies
     flipped = [k for k, s in m.uncertainty.items() if not s.stable]
     assert bool(flipped) == (copies == uncertainty.REPLICATES)
@@ -95,14 +101,7 @@ def test_a_state_the_first_copies_flip_takes_no_more_copies():
     q = np.asarray(clean.q)
     tr = clean.with_(q=q + np.random.default_rng(2).normal(0, 3e-4, q.shape), qd=None,
                      qdd=None)
-    m, jn = _measure(tr)
-    calls = []
-
-    def once(r, pinned, fk):
-        calls.append(r)
-        return _measure(r, pinned, fk)
-
-    attach(m, tr, jn, once)
+    m, calls = _attached(tr)
     assert set(m.inferred.states) == {"fearful", "curious"}
     assert all(s.stable for s in m.uncertainty.values())
     assert len(calls) == 1 + uncertainty.FIRST
