@@ -30,7 +30,7 @@ from .holds import Boundary, Rest
 from .peaks import episode_peak, path_travel, phase_peak
 from .recognisers import moved_along
 from .signal import curvature_gain, filter_at, odd, slope_gain, smooth
-from .surges import Phase, phases
+from .surges import phases
 
 __all__ = ["COMPUTED_NOISE", "STILL_TRANSLATION", "Context", "Piece", "Samples",
            "peak_acceleration", "pieces", "translation"]
@@ -199,15 +199,6 @@ def translation(c: Context, p: Piece, g0: np.ndarray | None) -> EpisodeValues | 
     return EpisodeValues(GAZE, p.t0, p.t1, values)
 
 
-def _phases(c: Context, p: Piece, speed: np.ndarray, noise: float) -> list[Phase]:
-    """The speeding-up and slowing-down phases of a piece (:mod:`.surges`): of each surge
-    the samples from its start to 95 % of its top speed, and back to its end, and those
-    up to or from the top speed (where a peak that grows to the top speed is: a
-    bang-bang law's switch); a phase cut by the recording's start or end is left out,
-    unless nothing else is left. ``noise``: the speed's std."""
-    return phases(speed, c.rest.h, p.at_rest0, p.at_rest1, noise)
-
-
 def peak_acceleration(c: Context, p: Piece, u: np.ndarray) -> tuple[float, float]:
     """Peak acceleration of the hand along the direction of travel ``u`` [m/s^2], and
     the std the joints' noise gives it: each speeding-up and slowing-down phase read as
@@ -247,7 +238,9 @@ def peak_acceleration(c: Context, p: Piece, u: np.ndarray) -> tuple[float, float
     steps = (2.0 if p.at_rest0 and not p.held0 else 1.0,
              2.0 if p.at_rest1 and not p.held1 else 1.0)
     # At a dip between two surges the acceleration turns from slowing down to speeding up.
-    found = [f for ph in _phases(c, p, speed, sigma_x * slope_gain(r.window, h))
+    # Each surge's speeding-up and slowing-down phases (:mod:`.surges`).
+    runs = phases(speed, h, p.at_rest0, p.at_rest1, sigma_x * slope_gain(r.window, h))
+    found = [f for ph in runs
              if (f := phase_peak(t, x, own(ph.a, -1), own(ph.b, +1), sigma_x, transient,
                                  travel if c.noise.max() > 0 else None,
                                  2.0 if ph.at_dip else steps[0] if ph.a == 0

@@ -19,6 +19,7 @@ from ..core.memo import table
 from .savgol import savgol, savgol_weights
 
 __all__ = [
+    "centred_mean",
     "Grid",
     "JointNoise",
     "curvature_gain",
@@ -266,3 +267,13 @@ def short_window(sigma: float, h: float) -> int:
     while w < longest and NOISE_SIGMAS * sigma * slope_gain(w, h) > SPEED_RESOLUTION:
         w += 2
     return w
+
+
+def centred_mean(x: np.ndarray, half: int) -> np.ndarray:
+    """The mean of ``x`` (N,) over the ``2 * half + 1`` samples centred on each, over
+    fewer (still centred) within ``half`` of either end: a running sum's differences."""
+    n = len(x)
+    c = np.concatenate([[0.0], np.cumsum(x)])
+    at = np.arange(n)
+    r = np.minimum(np.minimum(at, n - 1 - at), half)
+    return (c[at + r + 1] - c[at - r]) / (2 * r + 1)

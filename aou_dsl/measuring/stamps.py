@@ -21,7 +21,8 @@ import numpy as np
 from ..core.codes import R411
 from ..core.diagnostics import AouError, Span, diag
 from .recognisers import every_named
-from .uncertainty import VAGUE, VAGUE_TOLERANCES, Spread, half_width
+from .signal import centred_mean
+from .uncertainty import vague
 
 __all__ = ["STAMP_FOLLOW", "evened", "judge_stamps", "read_on_evened", "stamp_share",
            "stamped_on_arrival"]
@@ -74,11 +75,7 @@ def evened(t: np.ndarray, window: int = STAMP_WINDOW) -> np.ndarray:
     """A clock's stamps averaged over ``window`` samples (fewer, symmetric, at its ends):
     it still increases strictly, keeps a logging gap's time (spread over the window)
     and loses the stamps' jitter."""
-    half = window // 2
-    c = np.concatenate([[0.0], np.cumsum(t - t[0])])
-    i = np.arange(len(t))
-    r = np.minimum(np.minimum(i, len(t) - 1 - i), half)
-    return t[0] + (c[i + r + 1] - c[i - r]) / (2 * r + 1)
+    return t[0] + centred_mean(t - t[0], window // 2)
 
 
 def judge_stamps(m: Any, path: str, t: np.ndarray, q: np.ndarray, noise: np.ndarray,
@@ -97,11 +94,6 @@ def judge_stamps(m: Any, path: str, t: np.ndarray, q: np.ndarray, noise: np.ndar
     except AouError:
         return
 
-    def vague(name: str, value: float, s: Spread) -> bool:  # as the noise's rule
-        half, d = half_width(s, value), every_named()[name]
-        return half is not None and not d.is_count and \
-            half > max(VAGUE * abs(value), VAGUE_TOLERANCES * d.abs_tol)
-
     moved = []
     for name, sp in m.uncertainty.items():
         value, other = m.descriptors.get(name), other_m.descriptors.get(name)
@@ -114,18 +106,13 @@ def judge_stamps(m: Any, path: str, t: np.ndarray, q: np.ndarray, noise: np.ndar
             moved.append((name, value, other))
         m.uncertainty[name] = wide
     if moved:
-        h = float(np.median(np.diff(t)))
-        jitter = float(np.std(np.diff(t)))
         m.diagnostics.append(diag(
-            R411, f"the clock's stamps do not follow the samples (their steps vary by "
-            f"{jitter * 1e3:.2g} ms about {h * 1e3:.2g} ms, the positions' steps follow "
-            f"{max(share, 0.0):.0%} of that: stamps taken on arrival): read on the clock "
-            "evened out, " + "; ".join(f"{n} reads {o:.4g} instead of {v:.4g}"
-                                        for n, v, o in moved)
+            R411, _clock(t, f", the positions' steps follow {max(share, 0.0):.0%} of that")
+            + ": read on the clock evened out, "
+            + "; ".join(f"{n} reads {o:.4g} instead of {v:.4g}" for n, v, o in moved)
             + f". {'These are' if len(moved) > 1 else 'This is'} not to be trusted",
-            Span.whole_file(path),
-            hint="log the time each sample was taken (the controller's own stamp), not "
-            "the time it arrived", descriptors=[n for n, _, _ in moved], share=share))
+            Span.whole_file(path), hint=HINT, descriptors=[n for n, _, _ in moved],
+            share=share))
 
 
 def stamped_on_arrival(t: np.ndarray, q: np.ndarray, noise: np.ndarray) -> bool:
@@ -145,15 +132,24 @@ def read_on_evened(m: Any, path: str, t: np.ndarray, error: AouError) -> None:
     for n in names:
         if n in m.uncertainty:
             m.uncertainty[n] = replace(m.uncertainty[n], stable=False)
-    dt = np.diff(t)
     first = error.diagnostics[0]
     m.diagnostics.append(diag(
-        R411, f"the clock's stamps do not follow the samples (their steps vary by "
-        f"{float(np.std(dt)) * 1e3:.2g} ms about {float(np.median(dt)) * 1e3:.2g} ms: "
-        f"stamps taken on arrival), and on them the measurement failed ({first.code}: "
+        R411, _clock(t) + f", and on them the measurement failed ({first.code}: "
         f"{first.message}); read on the clock evened out instead: "
         + "; ".join(f"{n} reads {m.descriptors.get(n):.4g}" for n in names)
         + ". Values read from the evened clock are not to be trusted",
-        Span.whole_file(path),
-        hint="log the time each sample was taken (the controller's own stamp), not "
-        "the time it arrived", descriptors=names, own_clock_error=first.code))
+        Span.whole_file(path), hint=HINT, descriptors=names, own_clock_error=first.code))
+
+
+#: What to do about a clock stamped on arrival.
+HINT = "log the time each sample was taken (the controller's own stamp), not the time it " \
+    "arrived"
+
+
+def _clock(t: np.ndarray, follow: str = "") -> str:
+    """The start of R411's text for a clock ``t`` stamped on arrival: how its steps vary,
+    then ``follow`` (how far the positions follow them) inside the brackets."""
+    dt = np.diff(t)
+    return (f"the clock's stamps do not follow the samples (their steps vary by "
+            f"{float(np.std(dt)) * 1e3:.2g} ms about {float(np.median(dt)) * 1e3:.2g} ms"
+            f"{follow}: stamps taken on arrival)")

@@ -34,6 +34,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .signal import centred_mean
+
 __all__ = ["DIP", "DISTINCT", "SPAN", "SURGE", "Phase", "phases", "surges"]
 
 #: A dip splits two surges when the speed there is below this share of both tops.
@@ -68,11 +70,8 @@ def surges(speed: np.ndarray, h: float, noise: float = 0.0) -> list[tuple[int, i
     if n < 3:
         return [(0, n - 1)]
     half = min(int(0.5 * SPAN / h), (n - 1) // 2)
-    if half > 0:  # a moving average, over fewer samples (symmetric) at the ends
-        c = np.concatenate([[0.0], np.cumsum(speed)])
-        at = np.arange(n)
-        r = np.minimum(np.minimum(at, n - 1 - at), half)
-        speed = (c[at + r + 1] - c[at - r]) / (2 * r + 1)
+    if half > 0:
+        speed = centred_mean(speed, half)
     least, rise = SURGE * float(speed.max()), DISTINCT * noise
     dips: list[int] = []
     top, low, low_i, falling = float(speed[0]), 0.0, 0, False

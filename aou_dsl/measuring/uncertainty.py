@@ -39,7 +39,7 @@ from .linearised import Linearised
 from .recognisers import every_named
 from .signal import JointNoise, short_window, smooth, to_grid, unwrap
 
-__all__ = ["REPLICATES", "Inferred", "Spread", "attach"]
+__all__ = ["REPLICATES", "Inferred", "Spread", "attach", "vague"]
 
 #: Re-noised copies measured first; when they are all readable and read the
 #: recording's segmentation (every count and every presence), as the smoothed base
@@ -236,8 +236,8 @@ def attach(m, rec: Trajectory, jn: JointNoise,
         step = float(np.median(np.diff(np.asarray(rec.t, float))))
         m.uncertainty = {k: _spread(k, value[k], smooth_read[k], [r[k] for r in reads],
                                     step) for k in table}
-    vague = [k for k, s in m.uncertainty.items() if _vague(k, value[k], s)]
-    for k in vague:  # not to be trusted: a verdict on it is inconclusive
+    too_wide = [k for k, s in m.uncertainty.items() if vague(k, value[k], s)]
+    for k in too_wide:  # not to be trusted: a verdict on it is inconclusive
         m.uncertainty[k] = replace(m.uncertainty[k], stable=False)
     shaky = [k for k, s in m.uncertainty.items() if not s.stable]
     states = m.inferred.states
@@ -339,7 +339,9 @@ VAGUE = 0.2
 VAGUE_TOLERANCES = 3.0
 
 
-def _vague(name: str, value: float | int | None, s: Spread) -> bool:
+def vague(name: str, value: float | int | None, s: Spread) -> bool:
+    """Whether a value's interval ``s`` reaches too far from it to be trusted
+    (:data:`VAGUE`); never a count's."""
     half = half_width(s, value)
     d = every_named()[name]
     if half is None or d.is_count or value is None:
