@@ -57,6 +57,7 @@ from .holds import MIN_PAUSE, REST_SPEED, Boundary, Rest, boundaries, rest_at_en
 from .recognisers import claimed, every_named, extra_descriptors, extra_values
 from .roll import MIN_TILT, SHAPED_CYCLE, Lobe, lobe, roll_angle, rotations
 from .signal import Grid, JointNoise, joint_noise, short_window, smooth, to_grid, unwrap
+from .staircase import dequantised
 from .stamps import evened, judge_stamps, read_on_evened, stamped_on_arrival
 
 __all__ = ["MIN_PAUSE", "MIN_TILT", "STILL_TRANSLATION", "LineOfSight", "Measured",
@@ -184,6 +185,7 @@ def _context(rec: Trajectory, pinned: JointNoise | None = None, fk: Kinematics |
     t, q = _checked(rec, cols)
     q, _ = unwrap(q)
     jn = joint_noise(t, q) if pinned is None else pinned
+    q = dequantised(t, q, jn)
     noise = jn.effective
     h0 = float(np.median(np.diff(t)))
     window = short_window(float(noise.max()), h0)

@@ -153,7 +153,27 @@ def _joint_noise(t: np.ndarray, q: np.ndarray) -> JointNoise:
         r = _residuals(t, q)
         sigma = 1.4826 * np.median(np.abs(r), axis=0)
     quantum = np.array([_quantum(q[:, j]) if moving[j] else 0.0 for j in range(n)])
-    return JointNoise(np.where(moving, sigma, 0.0), quantum, moving)
+    return JointNoise(np.where(moving, sigma, 0.0), _shared(q, moving, quantum), moving)
+
+
+def _shared(q: np.ndarray, moving: np.ndarray, quantum: np.ndarray) -> np.ndarray:
+    """``quantum`` with a joint that steps too few times to show its own resolution
+    given the finest one the other joints show, when every step it takes is a whole
+    multiple of it (one encoder resolution for the arm: a joint that barely moves
+    still logs its few steps of it, which would otherwise read as motion out of no
+    noise)."""
+    found = quantum[quantum > 0]
+    if not len(found):
+        return quantum
+    step = float(found.min())
+    out = quantum.copy()
+    for j in np.flatnonzero(moving & (quantum == 0)):
+        d = np.abs(np.diff(q[:, j]))
+        d = d[d > 0]
+        if 0 < len(d) < 10 and np.all(np.abs(d / step - np.round(d / step)) < 0.02) \
+                and np.all(np.round(d / step) >= 1):
+            out[j] = step
+    return out
 
 
 @dataclass(frozen=True)

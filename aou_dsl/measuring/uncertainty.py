@@ -38,6 +38,7 @@ from .episodes import COMPUTED_NOISE
 from .linearised import Linearised
 from .recognisers import every_named
 from .signal import JointNoise, short_window, smooth, to_grid, unwrap
+from .staircase import dequantised, held_offsets, staircase_joints
 
 __all__ = ["REPLICATES", "Inferred", "Spread", "attach", "vague"]
 
@@ -123,7 +124,8 @@ def _copies(rec: Trajectory, cols: np.ndarray, jn: JointNoise, rng: np.random.Ge
     its own (``"raw"``), which the copies' kinematics are expanded about."""
     t = np.asarray(rec.t, float)
     q_all = np.asarray(rec.q, float)
-    q, _ = unwrap(q_all[:, cols])
+    stairs = unwrap(q_all[:, cols])[0]
+    q = dequantised(t, stairs, jn)
     level = jn.effective
     h0 = float(np.median(np.diff(t)))
     window = short_window(float(level.max()), h0)
@@ -137,16 +139,19 @@ def _copies(rec: Trajectory, cols: np.ndarray, jn: JointNoise, rng: np.random.Ge
     base_q[:, cols] = smooth_q
 
     # A joint whose rounding is coarser than its white noise logs a staircase, which
-    # stays put over a pause where white noise averages out: its copies are rounded to
-    # the same steps, on a grid shifted at random (where the truth lies in a step is
-    # unknown).
-    step = np.where(moving & (jn.quantum / math.sqrt(12.0) > jn.sigma), jn.quantum, 0.0)
-    rounded = step > 0
+    # stays put over a pause where white noise averages out: its copies hold each pause
+    # anywhere in its step, and are rounded to the same steps, on a grid shifted at
+    # random (where the truth lies in a step is unknown). Their white noise, the
+    # rounding's size, makes them step back and forth where the truth may lie near the
+    # middle between two steps.
+    rounded = staircase_joints(jn)
+    step = np.where(rounded, jn.quantum, 0.0)
 
     def copy() -> Trajectory:
         qc = q_all.copy()
         x = smooth_q + rng.standard_normal(q.shape) * level
         if rounded.any():
+            x += held_offsets(t, stairs, jn, rng)
             shift = rng.uniform(0.0, 1.0, q.shape[1]) * step
             x[:, rounded] = (np.round((x[:, rounded] + shift[rounded]) / step[rounded])
                              * step[rounded] - shift[rounded])
@@ -237,23 +242,35 @@ def attach(m, rec: Trajectory, jn: JointNoise,
         m.uncertainty = {k: _spread(k, value[k], smooth_read[k], [r[k] for r in reads],
                                     step) for k in table}
     too_wide = [k for k, s in m.uncertainty.items() if vague(k, value[k], s)]
-    for k in too_wide:  # not to be trusted: a verdict on it is inconclusive
+    # A value read from episodes the copies count differently may be read from one
+    # the noise made, or miss one it hid: not to be trusted either.
+    uncounted = {table[k].kind for k, s in m.uncertainty.items()
+                 if table[k].is_count and not s.stable}
+    over = [k for k, d in table.items() if d.kind in uncounted and not d.is_count
+            and value[k] is not None and m.uncertainty[k].stable]
+    for k in too_wide + over:  # not to be trusted: a verdict on it is inconclusive
         m.uncertainty[k] = replace(m.uncertainty[k], stable=False)
     shaky = [k for k, s in m.uncertainty.items() if not s.stable]
     states = m.inferred.states
     if shaky or len(states) > 1:
         noise = float(jn.effective.max())
-        what = [_shaky_text(k, value[k], m.uncertainty[k], len(reads)) for k in shaky]
+        what = [_shaky_text(k, value[k], m.uncertainty[k], len(reads))
+                + (f", read from {table[k].kind} episodes the copies count differently"
+                   if k in over else "") for k in shaky]
         if len(states) > 1:
             what.append(f"the inferred state reads {m.cv.state.value}, and "
                         f"{', '.join(states)} in the re-noised copies")
+        stairs = staircase_joints(jn)
+        source = (f"the joints' rounding (steps of {float(jn.quantum[stairs].max()):.2g} "
+                  "rad)" if stairs.any() else f"the joints' noise ({noise:.2g} rad)")
         m.diagnostics.append(diag(
-            R411, f"the joints' noise ({noise:.2g} rad) is more than this recording's "
+            R411, f"{source} is more than this recording's "
             f"segmentation bears: {'; '.join(what)}. "
             f"{'These are' if len(what) > 1 else 'This is'} not to be trusted",
             Span.whole_file(rec.path),
-            hint="log at a higher rate or with less noise; a longer pause or a slower "
-            "motion stands out of the noise better",
+            hint=("log with a finer encoder resolution" if stairs.any() else
+                  "log at a higher rate or with less noise")
+            + "; a longer pause or a slower motion stands out of the noise better",
             noise=noise, descriptors=shaky, states=list(states)))
 
 
