@@ -98,9 +98,12 @@ def profile_data(rec: Trajectory) -> ProfileData:
         # A recording's noise: its speed is drawn filtered, as measure and check read it.
         from ..measuring.episodes import COMPUTED_NOISE
         from ..measuring.signal import joint_noise, short_window, smooth, to_grid
+        from ..measuring.staircase import dequantised
 
-        sigma = float(joint_noise(t, q).effective.max(initial=0.0))
+        jn = joint_noise(t, q)
+        sigma = float(jn.effective.max(initial=0.0))
         if sigma > COMPUTED_NOISE:
+            q = dequantised(t, q, jn)  # a coarse encoder's staircase, as measure reads it
             w = short_window(sigma, float(np.median(np.diff(t))))
             grid = to_grid(t, q, w * float(np.median(np.diff(t))))
             extra.update(raw_t=t, raw_speed=speed, noise=sigma)

@@ -78,13 +78,16 @@ def filtered(t: np.ndarray, q: np.ndarray, amax: np.ndarray) -> Filtered | None:
         smooth,
         to_grid,
     )
+    from ..measuring.staircase import dequantised
 
     if len(t) < 8:
         return None
-    noise = joint_noise(t, q).effective
+    jn = joint_noise(t, q)
+    noise = jn.effective
     sigma = float(noise.max(initial=0.0))
     if sigma <= COMPUTED_NOISE:
         return None
+    q = dequantised(t, q, jn)  # a coarse encoder's staircase, as measure reads it
     h = float(np.median(np.diff(t)))
     wv = short_window(sigma, h)
     grid = to_grid(t, q, wv * h)
