@@ -92,23 +92,18 @@ def _knots(t: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     # A step's neighbours' crossing times; at the log's ends, the one neighbour's.
     before = np.concatenate(([held[1] if len(held) > 1 else held[0]], held[:-1]))
     after = np.concatenate((held[1:], [held[-2] if len(held) > 1 else held[0]]))
-    first, last = 0, len(held) - 1
-    knots_t: list[float] = []
-    knots_v: list[float] = []
-    hold: list[bool] = []
-    for k in range(len(held)):
-        if k > first:
-            knots_t.append(float(at[k - 1]))
-            knots_v.append(float(middle[k - 1]))
-            hold.append(False)
-        end = k in (first, last)
-        if end or held[k] > HOLD * (before[k] + after[k]):
-            # Reached at the pace it arrived with (at once where the log starts on
-            # it), left at the pace it left with (held to the log's end).
-            reach = edges[k] if k == first else edges[k] + before[k] / 2
-            leave = edges[k + 1] if k == last else edges[k + 1] - after[k] / 2
-            if leave > reach:
-                knots_t += [float(reach), float(leave)]
-                knots_v += [float(level[k])] * 2
-                hold += [True, True]
-    return np.asarray(knots_t), np.asarray(knots_v), np.asarray(hold, bool)
+    n = len(held)
+    k = np.arange(n)
+    holds = (k == 0) | (k == n - 1) | (held > HOLD * (before + after))
+    # Reached at the pace it arrived with (at once where the log starts on it), left at
+    # the pace it left with (held to the log's end).
+    reach = np.where(k == 0, edges[:-1], edges[:-1] + before / 2)
+    leave = np.where(k == n - 1, edges[1:], edges[1:] - after / 2)
+    holds &= leave > reach
+    # Per step, in time order: the crossing onto it (none for the first), its reach and
+    # its leave (a hold's only).
+    times = np.stack([np.concatenate(([t[0]], at)), reach, leave], axis=1)
+    values = np.stack([np.concatenate(([x[0]], middle)), level, level], axis=1)
+    kept = np.stack([k > 0, holds, holds], axis=1)
+    is_hold = np.broadcast_to(np.array([False, True, True]), kept.shape)
+    return times[kept], values[kept], is_hold[kept]
