@@ -106,6 +106,7 @@ class _Solver:
         pin = self.pin
         fid = self.arm.frame_id
         model, data, lo, hi = self.model, self.data, self.lo, self.hi
+        solve = self.lapack.solve
         for it in range(MAX_ITER + 1):
             # One pass: forward kinematics and every joint's Jacobian; then the frame's
             # placement and Jacobian from them.
@@ -119,12 +120,15 @@ class _Solver:
                 break
             je = -pin.Jlog6(dm.inverse()) @ jac
             # The damped pseudo-inverse (the matrix is positive definite: damped).
-            pinv = je.T @ self.lapack.solve(je @ je.T + _DAMPED, _EYE6,
-                                            signature="dd->d")
+            gram = je @ je.T
+            gram += _DAMPED
+            pinv = je.T @ solve(gram, _EYE6, signature="dd->d")
             dq = -pinv @ err
             if it < POSTURE_ITERS:
                 dq += (self.eye_n - pinv @ je) @ (POSTURE_GAIN * (self.posture - q))
-            step = float(np.abs(dq).max())
+            # The largest joint step (a NaN in it makes every joint's NaN: a diverged
+            # solve, reported so whatever the step).
+            step = max(map(abs, dq.tolist()))
             if step > MAX_ITER_STEP:  # far from the target: Newton steps overshoot
                 dq *= MAX_ITER_STEP / step
             q = np.minimum(np.maximum(q + dq, lo), hi)
