@@ -108,11 +108,7 @@ def _kept_waypoints(probe: Keyed) -> tuple[np.ndarray, list[tuple[np.ndarray, np
     ep, frame, step = probe.value
     n = max(MIN_WAYPOINTS, math.ceil(ep.path_length / step) + 1)
     s = np.linspace(0.0, ep.path_length, n)
-    a, b = ep.start, ep.end
-    targets = []
-    for si in s:
-        f = si / ep.path_length
-        targets.append(frame.target(a.lerp(b, f)))
+    targets = frame.targets(ep.start, ep.end, (si / ep.path_length for si in s))
     s.setflags(write=False)  # shared by the compilations that keep it
     return s, targets
 

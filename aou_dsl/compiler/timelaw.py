@@ -119,9 +119,10 @@ class TimeLaw:
         s = self.s[i] + self.sd[i] * dt + 0.5 * u * dt * dt
         area = self._area[i] + self.s[i] * dt + self.sd[i] * dt**2 / 2 + u * dt**3 / 6
         before, after = tau < 0.0, tau > end
+        rest = before | after
         s = np.where(after, self.length, s)
-        sd = np.where(before | after, 0.0, sd)
-        u = np.where(before | after, 0.0, u)
+        sd = np.where(rest, 0.0, sd)
+        u = np.where(rest, 0.0, u)
         area = np.where(before, 0.0, area + np.where(after, self.length * (tau - end), 0.0))
         return s, sd, u, area
 

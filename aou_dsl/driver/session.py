@@ -139,12 +139,16 @@ class Session:
               **changes: Any) -> BuildResult:
         """Lint, compile, check and measure ``text`` with the session's options (or
         ``options``, with ``changes``), re-using the last build of the same behaviour."""
+        return self._build(self.lint(text, path), path, options, changes)
+
+    def _build(self, linted: FileResult, path: str, options: BuildOptions | None,
+               changes: dict[str, Any]) -> BuildResult:
+        """:meth:`build` of a lint of the text."""
         from .builder import build_lint
 
         opts = options or self.options
         if changes:
             opts = opts.replace(**changes)
-        linted = self.lint(text, path)
         if linted.behaviour is None or linted.timeline is None:
             return build_lint(linted, opts)  # refused: nothing to compile, nothing kept
 
@@ -161,15 +165,19 @@ class Session:
     def build_file(self, path: str, options: BuildOptions | None = None,
                    **changes: Any) -> BuildResult:
         """:meth:`build` of a file's text; a file that cannot be read is a result with
-        its I501 diagnostic, as :func:`~aou_dsl.driver.builder.build_file` gives."""
-        from ..lang.linter import lint_file
+        its I501 diagnostic, as :func:`~aou_dsl.driver.builder.build_file` gives. The
+        file's lint is the one built from (a lint of the same text is the same lint: it
+        is not made twice)."""
+        from ..lang.linter import TRAJECTORY_EXTENSIONS, lint_file
         from .builder import build_lint
 
         linted = lint_file(path)
         if linted.source is None or linted.behaviour is None:
             opts = options or self.options
             return build_lint(linted, opts.replace(**changes) if changes else opts)
-        return self.build(linted.source, path, options, **changes)
+        if path.lower().endswith(TRAJECTORY_EXTENSIONS):  # lint_file's hint for those
+            return self.build(linted.source, path, options, **changes)  # is not the text's
+        return self._build(linted, path, options, changes)
 
     def measure(self, trajectory: Trajectory) -> Measured:
         """The eleven descriptors of a trajectory (measuring keeps no state to reuse)."""

@@ -19,6 +19,8 @@ points at the goal whatever the pose, so the line of sight is zero by constructi
 from __future__ import annotations
 
 import math
+import struct
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,7 +34,13 @@ def axis_angle(axis: np.ndarray, angle: float) -> np.ndarray:
     """Rotation matrix about a unit ``axis`` by ``angle`` [rad] (Rodrigues), shape (3, 3)."""
     x, y, z = axis
     k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
-    return np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * (k @ k)
+    return _EYE3 + np.sin(angle) * k + (1.0 - np.cos(angle)) * (k @ k)
+
+
+_EYE3 = np.eye(3)
+_EYE3.setflags(write=False)
+_Z = np.array([0.0, 0.0, 1.0])
+_Z.setflags(write=False)
 
 
 @dataclass(frozen=True)
@@ -49,12 +57,34 @@ class ReachFrame:
 
     def target(self, pose: Pose) -> tuple[np.ndarray, np.ndarray]:
         """Position (3,) and rotation (3, 3) of the end-effector at ``pose``."""
+        back, r = self._turn(pose.h, pose.v, pose.roll)
+        return self.goal + pose.d * back, r
+
+    def targets(self, start: Pose, end: Pose, fractions: Iterable[float]
+                ) -> list[tuple[np.ndarray, np.ndarray]]:
+        """``[target(start.lerp(end, f)) for f in fractions]``, the same numbers to the
+        bit; the rotation is computed once per distinct angles (bit for bit: a signed
+        zero is another angle), so a path that keeps its gaze and roll (an approach, a
+        retreat) turns once. The rotations are shared and read-only."""
+        out = []
+        turns: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+        for f in fractions:
+            pose = start.lerp(end, f)
+            key = struct.pack("3d", pose.h, pose.v, pose.roll)
+            turn = turns.get(key)
+            if turn is None:
+                turn = turns[key] = self._turn(pose.h, pose.v, pose.roll)
+                turn[1].setflags(write=False)
+            out.append((self.goal + pose.d * turn[0], turn[1]))
+        return out
+
+    def _turn(self, h: float, v: float, roll: float) -> tuple[np.ndarray, np.ndarray]:
+        """The unit vector from the goal back to the end-effector, and the end-effector's
+        rotation, at the angles of a pose."""
         x0, y0, z0 = self.R0.T
-        a, c = rotation_angles(pose.h, pose.v)
+        a, c = rotation_angles(h, v)
         b = axis_angle(x0, c) @ axis_angle(y0, a)
-        p = self.goal + pose.d * (b @ -z0)
-        r = b @ self.R0 @ axis_angle(np.array([0.0, 0.0, 1.0]), pose.roll)
-        return p, r
+        return b @ -z0, b @ self.R0 @ axis_angle(_Z, roll)
 
 
 def rotation_angles(h: float, v: float) -> tuple[float, float]:

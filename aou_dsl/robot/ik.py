@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import enum
 import math
+import operator
 from dataclasses import dataclass
 
 import numpy as np
@@ -106,6 +107,7 @@ class _Solver:
         pin = self.pin
         fid = self.arm.frame_id
         model, data, lo, hi = self.model, self.data, self.lo, self.hi
+        solve = self.lapack.solve
         for it in range(MAX_ITER + 1):
             # One pass: forward kinematics and every joint's Jacobian; then the frame's
             # placement and Jacobian from them.
@@ -119,12 +121,15 @@ class _Solver:
                 break
             je = -pin.Jlog6(dm.inverse()) @ jac
             # The damped pseudo-inverse (the matrix is positive definite: damped).
-            pinv = je.T @ self.lapack.solve(je @ je.T + _DAMPED, _EYE6,
-                                            signature="dd->d")
+            gram = je @ je.T
+            gram += _DAMPED
+            pinv = je.T @ solve(gram, _EYE6, signature="dd->d")
             dq = -pinv @ err
             if it < POSTURE_ITERS:
                 dq += (self.eye_n - pinv @ je) @ (POSTURE_GAIN * (self.posture - q))
-            step = float(np.abs(dq).max())
+            # The largest joint step (a NaN in it makes every joint's NaN: a diverged
+            # solve, reported so whatever the step).
+            step = max(map(abs, dq.tolist()))
             if step > MAX_ITER_STEP:  # far from the target: Newton steps overshoot
                 dq *= MAX_ITER_STEP / step
             q = np.minimum(np.maximum(q + dq, lo), hi)
@@ -201,13 +206,15 @@ def solve_path(arm: ArmModel, targets: list[tuple[np.ndarray, np.ndarray]],
         q = np.asarray(q_start, dtype=float)
     out = np.empty((len(targets), arm.n))
     worst_p = worst_r = 0.0
+    # The checks of each target read its few floats in Python: the same tests as
+    # numpy's, without an array made for each.
     for i, (p, r) in enumerate(targets):
-        if not (np.isfinite(p).all() and np.isfinite(r).all()):
+        if not (_finite(p) and _finite(r)):
             return IKResult(out[:i], worst_p, worst_r,
                             IKFailure(IKStatus.UNREACHABLE, i, np.inf, np.inf))
         q_new, pe, re, sigma = solver.solve(p, r, q)
         failure = None
-        if not (np.isfinite(q_new).all() and math.isfinite(pe) and math.isfinite(re)):
+        if not (_finite(q_new) and math.isfinite(pe) and math.isfinite(re)):
             failure = IKFailure(IKStatus.UNREACHABLE, i, np.inf, np.inf)
         elif pe > 1e-4 or re > 1e-3:
             at_limit = (q_new <= solver.lo + 1e-9) | (q_new >= solver.hi - 1e-9)
@@ -218,7 +225,7 @@ def solve_path(arm: ArmModel, targets: list[tuple[np.ndarray, np.ndarray]],
                 failure = IKFailure(IKStatus.UNREACHABLE, i, pe, re)
         elif sigma < MIN_SINGULAR:
             failure = IKFailure(IKStatus.SINGULARITY, i, pe, re)
-        elif i > 0 and np.abs(q_new - q).max() > MAX_STEP:
+        elif i > 0 and max(map(abs, map(operator.sub, q_new.tolist(), q.tolist()))) > MAX_STEP:
             j = arm.joint_names[int(np.argmax(np.abs(q_new - q)))]
             failure = IKFailure(IKStatus.DISCONTINUITY, i, pe, re, j)
         if failure is not None:
@@ -226,3 +233,9 @@ def solve_path(arm: ArmModel, targets: list[tuple[np.ndarray, np.ndarray]],
         out[i] = q = q_new
         worst_p, worst_r = max(worst_p, pe), max(worst_r, re)
     return IKResult(out, worst_p, worst_r)
+
+
+def _finite(x: np.ndarray) -> bool:
+    """Whether every value of a small array is finite (``np.isfinite(x).all()``)."""
+    values = x.ravel() if isinstance(x, np.ndarray) else np.ravel(x)
+    return all(map(math.isfinite, values.tolist()))

@@ -107,3 +107,27 @@ def test_warm_rebuilds_after_changes_of_each_kind_match_fresh_builds(tmp_path):
         path = tmp_path / f"{k}_{_CHANGES[k][0]}.aou"
         assert doc == path.with_suffix(".json").read_bytes(), _CHANGES[k]
         assert diags == path.with_suffix(".diag").read_text(), _CHANGES[k]
+
+
+def test_a_file_is_linted_once_to_be_built(tmp_path, monkeypatch):
+    """``build_file`` (what ``aouc compile`` runs) judges the file's text once: the
+    lint that read the file is the one built from, and the document is the one a build
+    of its text gives."""
+    from aou_dsl.lang import linter, relint
+
+    judged: list[str] = []
+    real = linter.judge
+
+    def spy(text, path, *args, **kwargs):
+        judged.append(path)
+        return real(text, path, *args, **kwargs)
+
+    monkeypatch.setattr(linter, "judge", spy)
+    monkeypatch.setattr(relint, "judge", spy)
+    path = tmp_path / "h.aou"
+    path.write_text(HESITANT)
+    res = Session().build_file(str(path))
+    assert res.ok and judged == [str(path)]
+    monkeypatch.undo()
+    assert encode(res.document, "json") == encode(Session().build(HESITANT, str(path))
+                                                  .document, "json")
