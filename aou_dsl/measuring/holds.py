@@ -29,7 +29,7 @@ import numpy as np
 from .extrema import maxima
 from .onset import REST_SPEED, carried_edge, soft_pause
 from .rest import LONG_WINDOW, Rest, rest_signals
-from .signal import NOISE_SIGMAS, odd, runs
+from .signal import NOISE_SIGMAS, line_fit, odd, runs
 
 __all__ = ["MIN_PAUSE", "REST_SPEED", "Boundary", "Rest", "boundaries", "rest_at_end",
            "rest_signals"]
@@ -107,18 +107,21 @@ def _lead(r: Rest, seg: np.ndarray, slow: bool) -> tuple[np.ndarray, int, float]
     its window early, which is allowed for), or the long one for an edge that slow
     motion made (``slow``)."""
     found = []
+    # ``seg`` runs one way from the rest: the same rows as a view, without a copy.
+    stop = int(seg[-1]) + (1 if seg[-1] >= seg[0] else -1)
+    rows = slice(int(seg[0]), stop if stop >= 0 else None, 1 if seg[-1] >= seg[0] else -1)
     for v, thr, window in ((r.v, r.thr, r.window), (r.v_long, r.thr_long, 0)):
         if v is None or thr is None:
             continue
         width = window or odd(LONG_WINDOW / r.h)
-        ratio = np.abs(v[seg]) / thr[seg]
+        ratio = np.abs(v[rows]) / thr[rows]
         moving = np.flatnonzero(ratio.max(axis=1) > CLEARLY)
         if len(moving) == 0:
             continue
         near = ratio[moving[0]:moving[0] + max(3, width)]
         j = int(np.argmax(near.max(axis=0)))
         k = moving[0] + int(np.argmax(near[:, j]))
-        vj = v[seg, j] * (1.0 if v[seg[k], j] >= 0 else -1.0) / thr[seg, j]
+        vj = v[rows, j] * (1.0 if v[seg[k], j] >= 0 else -1.0) / thr[rows, j]
         up = np.flatnonzero(vj > CLEARLY)
         if len(up):
             # A filter sees motion half its window before it starts.
@@ -172,7 +175,7 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False) -> Zero
     # The motion stops between its first clearly moving sample and the far end of the
     # rest (give or take a step), and no further into the rest than its ramp takes to
     # fall through the threshold (twice that, plus the filter's reach).
-    slope = abs(float(np.polyfit(ramp - ramp[0], vr, 1)[0])) if len(ramp) >= 2 else 0.0
+    slope = abs(line_fit(ramp - ramp[0], vr)[0]) if len(ramp) >= 2 else 0.0
     reach_in = 2.0 / (slope * unit) + (window // 2 + 1) * r.h if slope > 0 else math.inf
     edge = float(t[i])
     far_t = edge - step * min(abs(float(t[far]) - edge) + r.h, reach_in)
@@ -199,11 +202,11 @@ def _zero(t: np.ndarray, v: np.ndarray, straight: bool = False) -> float | None:
     if len(t) < 2:
         return None
     x = t - t[0]
-    slope, icpt = np.polyfit(x, v, 1)
-    if not np.isfinite(slope) or abs(slope) < 1e-15:
+    slope, icpt = line_fit(x, v)
+    if not math.isfinite(slope) or abs(slope) < 1e-15:
         return None
     if straight and len(t) >= 4:
-        miss = float(np.sqrt(np.mean((np.polyval([slope, icpt], x) - v) ** 2)))
+        miss = float(np.sqrt(np.mean((slope * x + icpt - v) ** 2)))
         if miss > 0.1 * float(np.max(np.abs(v))) + 1.0 / NOISE_SIGMAS:
             return None
     return float(t[0] - icpt / slope)

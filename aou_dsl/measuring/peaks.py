@@ -120,10 +120,21 @@ def path_travel(s: np.ndarray, q: np.ndarray, noise: np.ndarray
 @cached(maxsize=512)
 def _uniform_weights(w: int, h: float) -> np.ndarray:
     """The second-derivative weights of a least-squares quadratic through ``w`` samples
-    ``h`` [s] apart (any ``w`` >= 3, odd or even)."""
+    ``h`` [s] apart (any ``w`` >= 3, odd or even). The step is a mean of a phase's own,
+    rarely the same twice: the part that does not depend on it is kept per ``w``."""
+    twice, norm = _centred_squares(w)
+    return twice / (norm * h * h)
+
+
+@cached(maxsize=512)
+def _centred_squares(w: int) -> tuple[np.ndarray, float]:
+    """Twice the squared offsets from the centre of ``w`` samples, less their mean, and
+    the sum of the squares of the latter (read-only: cached)."""
     k = np.arange(w) - 0.5 * (w - 1)
     d = k * k - float(np.mean(k * k))
-    return 2.0 * d / (float(d @ d) * h * h)
+    twice = 2.0 * d
+    twice.flags.writeable = False
+    return twice, float(d @ d)
 
 
 @cached(maxsize=512)

@@ -74,11 +74,13 @@ def surges(speed: np.ndarray, h: float, noise: float = 0.0) -> list[tuple[int, i
         speed = centred_mean(speed, half)
     least, rise = SURGE * float(speed.max()), DISTINCT * noise
     dips: list[int] = []
-    top, low, low_i, falling = float(speed[0]), 0.0, 0, False
+    values = speed.tolist()  # Python floats: the walk compares one sample at a time
+    top, low, low_i, falling = values[0], 0.0, 0, False
     for i in range(1, n):
-        v = float(speed[i])
+        v = values[i]
         if not falling:
-            top = max(top, v)
+            if v > top:
+                top = v
             if top >= least and v < DIP * top and top - v > rise:
                 falling, low, low_i = True, v, i
         elif v < low:

@@ -1,0 +1,118 @@
+"""The measurement's cheaper forms of a few computations against the plain ones they
+replace, written here from their definitions: the roll's relative rotations (a matrix
+product of the stack), the quadratic's curvature weights (their formula at each step),
+the ramp's least-squares line (NumPy's polynomial fit) and the surges' walk over the
+speed (one sample at a time, as NumPy scalars)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from aou_dsl.measuring.peaks import _uniform_weights
+from aou_dsl.measuring.roll import roll_angle
+from aou_dsl.measuring.signal import centred_mean, line_fit
+from aou_dsl.measuring.surges import DIP, DISTINCT, SPAN, SURGE, surges
+
+
+def _rotations(rng: np.random.Generator, n: int) -> np.ndarray:
+    """``n`` rotations turning a little from one to the next about random axes, with
+    stretches held exactly (a hand at rest: entries of exactly zero in the relative
+    rotations)."""
+    out = np.empty((n, 3, 3))
+    r = np.linalg.qr(rng.normal(size=(3, 3)))[0]
+    for k in range(n):
+        if k % 7 < 3:  # held
+            out[k] = r
+            continue
+        w = rng.normal(size=3) * 0.05
+        angle = float(np.linalg.norm(w))
+        x, y, z = w / angle
+        skew = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
+        turn = np.eye(3) + math.sin(angle) * skew + (1 - math.cos(angle)) * skew @ skew
+        r = turn @ r
+        out[k] = r
+    return out
+
+
+def test_roll_angle_equals_the_stacked_products_bit_for_bit():
+    rng = np.random.default_rng(5)
+    for rot in (_rotations(rng, 400), np.repeat(np.eye(3)[None], 5, axis=0),
+                np.linalg.qr(rng.normal(size=(300, 3, 3)))[0]):
+        rel = np.einsum("nji,njk->nik", rot[:-1], rot[1:])
+        step = np.arctan2(rel[:, 1, 0] - rel[:, 0, 1], rel[:, 0, 0] + rel[:, 1, 1])
+        want = np.concatenate([[0.0], np.cumsum(step)])
+        got = roll_angle(rot)
+        assert np.array_equal(got, want)
+        assert np.array_equal(np.signbit(got), np.signbit(want))
+
+
+def test_roll_angle_counts_turns_past_half_a_turn():
+    """From the definition: a hand turned steadily about its forward axis by 400 deg."""
+    a = np.linspace(0.0, math.radians(400.0), 200)
+    c, s = np.cos(a), np.sin(a)
+    rot = np.zeros((len(a), 3, 3))
+    rot[:, 0, 0], rot[:, 0, 1], rot[:, 1, 0], rot[:, 1, 1] = c, -s, s, c
+    rot[:, 2, 2] = 1.0
+    assert np.allclose(roll_angle(rot), a, atol=1e-12)
+
+
+@pytest.mark.parametrize("w", [3, 4, 5, 17, 60, 301])
+def test_uniform_weights_equal_their_formula_at_any_step(w):
+    rng = np.random.default_rng(w)
+    for h in [0.001, 0.004, 1.0, *rng.uniform(1e-4, 1e-2, 20)]:
+        k = np.arange(w) - 0.5 * (w - 1)
+        d = k * k - float(np.mean(k * k))
+        want = 2.0 * d / (float(d @ d) * h * h)
+        assert np.array_equal(_uniform_weights(w, float(h)), want)
+
+
+def test_line_fit_is_the_least_squares_line():
+    rng = np.random.default_rng(8)
+    for n in (2, 3, 10, 400):
+        x = np.sort(rng.uniform(0.0, 0.5, n))
+        v = 3.0 + 40.0 * x + rng.normal(size=n)
+        slope, icpt = line_fit(x, v)
+        want = np.polyfit(x, v, 1)
+        assert abs(slope - want[0]) <= 1e-10 * abs(want[0])
+        assert abs(icpt - want[1]) <= 1e-10 * max(1.0, abs(want[1]))
+    assert line_fit(np.array([0.0, 1.0]), np.array([1.0, 3.0])) == (2.0, 1.0)
+    assert line_fit(np.full(3, 0.2), np.array([1.0, 2.0, 3.0])) == (0.0, 2.0)
+
+
+def _walked_dips(speed: np.ndarray, noise: float) -> list[int]:
+    """The surges' walk over the speed as first written: one NumPy scalar at a time."""
+    least, rise = SURGE * float(speed.max()), DISTINCT * noise
+    dips: list[int] = []
+    top, low, low_i, falling = float(speed[0]), 0.0, 0, False
+    for i in range(1, len(speed)):
+        v = float(speed[i])
+        if not falling:
+            top = max(top, v)
+            if top >= least and v < DIP * top and top - v > rise:
+                falling, low, low_i = True, v, i
+        elif v < low:
+            low, low_i = v, i
+        elif v >= least and low < DIP * v and v - low > rise:
+            dips.append(low_i)
+            falling, top = False, v
+    return dips
+
+
+def test_surges_split_where_the_walk_finds_its_dips():
+    """Speeds with several surges and noise: the surges start at the dips the plain
+    walk finds (those that the ends and the shortest span keep)."""
+    h = 0.001
+    rng = np.random.default_rng(2)
+    t = np.arange(0.0, 4.0, h)
+    for noise in (0.0, 0.002, 0.01):
+        speed = np.abs(np.sin(math.pi * t * rng.uniform(0.6, 1.6))) * 0.2
+        speed = speed + rng.normal(size=len(t)) * noise
+        half = int(0.5 * SPAN / h)
+        dips = _walked_dips(centred_mean(speed, half), noise)
+        got = surges(speed, h, noise)
+        starts = [s for s, _ in got[1:]]
+        assert set(starts) <= set(dips)
+        assert len(got) >= 2  # a sine of more than half a cycle surges more than once
