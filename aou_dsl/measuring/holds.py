@@ -245,12 +245,15 @@ def _dips(r: Rest, taken: np.ndarray) -> list[tuple[float, float, int]]:
     seq[2 * cross + 1] = np.minimum(between, seq[2 * cross + 1])
     joint = dict(zip(cross.tolist(), lead.tolist(), strict=True))
     idx, prominences = maxima(-seq)
+    # Only minima outside the rests and under 30 % of the peaks beside them (in a noisy
+    # recording, a few of the tens of thousands the noise makes).
+    half = idx // 2
+    kept = ~(taken[half] | ((idx % 2 == 1) & taken[np.minimum(half + 1, n - 1)])
+             | (seq[idx] > 0.3 * (seq[idx] + prominences)))
     out = []
     v = r.v if r.carried is None else r.carried[0]
-    for m, prom in zip(idx.tolist(), prominences.tolist(), strict=True):
+    for m, prom in zip(idx[kept].tolist(), prominences[kept].tolist(), strict=True):
         k = m // 2
-        if taken[k] or (m % 2 and taken[k + 1]) or seq[m] > 0.3 * (seq[m] + prom):
-            continue
         # Between two samples, a minimum is a reversal only where a joint's velocity
         # crosses zero there; else it is the middle of a flat stretch of equal levels
         # (a held sample, repeated), read at its sample as any other.

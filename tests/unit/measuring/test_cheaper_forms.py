@@ -116,3 +116,44 @@ def test_surges_split_where_the_walk_finds_its_dips():
         starts = [s for s, _ in got[1:]]
         assert set(starts) <= set(dips)
         assert len(got) >= 2  # a sine of more than half a cycle surges more than once
+
+
+def _plain_run(t: np.ndarray, a: int, b: int, level: float, noise: float, shortest: float,
+               resolution: float) -> int:
+    """The profile's run as first written: the weights' norm at every length tried."""
+    length = b - a + 1
+    step = float(t[b] - t[a]) / max(length - 1, 1)
+    w = min(max(3, int(math.ceil(shortest / step - 1e-9)) + 1), length)
+    while w < length:
+        k = np.arange(w) - 0.5 * (w - 1)
+        d = k * k - float(np.mean(k * k))
+        if noise * float(np.linalg.norm(2.0 * d / (float(d @ d) * step * step))) <= (
+                resolution * level):
+            break
+        w = min(w + max(1, w // 8), length)
+    return w
+
+
+def test_run_length_equals_the_weights_norm_at_every_length():
+    """Random phases, levels and noises, and the edge cases: each run found is the one
+    the weights' own norm picks, including where that norm sits on the bound."""
+    from aou_dsl.measuring.peaks import _run, _uniform_gain
+
+    rng = np.random.default_rng(4)
+    for _ in range(150):
+        h = float(rng.uniform(5e-4, 1e-2))
+        length = int(rng.integers(3, 3000))
+        t = np.cumsum(rng.uniform(0.9, 1.1, length)) * h
+        level = float(10.0 ** rng.uniform(-3, 1)) * rng.choice([1.0, -1.0, 0.0])
+        noise = float(10.0 ** rng.uniform(-8, -3)) * rng.choice([1.0, 0.0])
+        shortest, res = float(rng.choice([0.0, 0.06])), float(rng.choice([0.015, 0.005]))
+        assert _run(t, 0, length - 1, level, noise, shortest, res) == _plain_run(
+            t, 0, length - 1, level, noise, shortest, res)
+    # On the bound: the level that makes a run's noise exactly the resolution.
+    t = np.arange(500) * 0.001
+    step = float(t[-1] - t[0]) / 499
+    for w in (3, 10, 57, 200):
+        level = 1e-4 * _uniform_gain(w, step) / 0.015
+        for lv in (level, np.nextafter(level, 0.0), np.nextafter(level, 1.0)):
+            assert _run(t, 0, 499, lv, 1e-4, 0.0, 0.015) == _plain_run(
+                t, 0, 499, lv, 1e-4, 0.0, 0.015)
