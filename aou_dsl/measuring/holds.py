@@ -29,7 +29,7 @@ import numpy as np
 from .extrema import maxima
 from .onset import REST_SPEED, carried_edge, soft_pause
 from .rest import LONG_WINDOW, Rest, rest_signals
-from .signal import NOISE_SIGMAS, line_fit, odd, runs
+from .signal import NOISE_SIGMAS, line_fit, odd, row_max, runs
 
 __all__ = ["MIN_PAUSE", "REST_SPEED", "Boundary", "Rest", "boundaries", "rest_at_end",
            "rest_signals"]
@@ -91,7 +91,7 @@ def _rest_runs(r: Rest) -> tuple[list[tuple[int, int]], set[int]]:
         for i0, i1 in runs(rest):
             a, b = i0 + width, i1 - width
             if b > a:
-                slow = np.max(np.abs(r.v_long[a:b + 1]) / r.thr_long[a:b + 1], axis=1) >= 1
+                slow = row_max(np.abs(r.v_long[a:b + 1]) / r.thr_long[a:b + 1]) >= 1
                 for s0, s1 in runs(slow):
                     slow_edges.update((a + s0 - 1, a + s1 + 1))
                 rest[a:b + 1] &= ~slow
@@ -115,7 +115,7 @@ def _lead(r: Rest, seg: np.ndarray, slow: bool) -> tuple[np.ndarray, int, float]
             continue
         width = window or odd(LONG_WINDOW / r.h)
         ratio = np.abs(v[rows]) / thr[rows]
-        moving = np.flatnonzero(ratio.max(axis=1) > CLEARLY)
+        moving = np.flatnonzero(row_max(ratio) > CLEARLY)
         if len(moving) == 0:
             continue
         near = ratio[moving[0]:moving[0] + max(3, width)]

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .onset import REST_SPEED
-from .signal import NOISE_SIGMAS, odd, sg_coefficients, slope_gain, smooth
+from .signal import NOISE_SIGMAS, odd, row_max, sg_coefficients, slope_gain, smooth
 
 __all__ = ["LONG_WINDOW", "Rest", "rest_signals"]
 
@@ -71,7 +71,7 @@ def rest_signals(t: np.ndarray, h: float, q: np.ndarray, noise: np.ndarray,
     scale = 1.0 / np.sqrt(np.clip(density, 1e-3, 1.0))[:, None]
     thr = np.maximum(NOISE_SIGMAS * noise[None, :] * slope_gain(window, h) * scale,
                      REST_SPEED)
-    level = np.max(np.abs(v) / thr, axis=1)
+    level = row_max(np.abs(v) / thr)
     v_long = thr_long = None
     held, gain = q, 1.0
     if window > 3:

@@ -28,6 +28,7 @@ __all__ = [
     "joint_noise",
     "line_fit",
     "odd",
+    "row_max",
     "runs",
     "short_window",
     "slope_gain",
@@ -289,3 +290,13 @@ def line_fit(x: np.ndarray, v: np.ndarray) -> tuple[float, float]:
     sxx = float(dx @ dx)
     slope = float(dx @ (v - vm)) / sxx if sxx > 0 else 0.0
     return slope, vm - slope * xm
+
+
+def row_max(a: np.ndarray) -> np.ndarray:
+    """The largest of each row of the 2-D ``a`` (a NaN where a row holds one), as
+    ``a.max(axis=1)`` gives it: column by column, which on a few joints' columns is
+    several times faster than NumPy's reduction along the short rows."""
+    out = a[:, 0].copy()
+    for j in range(1, a.shape[1]):
+        np.maximum(out, a[:, j], out=out)
+    return out

@@ -157,3 +157,14 @@ def test_run_length_equals_the_weights_norm_at_every_length():
         for lv in (level, np.nextafter(level, 0.0), np.nextafter(level, 1.0)):
             assert _run(t, 0, 499, lv, 1e-4, 0.0, 0.015) == _plain_run(
                 t, 0, 499, lv, 1e-4, 0.0, 0.015)
+
+
+def test_row_max_is_numpys_row_maximum():
+    from aou_dsl.measuring.signal import row_max
+
+    rng = np.random.default_rng(6)
+    for shape in ((1, 1), (5, 1), (300, 7), (40, 3)):
+        a = rng.normal(size=shape)
+        a[rng.random(shape) < 0.05] = np.nan
+        a[rng.random(shape) < 0.05] = np.inf
+        assert np.array_equal(row_max(a), a.max(axis=1), equal_nan=True)
