@@ -168,3 +168,38 @@ def test_row_max_is_numpys_row_maximum():
         a[rng.random(shape) < 0.05] = np.nan
         a[rng.random(shape) < 0.05] = np.inf
         assert np.array_equal(row_max(a), a.max(axis=1), equal_nan=True)
+
+
+def test_maxima_keep_numpys_prominences_on_ties_and_plateaus():
+    """Rounded noise (plateaus, equal neighbours), a constant and a ramp: the peaks and
+    prominences :func:`.extrema.maxima` finds are those of a plain walk from each peak to
+    the first higher sample on either side."""
+    from aou_dsl.measuring.extrema import maxima
+
+    rng = np.random.default_rng(9)
+    cases = [np.round(rng.normal(size=int(rng.integers(3, 120))), int(rng.integers(0, 3)))
+             for _ in range(200)] + [np.full(9, 0.5), np.arange(9.0)]
+    for x in cases:
+        idx, prom = maxima(x)
+        want_idx, want_prom = [], []
+        i, n = 1, len(x)
+        while i < n - 1:
+            j = i
+            while j + 1 < n and x[j + 1] == x[i]:
+                j += 1
+            if x[i - 1] < x[i] and j < n - 1 and x[j + 1] < x[i]:
+                left = i - 1
+                base_l = x[left]
+                while left >= 0 and x[left] <= x[i]:
+                    base_l = min(base_l, x[left])
+                    left -= 1
+                right = j + 1
+                base_r = x[right]
+                while right < n and x[right] <= x[i]:
+                    base_r = min(base_r, x[right])
+                    right += 1
+                want_idx.append((i + j) // 2)
+                want_prom.append(x[i] - max(base_l, base_r))
+            i = j + 1
+        assert idx.tolist() == want_idx
+        assert np.allclose(prom, want_prom, rtol=0, atol=0)
