@@ -84,14 +84,14 @@ def _rest_runs(r: Rest) -> tuple[list[tuple[int, int]], set[int]]:
         if i1 - i0 < short or np.all(away <= 4.0 * r.noise + 1.01 * r.quantum + 1e-12):
             rest[i0:i1 + 1] = True
     slow_edges: set[int] = set()
-    if r.v_long is not None and r.thr_long is not None:
+    if r.ratio_long is not None:
         # A full window from each end: next to a rest, the start of a slow motion looks
         # still for a while; its edge is refined, not split off.
         width = odd(LONG_WINDOW / r.h)
         for i0, i1 in runs(rest):
             a, b = i0 + width, i1 - width
             if b > a:
-                slow = row_max(np.abs(r.v_long[a:b + 1]) / r.thr_long[a:b + 1]) >= 1
+                slow = row_max(r.ratio_long[a:b + 1]) >= 1
                 for s0, s1 in runs(slow):
                     slow_edges.update((a + s0 - 1, a + s1 + 1))
                 rest[a:b + 1] &= ~slow
@@ -110,11 +110,12 @@ def _lead(r: Rest, seg: np.ndarray, slow: bool) -> tuple[np.ndarray, int, float]
     # ``seg`` runs one way from the rest: the same rows as a view, without a copy.
     stop = int(seg[-1]) + (1 if seg[-1] >= seg[0] else -1)
     rows = slice(int(seg[0]), stop if stop >= 0 else None, 1 if seg[-1] >= seg[0] else -1)
-    for v, thr, window in ((r.v, r.thr, r.window), (r.v_long, r.thr_long, 0)):
-        if v is None or thr is None:
+    for v, thr, window, ratios in ((r.v, r.thr, r.window, r.ratio),
+                                   (r.v_long, r.thr_long, 0, r.ratio_long)):
+        if v is None or thr is None or ratios is None:
             continue
         width = window or odd(LONG_WINDOW / r.h)
-        ratio = np.abs(v[rows]) / thr[rows]
+        ratio = ratios[rows]
         moving = np.flatnonzero(row_max(ratio) > CLEARLY)
         if len(moving) == 0:
             continue
@@ -217,7 +218,7 @@ def _crossings(r: Rest) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     ``i + 1``: those ``i``, the leading joint, and the speed level there (every joint's
     velocity interpolated to the crossing). Sampled a few times per cycle, an
     oscillation's samples can all miss its reversals; the level between them does not."""
-    ratio = np.abs(r.v) / r.thr
+    ratio = r.ratio
     j = np.argmax(ratio[:-1] + ratio[1:], axis=1)
     rows = np.arange(len(j))
     va, vb = r.v[rows, j], r.v[rows + 1, j]

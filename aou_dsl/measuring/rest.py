@@ -30,8 +30,10 @@ class Rest:
         v: filtered joint velocities, (N, n).
         thr: each joint's rest threshold [rad/s] at each sample, (N, n) (larger where
             a logging gap leaves fewer raw samples).
-        level: the largest joint speed over its threshold, (N,): under 1 is rest.
-        v_long, thr_long: the same over :data:`LONG_WINDOW` (None for clean data).
+        ratio: each joint's speed over its threshold, ``|v| / thr``, (N, n).
+        level: the largest of those, (N,): under 1 is rest.
+        v_long, thr_long, ratio_long: the same over :data:`LONG_WINDOW` (None for
+            clean data).
         t_last: the recording's end [s].
         q: joint positions, (N, n); noise: each joint's noise [rad], (n,);
         quantum: each joint's resolution [rad] (0: none), (n,).
@@ -48,9 +50,11 @@ class Rest:
     window: int
     v: np.ndarray
     thr: np.ndarray
+    ratio: np.ndarray
     level: np.ndarray
     v_long: np.ndarray | None
     thr_long: np.ndarray | None
+    ratio_long: np.ndarray | None
     t_last: float
     q: np.ndarray
     noise: np.ndarray
@@ -71,8 +75,9 @@ def rest_signals(t: np.ndarray, h: float, q: np.ndarray, noise: np.ndarray,
     scale = 1.0 / np.sqrt(np.clip(density, 1e-3, 1.0))[:, None]
     thr = np.maximum(NOISE_SIGMAS * noise[None, :] * slope_gain(window, h) * scale,
                      REST_SPEED)
-    level = row_max(np.abs(v) / thr)
-    v_long = thr_long = None
+    ratio = np.abs(v) / thr
+    level = row_max(ratio)
+    v_long = thr_long = ratio_long = None
     held, gain = q, 1.0
     if window > 3:
         held = smooth(q, window, 0, h, order=3)
@@ -82,8 +87,9 @@ def rest_signals(t: np.ndarray, h: float, q: np.ndarray, noise: np.ndarray,
         v_long = _long_slope(q, wl, h)
         thr_long = np.maximum(NOISE_SIGMAS * noise[None, :] * slope_gain(wl, h) * scale,
                               REST_SPEED)
-    return Rest(t, h, window, v, thr, level, v_long, thr_long, t_last, q, noise, quantum,
-                held, gain, scale[:, 0], carried)
+        ratio_long = np.abs(v_long) / thr_long
+    return Rest(t, h, window, v, thr, ratio, level, v_long, thr_long, ratio_long, t_last, q,
+                noise, quantum, held, gain, scale[:, 0], carried)
 
 
 def _long_slope(q: np.ndarray, window: int, h: float) -> np.ndarray:
