@@ -362,7 +362,7 @@ def _held(r: Rest, t0: float, t1: float) -> tuple[float, float]:
     shivers back to back); its positions cannot."""
     k0 = int(np.searchsorted(r.t, t0, "left"))
     k1 = int(np.searchsorted(r.t, t1, "right"))
-    p = r.held[k0:k1]
+    p = r.held(k0, k1)
     if len(p) < 3:
         return t0, t0
     # Across a logging gap fewer raw samples make each filtered value: more noise.

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .onset import REST_SPEED
-from .signal import NOISE_SIGMAS, odd, row_max, sg_coefficients, slope_gain, smooth
+from .signal import NOISE_SIGMAS, odd, row_max, sg_coefficients, slope_gain, smooth, smooth_rows
 
 __all__ = ["LONG_WINDOW", "Rest", "rest_signals"]
 
@@ -37,8 +37,8 @@ class Rest:
         t_last: the recording's end [s].
         q: joint positions, (N, n); noise: each joint's noise [rad], (n,);
         quantum: each joint's resolution [rad] (0: none), (n,).
-        held: joint positions filtered over ``window`` (raw for clean data), for the
-            hold test, (N, n); held_gain: that filter's noise std per unit of noise.
+        held_gain: the noise std per unit of noise of the hold test's positions
+            (:meth:`held`).
         sparse: how much noisier a filtered value is than where the log has all its
             samples (above 1 across a logging gap), (N,).
         carried: the joint velocities and accelerations the file carries on these
@@ -59,10 +59,17 @@ class Rest:
     q: np.ndarray
     noise: np.ndarray
     quantum: np.ndarray
-    held: np.ndarray
     held_gain: float
     sparse: np.ndarray
     carried: tuple[np.ndarray, np.ndarray] | None = None
+
+    def held(self, k0: int, k1: int) -> np.ndarray:
+        """Joint positions filtered over ``window`` (raw for clean data) on samples
+        ``k0``..``k1 - 1``, for the hold test, (k1 - k0, n): only the rests it tests
+        are filtered, each value as the whole recording's filter gives it."""
+        if self.window <= 3:
+            return self.q[k0:k1]
+        return smooth_rows(self.q, self.window, 0, self.h, k0, k1, order=3)
 
 
 
@@ -78,9 +85,8 @@ def rest_signals(t: np.ndarray, h: float, q: np.ndarray, noise: np.ndarray,
     ratio = np.abs(v) / thr
     level = row_max(ratio)
     v_long = thr_long = ratio_long = None
-    held, gain = q, 1.0
+    gain = 1.0
     if window > 3:
-        held = smooth(q, window, 0, h, order=3)
         gain = float(np.linalg.norm(sg_coefficients(window, 3, 0, 1.0)))
     if window > 3 and len(t) > odd(LONG_WINDOW / h):
         wl = odd(LONG_WINDOW / h)
@@ -89,7 +95,7 @@ def rest_signals(t: np.ndarray, h: float, q: np.ndarray, noise: np.ndarray,
                               REST_SPEED)
         ratio_long = np.abs(v_long) / thr_long
     return Rest(t, h, window, v, thr, ratio, level, v_long, thr_long, ratio_long, t_last, q,
-                noise, quantum, held, gain, scale[:, 0], carried)
+                noise, quantum, gain, scale[:, 0], carried)
 
 
 def _long_slope(q: np.ndarray, window: int, h: float) -> np.ndarray:

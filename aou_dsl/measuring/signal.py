@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.memo import table
-from .savgol import savgol, savgol_weights
+from .savgol import savgol, savgol_rows, savgol_weights
 
 __all__ = [
     "centred_mean",
@@ -33,6 +33,7 @@ __all__ = [
     "short_window",
     "slope_gain",
     "smooth",
+    "smooth_rows",
     "to_grid",
     "unwrap",
 ]
@@ -226,6 +227,17 @@ def smooth(x: np.ndarray, window: int, deriv: int, h: float, order: int = 3) -> 
         return np.gradient(x, h, axis=0) if deriv == 1 else (
             x if deriv == 0 else np.zeros_like(x))
     return savgol(x, w, min(order, w - 1), deriv, h)
+
+
+def smooth_rows(x: np.ndarray, window: int, deriv: int, h: float, start: int, stop: int,
+                order: int = 3) -> np.ndarray:
+    """``smooth(x, window, deriv, h, order)[start:stop]``, the same numbers, computing
+    only those rows (a long recording's filter asked for a few stretches of it)."""
+    n = len(x)
+    w = min(window, n if n % 2 else n - 1)
+    if w < 3:
+        return smooth(x, window, deriv, h, order)[start:stop]
+    return savgol_rows(x, w, min(order, w - 1), deriv, h, start, stop)
 
 
 def sg_coefficients(window: int, order: int, deriv: int, h: float) -> np.ndarray:
