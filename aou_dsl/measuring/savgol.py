@@ -18,7 +18,7 @@ import numpy as np
 
 from ..core.memo import cached
 
-__all__ = ["savgol", "savgol_rows", "savgol_weights"]
+__all__ = ["savgol", "savgol_1d", "savgol_rows", "savgol_weights"]
 
 #: How far two mirrored weights may differ and still count as equal (or opposite), so
 #: that the pair is summed before it is weighted.
@@ -76,6 +76,25 @@ def savgol(x: np.ndarray, window: int, order: int, deriv: int = 0,
     for s in range(half, n - half, rows):
         e = min(n - half, s + rows)
         _correlate(x[s - half:e + half], weights, mirror, out[s:e])
+    _fit_end(x, out, slice(0, window), slice(0, half), order, deriv, delta)
+    _fit_end(x, out, slice(n - window, n), slice(n - half, n), order, deriv, delta)
+    return out
+
+
+def savgol_1d(x: np.ndarray, window: int, order: int, deriv: int = 0,
+              delta: float = 1.0) -> np.ndarray:
+    """:func:`savgol` of a 1-D ``x``, each window's sum a dot product of NumPy's
+    correlation (in its own order of summation): equal to it to rounding (about 1e-15 of
+    the signal's scale), and on a motion's few thousand samples several times faster,
+    where the fixed order's pass per weight costs more in calls than in arithmetic. The
+    ends are fitted as :func:`savgol` fits them."""
+    x = np.asarray(x, dtype=np.float64)
+    n, half = len(x), window // 2
+    if x.ndim != 1 or window % 2 == 0 or n < window or half < 1:
+        return savgol(x, window, order, deriv, delta)
+    weights, _ = _applied_weights(window, order, deriv, delta)
+    out = np.empty_like(x)
+    out[half:n - half] = np.correlate(x, weights, "valid")
     _fit_end(x, out, slice(0, window), slice(0, half), order, deriv, delta)
     _fit_end(x, out, slice(n - window, n), slice(n - half, n), order, deriv, delta)
     return out

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.memo import table
-from .savgol import savgol, savgol_rows, savgol_weights
+from .savgol import savgol, savgol_1d, savgol_rows, savgol_weights
 
 __all__ = [
     "centred_mean",
@@ -216,16 +216,21 @@ def to_grid(t: np.ndarray, q: np.ndarray, window: float) -> Grid:
     return Grid(tg, qg, h, np.maximum(density, 1.0 / (2 * half + 1)), t_last, True)
 
 
-def smooth(x: np.ndarray, window: int, deriv: int, h: float, order: int = 3) -> np.ndarray:
+def smooth(x: np.ndarray, window: int, deriv: int, h: float, order: int = 3,
+           exact: bool = True) -> np.ndarray:
     """A Savitzky-Golay filter along axis 0: the value (``deriv`` 0) or a derivative of
     the local polynomial of degree ``order`` through ``window`` samples. Window 3 is the
     central difference. Near the ends the polynomial is fitted to the first or last
-    window."""
+    window. Not ``exact``: a 1-D ``x`` is summed in NumPy's own order, the same to
+    rounding and faster (:func:`.savgol.savgol_1d`; for a recording, whose noise is
+    far above the rounding)."""
     n = len(x)
     w = min(window, n if n % 2 else n - 1)
     if w < 3:
         return np.gradient(x, h, axis=0) if deriv == 1 else (
             x if deriv == 0 else np.zeros_like(x))
+    if not exact:
+        return savgol_1d(x, w, min(order, w - 1), deriv, h)
     return savgol(x, w, min(order, w - 1), deriv, h)
 
 

@@ -209,3 +209,27 @@ def test_rows_equal_the_whole_filters_rows_bit_for_bit():
                     for laid in (x, np.asfortranarray(x)):  # a recording's: by column
                         got = savgol_rows(laid, window, order, deriv, 0.001, a, b)
                         assert np.array_equal(got, whole[max(a, 0):b]), (window, a, b)
+
+
+def test_one_dimensional_sums_equal_scipy_to_rounding():
+    """The recording's fast filter of a 1-D travel (NumPy's correlation for each
+    window's sum) against SciPy's filter (mode 'interp'): the ends bit for bit (fitted
+    alike), the rest within rounding of the signal's scale, for values and the first
+    and second derivatives, at the windows a recording's filter takes."""
+    from aou_dsl.measuring.savgol import savgol_1d
+
+    rng = np.random.default_rng(21)
+    for n in (61, 62, 200, 2500):
+        for x in _signals(rng, n, 0):
+            for window, order, deriv in ((61, 2, 1), (61, 3, 0), (31, 2, 1), (15, 3, 2),
+                                         (5, 2, 1)):
+                if window > n:
+                    continue
+                for delta in (0.001, 0.004):
+                    want = savgol_filter(x, window, order, deriv=deriv, delta=delta)
+                    got = savgol_1d(x, window, order, deriv, delta)
+                    half = window // 2
+                    scale = float(np.abs(x).max() + 1e-300) * delta ** -deriv
+                    assert np.array_equal(got[:half], want[:half])
+                    assert np.array_equal(got[n - half:], want[n - half:])
+                    assert np.abs(got - want).max() <= 1e-13 * scale, (n, window, deriv)
