@@ -28,7 +28,7 @@ import numpy as np
 
 from .extrema import maxima
 from .onset import REST_SPEED, carried_edge, soft_pause
-from .rest import LONG_WINDOW, Rest, rest_signals
+from .rest import CLEARLY, LONG_WINDOW, Rest, rest_at_end, rest_signals
 from .signal import NOISE_SIGMAS, line_fit, odd, row_max, runs
 
 __all__ = ["MIN_PAUSE", "REST_SPEED", "Boundary", "Rest", "boundaries", "rest_at_end",
@@ -40,8 +40,6 @@ MIN_PAUSE = 0.15
 HELD_SIGMAS = 5.0
 #: Drift of a held joint that is no motion [rad] (0.001 deg).
 STILL_ANGLE = 2e-5
-#: A joint is clearly moving at this many times its rest threshold (16 noise std).
-CLEARLY = 3.0
 #: The velocity ramp beside a stop is followed up to this fraction of its peak.
 RAMP_TOP = 0.6
 #: The joints move the same way on both sides of a rest when the cosine between their
@@ -380,27 +378,6 @@ def _held(r: Rest, t0: float, t1: float) -> tuple[float, float]:
         return t0, t0
     return (t0 if a == 0 else float(r.t[k0 + a]),
             t1 if b == len(p) - 1 else float(r.t[k0 + b]))
-
-
-def rest_at_end(r: Rest, last: bool) -> bool:
-    """Whether the arm is at rest at the recording's first sample (its last with
-    ``last``). A motion that starts from rest right at the first sample (under a jerk
-    limit it barely moves at first) looks moving to a velocity filter there; its velocity,
-    a cubic fitted over the first samples and followed back to the edge, is near zero
-    beside the speed it has reached. A log that starts mid-motion starts at speed."""
-    n = len(r.t)
-    k = n - 1 if last else 0
-    if r.level[k] < 1.0:
-        return True
-    m = min(n, max(2 * r.window + 1, odd(0.05 / r.h), 7))
-    idx = np.arange(n - m, n) if last else np.arange(m)
-    j = int(np.argmax(np.abs(r.q[idx[-1]] - r.q[idx[0]])))
-    tt = r.t[idx] - r.t[k]
-    c = np.polyfit(tt, r.q[idx, j], 3)
-    far = float(tt[0] if last else tt[-1])
-    v_edge = float(c[2])
-    v_far = float(3 * c[0] * far ** 2 + 2 * c[1] * far + c[2])
-    return abs(v_edge) <= max(0.1 * abs(v_far), CLEARLY * float(r.thr[k, j]))
 
 
 def _merged(bounds: list[Boundary]) -> list[Boundary]:

@@ -12,8 +12,10 @@ import numpy as np
 from .onset import REST_SPEED
 from .signal import NOISE_SIGMAS, odd, row_max, sg_coefficients, slope_gain, smooth, smooth_rows
 
-__all__ = ["LONG_WINDOW", "Rest", "rest_signals"]
+__all__ = ["CLEARLY", "LONG_WINDOW", "Rest", "rest_at_end", "rest_signals"]
 
+#: A joint is clearly moving at this many times its rest threshold (16 noise std).
+CLEARLY = 3.0
 #: Window of the slow-motion check inside long rests [s].
 LONG_WINDOW = 0.3
 #: Windows of the slow-motion check from which its filter runs through the FFT (from
@@ -116,3 +118,24 @@ def _long_slope(q: np.ndarray, window: int, h: float) -> np.ndarray:
     inner = full[window - 1:n]  # centred on rows half .. n - half - 1
     return np.concatenate([np.repeat(inner[:1], half, axis=0), inner,
                            np.repeat(inner[-1:], half, axis=0)])
+
+
+def rest_at_end(r: Rest, last: bool) -> bool:
+    """Whether the arm is at rest at the recording's first sample (its last with
+    ``last``). A motion that starts from rest right at the first sample (under a jerk
+    limit it barely moves at first) looks moving to a velocity filter there; its velocity,
+    a cubic fitted over the first samples and followed back to the edge, is near zero
+    beside the speed it has reached. A log that starts mid-motion starts at speed."""
+    n = len(r.t)
+    k = n - 1 if last else 0
+    if r.level[k] < 1.0:
+        return True
+    m = min(n, max(2 * r.window + 1, odd(0.05 / r.h), 7))
+    idx = np.arange(n - m, n) if last else np.arange(m)
+    j = int(np.argmax(np.abs(r.q[idx[-1]] - r.q[idx[0]])))
+    tt = r.t[idx] - r.t[k]
+    c = np.polyfit(tt, r.q[idx, j], 3)
+    far = float(tt[0] if last else tt[-1])
+    v_edge = float(c[2])
+    v_far = float(3 * c[0] * far ** 2 + 2 * c[1] * far + c[2])
+    return abs(v_edge) <= max(0.1 * abs(v_far), CLEARLY * float(r.thr[k, j]))
