@@ -8,6 +8,10 @@ weights from a least-squares solve; a symmetric or antisymmetric set of weights 
 to mirrored pairs of samples, outermost pair first; the ends fitted with their own
 polynomial). It needs only NumPy: importing SciPy's signal package costs a cold command
 about a second (tests/unit/measuring/test_savgol.py holds the two to the same bits).
+:func:`savgol_rows` gives some rows of it, the same bits. :func:`savgol_1d` sums each
+window in NumPy's own order instead, equal to rounding: the measurement uses it only on a
+recording's 1-D travels, whose noise is far above the rounding, never on a computed
+trajectory.
 """
 
 from __future__ import annotations
