@@ -29,7 +29,7 @@ import numpy as np
 from .extrema import maxima
 from .onset import REST_SPEED, carried_edge, soft_pause
 from .rest import CLEARLY, LONG_WINDOW, Rest, rest_at_end, rest_signals
-from .signal import NOISE_SIGMAS, line_fit, odd, row_max, runs
+from .signal import NOISE_SIGMAS, odd, row_max, runs
 
 __all__ = ["MIN_PAUSE", "REST_SPEED", "Boundary", "Rest", "boundaries", "rest_at_end",
            "rest_signals"]
@@ -174,7 +174,7 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False) -> Zero
     # The motion stops between its first clearly moving sample and the far end of the
     # rest (give or take a step), and no further into the rest than its ramp takes to
     # fall through the threshold (twice that, plus the filter's reach).
-    slope = abs(line_fit(ramp - ramp[0], vr)[0]) if len(ramp) >= 2 else 0.0
+    slope = abs(float(np.polyfit(ramp - ramp[0], vr, 1)[0])) if len(ramp) >= 2 else 0.0
     reach_in = 2.0 / (slope * unit) + (window // 2 + 1) * r.h if slope > 0 else math.inf
     edge = float(t[i])
     far_t = edge - step * min(abs(float(t[far]) - edge) + r.h, reach_in)
@@ -201,7 +201,7 @@ def _zero(t: np.ndarray, v: np.ndarray, straight: bool = False) -> float | None:
     if len(t) < 2:
         return None
     x = t - t[0]
-    slope, icpt = line_fit(x, v)
+    slope, icpt = (float(c) for c in np.polyfit(x, v, 1))
     if not math.isfinite(slope) or abs(slope) < 1e-15:
         return None
     if straight and len(t) >= 4:

@@ -26,7 +26,6 @@ __all__ = [
     "filter_at",
     "sg_coefficients",
     "joint_noise",
-    "line_fit",
     "odd",
     "row_max",
     "runs",
@@ -296,17 +295,6 @@ def centred_mean(x: np.ndarray, half: int) -> np.ndarray:
     at = np.arange(n)
     r = np.minimum(np.minimum(at, n - 1 - at), half)
     return (c[at + r + 1] - c[at - r]) / (2 * r + 1)
-
-
-def line_fit(x: np.ndarray, v: np.ndarray) -> tuple[float, float]:
-    """Slope and intercept of the least-squares line through ``(x, v)`` (at least two
-    distinct ``x``; else a flat line through their mean): the normal equations about
-    the means, which a few hundred points on a ramp leave well conditioned."""
-    xm, vm = float(x.mean()), float(v.mean())
-    dx = x - xm
-    sxx = float(dx @ dx)
-    slope = float(dx @ (v - vm)) / sxx if sxx > 0 else 0.0
-    return slope, vm - slope * xm
 
 
 def row_max(a: np.ndarray) -> np.ndarray:

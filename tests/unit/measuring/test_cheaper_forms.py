@@ -1,8 +1,8 @@
 """The measurement's cheaper forms of a few computations against the plain ones they
 replace, written here from their definitions: the roll's relative rotations (a matrix
 product of the stack), the quadratic's curvature weights (their formula at each step),
-the ramp's least-squares line (NumPy's polynomial fit) and the surges' walk over the
-speed (one sample at a time, as NumPy scalars)."""
+the surges' walk over the speed (one sample at a time, as NumPy scalars), the profile's
+run lengths, the rows' maxima and the peak finder's prominences."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import pytest
 
 from aou_dsl.measuring.peaks import _uniform_weights
 from aou_dsl.measuring.roll import roll_angle
-from aou_dsl.measuring.signal import centred_mean, line_fit
+from aou_dsl.measuring.signal import centred_mean
 from aou_dsl.measuring.surges import DIP, DISTINCT, SURGE, surges
 
 
@@ -67,19 +67,6 @@ def test_uniform_weights_equal_their_formula_at_any_step(w):
         d = k * k - float(np.mean(k * k))
         want = 2.0 * d / (float(d @ d) * h * h)
         assert np.array_equal(_uniform_weights(w, float(h)), want)
-
-
-def test_line_fit_is_the_least_squares_line():
-    rng = np.random.default_rng(8)
-    for n in (2, 3, 10, 400):
-        x = np.sort(rng.uniform(0.0, 0.5, n))
-        v = 3.0 + 40.0 * x + rng.normal(size=n)
-        slope, icpt = line_fit(x, v)
-        want = np.polyfit(x, v, 1)
-        assert abs(slope - want[0]) <= 1e-10 * abs(want[0])
-        assert abs(icpt - want[1]) <= 1e-10 * max(1.0, abs(want[1]))
-    assert line_fit(np.array([0.0, 1.0]), np.array([1.0, 3.0])) == (2.0, 1.0)
-    assert line_fit(np.full(3, 0.2), np.array([1.0, 2.0, 3.0])) == (0.0, 2.0)
 
 
 def _walked_dips(speed: np.ndarray, noise: float) -> list[int]:
