@@ -174,12 +174,14 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False) -> Zero
     # The motion stops between its first clearly moving sample and the far end of the
     # rest (give or take a step), and no further into the rest than its ramp takes to
     # fall through the threshold (twice that, plus the filter's reach).
-    slope = abs(float(np.polyfit(ramp - ramp[0], vr, 1)[0])) if len(ramp) >= 2 else 0.0
+    line = (tuple(float(c) for c in np.polyfit(ramp - ramp[0], vr, 1)) if len(ramp) >= 2
+            else None)  # the ramp's line, followed back to zero below
+    slope = abs(line[0]) if line is not None else 0.0
     reach_in = 2.0 / (slope * unit) + (window // 2 + 1) * r.h if slope > 0 else math.inf
     edge = float(t[i])
     far_t = edge - step * min(abs(float(t[far]) - edge) + r.h, reach_in)
     bounds = sorted((far_t, float(t[seg[up]])))
-    t0 = _zero(ramp, vr)
+    t0 = _zero(ramp, vr, line=line)
     if t0 is None:
         return Zero(edge, False)
     # The filter rounds the corner at the stop: samples whose window reaches across it
@@ -193,15 +195,17 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False) -> Zero
                 step * (r.q[seg[min(up + window, len(seg) - 1)]] - r.q[i]) / r.thr[i])
 
 
-def _zero(t: np.ndarray, v: np.ndarray, straight: bool = False) -> float | None:
+def _zero(t: np.ndarray, v: np.ndarray, straight: bool = False,
+          line: tuple[float, ...] | None = None) -> float | None:
     """Where the velocity ``v`` (positive, over the ramp ``t``) reached zero: the line
     through it followed back. With ``straight``, None unless the ramp is a straight line
     within 10 % of its height (a ramp that bends, like a shiver's soft start, is not
-    followed: its rest edge is kept)."""
+    followed: its rest edge is kept). ``line``: that line's slope and intercept in
+    ``t - t[0]``, when the caller has fitted it already."""
     if len(t) < 2:
         return None
     x = t - t[0]
-    slope, icpt = (float(c) for c in np.polyfit(x, v, 1))
+    slope, icpt = line if line is not None else (float(c) for c in np.polyfit(x, v, 1))
     if not math.isfinite(slope) or abs(slope) < 1e-15:
         return None
     if straight and len(t) >= 4:
