@@ -82,8 +82,7 @@ def rest_signals(t: np.ndarray, h: float, q: np.ndarray, noise: np.ndarray,
     joints' ``noise`` [rad] (0: a still or clean joint, threshold :data:`REST_SPEED`)."""
     v = smooth(q, window, 1, h, order=2)
     scale = 1.0 / np.sqrt(np.clip(density, 1e-3, 1.0))[:, None]
-    thr = np.maximum(NOISE_SIGMAS * noise[None, :] * slope_gain(window, h) * scale,
-                     REST_SPEED)
+    thr = _thresholds(noise, slope_gain(window, h), scale)
     ratio = np.abs(v) / thr
     level = row_max(ratio)
     v_long = thr_long = ratio_long = None
@@ -93,11 +92,21 @@ def rest_signals(t: np.ndarray, h: float, q: np.ndarray, noise: np.ndarray,
     if window > 3 and len(t) > odd(LONG_WINDOW / h):
         wl = odd(LONG_WINDOW / h)
         v_long = _long_slope(q, wl, h)
-        thr_long = np.maximum(NOISE_SIGMAS * noise[None, :] * slope_gain(wl, h) * scale,
-                              REST_SPEED)
+        thr_long = _thresholds(noise, slope_gain(wl, h), scale)
         ratio_long = np.abs(v_long) / thr_long
     return Rest(t, h, window, v, thr, ratio, level, v_long, thr_long, ratio_long, t_last, q,
                 noise, quantum, gain, scale[:, 0], carried)
+
+
+def _thresholds(noise: np.ndarray, gain: float, scale: np.ndarray) -> np.ndarray:
+    """Each joint's rest threshold at each sample, (N, n): ``NOISE_SIGMAS`` stds of its
+    filtered velocity (``gain`` per unit of noise, ``scale`` (N, 1) more across a logging
+    gap), at least :data:`REST_SPEED`. Where every sample was logged (no gap) it is one
+    row, read-only, the same for every sample."""
+    row = NOISE_SIGMAS * noise[None, :] * gain
+    if bool(np.all(scale == 1.0)):
+        return np.broadcast_to(np.maximum(row, REST_SPEED), (len(scale), len(noise)))
+    return np.maximum(row * scale, REST_SPEED)
 
 
 def _long_slope(q: np.ndarray, window: int, h: float) -> np.ndarray:

@@ -195,3 +195,18 @@ def test_maxima_keep_numpys_prominences_on_ties_and_plateaus():
             i = j + 1
         assert idx.tolist() == want_idx
         assert np.allclose(prom, want_prom, rtol=0, atol=0)
+
+
+def test_thresholds_equal_their_formula_with_and_without_a_gap():
+    """One row for every sample where all were logged, the full table across a gap:
+    either way the numbers of the plain expression, sample by sample."""
+    from aou_dsl.measuring.onset import REST_SPEED
+    from aou_dsl.measuring.rest import _thresholds
+    from aou_dsl.measuring.signal import NOISE_SIGMAS
+
+    noise = np.array([3e-4, 0.0, 1e-6, 2e-3])
+    for density in (np.ones(50), np.r_[np.ones(20), np.full(10, 0.25), np.ones(20)]):
+        scale = 1.0 / np.sqrt(np.clip(density, 1e-3, 1.0))[:, None]
+        want = np.maximum(NOISE_SIGMAS * noise[None, :] * 5.1 * scale, REST_SPEED)
+        got = _thresholds(noise, 5.1, scale)
+        assert got.shape == want.shape and np.array_equal(got, want)
