@@ -210,7 +210,10 @@ def peak_acceleration(c: Context, p: Piece, u: np.ndarray) -> tuple[float, float
         AouError: R406 when the joints' own accelerations cannot produce the peak.
     """
     r, h = c.rest, c.rest.h
-    speed = np.abs(smooth(c.pos[p.i0:p.i1 + 1] @ u, r.window, 1, h, order=2))
+    # A recording's travel is summed in NumPy's order (its noise is far above the
+    # rounding); a computed trajectory's in the filter's one fixed order.
+    speed = np.abs(smooth(c.pos[p.i0:p.i1 + 1] @ u, r.window, 1, h, order=2,
+                          exact=c.computed))
     jac = linear_jacobian(c.arm, c.q[(p.i0 + p.i1) // 2])
     sigma_x = float(np.sqrt(np.sum(((u @ jac) * c.noise) ** 2)))
     src = c.raw if c.raw is not None else Samples(r.t, c.q, c.pos)

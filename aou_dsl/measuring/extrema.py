@@ -32,7 +32,11 @@ def maxima(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         (ends == n - 1) | (x[np.minimum(ends + 1, n - 1)] < x[ends]))
     peak = crest & (starts >= 1) & (ends <= n - 2)
     first, last = starts[peak], ends[peak]
-    marks = np.union1d(np.concatenate([starts[crest], ends[crest]]), [0, n - 1])
+    # Both ends of every crest, and of ``x``: in order already (a crest ends before the
+    # next starts), so merged without a sort; a crest of one sample is one mark.
+    ordered = np.concatenate([[0], np.column_stack([starts[crest], ends[crest]]).ravel(),
+                              [n - 1]])
+    marks = ordered[np.concatenate([[True], ordered[1:] != ordered[:-1]])]
     prominences = _prominences(x, marks, first, last)
     return (first + last) // 2, prominences
 

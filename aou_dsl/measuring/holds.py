@@ -28,8 +28,8 @@ import numpy as np
 
 from .extrema import maxima
 from .onset import REST_SPEED, carried_edge, soft_pause
-from .rest import LONG_WINDOW, Rest, rest_signals
-from .signal import NOISE_SIGMAS, odd, runs
+from .rest import CLEARLY, LONG_WINDOW, Rest, rest_at_end, rest_signals
+from .signal import NOISE_SIGMAS, odd, row_max, runs
 
 __all__ = ["MIN_PAUSE", "REST_SPEED", "Boundary", "Rest", "boundaries", "rest_at_end",
            "rest_signals"]
@@ -40,8 +40,6 @@ MIN_PAUSE = 0.15
 HELD_SIGMAS = 5.0
 #: Drift of a held joint that is no motion [rad] (0.001 deg).
 STILL_ANGLE = 2e-5
-#: A joint is clearly moving at this many times its rest threshold (16 noise std).
-CLEARLY = 3.0
 #: The velocity ramp beside a stop is followed up to this fraction of its peak.
 RAMP_TOP = 0.6
 #: The joints move the same way on both sides of a rest when the cosine between their
@@ -84,14 +82,14 @@ def _rest_runs(r: Rest) -> tuple[list[tuple[int, int]], set[int]]:
         if i1 - i0 < short or np.all(away <= 4.0 * r.noise + 1.01 * r.quantum + 1e-12):
             rest[i0:i1 + 1] = True
     slow_edges: set[int] = set()
-    if r.v_long is not None and r.thr_long is not None:
+    if r.ratio_long is not None:
         # A full window from each end: next to a rest, the start of a slow motion looks
         # still for a while; its edge is refined, not split off.
         width = odd(LONG_WINDOW / r.h)
         for i0, i1 in runs(rest):
             a, b = i0 + width, i1 - width
             if b > a:
-                slow = np.max(np.abs(r.v_long[a:b + 1]) / r.thr_long[a:b + 1], axis=1) >= 1
+                slow = row_max(r.ratio_long[a:b + 1]) >= 1
                 for s0, s1 in runs(slow):
                     slow_edges.update((a + s0 - 1, a + s1 + 1))
                 rest[a:b + 1] &= ~slow
@@ -107,18 +105,22 @@ def _lead(r: Rest, seg: np.ndarray, slow: bool) -> tuple[np.ndarray, int, float]
     its window early, which is allowed for), or the long one for an edge that slow
     motion made (``slow``)."""
     found = []
-    for v, thr, window in ((r.v, r.thr, r.window), (r.v_long, r.thr_long, 0)):
-        if v is None or thr is None:
+    # ``seg`` runs one way from the rest: the same rows as a view, without a copy.
+    stop = int(seg[-1]) + (1 if seg[-1] >= seg[0] else -1)
+    rows = slice(int(seg[0]), stop if stop >= 0 else None, 1 if seg[-1] >= seg[0] else -1)
+    for v, thr, window, ratios in ((r.v, r.thr, r.window, r.ratio),
+                                   (r.v_long, r.thr_long, 0, r.ratio_long)):
+        if v is None or thr is None or ratios is None:
             continue
         width = window or odd(LONG_WINDOW / r.h)
-        ratio = np.abs(v[seg]) / thr[seg]
-        moving = np.flatnonzero(ratio.max(axis=1) > CLEARLY)
+        ratio = ratios[rows]
+        moving = np.flatnonzero(row_max(ratio) > CLEARLY)
         if len(moving) == 0:
             continue
         near = ratio[moving[0]:moving[0] + max(3, width)]
         j = int(np.argmax(near.max(axis=0)))
         k = moving[0] + int(np.argmax(near[:, j]))
-        vj = v[seg, j] * (1.0 if v[seg[k], j] >= 0 else -1.0) / thr[seg, j]
+        vj = v[rows, j] * (1.0 if v[seg[k], j] >= 0 else -1.0) / thr[rows, j]
         up = np.flatnonzero(vj > CLEARLY)
         if len(up):
             # A filter sees motion half its window before it starts.
@@ -172,12 +174,14 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False) -> Zero
     # The motion stops between its first clearly moving sample and the far end of the
     # rest (give or take a step), and no further into the rest than its ramp takes to
     # fall through the threshold (twice that, plus the filter's reach).
-    slope = abs(float(np.polyfit(ramp - ramp[0], vr, 1)[0])) if len(ramp) >= 2 else 0.0
+    line = (tuple(float(c) for c in np.polyfit(ramp - ramp[0], vr, 1)) if len(ramp) >= 2
+            else None)  # the ramp's line, followed back to zero below
+    slope = abs(line[0]) if line is not None else 0.0
     reach_in = 2.0 / (slope * unit) + (window // 2 + 1) * r.h if slope > 0 else math.inf
     edge = float(t[i])
     far_t = edge - step * min(abs(float(t[far]) - edge) + r.h, reach_in)
     bounds = sorted((far_t, float(t[seg[up]])))
-    t0 = _zero(ramp, vr)
+    t0 = _zero(ramp, vr, line=line)
     if t0 is None:
         return Zero(edge, False)
     # The filter rounds the corner at the stop: samples whose window reaches across it
@@ -191,19 +195,21 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False) -> Zero
                 step * (r.q[seg[min(up + window, len(seg) - 1)]] - r.q[i]) / r.thr[i])
 
 
-def _zero(t: np.ndarray, v: np.ndarray, straight: bool = False) -> float | None:
+def _zero(t: np.ndarray, v: np.ndarray, straight: bool = False,
+          line: tuple[float, ...] | None = None) -> float | None:
     """Where the velocity ``v`` (positive, over the ramp ``t``) reached zero: the line
     through it followed back. With ``straight``, None unless the ramp is a straight line
     within 10 % of its height (a ramp that bends, like a shiver's soft start, is not
-    followed: its rest edge is kept)."""
+    followed: its rest edge is kept). ``line``: that line's slope and intercept in
+    ``t - t[0]``, when the caller has fitted it already."""
     if len(t) < 2:
         return None
     x = t - t[0]
-    slope, icpt = np.polyfit(x, v, 1)
-    if not np.isfinite(slope) or abs(slope) < 1e-15:
+    slope, icpt = line if line is not None else (float(c) for c in np.polyfit(x, v, 1))
+    if not math.isfinite(slope) or abs(slope) < 1e-15:
         return None
     if straight and len(t) >= 4:
-        miss = float(np.sqrt(np.mean((np.polyval([slope, icpt], x) - v) ** 2)))
+        miss = float(np.sqrt(np.mean((slope * x + icpt - v) ** 2)))
         if miss > 0.1 * float(np.max(np.abs(v))) + 1.0 / NOISE_SIGMAS:
             return None
     return float(t[0] - icpt / slope)
@@ -214,7 +220,7 @@ def _crossings(r: Rest) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     ``i + 1``: those ``i``, the leading joint, and the speed level there (every joint's
     velocity interpolated to the crossing). Sampled a few times per cycle, an
     oscillation's samples can all miss its reversals; the level between them does not."""
-    ratio = np.abs(r.v) / r.thr
+    ratio = r.ratio
     j = np.argmax(ratio[:-1] + ratio[1:], axis=1)
     rows = np.arange(len(j))
     va, vb = r.v[rows, j], r.v[rows + 1, j]
@@ -242,12 +248,15 @@ def _dips(r: Rest, taken: np.ndarray) -> list[tuple[float, float, int]]:
     seq[2 * cross + 1] = np.minimum(between, seq[2 * cross + 1])
     joint = dict(zip(cross.tolist(), lead.tolist(), strict=True))
     idx, prominences = maxima(-seq)
+    # Only minima outside the rests and under 30 % of the peaks beside them (in a noisy
+    # recording, a few of the tens of thousands the noise makes).
+    half = idx // 2
+    kept = ~(taken[half] | ((idx % 2 == 1) & taken[np.minimum(half + 1, n - 1)])
+             | (seq[idx] > 0.3 * (seq[idx] + prominences)))
     out = []
     v = r.v if r.carried is None else r.carried[0]
-    for m, prom in zip(idx.tolist(), prominences.tolist(), strict=True):
+    for m, prom in zip(idx[kept].tolist(), prominences[kept].tolist(), strict=True):
         k = m // 2
-        if taken[k] or (m % 2 and taken[k + 1]) or seq[m] > 0.3 * (seq[m] + prom):
-            continue
         # Between two samples, a minimum is a reversal only where a joint's velocity
         # crosses zero there; else it is the middle of a flat stretch of equal levels
         # (a held sample, repeated), read at its sample as any other.
@@ -355,7 +364,7 @@ def _held(r: Rest, t0: float, t1: float) -> tuple[float, float]:
     shivers back to back); its positions cannot."""
     k0 = int(np.searchsorted(r.t, t0, "left"))
     k1 = int(np.searchsorted(r.t, t1, "right"))
-    p = r.held[k0:k1]
+    p = r.held(k0, k1)
     if len(p) < 3:
         return t0, t0
     # Across a logging gap fewer raw samples make each filtered value: more noise.
@@ -373,27 +382,6 @@ def _held(r: Rest, t0: float, t1: float) -> tuple[float, float]:
         return t0, t0
     return (t0 if a == 0 else float(r.t[k0 + a]),
             t1 if b == len(p) - 1 else float(r.t[k0 + b]))
-
-
-def rest_at_end(r: Rest, last: bool) -> bool:
-    """Whether the arm is at rest at the recording's first sample (its last with
-    ``last``). A motion that starts from rest right at the first sample (under a jerk
-    limit it barely moves at first) looks moving to a velocity filter there; its velocity,
-    a cubic fitted over the first samples and followed back to the edge, is near zero
-    beside the speed it has reached. A log that starts mid-motion starts at speed."""
-    n = len(r.t)
-    k = n - 1 if last else 0
-    if r.level[k] < 1.0:
-        return True
-    m = min(n, max(2 * r.window + 1, odd(0.05 / r.h), 7))
-    idx = np.arange(n - m, n) if last else np.arange(m)
-    j = int(np.argmax(np.abs(r.q[idx[-1]] - r.q[idx[0]])))
-    tt = r.t[idx] - r.t[k]
-    c = np.polyfit(tt, r.q[idx, j], 3)
-    far = float(tt[0] if last else tt[-1])
-    v_edge = float(c[2])
-    v_far = float(3 * c[0] * far ** 2 + 2 * c[1] * far + c[2])
-    return abs(v_edge) <= max(0.1 * abs(v_far), CLEARLY * float(r.thr[k, j]))
 
 
 def _merged(bounds: list[Boundary]) -> list[Boundary]:

@@ -30,7 +30,8 @@ class Linearised:
         self.arm = arm
         self.about = about or {}
         # Per clock: the expansion point's joints, hand positions and rotations, and the
-        # Jacobian's linear and angular parts joint by joint, (n, N, 3) each.
+        # Jacobian's linear and angular parts joint by joint, (n, 3, N) each (each axis
+        # a row of samples: the sums below run along them).
         self.at: dict[str, tuple[np.ndarray, ...]] = {}
 
     def __call__(self, q: np.ndarray, clock: str) -> tuple[np.ndarray, np.ndarray]:
@@ -50,11 +51,13 @@ class Linearised:
             return batch_fk(self.arm, q)
         q0, pos0, rot0, lin, ang = about
         dq = q - q0
-        pos, w = pos0.copy(), np.zeros_like(pos0)
+        pos, w = pos0.T.copy(), np.zeros((3, len(q)))
+        term = np.empty_like(pos)
         for j in range(dq.shape[1]):
-            pos += lin[j] * dq[:, j, None]
-            w += ang[j] * dq[:, j, None]
-        return pos, np.matmul(_turn(w), rot0)
+            step = np.ascontiguousarray(dq[:, j])
+            pos += np.multiply(lin[j], step, out=term)
+            w += np.multiply(ang[j], step, out=term)
+        return np.ascontiguousarray(pos.T), np.matmul(_turn(w.T), rot0)
 
 
 #: The copies' Jacobian is computed at every this many samples, and interpolated.
@@ -64,7 +67,7 @@ JACOBIAN_STEP = 8
 def _expansion(arm, q: np.ndarray, exact_rows: bool) -> tuple[np.ndarray, ...] | None:
     """The point the copies' kinematics are expanded about: ``q`` (N, n), its hand
     positions and rotations (``exact_rows``: computed here; else the measurement's own,
-    kept by the samples' bytes) and the Jacobian's linear and angular parts, (n, N, 3)
+    kept by the samples' bytes) and the Jacobian's linear and angular parts, (n, 3, N)
     each, from every :data:`JACOBIAN_STEP`-th row. None for an arm whose joints are not
     all revolute or prismatic."""
     from ..robot.batch_fk import batch_fk_jacobian, rows_fk
@@ -82,14 +85,14 @@ def _expansion(arm, q: np.ndarray, exact_rows: bool) -> tuple[np.ndarray, ...] |
         if got is None:
             return None
         rows = np.arange(n, dtype=float)
-        parts = np.empty((2, q.shape[1], n, 3))  # linear, angular; joint; sample; axis
+        parts = np.empty((2, q.shape[1], 3, n))  # linear, angular; joint; axis; sample
         for r in range(6):
             for j in range(q.shape[1]):
-                parts[r // 3, j, :, r % 3] = np.interp(rows, knots, got[2][:, r, j])
+                parts[r // 3, j, r % 3] = np.interp(rows, knots, got[2][:, r, j])
         pos, rot = rows_fk(arm, q)
         return q, pos, rot, parts[0], parts[1]
-    return (q, pos, rot, np.ascontiguousarray(jac[:, :3].transpose(2, 0, 1)),
-            np.ascontiguousarray(jac[:, 3:].transpose(2, 0, 1)))
+    return (q, pos, rot, np.ascontiguousarray(jac[:, :3].transpose(2, 1, 0)),
+            np.ascontiguousarray(jac[:, 3:].transpose(2, 1, 0)))
 
 
 def _turn(w: np.ndarray) -> np.ndarray:

@@ -80,13 +80,15 @@ def soft_edge(t: np.ndarray, q: np.ndarray, noise: np.ndarray, hold: tuple[int, 
     side = np.arange(edge, far + step, step)
     if len(side) < 4:
         return None
+    # The same samples as a view (``side`` runs one way from the edge): no copies.
+    rows = slice(edge, far + step if far + step >= 0 else None, step)
     sig = np.where(noise > 0, noise, np.inf)
-    z = np.abs(q[side] - ref) / sig
+    z = np.abs(q[rows] - ref) / sig
     j = int(np.argmax(z.max(axis=0)))
     clear = np.flatnonzero(z[:, j] > CLEAR)
     if not np.isfinite(sig[j]) or len(clear) == 0:
         return None
-    d = (q[side, j] - ref[j]) * np.sign(q[side[clear[0]], j] - ref[j])
+    d = (q[rows, j] - ref[j]) * np.sign(q[side[clear[0]], j] - ref[j])
     # The first lobe: up to where the deviation first swings back through the hold; the
     # onset is the part of it under ONSET_TOP of its top.
     back = np.flatnonzero(d[clear[0]:] < 0.0)

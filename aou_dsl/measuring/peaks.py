@@ -120,10 +120,21 @@ def path_travel(s: np.ndarray, q: np.ndarray, noise: np.ndarray
 @cached(maxsize=512)
 def _uniform_weights(w: int, h: float) -> np.ndarray:
     """The second-derivative weights of a least-squares quadratic through ``w`` samples
-    ``h`` [s] apart (any ``w`` >= 3, odd or even)."""
+    ``h`` [s] apart (any ``w`` >= 3, odd or even). The step is a mean of a phase's own,
+    rarely the same twice: the part that does not depend on it is kept per ``w``."""
+    twice, norm = _centred_squares(w)
+    return twice / (norm * h * h)
+
+
+@cached(maxsize=512)
+def _centred_squares(w: int) -> tuple[np.ndarray, float]:
+    """Twice the squared offsets from the centre of ``w`` samples, less their mean, and
+    the sum of the squares of the latter (read-only: cached)."""
     k = np.arange(w) - 0.5 * (w - 1)
     d = k * k - float(np.mean(k * k))
-    return 2.0 * d / (float(d @ d) * h * h)
+    twice = 2.0 * d
+    twice.flags.writeable = False
+    return twice, float(d @ d)
 
 
 @cached(maxsize=512)
@@ -140,16 +151,23 @@ def _runs_of(v: np.ndarray, w: int) -> np.ndarray:
                                            writeable=False)
 
 
-def curvatures(t: np.ndarray, x: np.ndarray, w: int) -> tuple[np.ndarray, np.ndarray]:
+def curvatures(t: np.ndarray, x: np.ndarray, w: int, noisy: bool = False
+               ) -> tuple[np.ndarray, np.ndarray]:
     """Over every run of ``w`` (>= 3) consecutive samples of ``x`` at times ``t``: the
     second derivative of the least-squares quadratic in time, and its std per unit of
-    white noise on ``x``. Run ``k`` covers samples ``k``..``k + w - 1``."""
+    white noise on ``x``. Run ``k`` covers samples ``k``..``k + w - 1``. With ``noisy``
+    (a recording's samples), an even clock's runs are summed by NumPy's correlation,
+    several times faster over long runs and different only in rounding (1e-14 of the
+    reading, far under the noise); without, in one fixed order (a computed trajectory's
+    equal readings are told apart by their rounding, which must not move)."""
     xw = _runs_of(x, w)
     steps = t[1:] - t[:-1]
     if len(steps):
         mean = float(steps.mean())
         if float(steps.max() - steps.min()) <= 1e-9 * mean:  # one clock
-            return xw @ _uniform_weights(w, mean), np.full(len(xw), _uniform_gain(w, mean))
+            weights = _uniform_weights(w, mean)
+            reads = np.correlate(x, weights, "valid") if noisy else xw @ weights
+            return reads, np.full(len(xw), _uniform_gain(w, mean))
     tw = _runs_of(t, w)
     centre = tw.mean(axis=1, keepdims=True)
     half = np.maximum(0.5 * (tw[:, -1] - tw[:, 0]), 1e-300)[:, None]
@@ -177,11 +195,16 @@ def _run(t: np.ndarray, a: int, b: int, level: float, noise: float, shortest: fl
     length = b - a + 1
     step = float(t[b] - t[a]) / max(length - 1, 1)
     w = min(max(3, int(math.ceil(shortest / step - 1e-9)) + 1), length)
+    bound = resolution * level
     while w < length:
-        # The gain of a run on an even clock of the phase's mean step.
-        gain = _uniform_gain(w, step)
-        if noise * gain <= resolution * level:
-            break
+        # The gain of a run on an even clock of the phase's mean step: first from its
+        # closed form, ``2 / (h^2 sqrt(w (w^2 - 1) (w^2 - 4) / 180))``, which settles
+        # every run clearly too short; the weights' own norm decides the close ones.
+        close = 2.0 / (step * step * math.sqrt(w * (w * w - 1.0) * (w * w - 4.0) / 180.0))
+        if noise * close <= bound + 1e-9 * (abs(bound) + noise * close):
+            gain = _uniform_gain(w, step)
+            if noise * gain <= bound:
+                break
         w = min(w + max(1, w // 8), length)
     return w
 
@@ -231,7 +254,8 @@ def phase_peak(t: np.ndarray, x: np.ndarray, a: int, b: int, sigma: float,
     if lo < a or hi > b:  # up to the top speed: a bang-bang law's switch steps by 2 levels
         step = max(step, 2.0)
     ws = max(w, min(_run(t, a, b, level, sigma, transient, DETECTION), (length + 1) // 2))
-    reads, gains = curvatures(t[lo:hi + 1], x[lo:hi + 1], ws)
+    noisy = transient > 0  # a recording: its noise is far above the sums' rounding
+    reads, gains = curvatures(t[lo:hi + 1], x[lo:hi + 1], ws, noisy)
     best = int(np.argmax(reads * sign))
     found, sd = float(reads[best]) * sign, sigma * float(gains[best])
     runs = max(1.0, (hi - lo + 1) / ws)
@@ -251,7 +275,7 @@ def phase_peak(t: np.ndarray, x: np.ndarray, a: int, b: int, sigma: float,
             return PhasePeak(edge * sign, sigma * edge_gain, float(at), transient)
     fine = _run(t, a, b, found, sigma, transient, RESOLUTION)
     if fine < ws:
-        acc_f, gain_f = curvatures(t[k0:k1 + 1], x[k0:k1 + 1], fine)
+        acc_f, gain_f = curvatures(t[k0:k1 + 1], x[k0:k1 + 1], fine, noisy)
         k = int(np.argmax(acc_f * sign))
         if float(acc_f[k]) * sign > found:
             k0, k1 = k0 + k, k0 + k + fine - 1

@@ -47,9 +47,15 @@ SINE_SHAPE = 0.12
 def roll_angle(rot: np.ndarray) -> np.ndarray:
     """The roll about the hand's forward (z) axis since the first sample [rad], (N,):
     the twist of each step's relative rotation, summed (so turns past 180 deg keep
-    counting)."""
-    rel = np.einsum("nji,njk->nik", rot[:-1], rot[1:])
-    step = np.arctan2(rel[:, 1, 0] - rel[:, 0, 1], rel[:, 0, 0] + rel[:, 1, 1])
+    counting). Only the four entries of each relative rotation ``R_k^T R_{k+1}`` that
+    the twist needs are formed, each summed from zero in the order of the inner index
+    (as a matrix product of the stack would, at a fifth of its cost)."""
+    a, b = rot[:-1], rot[1:]
+
+    def rel(i: int, k: int) -> np.ndarray:
+        return ((0.0 + a[:, 0, i] * b[:, 0, k]) + a[:, 1, i] * b[:, 1, k]) + a[:, 2, i] * b[:, 2, k]
+
+    step = np.arctan2(rel(1, 0) - rel(0, 1), rel(0, 0) + rel(1, 1))
     return np.concatenate([[0.0], np.cumsum(step)])
 
 

@@ -72,20 +72,7 @@ def surges(speed: np.ndarray, h: float, noise: float = 0.0) -> list[tuple[int, i
     half = min(int(0.5 * SPAN / h), (n - 1) // 2)
     if half > 0:
         speed = centred_mean(speed, half)
-    least, rise = SURGE * float(speed.max()), DISTINCT * noise
-    dips: list[int] = []
-    top, low, low_i, falling = float(speed[0]), 0.0, 0, False
-    for i in range(1, n):
-        v = float(speed[i])
-        if not falling:
-            top = max(top, v)
-            if top >= least and v < DIP * top and top - v > rise:
-                falling, low, low_i = True, v, i
-        elif v < low:
-            low, low_i = v, i
-        elif v >= least and low < DIP * v and v - low > rise:
-            dips.append(low_i)
-            falling, top = False, v
+    dips = _dips(speed, SURGE * float(speed.max()), DISTINCT * noise)
     least_span, kept = max(1, int(round(SPAN / h))), [0]
     for d in dips:
         if d - kept[-1] >= least_span and n - 1 - d >= least_span:
@@ -98,6 +85,35 @@ def surges(speed: np.ndarray, h: float, noise: float = 0.0) -> list[tuple[int, i
         kept.pop()
     bounds = [*kept, n - 1]
     return list(zip(bounds[:-1], bounds[1:], strict=True))
+
+
+def _dips(speed: np.ndarray, least: float, rise: float) -> list[int]:
+    """The dips of the finite ``speed`` (N,): a walk that, rising, keeps the top since
+    the last dip and starts falling at the first sample under :data:`DIP` of it (by more
+    than ``rise``, the top at least ``least``); falling, keeps the lowest sample (the
+    first of equal ones), and rises again at the first sample not under it that it is
+    under :data:`DIP` of (by more than ``rise``, the sample at least ``least``): that
+    lowest sample is a dip. Each stretch of the walk is found with running maxima and
+    minima over the samples left, not one sample at a time."""
+    dips: list[int] = []
+    n, i = len(speed), 0  # the walk rises from sample i, its top first speed[i]
+    while i < n - 1:
+        top = np.maximum.accumulate(speed[i:])
+        fall = np.flatnonzero((top[1:] >= least) & (speed[i + 1:] < DIP * top[1:])
+                              & (top[1:] - speed[i + 1:] > rise))
+        if len(fall) == 0:
+            break
+        f = i + 1 + int(fall[0])  # falling from here, the lowest first speed[f]
+        low = np.minimum.accumulate(speed[f:])[:-1]  # the lowest before each next sample
+        after = speed[f + 1:]
+        up = np.flatnonzero((after >= low) & (after >= least) & (low < DIP * after)
+                            & (after - low > rise))
+        if len(up) == 0:
+            break
+        r = f + 1 + int(up[0])
+        dips.append(f + int(np.argmin(speed[f:r])))
+        i = r
+    return dips
 
 
 def phases(speed: np.ndarray, h: float, at_rest0: bool, at_rest1: bool,

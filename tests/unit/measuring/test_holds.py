@@ -14,7 +14,8 @@ def _rest(level: np.ndarray) -> SimpleNamespace:
     n = len(level)
     v = level[:, None] * 0.01
     thr = np.full((n, 1), 0.001)
-    return SimpleNamespace(level=level, v=v, thr=thr, v_long=v, thr_long=thr, window=0,
+    return SimpleNamespace(level=level, v=v, thr=thr, ratio=np.abs(v) / thr, v_long=v,
+                           thr_long=thr, ratio_long=np.abs(v) / thr, window=0,
                            t=np.arange(n) * 0.004, h=0.004, carried=None,
                            q=np.cumsum(v, axis=0) * 0.004)
 

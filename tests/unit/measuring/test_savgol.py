@@ -189,3 +189,47 @@ def test_maxima_on_a_long_recording_are_fast_enough():
     ref, props = find_peaks(x, prominence=0.0)
     assert np.array_equal(idx, ref) and np.array_equal(prom, props["prominences"])
     assert math.isfinite(float(prom.sum()))
+
+
+def test_rows_equal_the_whole_filters_rows_bit_for_bit():
+    """A stretch of rows filtered on its own (the hold test's rests) is the same numbers
+    as those rows of the whole recording filtered, at the ends and across them, and
+    SciPy's filter gives them too."""
+    from aou_dsl.measuring.savgol import savgol_rows
+
+    rng = np.random.default_rng(12)
+    for cols in (0, 3, 7):
+        for x in _signals(rng, 180, cols):
+            for window, order, deriv in ((61, 3, 0), (61, 2, 1), (5, 3, 0), (9, 2, 2)):
+                whole = savgol(x, window, order, deriv, 0.001)
+                assert np.array_equal(whole, savgol_filter(
+                    x, window, order, deriv=deriv, delta=0.001, axis=0))
+                for a, b in ((0, 180), (0, 10), (25, 40), (10, 100), (150, 180),
+                             (170, 175), (40, 40), (-5, 500)):
+                    for laid in (x, np.asfortranarray(x)):  # a recording's: by column
+                        got = savgol_rows(laid, window, order, deriv, 0.001, a, b)
+                        assert np.array_equal(got, whole[max(a, 0):b]), (window, a, b)
+
+
+def test_one_dimensional_sums_equal_scipy_to_rounding():
+    """The recording's fast filter of a 1-D travel (NumPy's correlation for each
+    window's sum) against SciPy's filter (mode 'interp'): the ends bit for bit (fitted
+    alike), the rest within rounding of the signal's scale, for values and the first
+    and second derivatives, at the windows a recording's filter takes."""
+    from aou_dsl.measuring.savgol import savgol_1d
+
+    rng = np.random.default_rng(21)
+    for n in (61, 62, 200, 2500):
+        for x in _signals(rng, n, 0):
+            for window, order, deriv in ((61, 2, 1), (61, 3, 0), (31, 2, 1), (15, 3, 2),
+                                         (5, 2, 1)):
+                if window > n:
+                    continue
+                for delta in (0.001, 0.004):
+                    want = savgol_filter(x, window, order, deriv=deriv, delta=delta)
+                    got = savgol_1d(x, window, order, deriv, delta)
+                    half = window // 2
+                    scale = float(np.abs(x).max() + 1e-300) * delta ** -deriv
+                    assert np.array_equal(got[:half], want[:half])
+                    assert np.array_equal(got[n - half:], want[n - half:])
+                    assert np.abs(got - want).max() <= 1e-13 * scale, (n, window, deriv)
