@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.codes import R401, R403, R405, R406, R407
+from ..core.codes import R401, R403, R405, R406
 from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..core.trajectory import Trajectory
 from ..lang.cv import CVPoint, composition, infer
@@ -55,7 +55,7 @@ from .episodes import (
 )
 from .holds import MIN_PAUSE, REST_SPEED, Boundary, Rest, boundaries, rest_at_end, rest_signals
 from .recognisers import claimed, every_named, extra_descriptors, extra_values
-from .roll import MIN_TILT, SHAPED_CYCLE, Lobe, lobe, roll_angle, rotations
+from .roll import MIN_TILT, Lobe, lobe, roll_angle, rotations, undersampled
 from .signal import Grid, JointNoise, joint_noise, short_window, smooth, to_grid, unwrap
 from .staircase import dequantised
 from .stamps import evened, judge_stamps, read_on_evened, stamped_on_arrival
@@ -305,18 +305,6 @@ def _line_of_sight(ctx: Context) -> LineOfSight | None:
     return LineOfSight(ctx.rest.t[ok], np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0))))
 
 
-def _undersampled(where: Span, t0: float, t1: float, per_cycle: float, h: float
-                  ) -> Diagnostic:
-    """R407: an oscillation sampled too coarsely to tell a shiver from tilts."""
-    f = 1.0 / (per_cycle * h)
-    return diag(R407, f"the hand rolls back and forth at about {f:.2g} Hz from t={t0:.3f}s to "
-                f"t={t1:.3f}s, sampled {per_cycle:.2g} times per cycle: too few to tell a "
-                "shiver from tilts by its speed profile, so it is reported as neither",
-                where, hint=f"sample it at {math.ceil(SHAPED_CYCLE * f)} Hz or more "
-                f"({SHAPED_CYCLE} samples per cycle)", start=t0, end=t1,
-                frequency=f, samples_per_cycle=per_cycle)
-
-
 def _unequal(table: Mapping[str, Descriptor], name: str, vals: list[float]) -> bool:
     return max(vals) - min(vals) > table[name].tolerance(float(np.median(vals)))
 
@@ -398,7 +386,7 @@ def _measure(rec: Trajectory, pinned: JointNoise | None = None, fk: Kinematics |
     descriptors = derive(episodes)
     extra = extra_values(episodes)
     values = {**descriptors, **extra}
-    diags = [_undersampled(where, t0 + float(rec.t[0]), t1 + float(rec.t[0]), per_cycle,
+    diags = [undersampled(where, t0 + float(rec.t[0]), t1 + float(rec.t[0]), per_cycle,
                            ctx.rest.h) for t0, t1, per_cycle in coarse]
     if ctx.goal is None:
         diags.append(diag(R405, "the trajectory has no goal: gaze descriptors and the line "

@@ -18,11 +18,14 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..core.codes import R407
+from ..core.diagnostics import Diagnostic, Span, diag
 from ..lang.descriptors import EpisodeValues
 from ..lang.primitives import SHIVER, TILT
 from .episodes import Context, Piece
 
-__all__ = ["MIN_TILT", "SHAPED_CYCLE", "Lobe", "lobe", "roll_angle", "rotations"]
+__all__ = ["MIN_TILT", "SHAPED_CYCLE", "Lobe", "lobe", "roll_angle", "rotations",
+           "undersampled"]
 
 #: Smallest roll reported as a tilt [deg] (the tilt tolerance is 0.5 deg).
 MIN_TILT = 0.5
@@ -317,3 +320,15 @@ def rotations(c: Context, lobes: list[Lobe],
         k = hi + 1
     out += [e for i in range(k, len(lobes)) if i not in skip and (e := _tilt(lobes[i])) is not None]
     return out
+
+
+def undersampled(where: Span, t0: float, t1: float, per_cycle: float, h: float
+                  ) -> Diagnostic:
+    """R407: an oscillation sampled too coarsely to tell a shiver from tilts."""
+    f = 1.0 / (per_cycle * h)
+    return diag(R407, f"the hand rolls back and forth at about {f:.2g} Hz from t={t0:.3f}s to "
+                f"t={t1:.3f}s, sampled {per_cycle:.2g} times per cycle: too few to tell a "
+                "shiver from tilts by its speed profile, so it is reported as neither",
+                where, hint=f"sample it at {math.ceil(SHAPED_CYCLE * f)} Hz or more "
+                f"({SHAPED_CYCLE} samples per cycle)", start=t0, end=t1,
+                frequency=f, samples_per_cycle=per_cycle)
