@@ -20,13 +20,19 @@ def _v(v: float | int | None) -> str:
 
 
 def _pm(r) -> str:
-    """The measured value's 95 % interval as +- its larger half (a count's as lo..hi)."""
+    """The measured value's 95 % interval about it, as ``aouc measure`` prints it:
+    ``+-x`` when its two sides are within a tenth of each other, else ``+x -y`` (a
+    count's as lo..hi)."""
     if r.measured is None or r.low is None or r.high is None:
         return "" if r.high is None else f"or {_v(r.high)}"  # copies that found it
     if isinstance(r.measured, int) and not isinstance(r.measured, bool):
         return "" if r.low == r.high else f"{r.low}..{r.high}"
-    half = max(r.measured - r.low, r.high - r.measured)
-    return f"+-{half:.2g}" if half > 0 else ""
+    up, down = r.high - r.measured, r.measured - r.low
+    if max(up, down) <= 0:
+        return ""
+    if abs(up - down) <= 0.1 * max(up, down):
+        return f"+-{max(up, down):.2g}"
+    return f"+{up:.2g} -{down:.2g}"
 
 
 _SHOWN = {"pass": "pass", "fail": "FAIL", "inconclusive": "INCONCLUSIVE"}
@@ -38,13 +44,13 @@ def format_verdict(verdict) -> str:
     lines = [f"{verdict.path} against {verdict.against} (robot {verdict.robot})"]
     if verdict.goal_from_file:
         lines.append("  (the recording has no goal: measured at the behaviour's)")
-    lines.append(f"  {'descriptor':24s} {'declared':>10s} {'measured':>10s} {'95 %':>10s} "
+    lines.append(f"  {'descriptor':24s} {'declared':>10s} {'measured':>10s} {'95 %':>17s} "
                  f"{'tolerance':>11s}  {'unit':6s} result")
     for r in verdict.rows:
         tol = "-" if r.tolerance is None else (
             "exact" if r.tolerance == 0 else f"+-{r.tolerance:.3g}")
         lines.append(f"  {r.name:24s} {_v(r.declared):>10s} {_v(r.measured):>10s} "
-                     f"{_pm(r):>10s} {tol:>11s}  {r.unit:6s} {_SHOWN[r.result]}")
+                     f"{_pm(r):>17s} {tol:>11s}  {r.unit:6s} {_SHOWN[r.result]}")
     for side, cv in (("declared", verdict.declared_cv), ("measured", verdict.measured_cv)):
         lines.append(f"  C-V {side}: C={cv.C:+.2f} V={cv.V:+.2f} -> {cv.state.value}")
     n = sum(r.ok for r in verdict.rows)

@@ -234,14 +234,18 @@ def _result(d: Descriptor, want: float | int | None, got: float | int | None,
             low: float | int | None, high: float | int | None, stable: bool) -> str:
     """pass when the whole interval ``low..high`` of the measured ``got`` matches the
     declared ``want``, fail when none of it does, else inconclusive. A presence the
-    noise can flip (``stable`` False) is inconclusive unless the values the copies read
-    all miss the tolerance."""
+    noise can flip (``stable`` False), and a value not to be trusted (R411), are
+    inconclusive: the recording cannot tell, and an interval a wrong clock or a wrong
+    segmentation moved can miss the tolerance as a whole. A count the noise can flip
+    fails when no copy reads the declared count."""
     if want is None or got is None:
         if stable:
             return PASS if d.matches(want, got) else FAIL
         return INCONCLUSIVE
     if low is None or high is None:
         return PASS if d.matches(want, got) else FAIL
+    if not stable and not d.is_count:
+        return INCONCLUSIVE
     tol = d.tolerance(float(want))
     if d.matches(want, low) and d.matches(want, high) and stable:
         return PASS

@@ -101,3 +101,17 @@ def test_a_behaviour_file_with_errors_is_said_and_nothing_judged(recording, tmp_
     assert main(["measure", path, "--against", str(bad)]) == 1
     out, err = capsys.readouterr()
     assert "descriptor" not in out and "bad.aou:1:" in err
+
+
+def test_the_table_shows_a_lopsided_interval_as_measure_does():
+    """The verdict table printed every interval as +- its larger half, where `aouc
+    measure` prints +up -down: 0.05009 in 0.04231..0.05577 read "+-0.0078" in one and
+    "+0.0057 -0.0078" in the other."""
+    from types import SimpleNamespace
+
+    from aou_dsl.cli.against import _pm
+
+    row = SimpleNamespace(measured=0.05009, low=0.04231, high=0.05577)
+    assert _pm(row) == "+0.0057 -0.0078"
+    assert _pm(SimpleNamespace(measured=1.0, low=0.9, high=1.095)) == "+-0.1"
+    assert _pm(SimpleNamespace(measured=5, low=4, high=6)) == "4..6"

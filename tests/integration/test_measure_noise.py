@@ -262,6 +262,17 @@ def test_a_count_or_presence_the_noise_can_flip_is_inconclusive():
     assert _result(gaze, None, 12.0, 11.0, 13.0, True) == FAIL
 
 
+def test_a_value_not_to_be_trusted_is_inconclusive_even_outside_the_tolerance():
+    """A recording stamped on arrival read 0.119 m/s^2 on its clock evened out and 0.071
+    on its stamps, both marked not to be trusted (R411), for a motion declared and made
+    at 0.05: its interval took in both readings and missed the tolerance as a whole, and
+    the verdict was a failure of a motion that matched its file. Trusted, the same
+    interval fails."""
+    d = REGISTRY["approach_acceleration"]
+    assert _result(d, 0.05, 0.071, 0.065, 0.119, False) == INCONCLUSIVE
+    assert _result(d, 0.05, 0.071, 0.065, 0.119, True) == FAIL
+
+
 def _csv(tmp_path: Path, doc: dict, log: Logger) -> str:
     rec = record(doc, log, dynamic=False)
     path = tmp_path / "run.csv"
