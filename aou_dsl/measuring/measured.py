@@ -348,7 +348,7 @@ def measure(rec: Trajectory, *, uncertainty: bool = True) -> Measured:
     if uncertainty:
         from .uncertainty import attach
 
-        attach(m, rec, jn, _measure)
+        attach(m, rec, jn, _measure, None if failed is not None else _arrival(rec, jn))
         if failed is None:
             _stamps(m, rec, jn)
     if failed is not None:
@@ -362,6 +362,15 @@ def _joints(rec: Trajectory) -> tuple[np.ndarray, np.ndarray]:
     arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
     t, q = _checked(rec, rec.columns(arm.joint_names))
     return t, unwrap(q)[0]
+
+
+def _arrival(rec: Trajectory, jn: JointNoise) -> np.ndarray | None:
+    """A noisy recording's clock evened out when its stamps were taken on arrival
+    (:mod:`.stamps`), else None."""
+    if float(jn.effective.max(initial=0.0)) <= COMPUTED_NOISE:
+        return None
+    t, q = _joints(rec)
+    return evened(t) if stamped_on_arrival(t, q, jn.effective) else None
 
 
 def _stamps(m: Measured, rec: Trajectory, jn: JointNoise) -> None:

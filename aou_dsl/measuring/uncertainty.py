@@ -115,7 +115,8 @@ def exact(value: float | int | None) -> Spread:
     return Spread(None if value is None else 0.0, value, value, True)
 
 
-def _copies(rec: Trajectory, cols: np.ndarray, jn: JointNoise, rng: np.random.Generator
+def _copies(rec: Trajectory, cols: np.ndarray, jn: JointNoise, rng: np.random.Generator,
+            restamp: np.ndarray | None = None
             ) -> tuple[Trajectory, Callable[[], Trajectory], dict[str, np.ndarray]]:
     """``rec`` with its arm joints smoothed (the base); a maker of copies of the base
     with fresh noise at each moving joint's level, rounded again where the recording's
@@ -156,6 +157,10 @@ def _copies(rec: Trajectory, cols: np.ndarray, jn: JointNoise, rng: np.random.Ge
             x[:, rounded] = (np.round((x[:, rounded] + shift[rounded]) / step[rounded])
                              * step[rounded] - shift[rounded])
         qc[:, cols] = x
+        if restamp is not None:  # the same samples, stamped on another arrival
+            stamps = restamp + rng.permutation(t - restamp)
+            if bool(np.all(np.diff(stamps) > 0)):
+                return rec.with_(q=qc, t=stamps)
         return rec.with_(q=qc)
 
     return rec.with_(q=base_q), copy, {"grid": grid.q, "raw": q}
@@ -203,10 +208,12 @@ def _values(m) -> dict:
 
 
 def attach(m, rec: Trajectory, jn: JointNoise,
-           measure_once: Callable[[Trajectory, JointNoise | None, Linearised], tuple]
-           ) -> None:
+           measure_once: Callable[[Trajectory, JointNoise | None, Linearised], tuple],
+           restamp: np.ndarray | None = None) -> None:
     """Give ``m`` (a :class:`.measured.Measured` of ``rec``, whose joints' noise is
-    ``jn``) its uncertainty, and R411 when a count or a presence is not stable."""
+    ``jn``) its uncertainty, and R411 when a count or a presence is not stable.
+    ``restamp``: for a clock stamped on arrival, that clock evened out; each copy is
+    then stamped afresh about it (:func:`_copies`)."""
     value = _values(m)
     table = every_named()
     if float(jn.effective.max(initial=0.0)) <= COMPUTED_NOISE:
@@ -218,7 +225,7 @@ def attach(m, rec: Trajectory, jn: JointNoise,
     arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
     cols = rec.columns(arm.joint_names)
     rng = np.random.default_rng(SEED)
-    base, copy, about = _copies(rec, cols, jn, rng)
+    base, copy, about = _copies(rec, cols, jn, rng, restamp)
     fk = Linearised(arm, about)
     try:
         smooth_m = measure_once(base, jn, fk)[0]
@@ -263,13 +270,17 @@ def attach(m, rec: Trajectory, jn: JointNoise,
         stairs = staircase_joints(jn)
         source = (f"the joints' rounding (steps of {float(jn.quantum[stairs].max()):.2g} "
                   "rad)" if stairs.any() else f"the joints' noise ({noise:.2g} rad)")
+        if restamp is not None:
+            source += " and the clock's stamps, taken on arrival, are"
         m.diagnostics.append(diag(
-            R411, f"{source} is more than this recording's "
-            f"segmentation bears: {'; '.join(what)}. "
+            R411, f"{source}{'' if restamp is not None else ' is'} more than this "
+            f"recording's segmentation bears: {'; '.join(what)}. "
             f"{'These are' if len(what) > 1 else 'This is'} not to be trusted",
             Span.whole_file(rec.path),
-            hint=("log with a finer encoder resolution" if stairs.any() else
-                  "log at a higher rate or with less noise")
+            hint=("stamp each sample when it is taken, not when it arrives; "
+                  if restamp is not None else "")
+            + ("log with a finer encoder resolution" if stairs.any() else
+               "log at a higher rate or with less noise")
             + "; a longer pause or a slower motion stands out of the noise better",
             noise=noise, descriptors=shaky, states=list(states)))
 

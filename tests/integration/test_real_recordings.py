@@ -276,7 +276,7 @@ def tally(participants: list[str]) -> tuple[list[str], dict[str, int]]:
 
 # --- the claims ------------------------------------------------------------------------
 
-DEFAULT = ["P7", "P10"]
+DEFAULT = ["P7", "P10", "P13"]
 
 
 def _takes(participants: list[str]) -> list[str]:
@@ -328,13 +328,19 @@ def test_a_take_its_stamps_make_unreadable_is_read_on_the_evened_clock():
 def test_the_stamped_slow_take_is_not_ordered_and_the_other_is():
     """P7's slow take read 21 m/s^2 (independent: about 1), trusted, and so 'faster'
     than its sudden take: its clock's stamps, taken on arrival, moved the reading, the
-    same in every re-noised copy. Now it is untrusted and the order inconclusive;
-    P10's takes are ordered as the independent measurement orders them."""
+    same in every re-noised copy. Now it is untrusted and the order inconclusive.
+    P10's sudden take read 1.67 m/s^2 in [1.64, 1.74], trusted, where the independent
+    measurement reads 1.14 to 1.23: its copies kept the recording's stamps. Stamped
+    afresh, as a clock stamped on arrival could have been, they leave it untrusted, its
+    interval holding the independent range. P13's takes are ordered as the
+    independent measurement orders them."""
     rows, counts = tally(DEFAULT)
     assert order(read("P7_G"), read("P7_H")) == "inconclusive", rows
     assert not read("P7_G").trusted
-    assert order(read("P10_G"), read("P10_H")) == "sudden" == order_independent(
-        read("P10_G"), read("P10_H")), rows
+    p10 = read("P10_H")
+    assert not p10.trusted and p10.low <= p10.ind_low and p10.ind_high <= p10.high, rows
+    assert order(read("P13_G"), read("P13_H")) == "sudden" == order_independent(
+        read("P13_G"), read("P13_H")), rows
     assert counts["wrong"] == 0, rows
 
 
