@@ -8,8 +8,9 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ..core.diagnostics import Diagnostic
-from .args import EXIT_ERRORS, EXIT_INCONCLUSIVE, EXIT_OK
+from ..core.diagnostics import Diagnostic, Severity
+from ..core.rules import category
+from .args import EXIT_ERRORS, EXIT_INCONCLUSIVE, EXIT_OK, EXIT_USAGE
 from .report import format_github, format_json, format_text
 
 __all__ = ["cmd_measure_against", "format_verdict"]
@@ -70,14 +71,21 @@ def cmd_measure_against(args: argparse.Namespace, read) -> int:
     from ..measuring.verdict import judge
 
     lint = lint_file(args.against)
+    if lint.behaviour is None:  # the behaviour is what the recording is judged by
+        errors = [d for d in lint.diagnostics if d.severity == Severity.ERROR]
+        _unread(args, errors or lint.diagnostics, {lint.path: lint.source or ""})
+        # 2 when it could not be read at all, 1 for a file with errors (as `aouc lint`)
+        return EXIT_USAGE if any(category(d.code).is_usage for d in errors) else EXIT_ERRORS
     try:
-        rec = read(args.path, args)
-    except AouError as e:
-        b = lint.behaviour
-        if args.robot or b is None or not any(
-                d.code == I501 and "without its robot" in d.message for d in e.diagnostics):
-            raise
-        rec = read(args.path, args, robot=b.settings.robot)
+        try:
+            rec = read(args.path, args)
+        except AouError as e:
+            if args.robot or not any(d.code == I501 and "without its robot" in d.message
+                                     for d in e.diagnostics):
+                raise
+            rec = read(args.path, args, robot=lint.behaviour.settings.robot)
+    except AouError as e:  # not a verdict: exit 2, as for a file that cannot be read
+        return _unread(args, e.diagnostics, {})
     verdict = judge(rec, lint)
     outside: list[Diagnostic] = verdict.outside() + verdict.undecided() \
         + verdict.undeclared()
@@ -95,3 +103,19 @@ def cmd_measure_against(args: argparse.Namespace, read) -> int:
     if verdict.failed:
         return EXIT_ERRORS
     return EXIT_INCONCLUSIVE if verdict.inconclusive else EXIT_OK
+
+
+def _unread(args: argparse.Namespace, diags: list[Diagnostic], sources: dict) -> int:
+    """The diagnostics of a recording or behaviour that could not be read, in the
+    requested format (a JSON document with no verdict, GitHub annotations, or text);
+    exit 2, which no verdict gives."""
+    if args.format == "json":
+        print(format_json({"path": args.path, "against": args.against, "result": None,
+                           "diagnostics": [d.to_json() for d in diags]}))
+    elif args.format == "github":
+        for d in diags:
+            print(format_github(d))
+    else:
+        for d in diags:
+            print(format_text(d, sources.get(d.span.path)), file=sys.stderr)
+    return EXIT_USAGE

@@ -100,5 +100,7 @@ class Trajectory:
             raise AouError(diag(
                 R402, f"the trajectory lacks joint(s) {', '.join(missing)} of robot "
                 f"`{self.robot}`; its columns are {', '.join(self.joint_names)}",
-                Span.whole_file(self.path), missing=missing))
+                Span.whole_file(self.path), missing=missing,
+                hint="name each column after its joint, or map them with --map "
+                     "COLUMN=JOINT,... (or a mapping file)"))
         return np.array([self.joint_names.index(n) for n in names], dtype=int)

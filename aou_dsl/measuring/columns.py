@@ -56,8 +56,8 @@ def _pairs(text: str, where: str, line_of: dict[int, int] | None = None
 def column_map(spec: str) -> dict[str, str]:
     """The mapping ``--map`` gives: ``column=joint`` pairs separated by commas, or the
     path of a mapping file (a value without ``=``)."""
-    if "=" in spec:
-        return _pairs(spec, "<command line>", {})
+    if "=" in spec or (not os.path.isfile(spec) and (":" in spec or "," in spec)):
+        return _pairs(spec, "<command line>", {})  # pairs (a malformed one is R401)
     if not os.path.isfile(spec):
         raise AouError(diag(I501, f"cannot read the column mapping `{spec}`: no such file "
                             "(give column=joint pairs, or a mapping file)",

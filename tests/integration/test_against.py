@@ -115,3 +115,27 @@ def test_the_table_shows_a_lopsided_interval_as_measure_does():
     assert _pm(row) == "+0.0057 -0.0078"
     assert _pm(SimpleNamespace(measured=1.0, low=0.9, high=1.095)) == "+-0.1"
     assert _pm(SimpleNamespace(measured=5, low=4, high=6)) == "4..6"
+
+
+def test_a_file_that_cannot_be_read_exits_2_in_every_format(tmp_path, capsys):
+    """A recording with a non-number in it exited 1, the code of a failed verdict, and
+    printed nothing on stdout under --format json or github; a behaviour file that does
+    not exist was reported as the recording lacking its robot."""
+    import json as _json
+
+    from aou_dsl.cli.commands import main
+
+    bad = tmp_path / "bad.csv"
+    bad.write_text("t,panda_joint1\n0.0,0.1\n0.004,abc\n")
+    behaviour = str(BEHAVIOURS / "hesitant.aou")
+    assert main(["measure", str(bad), "--against", behaviour]) == 2
+    assert "R401" in capsys.readouterr().err
+    assert main(["measure", str(bad), "--against", behaviour, "--format", "json"]) == 2
+    doc = _json.loads(capsys.readouterr().out)
+    assert doc["result"] is None and doc["diagnostics"][0]["code"] == "R401"
+    assert main(["measure", str(bad), "--against", behaviour, "--format", "github"]) == 2
+    assert capsys.readouterr().out.startswith("::error file=")
+    missing = str(tmp_path / "nothere.aou")
+    assert main(["measure", str(bad), "--against", missing]) == 2
+    err = capsys.readouterr().err
+    assert "I501" in err and "nothere.aou" in err and "without its robot" not in err

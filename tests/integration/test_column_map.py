@@ -93,3 +93,17 @@ def test_measure_against_takes_the_robot_from_the_behaviour(logged, tmp_path, ca
     assert code in (0, 3) and doc["robot"] == "panda" and doc["goal_from_behaviour"]
     rows = {r["descriptor"]: r for r in doc["descriptors"]}
     assert rows["pause_count"]["result"] == "pass"
+
+
+def test_a_pair_written_with_a_colon_is_a_malformed_pair_not_a_missing_file(logged, tmp_path,
+                                                                            capsys):
+    """``--map j1:panda_joint1`` was looked up as a mapping file and refused as "no
+    such file" (I501) at a location named after the pair; it is a malformed pair (R401),
+    with the pairs' form in the hint. Without --map, R402 now says --map exists."""
+    path = _write(tmp_path, logged)
+    assert main(["measure", path, "--robot", "panda", "--map", "j1:panda_joint1"]) == 1
+    err = capsys.readouterr().err
+    assert "R401" in err and "I501" not in err and "column=joint" in err
+    main(["measure", path, "--robot", "panda"])
+    err = capsys.readouterr().err
+    assert "R402" in err and "--map" in err
