@@ -140,7 +140,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
         from .fitted import fitted_usage
 
         return fitted_usage("compile")
-    if args.tracked and (len(inputs) != 1 or not args.track):
+    if args.tracked and len(inputs) != 1:  # without --track: I504 (guard_outputs)
         return usage_error("compile", "--tracked needs --track and one .aou input")
     results = build_many(sources, options, args.jobs or default_jobs(), cluster=args.cluster,
                          encode=None if args.no_output else fmt)  # the workers encode
@@ -191,8 +191,10 @@ def _cmd_check(args: argparse.Namespace) -> int:
     from ..api import check
     from .ci_cmd import robot_refusals
     from .report import format_check
-    from .track_cmd import check_tracking, nothing_to_track
+    from .track_cmd import check_tracking, guard_tracked, nothing_to_track
 
+    # before any work: --tracked obeys the output rule (and needs --track)
+    guard_tracked(args, _reads(args, [args.path]))
     if args.format == "sarif":
         from .ci_cmd import check_sarif
 
