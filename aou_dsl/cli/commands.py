@@ -213,7 +213,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
                    **_scene_kw(args))
     failed = _check_diagnostics(args.path, report)
     if args.format != "json":
-        print(format_check(args.path, tr.robot, tr.t, report))
+        print(_with_not_run(format_check(args.path, tr.robot, tr.t, report), report))
     more, tracking = check_tracking(args, tr, _reads(args, [args.path])) if args.track \
         else ([], None)
     failed += more
@@ -223,6 +223,18 @@ def _cmd_check(args: argparse.Namespace) -> int:
                            "diagnostics": [d.to_json() for d in failed]}))
     _print_diags(failed)
     return EXIT_ERRORS if any(d.severity == Severity.ERROR for d in failed) else EXIT_OK
+
+
+def _with_not_run(text: str, report) -> str:
+    """The check report with a line ``n/a`` for each check that could not run, after
+    the checks that ran (as the clearances below say ``n/a``): never a ``pass``."""
+    if not report.not_run:
+        return text
+    lines = text.split("\n")
+    at = next((i for i, line in enumerate(lines) if line.startswith("  clearances:")),
+              len(lines))
+    rows = [f"  n/a   {c.name:<21} ({c.detail})" for c in report.not_run]
+    return "\n".join(lines[:at] + rows + lines[at:])
 
 
 def _check_diagnostics(path: str, report) -> list[Diagnostic]:
