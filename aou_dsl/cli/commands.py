@@ -193,8 +193,8 @@ def _cmd_check(args: argparse.Namespace) -> int:
     from .report import format_check
     from .track_cmd import check_tracking, guard_tracked, nothing_to_track
 
-    # before any work: --tracked obeys the output rule (and needs --track)
-    guard_tracked(args, _reads(args, [args.path]))
+    if args.tracked:  # before any work: the output rule (and it needs --track)
+        guard_tracked(args, _reads(args, [args.path]))
     if args.format == "sarif":
         from .ci_cmd import check_sarif
 
