@@ -140,7 +140,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
         from .fitted import fitted_usage
 
         return fitted_usage("compile")
-    if args.tracked and (len(inputs) != 1 or not args.track):
+    if args.tracked and len(inputs) != 1:  # without --track: I504 (guard_outputs)
         return usage_error("compile", "--tracked needs --track and one .aou input")
     results = build_many(sources, options, args.jobs or default_jobs(), cluster=args.cluster,
                          encode=None if args.no_output else fmt)  # the workers encode
@@ -191,8 +191,10 @@ def _cmd_check(args: argparse.Namespace) -> int:
     from ..api import check
     from .ci_cmd import robot_refusals
     from .report import format_check
-    from .track_cmd import check_tracking, nothing_to_track
+    from .track_cmd import check_tracking, guard_tracked, nothing_to_track
 
+    if args.tracked:  # before any work: the output rule (and it needs --track)
+        guard_tracked(args, _reads(args, [args.path]))
     if args.format == "sarif":
         from .ci_cmd import check_sarif
 
@@ -211,7 +213,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
                    **_scene_kw(args))
     failed = _check_diagnostics(args.path, report)
     if args.format != "json":
-        print(format_check(args.path, tr.robot, tr.t, report))
+        print(_with_not_run(format_check(args.path, tr.robot, tr.t, report), report))
     more, tracking = check_tracking(args, tr, _reads(args, [args.path])) if args.track \
         else ([], None)
     failed += more
@@ -221,6 +223,18 @@ def _cmd_check(args: argparse.Namespace) -> int:
                            "diagnostics": [d.to_json() for d in failed]}))
     _print_diags(failed)
     return EXIT_ERRORS if any(d.severity == Severity.ERROR for d in failed) else EXIT_OK
+
+
+def _with_not_run(text: str, report) -> str:
+    """The check report with a line ``n/a`` for each check that could not run, after
+    the checks that ran (as the clearances below say ``n/a``): never a ``pass``."""
+    if not report.not_run:
+        return text
+    lines = text.split("\n")
+    at = next((i for i, line in enumerate(lines) if line.startswith("  clearances:")),
+              len(lines))
+    rows = [f"  n/a   {c.name:<21} ({c.detail})" for c in report.not_run]
+    return "\n".join(lines[:at] + rows + lines[at:])
 
 
 def _check_diagnostics(path: str, report) -> list[Diagnostic]:

@@ -13,19 +13,24 @@ __all__ = ["guard_outputs"]
 def guard_outputs(args: argparse.Namespace, inputs: list[tuple[str, str | None]],
                   reads: Sequence[str]) -> tuple[list[str | None], str, ReadSet]:
     """Where each input's trajectory goes (None each with ``--no-output``) and in which
-    format, after every output (``-o``'s files, ``--write-fitted``, ``--sarif``) is
-    checked against the files the command reads and against each other; and those
+    format, after every output (``-o``'s files, ``--write-fitted``, ``--tracked``,
+    ``--sarif``) is checked against the files the command reads and against each other; and those
     files as a :class:`~aou_dsl.core.read_set.ReadSet`, indexed once, so that the rule
     of each output (here, and again when it is written) is a look-up, not a pass over
     every input.
 
     Raises:
-        AouError: I502 (or I506) naming the clash.
+        AouError: I502 (or I506) naming the clash (``-o`` naming an input is refused as
+            that before its format is read), I504 for ``--tracked`` without ``--track``.
     """
     from ..compiler.output import FOLDER_FORMATS, FORMATS, output_paths
     from ..core.files import check_format, guard_output
 
     reads = ReadSet(reads)
+    if args.output and reads.clash(args.output) is not None:
+        # an input first, whatever its extension: `-o x.aou` is refused as the file the
+        # command reads (the real reason), not as an unknown format
+        guard_output(args.output, reads)
     if args.no_output:
         dests: list[str | None] = [None] * len(inputs)
         fmt = "json"
@@ -41,6 +46,11 @@ def guard_outputs(args: argparse.Namespace, inputs: list[tuple[str, str | None]]
 
         check_fitted_output(args.write_fitted, reads, written)
         written.append(args.write_fitted)
+    if getattr(args, "tracked", None):  # needs --track; never onto what -o writes
+        from .track_cmd import guard_tracked
+
+        guard_tracked(args, reads, written)
+        written.append(args.tracked)
     if args.sarif:
-        guard_output(args.sarif, [*reads, *written])
+        guard_output(args.sarif, [*reads, *written], flag="--sarif")
     return dests, fmt, reads

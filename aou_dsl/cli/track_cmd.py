@@ -17,8 +17,39 @@ import numpy as np
 from ..core.diagnostics import AouError, Diagnostic, Span
 from ..version import __version__
 
-__all__ = ["check_tracking", "compile_tracked", "format_tracking", "nothing_to_track",
-           "run_tracking", "tracked_document"]
+__all__ = ["check_tracking", "compile_tracked", "format_tracking", "guard_tracked",
+           "nothing_to_track", "run_tracking", "tracked_document"]
+
+
+def guard_tracked(args: argparse.Namespace, reads: Sequence[str],
+                  written: Sequence[str] = ()) -> None:
+    """``--tracked FILE`` before any work: refused without ``--track`` (nothing would be
+    tracked, so nothing written: a silent exit 0 would leave the user waiting for a
+    file), else the output rule of ``-o`` against the files the command ``reads`` and
+    the ``written`` outputs, its hint naming ``--tracked``.
+
+    Raises:
+        AouError: I504 without ``--track``; I502 naming the clash.
+    """
+    from ..core.codes import I502, I504
+    from ..core.diagnostics import diag
+    from ..core.files import guard_output, same_file
+
+    dest = getattr(args, "tracked", None)
+    if not dest:
+        return
+    if not getattr(args, "track", False):
+        raise AouError(diag(I504, f"--tracked {dest} needs --track: without it nothing is "
+                            "tracked, so nothing would be written",
+                            Span.whole_file("<command line>"),
+                            hint="add --track, or leave out --tracked"))
+    guard_output(dest, reads, flag="--tracked")
+    for out in written:
+        if same_file(dest, out):
+            raise AouError(diag(I502, f"refusing to write the tracked motion into `{dest}`: "
+                                f"-o writes the output there (`{out}`)",
+                                Span.whole_file(dest),
+                                hint="give --tracked a path of its own"))
 
 
 @contextlib.contextmanager
@@ -234,8 +265,8 @@ def run_tracking(args: argparse.Namespace, tr, behaviour, *, reads: Sequence[str
     from ..safety.track_report import track_modes
 
     dest = getattr(args, "tracked", None)
-    if dest:
-        guard_output(dest, reads)
+    if dest:  # checked before any work (guard_tracked); again here, as it is written
+        guard_output(dest, reads, flag="--tracked")
     report = track_modes(tr, behaviour, selected=args.servo, written=written, fitted=fitted)
     robot_span = Span.whole_file("<command line>" if getattr(args, "robot", None)
                                  else tr.path)

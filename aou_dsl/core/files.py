@@ -108,11 +108,12 @@ def _special(mode: int) -> str | None:
 
 
 def guard_output(path: str, reads: Sequence[str] = (), *, force: bool = True,
-                 bag: bool = False) -> None:
+                 bag: bool = False, flag: str = "-o") -> None:
     """The output rule: refuse ``path`` when it is, or links to, one of the files the
     command ``reads``; when it is a device, a FIFO or a socket; for a ``bag`` (a folder),
     when it holds one of ``reads`` or anything but a bag aou wrote; and unless ``force``,
-    when it is an existing file aou did not write (:func:`is_own_output`).
+    when it is an existing file aou did not write (:func:`is_own_output`). ``flag`` is
+    the option that named ``path`` (``--tracked``, ``--sarif``): the hint names it.
 
     Raises:
         AouError: I502 naming the clash (an input, a special file, a folder holding
@@ -126,7 +127,7 @@ def guard_output(path: str, reads: Sequence[str] = (), *, force: bool = True,
         how, read = found
         raise AouError(diag(I502, f"refusing to write `{path}`: it {how} `{read}`, "
                             "which this command reads", where,
-                            hint="choose another output with -o", input=read))
+                            hint=f"choose another output with {flag}", input=read))
     try:
         mode = os.stat(path).st_mode
     except (OSError, ValueError):
@@ -134,7 +135,7 @@ def guard_output(path: str, reads: Sequence[str] = (), *, force: bool = True,
     kind = _special(mode)
     if kind is not None:
         raise AouError(diag(I502, f"refusing to write `{path}`: it is a {kind}, not a "
-                            "regular file", where, hint="choose a file name with -o"))
+                            "regular file", where, hint=f"choose a file name with {flag}"))
     if bag:
         _guard_bag(path, known, where, stat.S_ISDIR(mode))
     elif stat.S_ISDIR(mode):

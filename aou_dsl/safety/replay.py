@@ -55,6 +55,8 @@ SELF_RANGE = 0.1
 AGREE_SPOTS = 32
 #: Physics rate of the dynamic replay [Hz].
 PHYSICS_RATE = 1000.0
+#: The check that nothing touches the target cube at the goal.
+TARGET_CONTACT = "target-contact"
 
 
 @dataclass
@@ -66,6 +68,9 @@ class CheckReport:
     clearances: dict[str, float | None] = field(default_factory=dict)
     agreement: dict[str, float] = field(default_factory=dict)
     dynamic: dict[str, float] | None = None
+    #: The checks that could not run (target-contact without a goal or a target cube),
+    #: each with the reason in its detail: neither passed nor failed, so not in ``checks``.
+    not_run: list[Check] = field(default_factory=list)
 
     @property
     def ok(self) -> bool:
@@ -75,10 +80,15 @@ class CheckReport:
         return [c for c in self.checks if not c.ok]
 
     def to_json(self) -> dict:
-        return {"ok": self.ok, "robot": self.robot,
-                "checks": [c.to_json() for c in self.checks],
-                "clearances": self.clearances, "agreement": self.agreement,
-                "dynamic": self.dynamic}
+        """The report as JSON; ``not_run`` (each check's name and why) only when a check
+        could not run, so a report where every check ran is as before."""
+        out = {"ok": self.ok, "robot": self.robot,
+               "checks": [c.to_json() for c in self.checks],
+               "clearances": self.clearances, "agreement": self.agreement,
+               "dynamic": self.dynamic}
+        if self.not_run:
+            out["not_run"] = [{"name": c.name, "detail": c.detail} for c in self.not_run]
+        return out
 
 
 def _link_name(scene: Scene, j: int) -> str:
@@ -127,7 +137,14 @@ def replay(tr: Trajectory, *, options: SceneOptions | None = None,
                   target=goal is not None, memo=memo)
     kin_checks, clear = _contacts(sweep, t)
     agree_check, agree = _agreement(sweep, arm, frame, t, q)
-    report = CheckReport(tr.robot, checks + kin_checks + [agree_check], clear, agree)
+    not_run = []
+    if goal is None or scene.target is None:  # no cube at a goal: nothing to touch
+        kin_checks = [c for c in kin_checks if c.name != TARGET_CONTACT]
+        not_run.append(Check(TARGET_CONTACT, True, detail=(
+            "not run: the trajectory has no goal, so there is no target cube"
+            if goal is None else "not run: no target cube (--target-size 0)")))
+    report = CheckReport(tr.robot, checks + kin_checks + [agree_check], clear, agree,
+                         not_run=not_run)
     if dynamic:
         from .torque import check_torque
 
