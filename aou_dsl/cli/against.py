@@ -9,8 +9,7 @@ import argparse
 import sys
 
 from ..core.diagnostics import Diagnostic, Severity
-from ..core.rules import category
-from .args import EXIT_ERRORS, EXIT_INCONCLUSIVE, EXIT_OK, EXIT_USAGE
+from .args import EXIT_ERRORS, EXIT_INCONCLUSIVE, EXIT_OK, EXIT_USAGE, exit_for
 from .report import format_github, format_json, format_text
 
 __all__ = ["cmd_measure_against", "format_verdict"]
@@ -75,7 +74,7 @@ def cmd_measure_against(args: argparse.Namespace, read) -> int:
         errors = [d for d in lint.diagnostics if d.severity == Severity.ERROR]
         _unread(args, errors or lint.diagnostics, {lint.path: lint.source or ""})
         # 2 when it could not be read at all, 1 for a file with errors (as `aouc lint`)
-        return EXIT_USAGE if any(category(d.code).is_usage for d in errors) else EXIT_ERRORS
+        return exit_for(errors)
     try:
         try:
             rec = read(args.path, args)

@@ -25,7 +25,7 @@ from .argtypes import (
 )
 
 __all__ = ["EXIT_ERRORS", "EXIT_INCONCLUSIVE", "EXIT_INTERRUPTED", "EXIT_OK", "EXIT_USAGE",
-           "build_parser", "number", "shared_parser", "usage_error"]
+           "build_parser", "exit_for", "number", "scene_kw", "shared_parser", "usage_error"]
 
 EXIT_OK = 0
 EXIT_ERRORS = 1
@@ -34,6 +34,19 @@ EXIT_USAGE = 2
 EXIT_INCONCLUSIVE = 3
 #: Interrupted (Ctrl-C): 128 + SIGINT, as shells report it.
 EXIT_INTERRUPTED = 130
+
+
+def exit_for(diags) -> int:
+    """2 when the input could not be read or written (I codes), else 1."""
+    from ..core.rules import category
+
+    return EXIT_USAGE if any(category(d.code).is_usage for d in diags) else EXIT_ERRORS
+
+
+def scene_kw(args: argparse.Namespace) -> dict:
+    """The scene's target and table as the command line gives them."""
+    return {"target_size": args.target_size,
+            "table_height": None if args.no_table else args.table_height}
 
 
 class Parser(argparse.ArgumentParser):

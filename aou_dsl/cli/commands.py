@@ -16,9 +16,17 @@ from collections.abc import Callable, Sequence
 
 from ..core.codes import C306, C311, C320, C321
 from ..core.diagnostics import AouError, Diagnostic, Severity, Span
-from ..core.rules import category
 from ..editor import cmd_server
-from .args import EXIT_ERRORS, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE, shared_parser, usage_error
+from .args import (
+    EXIT_ERRORS,
+    EXIT_INTERRUPTED,
+    EXIT_OK,
+    EXIT_USAGE,
+    exit_for,
+    scene_kw,
+    shared_parser,
+    usage_error,
+)
 from .dmp_cmd import cmd_dmp
 from .endings import CtrlC, extra_missing, internal
 from .fmt import cmd_fmt
@@ -33,20 +41,9 @@ from .tools import cmd_robot, cmd_rules, cmd_synth
 __all__ = ["EXIT_ERRORS", "EXIT_OK", "EXIT_USAGE", "main"]
 
 
-def _exit_for(diags: list[Diagnostic]) -> int:
-    """2 when the input could not be read or written (I codes), else 1."""
-    usage = any(category(d.code).is_usage for d in diags)
-    return EXIT_USAGE if usage else EXIT_ERRORS
-
-
 def _fail(err: AouError) -> int:
     _print_diags(err.diagnostics)
-    return _exit_for(err.diagnostics)
-
-
-def _scene_kw(args: argparse.Namespace) -> dict:
-    return {"target_size": args.target_size,
-            "table_height": None if args.no_table else args.table_height}
+    return exit_for(err.diagnostics)
 
 
 def _package_dirs(args: argparse.Namespace) -> tuple[str, ...]:
@@ -94,7 +91,7 @@ def _cmd_explain(args: argparse.Namespace) -> int:
     r = lint_file(args.path)
     if not r.ok or r.behaviour is None or r.cv is None or r.timeline is None:
         _print_diags(r.diagnostics, sources={r.path: r.source or ""})
-        return _exit_for(r.diagnostics)
+        return exit_for(r.diagnostics)
     print(format_timeline(r.behaviour, r.cv, r.timeline))
     return EXIT_OK
 
@@ -132,7 +129,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
                                "(--format csv, or -o FILE.csv)")
         fmt = CSV_DERIVATIVES
     options = BuildOptions(robot=args.robot, rate=args.rate, check=not args.no_check,
-                           scene=SceneOptions(**_scene_kw(args)),
+                           scene=SceneOptions(**scene_kw(args)),
                            collision_check=not args.no_collision_check,
                            controller=args.controller, package_dirs=_package_dirs(args),
                            fit=args.fit)
@@ -158,7 +155,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
         found += res.diagnostics
         # the header, not res.document: that makes the samples' lists, in this process
         if not res.ok or res.header is None:
-            worst = max(worst, _exit_for(res.diagnostics))
+            worst = max(worst, exit_for(res.diagnostics))
             print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)
             continue
         try:
@@ -198,7 +195,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
     if args.format == "sarif":
         from .ci_cmd import check_sarif
 
-        return check_sarif(args, _read_kw(args), _scene_kw(args), _check_diagnostics)
+        return check_sarif(args, _read_kw(args), scene_kw(args), _check_diagnostics)
     if args.fit or args.write_fitted:
         from .fitted import check_fitted
 
@@ -210,10 +207,10 @@ def _cmd_check(args: argparse.Namespace) -> int:
     if any(d.severity == Severity.ERROR for d in refused):
         return EXIT_ERRORS
     report = check(tr, dynamic=not args.no_dynamic, controller=args.controller,
-                   **_scene_kw(args))
+                   **scene_kw(args))
     failed = _check_diagnostics(args.path, report)
     if args.format != "json":
-        print(_with_not_run(format_check(args.path, tr.robot, tr.t, report), report))
+        print(format_check(args.path, tr.robot, tr.t, report))
     more, tracking = check_tracking(args, tr, _reads(args, [args.path])) if args.track \
         else ([], None)
     failed += more
@@ -223,18 +220,6 @@ def _cmd_check(args: argparse.Namespace) -> int:
                            "diagnostics": [d.to_json() for d in failed]}))
     _print_diags(failed)
     return EXIT_ERRORS if any(d.severity == Severity.ERROR for d in failed) else EXIT_OK
-
-
-def _with_not_run(text: str, report) -> str:
-    """The check report with a line ``n/a`` for each check that could not run, after
-    the checks that ran (as the clearances below say ``n/a``): never a ``pass``."""
-    if not report.not_run:
-        return text
-    lines = text.split("\n")
-    at = next((i for i, line in enumerate(lines) if line.startswith("  clearances:")),
-              len(lines))
-    rows = [f"  n/a   {c.name:<21} ({c.detail})" for c in report.not_run]
-    return "\n".join(lines[:at] + rows + lines[at:])
 
 
 def _check_diagnostics(path: str, report) -> list[Diagnostic]:
@@ -331,7 +316,7 @@ def _render(paths: list[str], output: str, args: argparse.Namespace, read_kw: di
         raise
     start = time.perf_counter()
     info = render_video(motions, output, fps=args.fps, camera=camera,
-                        scene_options=SceneOptions(**_scene_kw(args),
+                        scene_options=SceneOptions(**scene_kw(args),
                                                    package_dirs=_package_dirs(args)),
                         workers=workers, inputs=reads)
     print(f"wrote {output}: {info['frames']} frames at {info['fps']:g} fps "
@@ -359,7 +344,7 @@ def _cmd_variants(args: argparse.Namespace) -> int:
     base = lint_file(args.path)
     if not base.ok or base.behaviour is None or base.source is None:
         _print_diags(base.diagnostics, sources={args.path: base.source or ""})
-        return _exit_for(base.diagnostics)
+        return exit_for(base.diagnostics)
     folder = args.output or "."
     variants = make_variants(base.behaviour, base.source, name, low, high,
                              os.path.join(folder, f"{base_stem(args.path)}-{name}"))

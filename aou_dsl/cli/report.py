@@ -174,6 +174,8 @@ def format_check(path: str, robot: str, t, report) -> str:
         val = "" if c.value is None else f" value {c.value:.4g}"
         lim = "" if c.limit is None else f" limit {c.limit:.4g}"
         lines.append(f"  {mark}  {c.name:<21}{where}{who}{val}{lim}  ({c.detail})")
+    # A check that could not run (no goal, no target) is n/a, as its clearance below.
+    lines += [f"  n/a   {c.name:<21} ({c.detail})" for c in report.not_run]
     lines.append("  clearances: " + ", ".join(
         f"{k} {'n/a' if v is None else f'{v * 1000:.1f} mm'}"
         for k, v in report.clearances.items()))

@@ -287,14 +287,14 @@ def test_every_code_is_a_constant_and_no_code_is_spelt_out():
 
 def test_the_exit_status_comes_from_the_rule_category():
     """Usage codes (I) exit 2, every other category 1, by the registry's category."""
-    from aou_dsl.cli.commands import _exit_for
+    from aou_dsl.cli.args import exit_for
     from aou_dsl.core.diagnostics import Span, diag
     from aou_dsl.core.rules import RULES, Category
 
     where = Span.whole_file("x.aou")
     for code, rule in RULES.items():
         want = 2 if rule.category is Category.USAGE else 1
-        assert _exit_for([diag(code, "m", where)]) == want, code
+        assert exit_for([diag(code, "m", where)]) == want, code
 
 
 def test_every_subpackage_ships_in_the_wheel():
