@@ -41,17 +41,10 @@ def check_fitted_output(path: str, reads: Sequence[str], outputs: Sequence[str] 
         AouError: I502 naming the clash (the codes of
             :func:`aou_dsl.core.files.check_output`).
     """
-    from ..core.codes import I502
-    from ..core.diagnostics import Span, diag
-    from ..core.files import check_output, same_file
+    from ..core.files import apart_from, check_output
 
     check_output(path, reads=reads)
-    for out in outputs:
-        if same_file(path, out):
-            raise AouError(diag(I502, f"refusing to write the fitted text into `{path}`: "
-                                f"-o writes the output there (`{out}`)",
-                                Span.whole_file(path),
-                                hint="give --write-fitted a path of its own"))
+    apart_from(path, outputs, "the fitted text", "--write-fitted")
 
 
 def fitted_usage(command: str) -> int:

@@ -31,9 +31,9 @@ def guard_tracked(args: argparse.Namespace, reads: Sequence[str],
     Raises:
         AouError: I504 without ``--track``; I502 naming the clash.
     """
-    from ..core.codes import I502, I504
+    from ..core.codes import I504
     from ..core.diagnostics import diag
-    from ..core.files import guard_output, same_file
+    from ..core.files import apart_from, guard_output
 
     dest = getattr(args, "tracked", None)
     if not dest:
@@ -44,12 +44,7 @@ def guard_tracked(args: argparse.Namespace, reads: Sequence[str],
                             Span.whole_file("<command line>"),
                             hint="add --track, or leave out --tracked"))
     guard_output(dest, reads, flag="--tracked")
-    for out in written:
-        if same_file(dest, out):
-            raise AouError(diag(I502, f"refusing to write the tracked motion into `{dest}`: "
-                                f"-o writes the output there (`{out}`)",
-                                Span.whole_file(dest),
-                                hint="give --tracked a path of its own"))
+    apart_from(dest, written, "the tracked motion", "--tracked")
 
 
 @contextlib.contextmanager

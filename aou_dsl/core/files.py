@@ -33,9 +33,9 @@ from .diagnostics import AouError, Span, diag
 from .output_folders import is_aou_bag, is_aou_dmp
 from .read_set import ReadSet
 
-__all__ = ["atomic", "check_format", "check_output", "decode", "guard_output", "is_own_output",
-           "make_folders", "read_bytes", "read_text", "same_file", "sweep_stale", "temp_prefix",
-           "write_atomic"]
+__all__ = ["apart_from", "atomic", "check_format", "check_output", "decode", "guard_output",
+           "is_own_output", "make_folders", "read_bytes", "read_text", "same_file", "sweep_stale",
+           "temp_prefix", "write_atomic"]
 
 
 def check_output(path: str, formats: Sequence[str] = (), *, reads: Sequence[str] = (),
@@ -105,6 +105,19 @@ def _special(mode: int) -> str | None:
         if test(mode):
             return name
     return None
+
+
+def apart_from(path: str, outputs: Sequence[str], what: str, flag: str) -> None:
+    """Refuse (I502) a second output ``path`` (given by ``flag``, holding ``what``) that
+    is, or links to, one of the command's ``outputs`` of ``-o``: one would overwrite
+    the other."""
+    from .diagnostics import AouError, Span, diag
+
+    for out in outputs:
+        if same_file(path, out):
+            raise AouError(diag(I502, f"refusing to write {what} into `{path}`: -o writes "
+                                f"the output there (`{out}`)", Span.whole_file(path),
+                                hint=f"give {flag} a path of its own"))
 
 
 def guard_output(path: str, reads: Sequence[str] = (), *, force: bool = True,
