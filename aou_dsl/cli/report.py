@@ -191,7 +191,7 @@ def format_check(path: str, robot: str, t, report) -> str:
     return "\n".join(lines)
 
 
-def _interval(value, spread) -> str:
+def _interval(value, spread, noisy: bool = False) -> str:
     """A descriptor's 95 % interval beside its value: ``+- x`` around a value (``+0.1
     -0.02`` when lopsided), ``4..6`` for a count or a presence the noise can flip,
     ``exact`` for a value read without noise."""
@@ -201,8 +201,8 @@ def _interval(value, spread) -> str:
     if value is None and spread.stable:
         return ""
     if value is None or isinstance(value, int) and not isinstance(value, bool):
-        if lo == hi and spread.stable:
-            return "exact"
+        if lo == hi and spread.stable:  # read alike by every copy of a noisy recording
+            return "in every copy" if noisy else "exact"
 
         def v(x) -> str:
             return "absent" if x is None else (f"{x:.4g}" if isinstance(x, float) else str(x))
@@ -233,6 +233,7 @@ def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = 
     n = len(m.episodes)
     lines = [f"{path}: {robot}, {m.duration:.2f} s, {n} episode{'' if n == 1 else 's'}"]
     from ..lang.descriptors import REGISTRY
+    from ..measuring.episodes import COMPUTED_NOISE
     from ..measuring.recognisers import extra_descriptors
 
     units = {k: d.unit for k, d in REGISTRY.items()}
@@ -241,7 +242,8 @@ def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = 
                  if v is not None and k in m.uncertainty and not m.uncertainty[k].stable]
     for k, v in (dict(m.descriptors) | m.extra).items():  # the plugins' after the eleven
         val = "null" if v is None else (f"{v:.4g}" if isinstance(v, float) else str(v))
-        lines.append(f"  {k:<22} {val:>10} {_interval(v, m.uncertainty.get(k)):<14} "
+        spread = _interval(v, m.uncertainty.get(k), m.noise > COMPUTED_NOISE)
+        lines.append(f"  {k:<22} {val:>10} {spread:<14} "
                      f"{units.get(k, '')}{'  not to be trusted' if k in untrusted else ''}"
                      .rstrip())
     los, inf = m.line_of_sight, m.inferred
