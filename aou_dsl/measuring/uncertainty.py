@@ -34,6 +34,7 @@ import numpy as np
 from ..core.codes import R411
 from ..core.diagnostics import AouError, Span, diag
 from ..core.trajectory import Trajectory
+from ..lang.descriptors import REGISTRY
 from .episodes import COMPUTED_NOISE
 from .linearised import Linearised
 from .recognisers import every_named
@@ -198,8 +199,10 @@ def _spread(name: str, value: float | int | None, base: float | int | None,
     # A peak acceleration is a mean of the acceleration over what it is read from:
     # never above the peak, and below it by what the reading did not resolve.
     above = PEAK_SHAPE * abs(v) if d.unit == ACCELERATION else 0.0
-    return Spread(sd, min(v, corrected) - half, max(v, corrected) + half + above,
-                  absent == 0, absent)
+    low = min(v, corrected) - half
+    if name in REGISTRY:  # the eleven are magnitudes: none reaches below zero
+        low = max(low, 0.0)
+    return Spread(sd, low, max(v, corrected) + half + above, absent == 0, absent)
 
 
 def _values(m) -> dict:
@@ -333,7 +336,7 @@ def _inferred(m, base, copies: list) -> Inferred:
     states = tuple(dict.fromkeys([m.cv.state.value] + [c.cv.state.value for c in copies]))
     exactly = base is m
 
-    def one(get) -> Spread | None:
+    def one(get, floor: float = -math.inf) -> Spread | None:
         value = get(m)
         if value is None:
             return None
@@ -346,8 +349,8 @@ def _inferred(m, base, copies: list) -> Inferred:
         sd = float(np.std(reads, ddof=1))
         corrected = value - BIAS * (float(np.mean(reads)) - b)
         t95 = T95[len(reads) - 1]
-        return Spread(sd, min(value, corrected) - t95 * sd, max(value, corrected) + t95 * sd,
-                      len(states) == 1)
+        return Spread(sd, max(floor, min(value, corrected) - t95 * sd),
+                      max(value, corrected) + t95 * sd, len(states) == 1)
 
     def sight(attr: str):
         def get(x) -> float | None:
@@ -357,7 +360,7 @@ def _inferred(m, base, copies: list) -> Inferred:
 
     c, v = one(lambda x: x.cv.C), one(lambda x: x.cv.V)
     assert c is not None and v is not None
-    return Inferred(c, v, states, one(sight("median")), one(sight("max")))
+    return Inferred(c, v, states, one(sight("median"), 0.0), one(sight("max"), 0.0))
 
 
 #: A value whose 95 % interval reaches further than this fraction of itself from it is

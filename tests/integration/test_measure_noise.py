@@ -317,6 +317,19 @@ def test_a_real_miss_still_fails_under_noise(shipped, tmp_path, capsys):
                 ).endswith("FAIL")
 
 
+def test_no_interval_reaches_below_zero_for_a_magnitude(shipped):
+    """The eleven descriptors and the line of sight are magnitudes; the copies' spread
+    put hesitant's approach at 1e-3 rad and 250 Hz in -2.8 to 1.9 m/s^2. An interval
+    reaching below zero tells the reader nothing the zero does not."""
+    _, m = logged(shipped["hesitant"][0], logger(1e-3, 250.0, 3))
+    lows = {k: s.low for k, s in m.uncertainty.items() if s.low is not None}
+    assert lows and min(lows.values()) >= 0.0, lows
+    approach = m.uncertainty["approach_acceleration"]
+    assert approach.low == 0.0 and not approach.stable  # reaching down to it: R411
+    sight = m.inferred.sight_max
+    assert sight is not None and sight.low >= 0.0
+
+
 def test_measure_prints_and_writes_every_interval(shipped, tmp_path, capsys):
     path = _csv(tmp_path, shipped["fearful"][0], logger(3e-4, 250.0, 2))
     assert main(["measure", path, "--robot", "panda", *GOAL]) == 0
