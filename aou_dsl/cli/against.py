@@ -10,7 +10,7 @@ import sys
 
 from ..core.diagnostics import Diagnostic, Severity
 from .args import EXIT_ERRORS, EXIT_INCONCLUSIVE, EXIT_OK, EXIT_USAGE, exit_for
-from .report import format_github, format_json, format_text
+from .report import about, format_github, format_json, format_text
 
 __all__ = ["cmd_measure_against", "format_verdict"]
 
@@ -20,19 +20,13 @@ def _v(v: float | int | None) -> str:
 
 
 def _pm(r) -> str:
-    """The measured value's 95 % interval about it, as ``aouc measure`` prints it:
-    ``+-x`` when its two sides are within a tenth of each other, else ``+x -y`` (a
-    count's as lo..hi)."""
+    """The measured value's 95 % interval about it, as ``aouc measure`` prints it
+    (:func:`.report.about`; a count's as lo..hi)."""
     if r.measured is None or r.low is None or r.high is None:
         return "" if r.high is None else f"or {_v(r.high)}"  # copies that found it
     if isinstance(r.measured, int) and not isinstance(r.measured, bool):
         return "" if r.low == r.high else f"{r.low}..{r.high}"
-    up, down = r.high - r.measured, r.measured - r.low
-    if max(up, down) <= 0:
-        return ""
-    if abs(up - down) <= 0.1 * max(up, down):
-        return f"+-{max(up, down):.2g}"
-    return f"+{up:.2g} -{down:.2g}"
+    return about(r.measured, r.low, r.high)
 
 
 _SHOWN = {"pass": "pass", "fail": "FAIL", "inconclusive": "INCONCLUSIVE"}

@@ -194,7 +194,8 @@ def format_check(path: str, robot: str, t, report) -> str:
 def _interval(value, spread, noisy: bool = False) -> str:
     """A descriptor's 95 % interval beside its value: ``+- x`` around a value (``+0.1
     -0.02`` when lopsided), ``4..6`` for a count or a presence the noise can flip,
-    ``exact`` for a value read without noise."""
+    ``exact`` for a value read without noise, ``in every copy`` for a count every
+    re-noised copy of a ``noisy`` recording reads alike."""
     if spread is None:
         return ""
     lo, hi = spread.low, spread.high
@@ -209,9 +210,15 @@ def _interval(value, spread, noisy: bool = False) -> str:
         return f"({v(lo)}..{v(hi)})"
     if lo is None or hi is None:
         return "(unstable)"
-    up, down = hi - value, value - lo
+    return about(value, lo, hi) or "exact"
+
+
+def about(value: float, low: float, high: float) -> str:
+    """The interval ``low..high`` about ``value``: ``+- x`` when its two sides are within
+    a tenth of each other, else ``+up -down``; empty for none at all."""
+    up, down = high - value, value - low
     if up <= 0 and down <= 0:
-        return "exact"
+        return ""
     if abs(up - down) <= 0.1 * max(up, down):
         return f"+- {max(up, down):.2g}"
     return f"+{up:.2g} -{down:.2g}"

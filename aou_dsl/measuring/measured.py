@@ -348,9 +348,16 @@ def measure(rec: Trajectory, *, uncertainty: bool = True) -> Measured:
     if uncertainty:
         from .uncertainty import attach
 
-        attach(m, rec, jn, _measure, None if failed is not None else _arrival(rec, jn))
-        if failed is None:
-            _stamps(m, rec, jn)
+        # A noisy recording's own clock and joints, unless it was read on another clock
+        clock = None if failed is not None or float(jn.effective.max(initial=0.0)) <= \
+            COMPUTED_NOISE else _joints(rec)
+        restamp = None  # a clock stamped on arrival, evened out: the copies restamp it
+        if clock is not None and stamped_on_arrival(*clock, jn.effective):
+            restamp = evened(clock[0])
+        attach(m, rec, jn, _measure, restamp)
+        if clock is not None and m.uncertainty:  # the clock judged: read again if it moves
+            judge_stamps(m, rec.path, *clock, jn.effective,
+                         lambda even: _measure(rec.with_(t=even), jn)[0])
     if failed is not None:
         read_on_evened(m, rec.path, t, failed)
     judge_cuts(m, rec.path, list(m.cuts))
@@ -362,25 +369,6 @@ def _joints(rec: Trajectory) -> tuple[np.ndarray, np.ndarray]:
     arm = load_arm(rec.robot, rec.ee_frame, rec.package_dirs, rec.ee_definition)
     t, q = _checked(rec, rec.columns(arm.joint_names))
     return t, unwrap(q)[0]
-
-
-def _arrival(rec: Trajectory, jn: JointNoise) -> np.ndarray | None:
-    """A noisy recording's clock evened out when its stamps were taken on arrival
-    (:mod:`.stamps`), else None."""
-    if float(jn.effective.max(initial=0.0)) <= COMPUTED_NOISE:
-        return None
-    t, q = _joints(rec)
-    return evened(t) if stamped_on_arrival(t, q, jn.effective) else None
-
-
-def _stamps(m: Measured, rec: Trajectory, jn: JointNoise) -> None:
-    """Judge the recording's clock (:mod:`.stamps`): only a noisy recording's, read
-    again on its clock evened out when the stamps do not follow the samples."""
-    if float(jn.effective.max(initial=0.0)) <= COMPUTED_NOISE or not m.uncertainty:
-        return
-    t, q = _joints(rec)
-    judge_stamps(m, rec.path, t, q, jn.effective,
-                 lambda even: _measure(rec.with_(t=even), jn)[0])
 
 
 def _measure(rec: Trajectory, pinned: JointNoise | None = None, fk: Kinematics | None = None

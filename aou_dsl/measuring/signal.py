@@ -121,9 +121,13 @@ def _quantum(col: np.ndarray) -> float:
     step = float(d.min())
     if step <= 1e-12 * max(1.0, float(np.abs(col).max())):
         return 0.0
+    return step if _whole(d, step).mean() >= 0.95 else 0.0
+
+
+def _whole(d: np.ndarray, step: float) -> np.ndarray:
+    """Whether each of the steps ``d`` (> 0) is a whole multiple of ``step``."""
     ratio = d / step
-    whole = np.abs(ratio - np.round(ratio)) < 0.02
-    return step if whole.mean() >= 0.95 else 0.0
+    return (np.abs(ratio - np.round(ratio)) < 0.02) & (np.round(ratio) >= 1)
 
 
 def joint_noise(t: np.ndarray, q: np.ndarray) -> JointNoise:
@@ -172,8 +176,7 @@ def _shared(q: np.ndarray, moving: np.ndarray, quantum: np.ndarray) -> np.ndarra
     for j in np.flatnonzero(moving & (quantum == 0)):
         d = np.abs(np.diff(q[:, j]))
         d = d[d > 0]
-        if 0 < len(d) < 10 and np.all(np.abs(d / step - np.round(d / step)) < 0.02) \
-                and np.all(np.round(d / step) >= 1):
+        if 0 < len(d) < 10 and bool(np.all(_whole(d, step))):
             out[j] = step
     return out
 

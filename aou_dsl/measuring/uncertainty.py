@@ -273,11 +273,11 @@ def attach(m, rec: Trajectory, jn: JointNoise,
         stairs = staircase_joints(jn)
         source = (f"the joints' rounding (steps of {float(jn.quantum[stairs].max()):.2g} "
                   "rad)" if stairs.any() else f"the joints' noise ({noise:.2g} rad)")
-        if restamp is not None:
-            source += " and the clock's stamps, taken on arrival, are"
+        source += (" and the clock's stamps, taken on arrival, are" if restamp is not None
+                   else " is")
         m.diagnostics.append(diag(
-            R411, f"{source}{'' if restamp is not None else ' is'} more than this "
-            f"recording's segmentation bears: {'; '.join(what)}. "
+            R411, f"{source} more than this recording's segmentation bears: "
+            f"{'; '.join(what)}. "
             f"{'These are' if len(what) > 1 else 'This is'} not to be trusted",
             Span.whole_file(rec.path),
             hint=("stamp each sample when it is taken, not when it arrives; "

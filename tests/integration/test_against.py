@@ -113,7 +113,7 @@ def test_the_table_shows_a_lopsided_interval_as_measure_does():
 
     row = SimpleNamespace(measured=0.05009, low=0.04231, high=0.05577)
     assert _pm(row) == "+0.0057 -0.0078"
-    assert _pm(SimpleNamespace(measured=1.0, low=0.9, high=1.095)) == "+-0.1"
+    assert _pm(SimpleNamespace(measured=1.0, low=0.9, high=1.095)) == "+- 0.1"
     assert _pm(SimpleNamespace(measured=5, low=4, high=6)) == "4..6"
 
 
