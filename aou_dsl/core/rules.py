@@ -297,7 +297,8 @@ _RULE_LIST = [
     Rule("R403", "unequal-episodes", _W,
          "Episodes of one kind measure different values; the model assumes they are equal.",
          "The descriptor follows its rule (median, or maximum for peaks and gazes); "
-         "per-episode values are in the JSON output.",
+         "per-episode values are in the JSON output. On a noisy recording it is noted "
+         "only where the episodes differ by more than the noise can make them.",
          "two retreats of 4 cm and 8 cm"),
     Rule("R404", "implausible-units", _E,
          "The columns of a recording look like degrees (or its times like milliseconds), "

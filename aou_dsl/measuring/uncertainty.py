@@ -35,6 +35,7 @@ from ..core.codes import R411
 from ..core.diagnostics import AouError, Span, diag
 from ..core.trajectory import Trajectory
 from ..lang.descriptors import REGISTRY
+from .episode_spread import beyond_noise
 from .episodes import COMPUTED_NOISE
 from .linearised import Linearised
 from .recognisers import every_named
@@ -245,6 +246,7 @@ def attach(m, rec: Trajectory, jn: JointNoise,
     reads = [_values(r) for r in read_m]
     smooth_read = None if smooth_m is None else _values(smooth_m)
     m.inferred = _inferred(m, smooth_m, read_m)
+    beyond_noise(m, read_m, T95)
     if len(reads) < 2 or smooth_read is None:
         m.uncertainty = {k: Spread(None, value[k], value[k], False) for k in table}
     else:
