@@ -183,7 +183,9 @@ def profile_figure(d: ProfileData):
                   label="raw (differences)")
         ax_v.plot(d.t, d.speed, color="black", lw=1.2,
                   label=f"filtered (noise {d.noise:.2g} rad)")
-        ax_v.legend(fontsize=7, loc="upper right")
+        # above the panel, where the episodes' labels cannot be under it
+        ax_v.legend(fontsize=7, loc="lower right", bbox_to_anchor=(1.0, 1.0), ncol=2,
+                    frameon=False, borderaxespad=0.2)
     else:
         ax_v.plot(d.t, d.speed, color="black", lw=1.2, label="end-effector speed")
     # The filtered speed sets the scale: the raw one's noise may reach far above it.
@@ -203,7 +205,8 @@ def profile_figure(d: ProfileData):
     ax_v.set_title((f"{title} (episodes as measured)" if d.measured else title)
                    + ("" if d.has_goal else "; no goal: no goal distance")
                    + (f"; the first {MAX_SHADED} of {len(d.episodes)} episodes shaded"
-                      if len(d.episodes) > MAX_SHADED else ""))
+                      if len(d.episodes) > MAX_SHADED else ""),
+                   loc="left" if len(d.raw_speed) else "center")
     if "d" in panel:
         panel["d"].plot(d.t, d.distance, color="#34495e", lw=1.2)
         panel["d"].set_ylabel("goal distance [m]")

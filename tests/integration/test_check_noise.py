@@ -122,3 +122,22 @@ def test_plot_draws_a_staircase_as_measure_reads_it(hesitant):
     d = profile_data(_staircase(hesitant))
     truth = np.interp(d.t, clean.t, clean.speed)
     assert np.abs(d.speed - truth).max() <= 0.2 * truth.max()
+
+
+def test_the_speed_legend_covers_no_episode_label(hesitant):
+    """The legend of a recording's speed panel (raw and filtered) and the episodes'
+    labels along the panel's top, as drawn: no label's box meets the legend's, the
+    last approach's label included."""
+    from aou_dsl.media.plot import profile_data, profile_figure
+
+    rec = record(hesitant, Logger(rate=250.0, jitter=0.0, noise=1e-3, seed=5),
+                 dynamic=False)
+    fig = profile_figure(profile_data(_trajectory(rec)))
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    ax = fig.axes[0]
+    legend = ax.get_legend().get_window_extent(renderer)
+    labels = [t for t in ax.texts if t.get_text()]
+    assert len(labels) >= 10
+    assert not [t.get_text() for t in labels if t.get_window_extent(renderer).overlaps(legend)]
+    assert not ax.title.get_window_extent(renderer).overlaps(legend)
