@@ -212,22 +212,24 @@ def stats() -> dict[str, CacheStats]:
 _DIGESTS = table("aou_dsl.core.memo.file_digest", FILES_KEPT)
 
 
-def _stamp(path: str) -> tuple[int, int, int, int] | None:
+def _stamp(path: str) -> tuple[int, int, int, int, int] | None:
     """A regular file's identity; None for anything else (reading a device, a FIFO or
-    a folder to hash it may never end: the load that reads it says what it is)."""
+    a folder to hash it may never end: the load that reads it says what it is). The
+    status change time is in it: a copy that puts the old modification time back
+    (``cp -p``, ``rsync -t``, ``tar``) cannot set that one."""
     try:
         st = os.stat(path)
     except (OSError, ValueError, TypeError):  # not there, a NUL in it, not a path
         return None
     if not stat.S_ISREG(st.st_mode):
         return None
-    return st.st_size, st.st_mtime_ns, st.st_ino, st.st_dev
+    return st.st_size, st.st_mtime_ns, st.st_ino, st.st_dev, st.st_ctime_ns
 
 
 def file_digest(path: str) -> str:
     """The SHA-256 of the file at ``path``, in hex ("" when it cannot be read): the
-    bytes are hashed again only when the file's size, modification time or inode
-    changed since, or when it had been written within :data:`RACY_NS` of its last
+    bytes are hashed again only when the file's size, modification time, status change
+    time or inode changed since, or when it had been written within :data:`RACY_NS` of its last
     hashing (a second write in the same clock tick keeps the ``stat``)."""
     stamp = _stamp(path)
     if stamp is None:

@@ -199,7 +199,12 @@ def _build_lint(lint: FileResult, opts: BuildOptions) -> BuildResult:
         return res
     copts = CompileOptions(package_dirs=opts.package_dirs) if opts.rate is None else \
         CompileOptions(rate=opts.rate, package_dirs=opts.package_dirs)
-    attempt, checks = _compile_checked(lint, b, tl, copts, opts)
+    try:
+        attempt, checks = _compile_checked(lint, b, tl, copts, opts)
+    except AouError as err:  # a robot file the check reads refuses it (a mesh gone)
+        res.diagnostics += err.diagnostics
+        res.seconds = time.perf_counter() - start
+        return res
     res.compiled = compiled = attempt.compiled
     res.checks = attempt.checks
     res.diagnostics += attempt.diagnostics

@@ -104,8 +104,10 @@ def _builtin_urdf(sub: str) -> str | None:
         return None
 
 
-def _meshes(urdf: str, package_dirs: Iterable[str]) -> list[str]:
-    """The mesh files a URDF names that exist (as PyBullet would load them)."""
+def _meshes(urdf: str, package_dirs: Iterable[str], missing: list[str] | None = None
+            ) -> list[str]:
+    """The mesh files a URDF names that exist (as PyBullet would load them); the URIs
+    that name none are appended to ``missing`` when given."""
     import xml.etree.ElementTree as ET
 
     from .urdf import resolve_uri
@@ -126,19 +128,23 @@ def _meshes(urdf: str, package_dirs: Iterable[str]) -> list[str]:
             path = None
         if path is not None:
             out.append(path)
+        elif missing is not None:
+            missing.append(uri)
     return out
 
 
-def robot_files(robot: str, package_dirs: Iterable[str] = ()) -> list[str]:
+def robot_files(robot: str, package_dirs: Iterable[str] = (),
+                missing: list[str] | None = None) -> list[str]:
     """The files loading ``robot`` reads: the robot file itself (unless a built-in name),
-    the URDF and its meshes."""
+    the URDF and its meshes; the URIs of the meshes it names that are not there are
+    appended to ``missing`` when given (a file that appears later is read then)."""
     from ..core.robot_specs import ROBOTS
 
     out = [] if robot in ROBOTS else [robot]
     urdf, dirs = _urdf_of(robot)
     if urdf is not None:
         out.append(urdf)
-        out += _meshes(urdf, (*dirs, *package_dirs))
+        out += _meshes(urdf, (*dirs, *package_dirs), missing)
     return out
 
 

@@ -87,13 +87,15 @@ def robot_key(robot: str, package_dirs: Sequence[str] = (), *, meshes: bool = Tr
             return key[:head]
     from .files_read import robot_files
 
+    missing: list[str] = []
     try:
-        paths = tuple(robot_files(robot, dirs))
+        paths = tuple(robot_files(robot, dirs, missing))
     except Exception:  # noqa: BLE001 - the load itself says what is wrong
         paths = () if robot in ROBOTS else (robot,)
     key = files_key(paths)
     head = min(len(paths), (0 if robot in ROBOTS else 1) + 1)  # the robot file, its URDF
-    _FILES.put((robot, dirs), (paths, key, head))
+    if not missing:  # a mesh not there yet is looked for again at the next call
+        _FILES.put((robot, dirs), (paths, key, head))
     return key if meshes else key[:head]
 
 

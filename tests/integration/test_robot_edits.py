@@ -113,6 +113,57 @@ def test_an_edited_urdf_and_mesh_make_a_new_arm_and_scene(tmp_path):
         "small.toml", "small.urdf", "tip.stl"]
 
 
+def _small_with_mesh(folder) -> str:
+    """Hesitant on the small arm, whose tool has a collision mesh ``tip.stl`` (not
+    written here)."""
+    urdf = small_arm().replace(
+        '<link name="tool"/>', '<link name="tool"><collision><geometry>'
+        '<mesh filename="tip.stl"/></geometry></collision></link>')
+    (folder / "small.urdf").write_text(urdf)
+    (folder / "small.toml").write_text(
+        'urdf = "small.urdf"\njoint_accel = 7.0\njoint_jerk = 900.0\n')
+    path = folder / "hesitant.aou"
+    path.write_text((BEHAVIOURS / "hesitant.aou").read_text().replace(
+        "robot panda\n", 'robot "small.toml"\n'))
+    return str(path)
+
+
+def test_a_mesh_missing_then_written_is_said_and_then_read(tmp_path):
+    """A session (as the editor and the studio hold one) builds on a robot whose mesh is
+    missing: the result carries V109, nothing is raised; once the mesh is written the
+    next build reads it and passes, as a new process would, though no file the session
+    had read changed."""
+    path = _small_with_mesh(tmp_path)
+    session = Session()
+    missing = session.build_file(path)
+    assert not missing.ok and "V109" in _codes(missing)
+    assert any("tip.stl" in d.message for d in missing.diagnostics)
+    (tmp_path / "tip.stl").write_text(
+        "solid m\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 0.01 0 0\n"
+        "vertex 0 0.01 0\nendloop\nendfacet\nendsolid m\n")
+    present = session.build_file(path)
+    assert present.ok, [d.message for d in present.diagnostics]
+
+
+def test_a_copy_that_puts_the_old_mtime_back_is_still_seen(tmp_path):
+    """``cp -p`` or ``rsync -t`` writes new bytes of the same size and gives the file
+    its old modification time: the status change time still tells the file changed."""
+    (tmp_path / "arm.toml").write_text(FAST)
+    hour_ago = time.time_ns() - 3600 * 10**9  # long since written: hashed once, trusted
+    os.utime(tmp_path / "arm.toml", ns=(hour_ago, hour_ago))
+    path = _fearful(tmp_path)
+    session = Session()
+    assert session.build_file(path).ok
+    old = os.stat(tmp_path / "arm.toml")
+    time.sleep(0.02)
+    (tmp_path / "arm.toml").write_text(SLOW)
+    os.utime(tmp_path / "arm.toml", ns=(old.st_atime_ns, old.st_mtime_ns))
+    new = os.stat(tmp_path / "arm.toml")
+    assert (new.st_size, new.st_mtime_ns, new.st_ino) == (
+        old.st_size, old.st_mtime_ns, old.st_ino)
+    assert "C308" in _codes(session.build_file(path))
+
+
 def test_a_file_written_twice_in_one_clock_tick_is_hashed_again(tmp_path):
     """Two writes of the same size that leave the same stat (size, mtime, inode) are
     told apart: a file written lately is hashed again until its stat is old enough."""
