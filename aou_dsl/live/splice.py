@@ -55,7 +55,9 @@ State3 = tuple[np.ndarray, np.ndarray, np.ndarray]
 class Regulator(Protocol):
     """What a splice reads of the regulator that runs it (:class:`.regulator.Regulator`)."""
 
-    arm: ArmModel
+    @property
+    def arm(self) -> ArmModel: ...
+
     robot: str
     goal: tuple[float, float, float] | None
     transition_scale: float

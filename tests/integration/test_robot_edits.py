@@ -164,6 +164,26 @@ def test_a_copy_that_puts_the_old_mtime_back_is_still_seen(tmp_path):
     assert "C308" in _codes(session.build_file(path))
 
 
+def test_the_live_regulator_plans_on_the_robot_file_as_edited(tmp_path, monkeypatch):
+    """A regulator that planned fearful at 2.0 rad/s plans it again within 0.5 once the
+    file says 0.5, the very plan a new regulator makes, and its transitions read the
+    new limits."""
+    from aou_dsl.lang.ir import State
+    from aou_dsl.live.regulator import Regulator
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "arm.toml").write_text(FAST)
+    reg = Regulator(robot="arm.toml")
+    fast = reg.plan(State.FEARFUL, 1.0)
+    assert float(np.max(np.abs(fast.qd))) > 0.5
+    (tmp_path / "arm.toml").write_text(SLOW)
+    slow = reg.plan(State.FEARFUL, 1.0)
+    assert float(np.max(np.abs(slow.qd))) <= 0.5
+    assert list(reg.arm.vmax) == [0.5] * reg.arm.n
+    new = Regulator(robot="arm.toml").plan(State.FEARFUL, 1.0)
+    assert np.array_equal(slow.q, new.q) and np.array_equal(slow.t, new.t)
+
+
 def test_a_file_written_twice_in_one_clock_tick_is_hashed_again(tmp_path):
     """Two writes of the same size that leave the same stat (size, mtime, inode) are
     told apart: a file written lately is hashed again until its stat is old enough."""
