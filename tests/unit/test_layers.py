@@ -211,9 +211,13 @@ def _unregistered_caches(text: str, where: str) -> list[str]:
     decorator, called, or imported by name). ``functools.cached_property`` is a value
     kept on one object, not process-wide, and is allowed."""
     offenders = []
-    for node in ast.walk(ast.parse(text)):
+    tree = ast.parse(text)
+    names = {"functools"} | {a.asname for node in ast.walk(tree)
+                             if isinstance(node, ast.Import)
+                             for a in node.names if a.name == "functools" and a.asname}
+    for node in ast.walk(tree):
         if isinstance(node, ast.Attribute) and node.attr in _UNREGISTERED and \
-                isinstance(node.value, ast.Name) and node.value.id == "functools":
+                isinstance(node.value, ast.Name) and node.value.id in names:
             offenders.append(f"{where}:{node.lineno}: functools.{node.attr}")
         elif isinstance(node, ast.ImportFrom) and node.module == "functools":
             offenders += [f"{where}:{node.lineno}: from functools import {a.name}"
@@ -238,10 +242,59 @@ def test_a_planted_functools_cache_is_found():
                "@functools.lru_cache(maxsize=8)\ndef g(x):\n    return x\n\n"
                "h = functools.lru_cache(None)(len)\n"
                "from functools import cache as kept\n\n"
-               "class A:\n    @functools.cached_property\n    def a(self):\n        return 1\n")
+               "class A:\n    @functools.cached_property\n    def a(self):\n        return 1\n"
+               "import functools as ft\n\n@ft.lru_cache\ndef k(x):\n    return x\n")
     assert [o.split(": ", 1)[1] for o in _unregistered_caches(planted, "x.py")] == [
         "functools.cache", "functools.lru_cache", "functools.lru_cache",
-        "from functools import cache"]
+        "from functools import cache", "functools.lru_cache"]
+
+
+def _class_memos(text: str, where: str) -> list[str]:
+    """Each dict, list or set made in a class body that the module then changes through
+    the class or one of its objects (one value shared by every object of the process: a
+    cache no session reaches)."""
+    offenders = []
+    for cls in ast.walk(ast.parse(text)):
+        if not isinstance(cls, ast.ClassDef):
+            continue
+        for node in cls.body:
+            targets = [node.target] if isinstance(node, ast.AnnAssign) else (
+                node.targets if isinstance(node, ast.Assign) else [])
+            value = getattr(node, "value", None)
+            if not (isinstance(value, (ast.Dict, ast.List, ast.Set)) or (
+                    isinstance(value, ast.Call) and getattr(value.func, "id", "") in
+                    ("dict", "list", "set", "defaultdict", "OrderedDict"))):
+                continue
+            for name in (t.id for t in targets if isinstance(t, ast.Name)):
+                owner = rf"\b(self|cls|{cls.name})\.{name}"
+                if not re.search(rf"\bself\.{name}\s*(:[^=]*)?=(?!=)", text) and re.search(
+                        rf"{owner}\s*\[[^\]]*\]\s*=(?!=)|{owner}\.(append|add|update|"
+                        rf"setdefault|pop|clear|extend|insert|remove)\(", text):
+                    offenders.append(f"{where}:{node.lineno}: {cls.name}.{name} is changed")
+    return offenders
+
+
+def test_no_class_keeps_a_memo_of_its_own():
+    """No class holds a container in its body that its objects fill: a memo that way is
+    the process's, out of the registry's and a session's reach."""
+    offenders = []
+    for p in sorted(PACKAGE.rglob("*.py")):
+        offenders += _class_memos(p.read_text(), str(p.relative_to(ROOT)))
+    assert not offenders, offenders
+
+
+def test_a_planted_class_memo_is_found():
+    """The class check is not vacuous: a class-level dict filled through ``self`` or
+    through the class fails; one each object sets for itself, or that is only read,
+    does not."""
+    planted = ("class A:\n    seen = {}\n    def f(self, x):\n        self.seen[x] = 1\n"
+               "class B:\n    kept: dict = dict()\n    def f(self, x):\n"
+               "        B.kept.setdefault(x, 1)\n"
+               "class C:\n    names = {1: 2}\n    def f(self, x):\n        return self.names[x]\n"
+               "class D:\n    own = {}\n    def __init__(self):\n        self.own = {}\n"
+               "    def f(self, x):\n        self.own[x] = 1\n")
+    assert [o.split(": ", 1)[1] for o in _class_memos(planted, "x.py")] == [
+        "A.seen is changed", "B.kept is changed"]
 
 
 def test_architecture_page_names_only_modules_that_exist():
