@@ -98,8 +98,10 @@ def bench_dmp() -> None:
     replan_cpu = time.process_time() - c
     rt = rep.trajectory
     re_jerk, re_step = _smoothness(rt.t, rt.qdd, 0.0)
-    say("  intensity 0.5 -> 1 in the first pause:   DMPs whole   DMPs live   regulator"
-        "   re-plan (warm)")
+    say("  [warm] intensity 0.5 -> 1 in the first pause (a new intensity; the running "
+        "motion's rolls kept), each way:")
+    say("                                          DMPs whole   DMPs live   regulator"
+        "     re-plan")
     say("    wall time [ms]                        " + "".join(
         f"{ways[w][0] * 1000:>11.1f} " for w in ("whole", "live", "regulator"))
         + f"{rep.seconds * 1000:>13.1f}")

@@ -96,7 +96,7 @@ def bench_live() -> None:
     figure("live_tick_p99_ms", "loop tick at 100 Hz, geometric model (p99)",
            1000 * float(np.percentile(ticks, 99)), "ms", kind="warm", at_most=10.0,
            fmt="{:.2f}")
-    say(f"  loop ticks: median {1000 * statistics.median(ticks):.2f} ms, max "
+    say(f"  [warm] loop ticks: median {1000 * statistics.median(ticks):.2f} ms, max "
         f"{1000 * max(ticks):.1f} ms over {len(ticks)} ticks")
     figure("live_replan_p95_ms", "re-plan after a change of state, to the arm (p95)",
            1000 * float(np.percentile(replans, 95)), "ms", kind="warm", at_most=100.0,

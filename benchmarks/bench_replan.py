@@ -60,14 +60,14 @@ def main(argv: list[str]) -> int:
 
     ms = sorted(w * 1000 for w in walls)
     print(f"live re-plan on {robot}: {repeats} mid-motion re-plans, confident -> hesitant")
-    print(f"  cold (once): loading the arm {load * 1000:.0f} ms; making a plan "
+    print(f"  [cold] once: loading the arm {load * 1000:.0f} ms; making a plan "
           + ", ".join(f"{s} {t * 1000:.0f} ms" for s, t in cold.items()))
-    print(f"  warm re-plan: median {statistics.median(ms):.1f} ms, "
+    print(f"  [warm] warm re-plan: median {statistics.median(ms):.1f} ms, "
           f"90th percentile {ms[int(0.9 * (len(ms) - 1))]:.1f} ms, max {ms[-1]:.1f} ms "
           f"(goal <= 100 ms: {'met' if statistics.median(ms) <= 100 else 'NOT met'})")
-    print("  where the time goes (median): " + ", ".join(
+    print("  [warm] where the time goes (median): " + ", ".join(
         f"{name} {statistics.median(v) * 1000:.1f} ms" for name, v in steps.items()))
-    print(f"  a re-plan into a plan not made yet (synthesis, compile, checks): "
+    print(f"  [warm] a re-plan into a plan not made yet (synthesis, compile, checks): "
           f"{miss.seconds * 1000:.0f} ms, of which making the plan "
           f"{miss.timings['plan'] * 1000:.0f} ms (Regulator.prepare() avoids it)")
     return 0
