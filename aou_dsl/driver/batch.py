@@ -210,7 +210,7 @@ def _build_here(lint: FileResult, session: Session, options: BuildOptions,
 
     if not _buildable(lint) or lint.source is None:
         return build_lint(lint, options)  # refused by lint (or unread): nothing to compile
-    res = session.build(lint.source, lint.path)
+    res = session.build_linted(lint)  # as --jobs 1 builds it, the lint not made again
     if outputs is None:
         return _pack(res, encode)
     from .delivery import stage

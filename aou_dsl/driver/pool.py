@@ -45,7 +45,9 @@ _STOP_TIMEOUT = 2.0
 #: by each worker when its first build needs it: slower, never different.
 _STAGES = ("aou_dsl.driver.builder", "aou_dsl.compiler.pipeline", "aou_dsl.compiler.output",
            "aou_dsl.compiler.branches", "aou_dsl.safety.replay", "aou_dsl.safety.controllers",
-           "aou_dsl.measuring.measured", "aou_dsl.lang.declared", "scipy.interpolate")
+           "aou_dsl.measuring.measured", "aou_dsl.lang.declared", "aou_dsl.robot.rows",
+           "aou_dsl.fit.amplitude", "aou_dsl.fit.every_change", "aou_dsl.fit.reach",
+           "scipy.interpolate")
 
 
 def default_jobs() -> int:
