@@ -18,7 +18,9 @@ order of the inputs, whatever order they finish in; each result is the one
 The parent's own share is what caps the speed-up, so it is kept small: a document's
 samples come back as the trajectory's arrays (one buffer each, not a float at a time),
 and with ``encode=`` the workers also encode the documents, so that writing them
-(:func:`write_result`) is copying bytes.
+(:func:`write_result`) is copying bytes; with ``outputs=`` the process that built a
+document writes it beside its output, and the caller only names it
+(:mod:`~aou_dsl.driver.delivery`).
 - ``cluster=``: a ``distributed.Client`` or a scheduler address (``"tcp://host:8786"``);
   the files are read here and their text sent, so the workers need aou (the same
   version) but not the inputs. A robot file a behaviour names must exist at the same
