@@ -105,8 +105,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     from ..driver.parallel import build_many, default_jobs
     from ..lang.linter import collect_inputs
     from .ci_cmd import keep_changed, no_output_misused, write_sarif
-    from .dmp_cmd import write_compiled
-    from .outputs import guard_outputs
+    from .outputs import guard_outputs, put_output, where_built
 
     inputs, problems = collect_inputs(args.paths)
     if problems:
@@ -140,7 +139,8 @@ def _cmd_compile(args: argparse.Namespace) -> int:
     if args.tracked and len(inputs) != 1:  # without --track: I504 (guard_outputs)
         return usage_error("compile", "--tracked needs --track and one .aou input")
     results = build_many(sources, options, args.jobs or default_jobs(), cluster=args.cluster,
-                         encode=None if args.no_output else fmt)  # the workers encode
+                         encode=None if args.no_output else fmt,  # the workers encode
+                         outputs=where_built(args, dests, fmt, reads))  # or even write
     worst = EXIT_OK
     found: list[Diagnostic] = []  # for --sarif
     for k, ((src, _), dest, res) in enumerate(zip(inputs, dests, results, strict=True), 1):
@@ -159,8 +159,7 @@ def _cmd_compile(args: argparse.Namespace) -> int:
             print(f"[{k}/{len(inputs)}] {src}: failed, nothing written", file=sys.stderr)
             continue
         try:
-            if dest is not None:  # else --no-output
-                write_compiled(dest, res, fmt, inputs=reads)
+            put_output(dest, res, fmt, reads)  # unless the process that built it did
         except AouError as err:
             worst = max(worst, _fail(err))
             continue

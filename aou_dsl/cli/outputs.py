@@ -4,10 +4,15 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from ..core.read_set import ReadSet
 
-__all__ = ["guard_outputs"]
+if TYPE_CHECKING:
+    from ..driver.builder import BuildResult
+    from ..driver.delivery import Outputs
+
+__all__ = ["guard_outputs", "put_output", "where_built"]
 
 
 def guard_outputs(args: argparse.Namespace, inputs: list[tuple[str, str | None]],
@@ -54,3 +59,36 @@ def guard_outputs(args: argparse.Namespace, inputs: list[tuple[str, str | None]]
     if args.sarif:
         guard_output(args.sarif, [*reads, *written], flag="--sarif")
     return dests, fmt, reads
+
+
+def where_built(args: argparse.Namespace, dests: list[str | None], fmt: str, reads: ReadSet
+                ) -> Outputs | None:
+    """The outputs a batch may write as it builds (each document by the process that
+    built it, named here in input order by :func:`put_output`): files of a byte format,
+    unless ``--track`` changes the result first. None: the command writes every output
+    itself."""
+    from ..compiler.output import FOLDER_FORMATS
+    from ..driver.delivery import Outputs
+
+    if args.no_output or fmt in FOLDER_FORMATS or getattr(args, "track", None):
+        return None
+    return Outputs(tuple(dests), fmt, reads)
+
+
+def put_output(dest: str | None, res: BuildResult, fmt: str, reads: ReadSet) -> None:
+    """``res``'s document at ``dest`` (nothing with ``--no-output``): the file the
+    process that built it wrote, named, or else written here.
+
+    Raises:
+        AouError: I502 when it cannot be written.
+    """
+    from .dmp_cmd import write_compiled
+
+    if dest is None:
+        return
+    if res.staged is not None:
+        from ..driver.delivery import name
+
+        name(dest, res, reads)
+    else:
+        write_compiled(dest, res, fmt, inputs=reads)

@@ -33,6 +33,7 @@ from .session import Session
 if TYPE_CHECKING:
     from ..lang.linter import FileResult
     from .builder import BuildResult
+    from .delivery import Outputs
     from .pool import BuildPool
 
 __all__ = ["shared_map"]
@@ -63,8 +64,11 @@ class _Queue:
     for this process to finish a build of its own."""
 
     def __init__(self, lints: list[FileResult], groups: list[tuple[int, ...]],
-                 options: BuildOptions, encode: str | None, pool: BuildPool):
+                 options: BuildOptions, encode: str | None, pool: BuildPool,
+                 outputs: Outputs | None = None):
         self.lints, self.options, self.encode, self.pool = lints, options, encode, pool
+        self.outputs = outputs
+        self.rule = outputs.rule() if outputs is not None else None  # what a worker needs
         self.todo = deque(groups)
         self.lock = threading.Lock()
         self.sent: dict[tuple[int, ...], Future] = {}
@@ -85,8 +89,9 @@ class _Queue:
                 return
             group = self.todo.popleft()
             try:
+                dests = None if self.outputs is None else [self.outputs.dests[k] for k in group]
                 f = self.pool.submit(build_group, [self.lints[k] for k in group],
-                                     self.options, self.encode)
+                                     self.options, self.encode, dests, self.rule)
             except RuntimeError:  # the pool is stopped or broken: this process builds it
                 self.todo.appendleft(group)
                 return
@@ -102,6 +107,11 @@ class _Queue:
     def pending(self) -> list[Future]:
         with self.lock:
             return [f for f in self.sent.values() if not f.done()]
+
+    def received(self) -> list[BuildResult]:
+        """Every result that has come back from a worker."""
+        return [r for _, f in self.finished() if not f.cancelled() and f.exception() is None
+                for r in f.result()]
 
     def finished(self) -> list[tuple[tuple[int, ...], Future]]:
         with self.lock:
@@ -121,7 +131,8 @@ def _groups(lints: list[FileResult]) -> list[tuple[int, ...]]:
 
 
 def shared_map(paths: list[str], options: BuildOptions, jobs: int,
-               encode: str | None = None) -> Iterator[BuildResult]:
+               encode: str | None = None, outputs: Outputs | None = None
+               ) -> Iterator[BuildResult]:
     """Build ``paths`` on this process and ``jobs - 1`` workers; results in input order.
 
     Where workers are forked, a batch of at most two groups that compile is built here
@@ -134,6 +145,8 @@ def shared_map(paths: list[str], options: BuildOptions, jobs: int,
         jobs: processes in all, this one included (at least 2).
         encode: a byte format the results' documents are also encoded in (as
             :func:`~aou_dsl.driver.parallel.build_many` says).
+        outputs: where the documents go: each is written by the process that built it
+            (:mod:`~aou_dsl.driver.delivery`); None: by the caller.
     """
     from ..lang.linter import lint_file
     from .pool import BuildPool, can_fork
@@ -146,18 +159,22 @@ def shared_map(paths: list[str], options: BuildOptions, jobs: int,
         # two files at most to compile: a worker would only add its start
         for group in groups:
             for k in group:
-                results[k] = _build_here(lints[k], session, options, encode)
+                results[k] = _build_here(lints[k], session, options, encode, None, k)
         yield from (r for r in results if r is not None)
         return
     # Forked before this process builds anything: once the libraries and robots are
     # loaded here (the workers share them), every build can go to either process.
     pool = BuildPool(jobs - 1, robots=_robots(lints, options), options=options, wait=False)
+    queue = _Queue(lints, groups, options, encode, pool, outputs)
     try:
-        queue = _Queue(lints, groups, options, encode, pool)
         queue.start()
         yield from _run(queue, session, results)
     finally:
         pool.terminate()  # workers still warming up are not waited for
+        if outputs is not None:  # what was written and never named (interrupted)
+            from .delivery import discard
+
+            discard([*results, *queue.received()], outputs)
 
 
 def _run(queue: _Queue, session: Session, results: list[BuildResult | None]
@@ -170,7 +187,8 @@ def _run(queue: _Queue, session: Session, results: list[BuildResult | None]
         group = queue.shortest()
         if group is not None:
             for k in group:
-                results[k] = _build_here(queue.lints[k], session, queue.options, queue.encode)
+                results[k] = _build_here(queue.lints[k], session, queue.options, queue.encode,
+                                         queue.outputs, k)
         else:
             wait(queue.pending(), timeout=_POLL, return_when=FIRST_COMPLETED)
         for got, f in queue.finished():
@@ -183,10 +201,19 @@ def _run(queue: _Queue, session: Session, results: list[BuildResult | None]
 
 
 def _build_here(lint: FileResult, session: Session, options: BuildOptions,
-                encode: str | None) -> BuildResult:
+                encode: str | None, outputs: Outputs | None, k: int) -> BuildResult:
+    """The build of file ``k`` in this process, with ``outputs`` written at once beside
+    its output, to be named in input order (not when the results before it in input
+    order have come back)."""
     from .builder import build_lint
-    from .pool import _pack
+    from .delivery import _pack
 
-    if _buildable(lint) and lint.source is not None:
-        return _pack(session.build(lint.source, lint.path), encode)
-    return build_lint(lint, options)  # refused by lint (or unread): nothing to compile
+    if not _buildable(lint) or lint.source is None:
+        return build_lint(lint, options)  # refused by lint (or unread): nothing to compile
+    res = session.build_linted(lint)  # as --jobs 1 builds it, the lint not made again
+    if outputs is None:
+        return _pack(res, encode)
+    from .delivery import stage
+
+    stage(res, outputs.dests[k], outputs)
+    return _pack(res, None if res.staged else encode)

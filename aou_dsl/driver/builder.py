@@ -48,6 +48,9 @@ class BuildResult:
     seconds: float = 0.0
     #: With ``fit``: the file's text with the fitted values (None: nothing was fitted).
     fitted_source: str | None = None
+    #: The temporary file the process that built it wrote the document into, waiting
+    #: for its name (:mod:`~aou_dsl.driver.delivery`); None: nothing staged.
+    staged: str | None = field(default=None, repr=False, compare=False)
     _document: dict | None = field(default=None, init=False, repr=False, compare=False)
 
     @property

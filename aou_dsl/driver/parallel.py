@@ -18,7 +18,9 @@ order of the inputs, whatever order they finish in; each result is the one
 The parent's own share is what caps the speed-up, so it is kept small: a document's
 samples come back as the trajectory's arrays (one buffer each, not a float at a time),
 and with ``encode=`` the workers also encode the documents, so that writing them
-(:func:`write_result`) is copying bytes.
+(:func:`write_result`) is copying bytes; with ``outputs=`` the process that built a
+document writes it beside its output, and the caller only names it
+(:mod:`~aou_dsl.driver.delivery`).
 - ``cluster=``: a ``distributed.Client`` or a scheduler address (``"tcp://host:8786"``);
   the files are read here and their text sent, so the workers need aou (the same
   version) but not the inputs. A robot file a behaviour names must exist at the same
@@ -41,12 +43,14 @@ from .session import Session
 
 if TYPE_CHECKING:
     from .builder import BuildResult
+    from .delivery import Outputs
 
 __all__ = ["BuildPool", "build_many", "build_text", "default_jobs", "encoded", "write_result"]
 
 def build_many(paths: Iterable[str], options: BuildOptions | None = None, jobs: int = 1,
                *, cluster: Any = None, pool: BuildPool | None = None,
-               encode: str | None = None) -> Iterator[BuildResult]:
+               encode: str | None = None, outputs: Outputs | None = None
+               ) -> Iterator[BuildResult]:
     """Build every path with ``build_file(path, options)``; results in input order. A
     robot's own warnings (C313) come with the first file that meets them only.
 
@@ -61,13 +65,18 @@ def build_many(paths: Iterable[str], options: BuildOptions | None = None, jobs: 
         encode: a file format (``json``, ``csv``, ``npz``, ``yaml``): the workers also
             encode each document in it, for :func:`write_result` (the writing that is
             left to this process is then copying bytes).
+        outputs: where each document goes (:class:`~aou_dsl.driver.delivery.Outputs`):
+            with ``jobs`` > 1 on this machine, the process that built a document writes
+            it and says so on the result (``written`` or ``unwritten``); elsewhere the
+            caller writes them.
     """
     yield from once_per_run(_build_many(list(paths), options or BuildOptions(), jobs,
-                                        cluster, pool, encode))
+                                        cluster, pool, encode, outputs))
 
 
 def _build_many(paths: list[str], opts: BuildOptions, jobs: int, cluster: Any,
-                pool: BuildPool | None, encode: str | None) -> Iterator[BuildResult]:
+                pool: BuildPool | None, encode: str | None, outputs: Outputs | None
+                ) -> Iterator[BuildResult]:
     if cluster is not None:
         yield from _on_cluster(paths, opts, cluster, encode)
     elif pool is not None:
@@ -79,7 +88,7 @@ def _build_many(paths: list[str], opts: BuildOptions, jobs: int, cluster: Any,
     else:  # this process builds too; workers join as they warm up
         from .batch import shared_map
 
-        yield from shared_map(paths, opts, min(jobs, len(paths)), encode)
+        yield from shared_map(paths, opts, min(jobs, len(paths)), encode, outputs)
 
 
 def build_text(text: str, path: str, options: BuildOptions, encode: str | None = None

@@ -23,11 +23,13 @@ from collections.abc import Iterable, Iterator
 from typing import TYPE_CHECKING, Any
 
 from ..core.options import BuildOptions
+from .delivery import _pack, encoded
 from .session import warm
 
 if TYPE_CHECKING:
     from ..lang.linter import FileResult
     from .builder import BuildResult
+    from .delivery import Outputs
 
 __all__ = ["BuildPool", "build_group", "can_fork", "default_jobs", "encoded", "preload"]
 
@@ -43,7 +45,9 @@ _STOP_TIMEOUT = 2.0
 #: by each worker when its first build needs it: slower, never different.
 _STAGES = ("aou_dsl.driver.builder", "aou_dsl.compiler.pipeline", "aou_dsl.compiler.output",
            "aou_dsl.compiler.branches", "aou_dsl.safety.replay", "aou_dsl.safety.controllers",
-           "aou_dsl.measuring.measured", "aou_dsl.lang.declared", "scipy.interpolate")
+           "aou_dsl.measuring.measured", "aou_dsl.lang.declared", "aou_dsl.robot.rows",
+           "aou_dsl.fit.amplitude", "aou_dsl.fit.every_change", "aou_dsl.fit.reach",
+           "scipy.interpolate")
 
 
 def default_jobs() -> int:
@@ -105,60 +109,26 @@ def _build_linted(lint: FileResult, options: BuildOptions, encode: str | None
     return _pack(build_lint(lint, options), encode)
 
 
-def build_group(lints: list[FileResult], options: BuildOptions, encode: str | None
+def build_group(lints: list[FileResult], options: BuildOptions, encode: str | None,
+                dests: list[str | None] | None = None, outputs: Outputs | None = None
                 ) -> list[BuildResult]:
     """The builds of files the parent has linted, one after another in this worker (files
-    with one text: after the first, each costs what a warm process's rebuild costs)."""
-    return [_build_linted(lint, options, encode) for lint in lints]
+    with one text: after the first, each costs what a warm process's rebuild costs).
+    With ``outputs`` (the format and the files read), each document is written here
+    into a file beside its entry of ``dests`` (:func:`~aou_dsl.driver.delivery.stage`)
+    for the parent to name; only one that could not be goes back encoded."""
+    from .builder import build_lint
 
+    if outputs is None or dests is None:
+        return [_build_linted(lint, options, encode) for lint in lints]
+    from .delivery import stage
 
-
-# --- what goes back to the parent --------------------------------------------------------
-
-#: The attribute a worker puts the encoded document in: ``(format, bytes)``.
-_ENCODED = "_encoded"
-def _pack(res: BuildResult, encode: str | None) -> BuildResult:
-    """In the worker: the result ready to go back; its document also encoded in
-    ``encode`` when asked (a byte format, from the trajectory's arrays), so that the
-    parent only writes bytes. The
-    document's lists of samples stay behind: the parent makes them again from the
-    trajectory's arrays when it needs them, which travel as raw bytes (lists pickle
-    float by float, which made reading the results back most of the parent's work)."""
-    if encode is not None:
-        from ..compiler.output import FOLDER_FORMATS
-        from ..compiler.output import encode as encode_doc
-
-        doc = _encodable(res) if encode not in FOLDER_FORMATS else None
-        if doc is not None:
-            setattr(res, _ENCODED, (encode, encode_doc(doc, encode)))
-    res.drop_samples()
-    return res
-
-
-def encoded(res: BuildResult, fmt: str) -> bytes:
-    """The bytes of ``res.document`` in ``fmt`` (a byte format): those a worker encoded
-    (``build_many(..., encode=fmt)``), else encoded here."""
-    from ..compiler.output import encode
-
-    done = getattr(res, _ENCODED, None)
-    if done is not None and done[0] == fmt:
-        return done[1]
-    doc = _encodable(res)
-    if doc is None:
-        raise ValueError(f"{res.path}: the build failed, there is no document")
-    return encode(doc, fmt)
-
-
-def _encodable(res: BuildResult) -> dict | None:
-    """A build's document to encode, its samples as the trajectory's arrays (the same
-    bytes as its lists, written without making them); None when the build failed."""
-    from ..compiler.output import array_document
-
-    tr = res.compiled.trajectory if res.compiled is not None else None
-    if res.header is None or tr is None:
-        return res.document
-    return array_document(res.header, tr)
-
+    out = []
+    for lint, dest in zip(lints, dests, strict=True):
+        res = build_lint(lint, options)
+        stage(res, dest, outputs)
+        out.append(_pack(res, None if res.staged else encode))
+    return out
 
 
 # --- the pool -----------------------------------------------------------------------------

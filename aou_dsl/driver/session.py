@@ -168,10 +168,18 @@ class Session:
         its I501 diagnostic, as :func:`~aou_dsl.driver.builder.build_file` gives. The
         file's lint is the one built from (a lint of the same text is the same lint: it
         is not made twice)."""
-        from ..lang.linter import TRAJECTORY_EXTENSIONS, lint_file
+        from ..lang.linter import lint_file
+
+        return self.build_linted(lint_file(path), options, **changes)
+
+    def build_linted(self, linted: FileResult, options: BuildOptions | None = None,
+                     **changes: Any) -> BuildResult:
+        """:meth:`build_file` of a file already linted (``lint_file`` of its path): the
+        same result, without linting it again."""
+        from ..lang.linter import TRAJECTORY_EXTENSIONS
         from .builder import build_lint
 
-        linted = lint_file(path)
+        path = linted.path
         if linted.source is None or linted.behaviour is None:
             opts = options or self.options
             return build_lint(linted, opts.replace(**changes) if changes else opts)

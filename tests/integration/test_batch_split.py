@@ -151,3 +151,96 @@ def test_a_batch_is_written_without_making_the_documents_lists(tmp_path, monkeyp
     out = tmp_path / "2again"
     assert main(["compile", *paths, "-o", f"{out}/", "--jobs", "2", "--rate", "100"]) == 0
     assert {p.name: p.read_bytes() for p in out.iterdir()} == one
+
+
+# --- each document written where it was built, named here in input order ---------------
+
+_FOUR = ("curious", "confident", "hesitant", "inactive")
+
+
+@forking
+def test_documents_are_written_where_they_were_built_and_named_here(tmp_path, monkeypatch):
+    """Into a folder that exists, ``--jobs 2`` writes no document in this process: each
+    is written beside its output by the process that built it (the worker's never comes
+    back through the pipe), and only named here; the files are those ``--jobs 1``
+    writes, and no temporary file is left."""
+    from aou_dsl.cli import dmp_cmd
+    from aou_dsl.cli.commands import main
+
+    if _ran_alone("test_documents_are_written_where_they_were_built_and_named_here"):
+        return
+    paths = [str(BEHAVIOURS / f"{n}.aou") for n in _FOUR]
+    assert main(["compile", *paths, "-o", f"{tmp_path / 'one'}/", "--rate", "100"]) == 0
+    one = {p.name: p.read_bytes() for p in (tmp_path / "one").iterdir()}
+
+    def written_here(*args, **kwargs):
+        raise AssertionError("a document was written by the command")
+
+    monkeypatch.setattr(dmp_cmd, "write_compiled", written_here)
+    (tmp_path / "two").mkdir()
+    assert main(["compile", *paths, "-o", f"{tmp_path / 'two'}/", "--jobs", "2",
+                 "--rate", "100"]) == 0
+    assert {p.name: p.read_bytes() for p in (tmp_path / "two").iterdir()} == one
+    assert sorted(one) == sorted(f"{n}.json" for n in _FOUR)
+
+
+@forking
+def test_a_batch_closed_early_leaves_no_file_it_staged(tmp_path):
+    """A batch left after its first result (as Ctrl-C leaves it) removes the documents
+    written for outputs that were never named, here and in the worker it stopped."""
+    from aou_dsl.driver.delivery import Outputs
+
+    if _ran_alone("test_a_batch_closed_early_leaves_no_file_it_staged"):
+        return
+    paths = [str(BEHAVIOURS / f"{n}.aou") for n in _FOUR]
+    dests = tuple(str(tmp_path / f"{n}.json") for n in _FOUR)
+    got = build_many(paths, OPTIONS, jobs=2, encode="json",
+                     outputs=Outputs(dests, "json", paths))
+    first = next(got)
+    assert first.staged is not None and first.staged.startswith(str(tmp_path))
+    got.close()
+    assert sorted(tmp_path.iterdir()) == []
+
+
+def test_an_output_that_became_an_input_is_refused_when_named(tmp_path):
+    """The output rule is asked again when a staged document is named: an output that
+    has become a link to an input since the command began is refused (I502), the input
+    keeps its bytes, and the staged file is removed."""
+    from aou_dsl.core.diagnostics import AouError
+    from aou_dsl.driver.delivery import Outputs, name, stage
+
+    source = tmp_path / "hesitant.aou"
+    shutil.copy(BEHAVIOURS / "hesitant.aou", source)
+    before = source.read_bytes()
+    dest = tmp_path / "out" / "hesitant.json"
+    dest.parent.mkdir()
+    outputs = Outputs((str(dest),), "json", [str(source)])
+    res = build_file(str(source), OPTIONS)
+    stage(res, str(dest), outputs)
+    assert res.staged is not None
+    dest.symlink_to(source)
+    with pytest.raises(AouError) as err:
+        name(str(dest), res, outputs.reads)
+    assert [d.code for d in err.value.diagnostics] == ["I502"]
+    assert source.read_bytes() == before
+    assert [p.name for p in dest.parent.iterdir()] == ["hesitant.json"]  # the link only
+    assert dest.is_symlink()
+
+
+def test_an_output_onto_an_input_is_refused_under_jobs_before_any_work(tmp_path):
+    """``-o`` naming a folder where an input's output would be a link to another input:
+    refused before any build, nothing written, the input as it was."""
+    from aou_dsl.cli.commands import main
+
+    src = tmp_path / "in"
+    src.mkdir()
+    for n in _FOUR:
+        shutil.copy(BEHAVIOURS / f"{n}.aou", src / f"{n}.aou")
+    before = (src / "curious.aou").read_bytes()
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "hesitant.json").symlink_to(src / "curious.aou")
+    assert main(["compile", *(str(src / f"{n}.aou") for n in _FOUR), "-o", f"{out}/",
+                 "--jobs", "2", "--rate", "100"]) != 0
+    assert (src / "curious.aou").read_bytes() == before
+    assert sorted(p.name for p in out.iterdir()) == ["hesitant.json"]
