@@ -51,6 +51,13 @@ class ReadSet(tuple[str, ...]):
             self._inode.setdefault((st.st_dev, st.st_ino), i)
         return self
 
+    def __reduce__(self) -> tuple:
+        """Pickled with its index as taken: a worker that unpickles it compares the
+        identities the command took before any work, without looking at every input on
+        the file system again for every file it is sent."""
+        return (_restored, (tuple(self), self._real, self._inode, self._unresolved,
+                            self._holders))
+
     def clash(self, path: str) -> tuple[str, str] | None:
         """How writing ``path`` would write over an input, and which (the first in
         order): ``("is", read)``, ``("links to", read)``, ``("is a hard link of",
@@ -98,3 +105,12 @@ class ReadSet(tuple[str, ...]):
         if self._unresolved is not None and (first is None or self._unresolved < first):
             os.path.realpath(self[self._unresolved])  # raises as the loop over inputs did
         return None if first is None else self[first]
+
+
+def _restored(paths: tuple[str, ...], real: dict[str, int], inode: dict[tuple[int, int], int],
+              unresolved: int | None, holders: dict[str, int] | None) -> ReadSet:
+    """A :class:`ReadSet` as it was pickled (:meth:`ReadSet.__reduce__`)."""
+    self = tuple.__new__(ReadSet, paths)
+    self._real, self._inode = real, inode
+    self._unresolved, self._holders = unresolved, holders
+    return self

@@ -30,7 +30,7 @@ from __future__ import annotations
 import contextlib
 import os
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from ..core.diagnostics import AouError
 from ..core.read_set import ReadSet
@@ -39,6 +39,7 @@ if TYPE_CHECKING:
     from .builder import BuildResult
 
 __all__ = ["Outputs", "discard", "encoded", "name", "stage"]
+
 
 @dataclass(frozen=True)
 class Outputs:
@@ -63,20 +64,6 @@ class Outputs:
         """The format and the files read without the destinations: what goes to a worker
         with each file (its destination beside it), the same size whatever the batch."""
         return Outputs((), self.fmt, self.reads)
-
-    def __reduce__(self) -> tuple[Any, tuple]:
-        """Pickled with the index of the files read as it is: a ``ReadSet`` pickled as
-        itself would look at every input on the file system again in the worker, for
-        every file sent, and the identities the output rule compares are the ones taken
-        before any work."""
-        return (_unpickled, (self.dests, self.fmt, tuple(self.reads), dict(self.reads.__dict__)))
-
-
-def _unpickled(dests: tuple[str | None, ...], fmt: str, paths: tuple[str, ...], index: dict
-               ) -> Outputs:
-    reads = tuple.__new__(ReadSet, paths)
-    reads.__dict__.update(index)
-    return Outputs(dests, fmt, reads)
 
 
 def stage(res: BuildResult, dest: str | None, outputs: Outputs) -> None:
@@ -155,6 +142,8 @@ def discard(results: list, outputs: Outputs) -> None:
 
 #: The attribute a worker puts the encoded document in: ``(format, bytes)``.
 _ENCODED = "_encoded"
+
+
 def _pack(res: BuildResult, encode: str | None) -> BuildResult:
     """In the worker: the result ready to go back; its document also encoded in
     ``encode`` when asked (a byte format, from the trajectory's arrays), so that the

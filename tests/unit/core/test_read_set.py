@@ -19,6 +19,7 @@ import pytest
 from aou_dsl.cli.outputs import guard_outputs
 from aou_dsl.core.diagnostics import AouError
 from aou_dsl.core.files import guard_output
+from aou_dsl.core.read_set import ReadSet
 
 #: Inputs in a batch: enough that asking every input for every output is a quarter of a
 #: million questions, few enough to make on any file system in a moment.
@@ -159,3 +160,23 @@ def test_a_batch_asks_the_file_system_about_each_file_a_bounded_number_of_times(
 
 if __name__ == "__main__":
     pytest.main([__file__, "-q"])
+
+
+def test_a_pickled_set_keeps_the_identities_taken_before_any_work(tmp_path):
+    """A worker gets the set pickled: it answers as the command's own set does, from
+    the identities taken when the set was made (an input removed since, whose bytes
+    another name now holds, still refuses that name as its hard link)."""
+    import pickle
+
+    a, b = tmp_path / "a.aou", tmp_path / "b.aou"
+    a.write_text("x")
+    b.write_text("y")
+    (tmp_path / "link.json").symlink_to(a)
+    reads = ReadSet([str(a), str(b)])
+    os.link(b, tmp_path / "held.json")
+    b.unlink()
+    back = pickle.loads(pickle.dumps(reads))
+    assert isinstance(back, ReadSet) and tuple(back) == tuple(reads)
+    for path in (a, b, tmp_path / "link.json", tmp_path / "held.json", tmp_path / "new"):
+        assert back.clash(str(path)) == reads.clash(str(path)), path
+    assert back.clash(str(tmp_path / "held.json")) == ("is a hard link of", str(b))
