@@ -151,8 +151,9 @@ def check_limits(arm: ArmModel, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
     pos = Check(pos.name, pos.ok, pos.time, pos.joint,
                 pos.value + mid[names.index(pos.joint)], pos.limit + mid[names.index(pos.joint)],
                 pos.detail)
+    source = "the robot description's" if arm.spec.joint_velocity else "the URDF"
     vel = _worst("joint-velocity", t, qd, arm.vmax, names,
-                 "against the URDF velocity limits" + note)
+                 f"against {source} velocity limits" + note)
     acc = _worst("joint-acceleration", t, qdd, arm.amax, names,
                  "against the robot table's acceleration limits" + note)
     return [pos, vel, acc]

@@ -66,6 +66,7 @@ def test_a_session_builds_and_checks_on_the_robot_file_as_edited(tmp_path):
     assert "C308" in _codes(again), [d.message for d in again.diagnostics]
     (velocity,) = [c for c in replay(fast).checks if c.name == "joint-velocity"]
     assert not velocity.ok and velocity.limit == pytest.approx(0.5)
+    assert "the robot description's velocity limits" in velocity.detail  # not the URDF's
 
     fresh = _fresh_compile(path, str(tmp_path / "fresh.json"))
     assert fresh.returncode == 1 and "C308" in fresh.stderr, fresh.stderr
