@@ -62,7 +62,7 @@ def main(argv: list[str]) -> int:
     print(f"live re-plan on {robot}: {repeats} mid-motion re-plans, confident -> hesitant")
     print(f"  [cold] once: loading the arm {load * 1000:.0f} ms; making a plan "
           + ", ".join(f"{s} {t * 1000:.0f} ms" for s, t in cold.items()))
-    print(f"  [warm] warm re-plan: median {statistics.median(ms):.1f} ms, "
+    print(f"  [warm] re-plan: median {statistics.median(ms):.1f} ms, "
           f"90th percentile {ms[int(0.9 * (len(ms) - 1))]:.1f} ms, max {ms[-1]:.1f} ms "
           f"(goal <= 100 ms: {'met' if statistics.median(ms) <= 100 else 'NOT met'})")
     print("  [warm] where the time goes (median): " + ", ".join(

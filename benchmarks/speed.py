@@ -244,7 +244,7 @@ def bench_build(repeat: int = 15) -> None:
            duration / cli_ms * 1000, "", kind="warm", at_least=270.0, fmt="{:.0f}")
     figure("build_cached_ms", "aou_dsl.compile of the same file again", cached_ms, "ms",
            kind="cached")
-    say(f"  where the warm time goes: lint {lint_ms:.1f} ms, compile {compile_ms:.1f} ms, "
+    say(f"  [warm] where the time goes: lint {lint_ms:.1f} ms, compile {compile_ms:.1f} ms, "
         f"safety replay {replay_ms:.1f} ms ({len(dense[-1].t)} samples), measure "
         f"{measure_ms:.1f} ms; the rest of aouc compile (arguments, the document, writing) "
         f"{cli_ms - api_ms:.1f} ms; motion {duration:.2f} s")
@@ -382,8 +382,8 @@ def bench_lint() -> None:
                                text=True, check=True)
             secs, rss, printed = r.stdout.split()
             per_line[n] = float(secs) / n
-            say(f"  {n:>6} lines ({os.path.getsize(path) / 1e6:.2f} MB): {float(secs):.2f} s, "
-                f"peak memory {float(rss):.0f} MB, {printed} lines printed")
+            say(f"  [cold] {n:>6} lines ({os.path.getsize(path) / 1e6:.2f} MB): "
+                f"{float(secs):.2f} s, peak memory {float(rss):.0f} MB, {printed} lines printed")
             last_rss = float(rss)
         figure("lint_time_per_line_growth", "time per line, 64k lines / 8k lines (each cold)",
                per_line[64000] / per_line[8000], "x", kind=None, at_most=1.5, fmt="{:.2f}")
@@ -476,7 +476,7 @@ def bench_jobs(per: int = 3, rounds: int = 5) -> None:
                     or encode(a.document, "json") == encode(b.document, "json")
                     for a, b in zip(one, many, strict=True))
     ceiling = statistics.median(ceilings)
-    say(f"  {len(paths)} files a round; the pool started in {start:.2f} s, once; documents "
+    say(f"  {len(paths)} files a round; [cold] the pool started in {start:.2f} s, once; documents "
         f"identical to --jobs 1: {same}; {load()}; what {cores} processes can gain on this "
         f"machine now (pure-Python loops): {ceiling:.2f}x")
     figure("jobs_speedup", f"speed-up of a warm pool on {cores} cores", statistics.median(walls),
@@ -547,7 +547,7 @@ def bench_sweep(files: int = 40, rounds: int = 3) -> None:
             walls[2].append(w2)
             ceilings.append(_ceiling(2))
             same = same and _same_bytes(out[1], out[2])
-    say(f"  --jobs 1 {statistics.median(walls[1]):.2f} s, --jobs 2 "
+    say(f"  [cold] --jobs 1 {statistics.median(walls[1]):.2f} s, --jobs 2 "
         f"{statistics.median(walls[2]):.2f} s (medians); CPU time of --jobs 2 over --jobs "
         f"1's {statistics.median(cpu_ratios):.2f}; {load()} at the end; what 2 processes "
         f"can gain on this machine now (pure-Python loops): {statistics.median(ceilings):.2f}x")
@@ -583,7 +583,7 @@ def bench_render() -> None:
         info = render_video([tr], os.path.join(tmp, "h.mp4"), quiet=True)
         secs, used = time.perf_counter() - t, cpu() - c  # the drawing processes and ffmpeg
     ceiling = _ceiling(cores or 1)
-    say(f"  {info['frames']} frames, {info['duration']:.2f} s of video in {secs:.1f} s, "
+    say(f"  [warm] {info['frames']} frames, {info['duration']:.2f} s of video in {secs:.1f} s, "
         f"{used:.1f} s of CPU time in all; load {os.getloadavg()[0]:.2f}; what {cores} "
         f"processes can gain on this machine now (pure-Python loops): {ceiling:.2f}x")
     figure("render_realtime_factor", "video duration / rendering time (motion compiled "
@@ -605,7 +605,7 @@ def bench_replan() -> None:
         bench_replan.main([])
     text = out.getvalue()
     say(text.rstrip())
-    found = re.search(r"warm re-plan: median ([0-9.]+) ms", text)
+    found = re.search(r"\[warm\] re-plan: median ([0-9.]+) ms", text)
     if found is None:
         raise RuntimeError("bench_replan.py no longer prints its median re-plan time")
     figure("replan_ms", "mid-motion re-plan from a new state, the plans made before "
