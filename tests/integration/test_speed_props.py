@@ -19,7 +19,7 @@ import subprocess
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from aou_dsl.core.trajectory import Trajectory
@@ -144,6 +144,9 @@ def _check_against_every_sample(robot: str, q: np.ndarray, goal: tuple) -> None:
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(seed=st.integers(0, 10_000), reach=st.sampled_from([0.4, 1.0, 1.8]),
        offset=st.sampled_from([0.0, 0.05, 0.15]), robot=st.sampled_from(["panda", "ur5"]))
+# a UR5 deep in the target cube: its penetration depth changed faster than the motion
+# bound allows, and the sweep read -0.0424 m where every sample reads -0.0431 m
+@example(seed=2048, reach=1.8, offset=0.0, robot="ur5")
 def test_fast_replay_finds_what_every_sample_finds(seed, reach, offset, robot):
     q = _motion(robot, seed, 240, reach)
     _check_against_every_sample(robot, q, _goal_on_path(robot, q, seed, offset))
