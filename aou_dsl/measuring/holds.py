@@ -221,7 +221,15 @@ def _crossings(r: Rest) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     velocity interpolated to the crossing). Sampled a few times per cycle, an
     oscillation's samples can all miss its reversals; the level between them does not."""
     ratio = r.ratio
-    j = np.argmax(ratio[:-1] + ratio[1:], axis=1)
+    # The first largest of each row, column by column (NumPy's along the short rows is
+    # several times slower): a later column leads only where it is strictly larger.
+    lead = ratio[:-1, 0] + ratio[1:, 0]
+    j = np.zeros(len(lead), np.intp)
+    for k in range(1, ratio.shape[1]):
+        pair = ratio[:-1, k] + ratio[1:, k]
+        ahead = pair > lead
+        j[ahead] = k
+        np.maximum(lead, pair, out=lead)
     rows = np.arange(len(j))
     va, vb = r.v[rows, j], r.v[rows + 1, j]
     idx = np.flatnonzero(va * vb < 0)
@@ -247,12 +255,14 @@ def _dips(r: Rest, taken: np.ndarray) -> list[tuple[float, float, int]]:
     cross, lead, between = _crossings(r)
     seq[2 * cross + 1] = np.minimum(between, seq[2 * cross + 1])
     joint = dict(zip(cross.tolist(), lead.tolist(), strict=True))
-    idx, prominences = maxima(-seq)
-    # Only minima outside the rests and under 30 % of the peaks beside them (in a noisy
-    # recording, a few of the tens of thousands the noise makes).
-    half = idx // 2
-    kept = ~(taken[half] | ((idx % 2 == 1) & taken[np.minimum(half + 1, n - 1)])
-             | (seq[idx] > 0.3 * (seq[idx] + prominences)))
+    # Only minima outside the rests (in a noisy recording, most of the tens of thousands
+    # the noise makes lie in them: their prominences are not looked for) and under 30 %
+    # of the peaks beside them.
+    free = np.empty(len(seq), bool)
+    free[0::2] = ~taken
+    free[1::2] = ~(taken[:-1] | taken[1:])
+    idx, prominences = maxima(-seq, free)
+    kept = ~(seq[idx] > 0.3 * (seq[idx] + prominences))
     out = []
     v = r.v if r.carried is None else r.carried[0]
     for m, prom in zip(idx[kept].tolist(), prominences[kept].tolist(), strict=True):
