@@ -126,14 +126,19 @@ def _anchor(c: Context, b: Boundary, side: int) -> tuple[np.ndarray, float]:
     samples, or the filtered value at an instant."""
     t = c.rest.t
     if b.pause:
-        inner = (t >= b.t0 + 0.25 * (b.t1 - b.t0)) & (t <= b.t1 - 0.25 * (b.t1 - b.t0))
-        idx = np.flatnonzero(inner)
-        if len(idx) == 0:
-            idx = np.arange(b.i0, b.i1 + 1)
+        # The samples from t0 + a quarter to t1 less a quarter (the times increase).
+        k0 = int(np.searchsorted(t, b.t0 + 0.25 * (b.t1 - b.t0), "left"))
+        k1 = int(np.searchsorted(t, b.t1 - 0.25 * (b.t1 - b.t0), "right"))
+        idx = np.arange(k0, k1) if k1 > k0 else np.arange(b.i0, b.i1 + 1)
+        # Gathered (a copy laid out by rows), not a view: the mean sums in that order.
         return c.pos[idx].mean(axis=0), float(c.roll[idx].mean())
     tt = b.t0 if side < 0 else b.t1
-    p = np.array([np.interp(tt, t, c.pos_s[:, k]) for k in range(3)])
-    return p, float(np.interp(tt, t, c.roll))
+    # Interpolated between the two samples around it, as over all of them (not copying
+    # a column of the whole recording for each).
+    k = int(np.searchsorted(t, tt, "right"))
+    near = slice(max(k - 1, 0), k + 1)
+    p = np.array([np.interp(tt, t[near], c.pos_s[near, j]) for j in range(3)])
+    return p, float(np.interp(tt, t[near], c.roll[near]))
 
 
 def pieces(c: Context, bounds: list[Boundary]) -> list[Piece | Boundary]:
