@@ -29,7 +29,7 @@ from ..robot.kinematics import ArmModel
 from .holds import Boundary, Rest
 from .peaks import episode_peak, path_travel, phase_peak
 from .recognisers import moved_along
-from .signal import curvature_gain, filter_at, odd, slope_gain, smooth
+from .signal import curvature_gain, filter_at, odd, row_sum, slope_gain, smooth
 from .surges import phases
 
 __all__ = ["COMPUTED_NOISE", "STILL_TRANSLATION", "Context", "Piece", "Samples",
@@ -176,7 +176,8 @@ def _bearing(a: np.ndarray, b: np.ndarray, normal: np.ndarray) -> float:
 def translation(c: Context, p: Piece, g0: np.ndarray | None) -> EpisodeValues | None:
     """An approach, retreat or gaze; None when the hand did not translate."""
     seg = c.pos_s[p.i0:p.i1 + 1]
-    travel = max(float(np.linalg.norm(seg - p.p0, axis=1).max()),
+    off = seg - p.p0  # the largest distance is the root of the largest square
+    travel = max(float(np.sqrt(row_sum(off * off).max())),
                  float(np.linalg.norm(p.p1 - p.p0)))
     if travel <= STILL_TRANSLATION:
         return None

@@ -382,7 +382,10 @@ def _held(r: Rest, t0: float, t1: float) -> tuple[float, float]:
             + STILL_ANGLE)
     third = len(p) // 3
     ref = np.median(p[third:len(p) - third], axis=0)
-    inside = np.all(np.abs(p - ref) <= band, axis=1)
+    near = np.abs(p - ref) <= band
+    inside = near[:, 0].copy()  # every joint near: column by column (rows are short)
+    for j in range(1, near.shape[1]):
+        inside &= near[:, j]
     # A brief excursion inside is noise (a logging gap); one at an end is motion.
     for a, b in runs(~inside):
         if a > 0 and b < len(inside) - 1 and b - a < r.window:
