@@ -261,6 +261,14 @@ def _dips(r: Rest, taken: np.ndarray) -> list[tuple[float, float, int]]:
     free = np.empty(len(seq), bool)
     free[0::2] = ~taken
     free[1::2] = ~(taken[:-1] | taken[1:])
+    # Nor those that cannot be: the peak beside a minimum at or above the rest level
+    # lies before the level next falls under it, so within the stretch between two
+    # samples under the rest level; a minimum over 30 % of that stretch's highest
+    # (with room for rounding) is over 30 % of its peaks.
+    low = seq < 1.0
+    starts = np.flatnonzero(np.concatenate([[True], low[1:]]))
+    highest = np.repeat(np.maximum.reduceat(seq, starts), np.diff(np.append(starts, len(seq))))
+    free &= low | (seq <= 0.3 * (1.0 + 1e-6) * highest)
     idx, prominences = maxima(-seq, free)
     kept = ~(seq[idx] > 0.3 * (seq[idx] + prominences))
     out = []
