@@ -311,8 +311,13 @@ def _line_of_sight(ctx: Context) -> LineOfSight | None:
     g = ctx.goal - ctx.pos_s
     norm = np.sqrt(row_sum(g * g))  # np.linalg.norm's, row by row
     ok = norm > 1e-6
-    cosang = np.einsum("ij,ij->i", ctx.rot[:, :, 2][ok], g[ok]) / norm[ok]
-    return LineOfSight(ctx.rest.t[ok], np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0))))
+    if ok.all():  # every row: copies laid out by rows, as the selection gives them
+        axis, g, norm, t = (np.ascontiguousarray(ctx.rot[:, :, 2]), np.ascontiguousarray(g),
+                            norm, ctx.rest.t.copy())
+    else:
+        axis, g, norm, t = ctx.rot[:, :, 2][ok], g[ok], norm[ok], ctx.rest.t[ok]
+    cosang = np.einsum("ij,ij->i", axis, g) / norm
+    return LineOfSight(t, np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0))))
 
 
 def _unequal(table: Mapping[str, Descriptor], name: str, vals: list[float]) -> bool:
