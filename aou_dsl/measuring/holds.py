@@ -21,6 +21,7 @@ A pause beside an oscillation, whose envelope fades in and out, has its edges pl
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -174,7 +175,7 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False) -> Zero
     # The motion stops between its first clearly moving sample and the far end of the
     # rest (give or take a step), and no further into the rest than its ramp takes to
     # fall through the threshold (twice that, plus the filter's reach).
-    line = (tuple(float(c) for c in np.polyfit(ramp - ramp[0], vr, 1)) if len(ramp) >= 2
+    line = (_line(ramp - ramp[0], vr) if len(ramp) >= 2
             else None)  # the ramp's line, followed back to zero below
     slope = abs(line[0]) if line is not None else 0.0
     reach_in = 2.0 / (slope * unit) + (window // 2 + 1) * r.h if slope > 0 else math.inf
@@ -205,7 +206,7 @@ def _zero(t: np.ndarray, v: np.ndarray, straight: bool = False,
     if len(t) < 2:
         return None
     x = t - t[0]
-    slope, icpt = line if line is not None else (float(c) for c in np.polyfit(x, v, 1))
+    slope, icpt = line if line is not None else _line(x, v)
     if not math.isfinite(slope) or abs(slope) < 1e-15:
         return None
     if straight and len(t) >= 4:
@@ -213,6 +214,26 @@ def _zero(t: np.ndarray, v: np.ndarray, straight: bool = False,
         if miss > 0.1 * float(np.max(np.abs(v))) + 1.0 / NOISE_SIGMAS:
             return None
     return float(t[0] - icpt / slope)
+
+
+def _line(x: np.ndarray, y: np.ndarray) -> tuple[float, float]:
+    """The slope and intercept of the least-squares line through ``(x, y)``: the
+    numbers ``np.polyfit(x, y, 1)`` gives (the same scaled design, the same solver,
+    without its checks and its general degree, which cost more than the solve on the
+    few tens of samples of a ramp; its warning on a rank-deficient fit too)."""
+    x, y = x + 0.0, y + 0.0  # as polyfit takes them (no negative zeros)
+    lhs = np.empty((len(x), 2))
+    lhs[:, 0], lhs[:, 1] = x, 1.0
+    scale = np.sqrt((lhs * lhs).sum(axis=0))
+    lhs /= scale
+    c, _, rank, _ = np.linalg.lstsq(lhs, y, len(x) * _EPS)
+    if rank != 2:
+        warnings.warn("Polyfit may be poorly conditioned", np.exceptions.RankWarning,
+                      stacklevel=2)
+    return float(c[0] / scale[0]), float(c[1] / scale[1])
+
+
+_EPS = float(np.finfo(np.float64).eps)
 
 
 def _crossings(r: Rest) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
