@@ -282,10 +282,12 @@ def filter_at(x: np.ndarray, window: int, deriv: int, h: float, at: np.ndarray,
     half = window // 2
     c = sg_coefficients(window, order, deriv, h)
     at = np.asarray(at)
-    if x.ndim == 2 and x.flags.c_contiguous and len(at):
-        # Each window is a stretch of the rows, laid out as a gathered copy lays it out:
-        # the same product, without copying the windows (long ones at a high rate).
-        return np.stack([x[k - half:k + half + 1].T @ c for k in at.tolist()])
+    if x.ndim == 2 and len(at):
+        # Each window a stretch of the rows laid out by rows (a view of rows laid out
+        # so, else a copy), as the gathered windows lie: the same product, without the
+        # gather's indices and its moved axes.
+        return np.stack([np.ascontiguousarray(x[k - half:k + half + 1]).T @ c
+                         for k in at.tolist()])
     windows = x[at[:, None] + np.arange(-half, half + 1)]  # (K, window, ...)
     return np.moveaxis(windows, 1, -1) @ c
 
