@@ -30,7 +30,7 @@ import numpy as np
 from .extrema import maxima
 from .onset import REST_SPEED, carried_edge, soft_pause
 from .rest import CLEARLY, LONG_WINDOW, Rest, rest_at_end, rest_signals
-from .signal import NOISE_SIGMAS, odd, row_max, runs
+from .signal import NOISE_SIGMAS, median0, odd, row_max, runs
 
 __all__ = ["MIN_PAUSE", "REST_SPEED", "Boundary", "Rest", "boundaries", "rest_at_end",
            "rest_signals"]
@@ -410,7 +410,7 @@ def _held(r: Rest, t0: float, t1: float) -> tuple[float, float]:
     band = (HELD_SIGMAS * r.noise * r.held_gain * r.sparse[k0:k1, None] + 1.01 * r.quantum
             + STILL_ANGLE)
     third = len(p) // 3
-    ref = np.median(p[third:len(p) - third], axis=0)
+    ref = median0(p[third:len(p) - third])
     near = np.abs(p - ref) <= band
     inside = near[:, 0].copy()  # every joint near: column by column (rows are short)
     for j in range(1, near.shape[1]):

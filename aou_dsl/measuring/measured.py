@@ -60,6 +60,7 @@ from .signal import (
     Grid,
     JointNoise,
     joint_noise,
+    median0,
     row_sum,
     short_window,
     smooth,
@@ -88,7 +89,7 @@ class LineOfSight:
 
     @property
     def median(self) -> float:
-        return float(np.median(self.angle))
+        return float(median0(self.angle))
 
     @property
     def max(self) -> float:
@@ -197,7 +198,7 @@ def _context(rec: Trajectory, pinned: JointNoise | None = None, fk: Kinematics |
     jn = joint_noise(t, q) if pinned is None else pinned
     q = dequantised(t, q, jn)
     noise = jn.effective
-    h0 = float(np.median(np.diff(t)))
+    h0 = float(median0(np.diff(t)))  # a checked clock: finite
     window = short_window(float(noise.max()), h0)
     grid = to_grid(t, q, window * h0)
     carried = _carried(rec, cols, grid)

@@ -30,6 +30,8 @@ import math
 
 import numpy as np
 
+from .signal import median0
+
 __all__ = ["REST_SPEED", "carried_edge", "held_at", "soft_edge", "soft_pause"]
 
 #: Joint speed under which clean data are at rest [rad/s].
@@ -128,7 +130,7 @@ def held_at(q: np.ndarray, hold: tuple[int, int]) -> np.ndarray:
     over its middle third."""
     h0, h1 = hold
     third = (h1 - h0 + 1) // 3
-    return np.median(q[h0 + third:h1 - third + 1], axis=0)
+    return median0(q[h0 + third:h1 - third + 1])
 
 
 def _best(lag: np.ndarray, y: np.ndarray, starts: np.ndarray, shapes: list[np.ndarray]

@@ -52,7 +52,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.memo import cached
-from .signal import row_sum
+from .signal import median0, row_sum
 
 __all__ = ["PhasePeak", "curvatures", "episode_peak", "path_travel", "phase_peak"]
 
@@ -114,7 +114,7 @@ def path_travel(s: np.ndarray, q: np.ndarray, noise: np.ndarray
         weight = row_sum(g * g * w)
         if np.any(weight <= 0):
             continue
-        return s + row_sum(miss * g * w) / weight, float(np.sqrt(1.0 / np.median(weight)))
+        return s + row_sum(miss * g * w) / weight, float(np.sqrt(1.0 / median0(weight)))
     return None
 
 
