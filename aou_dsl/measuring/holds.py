@@ -188,7 +188,11 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False) -> Zero
     # The filter rounds the corner at the stop: samples whose window reaches across it
     # are left out of a second fit.
     keep = np.abs(ramp - t0) > (window // 2) * r.h
-    if keep.sum() >= 2:
+    if keep.all():  # none left out: the same samples, the line already fitted
+        t0 = _zero(ramp, vr, straight=True, line=line)
+        if t0 is None:
+            return Zero(edge, False)
+    elif keep.sum() >= 2:
         t0 = _zero(ramp[keep], vr[keep], straight=True)
         if t0 is None:
             return Zero(edge, False)
