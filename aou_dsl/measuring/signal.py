@@ -347,7 +347,7 @@ def row_sum(a: np.ndarray) -> np.ndarray:
     that is left to it."""
     if a.shape[1] >= 8 or a.shape[1] == 0:
         return a.sum(axis=1)
-    out = a[:, 0].copy()
+    out = 0.0 + a[:, 0]  # NumPy's sum starts at +0.0: a row of zeros sums to +0.0
     for j in range(1, a.shape[1]):
         out += a[:, j]
     return out
