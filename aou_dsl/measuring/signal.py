@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -353,7 +354,7 @@ def row_sum(a: np.ndarray) -> np.ndarray:
     return out
 
 
-def median0(a: np.ndarray) -> np.ndarray | float:
+def median0(a: np.ndarray) -> Any:
     """``np.median(a, axis=0)`` of finite values, the same numbers (a zero as +0.0, as
     its mean of the middle ones gives it): from one partition about the middle, without
     NumPy's look for NaNs (a finite recording has none) and its general axes, which on
