@@ -21,7 +21,6 @@ A pause beside an oscillation, whose envelope fades in and out, has its edges pl
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -30,7 +29,7 @@ import numpy as np
 from .extrema import maxima
 from .onset import REST_SPEED, carried_edge, soft_pause
 from .rest import CLEARLY, LONG_WINDOW, Rest, rest_at_end, rest_signals
-from .signal import NOISE_SIGMAS, median0, odd, row_max, runs
+from .signal import NOISE_SIGMAS, line_fit, median0, odd, row_max, runs
 
 __all__ = ["MIN_PAUSE", "REST_SPEED", "Boundary", "Rest", "boundaries", "rest_at_end",
            "rest_signals"]
@@ -175,7 +174,7 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False) -> Zero
     # The motion stops between its first clearly moving sample and the far end of the
     # rest (give or take a step), and no further into the rest than its ramp takes to
     # fall through the threshold (twice that, plus the filter's reach).
-    line = (_line(ramp - ramp[0], vr) if len(ramp) >= 2
+    line = (line_fit(ramp - ramp[0], vr) if len(ramp) >= 2
             else None)  # the ramp's line, followed back to zero below
     slope = abs(line[0]) if line is not None else 0.0
     reach_in = 2.0 / (slope * unit) + (window // 2 + 1) * r.h if slope > 0 else math.inf
@@ -210,7 +209,7 @@ def _zero(t: np.ndarray, v: np.ndarray, straight: bool = False,
     if len(t) < 2:
         return None
     x = t - t[0]
-    slope, icpt = line if line is not None else _line(x, v)
+    slope, icpt = line if line is not None else line_fit(x, v)
     if not math.isfinite(slope) or abs(slope) < 1e-15:
         return None
     if straight and len(t) >= 4:
@@ -220,34 +219,13 @@ def _zero(t: np.ndarray, v: np.ndarray, straight: bool = False,
     return float(t[0] - icpt / slope)
 
 
-def _line(x: np.ndarray, y: np.ndarray) -> tuple[float, float]:
-    """The slope and intercept of the least-squares line through ``(x, y)``: the
-    numbers ``np.polyfit(x, y, 1)`` gives (the same scaled design, the same solver,
-    without its checks and its general degree, which cost more than the solve on the
-    few tens of samples of a ramp; its warning on a rank-deficient fit too)."""
-    x, y = x + 0.0, y + 0.0  # as polyfit takes them (no negative zeros)
-    lhs = np.empty((len(x), 2))
-    lhs[:, 0], lhs[:, 1] = x, 1.0
-    scale = np.sqrt((lhs * lhs).sum(axis=0))
-    lhs /= scale
-    c, _, rank, _ = np.linalg.lstsq(lhs, y, len(x) * _EPS)
-    if rank != 2:
-        warnings.warn("Polyfit may be poorly conditioned", np.exceptions.RankWarning,
-                      stacklevel=2)
-    return float(c[0] / scale[0]), float(c[1] / scale[1])
-
-
-_EPS = float(np.finfo(np.float64).eps)
-
-
 def _crossings(r: Rest) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Where the leading joint's velocity changes sign between two samples ``i`` and
     ``i + 1``: those ``i``, the leading joint, and the speed level there (every joint's
     velocity interpolated to the crossing). Sampled a few times per cycle, an
     oscillation's samples can all miss its reversals; the level between them does not."""
     ratio = r.ratio
-    # The first largest of each row, column by column (NumPy's along the short rows is
-    # several times slower): a later column leads only where it is strictly larger.
+    # Each row's first largest, column by column (as row_max finds the largest).
     lead = ratio[:-1, 0] + ratio[1:, 0]
     j = np.zeros(len(lead), np.intp)
     for k in range(1, ratio.shape[1]):
@@ -415,10 +393,7 @@ def _held(r: Rest, t0: float, t1: float) -> tuple[float, float]:
             + STILL_ANGLE)
     third = len(p) // 3
     ref = median0(p[third:len(p) - third])
-    near = np.abs(p - ref) <= band
-    inside = near[:, 0].copy()  # every joint near: column by column (rows are short)
-    for j in range(1, near.shape[1]):
-        inside &= near[:, j]
+    inside = ~row_max(np.abs(p - ref) > band)  # every joint near (by columns: rows are short)
     # A brief excursion inside is noise (a logging gap); one at an end is motion.
     for a, b in runs(~inside):
         if a > 0 and b < len(inside) - 1 and b - a < r.window:

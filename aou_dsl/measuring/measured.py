@@ -167,8 +167,7 @@ def _checked(rec: Trajectory, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     q = np.asarray(rec.q, float)[:, cols]
     if t.ndim != 1 or len(t) < 3 or q.shape[0] != len(t):
         raise _bad(rec.path, f"a trajectory needs at least 3 samples, found {len(t)}")
-    # Checked as a whole first: a row by row reduction over a few joints is slow.
-    if not (np.isfinite(t).all() and np.isfinite(q).all()):
+    if not (np.isfinite(t).all() and np.isfinite(q).all()):  # whole first: rows are short
         bad = ~(np.isfinite(t) & np.isfinite(q).all(axis=1))
         i = int(np.argmax(bad))
         raise _bad(rec.path, f"sample {i} is not a finite number", sample=i)
@@ -312,11 +311,10 @@ def _line_of_sight(ctx: Context) -> LineOfSight | None:
     g = ctx.goal - ctx.pos_s
     norm = np.sqrt(row_sum(g * g))  # np.linalg.norm's, row by row
     ok = norm > 1e-6
-    if ok.all():  # every row: copies laid out by rows, as the selection gives them
-        axis, g, norm, t = (np.ascontiguousarray(ctx.rot[:, :, 2]), np.ascontiguousarray(g),
-                            norm, ctx.rest.t.copy())
-    else:
-        axis, g, norm, t = ctx.rot[:, :, 2][ok], g[ok], norm[ok], ctx.rest.t[ok]
+    # Every row (the usual) taken without a selection, laid out by rows as it lays them.
+    axis, g, norm, t = ((np.ascontiguousarray(ctx.rot[:, :, 2]), np.ascontiguousarray(g), norm,
+                         ctx.rest.t.copy()) if ok.all() else
+                        (ctx.rot[:, :, 2][ok], g[ok], norm[ok], ctx.rest.t[ok]))
     cosang = np.einsum("ij,ij->i", axis, g) / norm
     return LineOfSight(t, np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0))))
 

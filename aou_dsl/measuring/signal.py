@@ -11,6 +11,7 @@ joint by joint (docs/measure.md explains the choices).
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -27,6 +28,7 @@ __all__ = [
     "filter_at",
     "sg_coefficients",
     "joint_noise",
+    "line_fit",
     "median0",
     "odd",
     "row_max",
@@ -367,3 +369,23 @@ def median0(a: np.ndarray) -> Any:
         return 0.0 + np.partition(a, (h, n - 1), axis=0)[h]
     part = np.partition(a, (h - 1, h), axis=0)
     return (0.0 + part[h - 1] + part[h]) / 2.0
+
+
+def line_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float]:
+    """The slope and intercept of the least-squares line through ``(x, y)``: the
+    numbers ``np.polyfit(x, y, 1)`` gives (the same scaled design, the same solver,
+    without its checks and its general degree, which cost more than the solve on the
+    few tens of samples of a ramp; its warning on a rank-deficient fit too)."""
+    x, y = x + 0.0, y + 0.0  # as polyfit takes them (no negative zeros)
+    lhs = np.empty((len(x), 2))
+    lhs[:, 0], lhs[:, 1] = x, 1.0
+    scale = np.sqrt((lhs * lhs).sum(axis=0))
+    lhs /= scale
+    c, _, rank, _ = np.linalg.lstsq(lhs, y, len(x) * _EPS)
+    if rank != 2:
+        warnings.warn("Polyfit may be poorly conditioned", np.exceptions.RankWarning,
+                      stacklevel=2)
+    return float(c[0] / scale[0]), float(c[1] / scale[1])
+
+
+_EPS = float(np.finfo(np.float64).eps)

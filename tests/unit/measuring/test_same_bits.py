@@ -13,8 +13,8 @@ from types import SimpleNamespace
 import numpy as np
 
 from aou_dsl.measuring.extrema import maxima
-from aou_dsl.measuring.holds import _crossings, _dips, _line
-from aou_dsl.measuring.signal import filter_at, median0, row_sum, sg_coefficients
+from aou_dsl.measuring.holds import _crossings, _dips
+from aou_dsl.measuring.signal import filter_at, line_fit, median0, row_sum, sg_coefficients
 
 
 def _wide(rng: np.random.Generator, shape: tuple[int, ...]) -> np.ndarray:
@@ -59,12 +59,12 @@ def test_line_is_polyfit_of_degree_one():
             x = np.cumsum(rng.uniform(0.2, 2.0, k)) * 10.0 ** float(rng.integers(-4, 1))
             x -= x[0]
             y = rng.normal(size=k) * 10.0 ** float(rng.integers(-3, 3))
-            assert _line(x, y) == tuple(float(c) for c in np.polyfit(x, y, 1))
+            assert line_fit(x, y) == tuple(float(c) for c in np.polyfit(x, y, 1))
 
 
 def test_line_warns_where_polyfit_warns():
     x, y = np.full(5, 2.0), np.arange(5.0)  # x no line can be told along
-    for fit in (_line, lambda a, b: np.polyfit(a, b, 1)):
+    for fit in (line_fit, lambda a, b: np.polyfit(a, b, 1)):
         with warnings.catch_warnings(record=True) as seen:
             warnings.simplefilter("always")
             fit(x, y)
