@@ -29,7 +29,7 @@ from ..robot.kinematics import ArmModel
 from .holds import Boundary, Rest
 from .peaks import episode_peak, path_travel, phase_peak
 from .recognisers import moved_along
-from .signal import curvature_gain, filter_at, odd, row_sum, slope_gain, smooth
+from .signal import curvature_gain, filters_at, odd, row_sum, slope_gain, smooth
 from .surges import phases
 
 __all__ = ["COMPUTED_NOISE", "STILL_TRANSLATION", "Context", "Piece", "Samples",
@@ -275,8 +275,7 @@ def _self_check(c: Context, peak: float, at: int, window: int, u: np.ndarray,
     near = np.unique(np.clip(np.linspace(at - half, at + half, 5).round().astype(int),
                              half, n - 1 - half))
     q = c.q[near]
-    qd = filter_at(c.q, window, 1, h, near)
-    qdd = filter_at(c.q, window, 2, h, near)
+    qd, qdd = filters_at(c.q, window, (1, 2), h, near)
     joint_side = classical_acceleration(c.arm, q, qd, qdd) @ u
     noise = max(sd, sigma_x * curvature_gain(window, h))
     bound = 1.25 * float(np.abs(joint_side).max()) + 4.0 * noise

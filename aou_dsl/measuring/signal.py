@@ -26,6 +26,7 @@ __all__ = [
     "JointNoise",
     "curvature_gain",
     "filter_at",
+    "filters_at",
     "sg_coefficients",
     "joint_noise",
     "line_fit",
@@ -283,17 +284,23 @@ def filter_at(x: np.ndarray, window: int, deriv: int, h: float, at: np.ndarray,
     """:func:`smooth` of ``x`` evaluated only at the samples ``at``, each of which must
     have ``window // 2`` samples on either side: each is the weights' dot product with
     its own window of samples, whatever the other samples hold."""
+    return filters_at(x, window, (deriv,), h, at, order)[0]
+
+
+def filters_at(x: np.ndarray, window: int, derivs: tuple[int, ...], h: float,
+               at: np.ndarray, order: int = 3) -> list[np.ndarray]:
+    """:func:`filter_at` for each of ``derivs``, from one copy of the windows."""
     half = window // 2
-    c = sg_coefficients(window, order, deriv, h)
+    cs = [sg_coefficients(window, order, d, h) for d in derivs]
     at = np.asarray(at)
     if x.ndim == 2 and len(at):
         # Each window a stretch of the rows laid out by rows (a view of rows laid out
         # so, else a copy), as the gathered windows lie: the same product, without the
         # gather's indices and its moved axes.
-        return np.stack([np.ascontiguousarray(x[k - half:k + half + 1]).T @ c
-                         for k in at.tolist()])
-    windows = x[at[:, None] + np.arange(-half, half + 1)]  # (K, window, ...)
-    return np.moveaxis(windows, 1, -1) @ c
+        wins = [np.ascontiguousarray(x[k - half:k + half + 1]).T for k in at.tolist()]
+        return [np.stack([w @ c for w in wins]) for c in cs]
+    windows = np.moveaxis(x[at[:, None] + np.arange(-half, half + 1)], 1, -1)
+    return [windows @ c for c in cs]
 
 
 def slope_gain(window: int, h: float) -> float:

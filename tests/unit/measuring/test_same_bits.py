@@ -14,7 +14,14 @@ import numpy as np
 
 from aou_dsl.measuring.extrema import maxima
 from aou_dsl.measuring.holds import _crossings, _dips
-from aou_dsl.measuring.signal import filter_at, line_fit, median0, row_sum, sg_coefficients
+from aou_dsl.measuring.signal import (
+    filter_at,
+    filters_at,
+    line_fit,
+    median0,
+    row_sum,
+    sg_coefficients,
+)
 
 
 def _wide(rng: np.random.Generator, shape: tuple[int, ...]) -> np.ndarray:
@@ -143,8 +150,9 @@ def test_filter_at_equals_the_gathered_windows_in_either_layout():
         for window in (3, 5, 61, 301, 1001):
             half = window // 2
             at = np.sort(rng.integers(half, len(q) - half, 5))
-            for deriv in (1, 2):
-                c = sg_coefficients(window, 3, deriv, 0.001)
-                gathered = q[at[:, None] + np.arange(-half, half + 1)]
-                want = np.moveaxis(gathered, 1, -1) @ c
-                assert np.array_equal(filter_at(q, window, deriv, 0.001, at), want)
+            gathered = np.moveaxis(q[at[:, None] + np.arange(-half, half + 1)], 1, -1)
+            want = [gathered @ sg_coefficients(window, 3, d, 0.001) for d in (1, 2)]
+            for d in (1, 2):
+                assert np.array_equal(filter_at(q, window, d, 0.001, at), want[d - 1])
+            both = filters_at(q, window, (1, 2), 0.001, at)
+            assert all(np.array_equal(g, w) for g, w in zip(both, want, strict=True))
