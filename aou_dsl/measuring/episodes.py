@@ -29,7 +29,7 @@ from ..robot.kinematics import ArmModel
 from .holds import Boundary, Rest
 from .peaks import episode_peak, path_travel, phase_peak
 from .recognisers import moved_along
-from .signal import curvature_gain, filter_at, odd, slope_gain, smooth
+from .signal import curvature_gain, filters_at, odd, row_sum, slope_gain, smooth
 from .surges import phases
 
 __all__ = ["COMPUTED_NOISE", "STILL_TRANSLATION", "Context", "Piece", "Samples",
@@ -126,14 +126,19 @@ def _anchor(c: Context, b: Boundary, side: int) -> tuple[np.ndarray, float]:
     samples, or the filtered value at an instant."""
     t = c.rest.t
     if b.pause:
-        inner = (t >= b.t0 + 0.25 * (b.t1 - b.t0)) & (t <= b.t1 - 0.25 * (b.t1 - b.t0))
-        idx = np.flatnonzero(inner)
-        if len(idx) == 0:
-            idx = np.arange(b.i0, b.i1 + 1)
+        # The samples from t0 + a quarter to t1 less a quarter (the times increase).
+        k0 = int(np.searchsorted(t, b.t0 + 0.25 * (b.t1 - b.t0), "left"))
+        k1 = int(np.searchsorted(t, b.t1 - 0.25 * (b.t1 - b.t0), "right"))
+        idx = np.arange(k0, k1) if k1 > k0 else np.arange(b.i0, b.i1 + 1)
+        # Gathered (a copy laid out by rows), not a view: the mean sums in that order.
         return c.pos[idx].mean(axis=0), float(c.roll[idx].mean())
     tt = b.t0 if side < 0 else b.t1
-    p = np.array([np.interp(tt, t, c.pos_s[:, k]) for k in range(3)])
-    return p, float(np.interp(tt, t, c.roll))
+    # Interpolated between the two samples around it, as over all of them (not copying
+    # a column of the whole recording for each).
+    k = int(np.searchsorted(t, tt, "right"))
+    near = slice(max(k - 1, 0), k + 1)
+    p = np.array([np.interp(tt, t[near], c.pos_s[near, j]) for j in range(3)])
+    return p, float(np.interp(tt, t[near], c.roll[near]))
 
 
 def pieces(c: Context, bounds: list[Boundary]) -> list[Piece | Boundary]:
@@ -171,7 +176,8 @@ def _bearing(a: np.ndarray, b: np.ndarray, normal: np.ndarray) -> float:
 def translation(c: Context, p: Piece, g0: np.ndarray | None) -> EpisodeValues | None:
     """An approach, retreat or gaze; None when the hand did not translate."""
     seg = c.pos_s[p.i0:p.i1 + 1]
-    travel = max(float(np.linalg.norm(seg - p.p0, axis=1).max()),
+    off = seg - p.p0  # the largest distance is the root of the largest square
+    travel = max(float(np.sqrt(row_sum(off * off).max())),
                  float(np.linalg.norm(p.p1 - p.p0)))
     if travel <= STILL_TRANSLATION:
         return None
@@ -269,8 +275,7 @@ def _self_check(c: Context, peak: float, at: int, window: int, u: np.ndarray,
     near = np.unique(np.clip(np.linspace(at - half, at + half, 5).round().astype(int),
                              half, n - 1 - half))
     q = c.q[near]
-    qd = filter_at(c.q, window, 1, h, near)
-    qdd = filter_at(c.q, window, 2, h, near)
+    qd, qdd = filters_at(c.q, window, (1, 2), h, near)
     joint_side = classical_acceleration(c.arm, q, qd, qdd) @ u
     noise = max(sd, sigma_x * curvature_gain(window, h))
     bound = 1.25 * float(np.abs(joint_side).max()) + 4.0 * noise

@@ -18,9 +18,12 @@ import numpy as np
 __all__ = ["maxima"]
 
 
-def maxima(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def maxima(x: np.ndarray, among: np.ndarray | None = None
+           ) -> tuple[np.ndarray, np.ndarray]:
     """The local maxima of the finite 1-D sequence ``x`` (their indices, increasing) and
-    their prominences."""
+    their prominences; with ``among`` (booleans, one per sample), only the maxima
+    reported at a sample it marks (each one's prominence is the same either way: the
+    walks see every sample; only those not asked for are not walked)."""
     x = np.asarray(x, dtype=np.float64)
     n = len(x)
     if n < 3:
@@ -32,6 +35,9 @@ def maxima(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         (ends == n - 1) | (x[np.minimum(ends + 1, n - 1)] < x[ends]))
     peak = crest & (starts >= 1) & (ends <= n - 2)
     first, last = starts[peak], ends[peak]
+    if among is not None:
+        asked = among[(first + last) // 2]
+        first, last = first[asked], last[asked]
     # Both ends of every crest, and of ``x``: in order already (a crest ends before the
     # next starts), so merged without a sort; a crest of one sample is one mark.
     ordered = np.concatenate([[0], np.column_stack([starts[crest], ends[crest]]).ravel(),

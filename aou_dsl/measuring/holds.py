@@ -29,7 +29,7 @@ import numpy as np
 from .extrema import maxima
 from .onset import REST_SPEED, carried_edge, soft_pause
 from .rest import CLEARLY, LONG_WINDOW, Rest, rest_at_end, rest_signals
-from .signal import NOISE_SIGMAS, odd, row_max, runs
+from .signal import NOISE_SIGMAS, line_fit, median0, odd, row_max, runs
 
 __all__ = ["MIN_PAUSE", "REST_SPEED", "Boundary", "Rest", "boundaries", "rest_at_end",
            "rest_signals"]
@@ -174,7 +174,7 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False) -> Zero
     # The motion stops between its first clearly moving sample and the far end of the
     # rest (give or take a step), and no further into the rest than its ramp takes to
     # fall through the threshold (twice that, plus the filter's reach).
-    line = (tuple(float(c) for c in np.polyfit(ramp - ramp[0], vr, 1)) if len(ramp) >= 2
+    line = (line_fit(ramp - ramp[0], vr) if len(ramp) >= 2
             else None)  # the ramp's line, followed back to zero below
     slope = abs(line[0]) if line is not None else 0.0
     reach_in = 2.0 / (slope * unit) + (window // 2 + 1) * r.h if slope > 0 else math.inf
@@ -187,7 +187,11 @@ def _ramp_zero(r: Rest, i: int, step: int, far: int, slow: bool = False) -> Zero
     # The filter rounds the corner at the stop: samples whose window reaches across it
     # are left out of a second fit.
     keep = np.abs(ramp - t0) > (window // 2) * r.h
-    if keep.sum() >= 2:
+    if keep.all():  # none left out: the same samples, the line already fitted
+        t0 = _zero(ramp, vr, straight=True, line=line)
+        if t0 is None:
+            return Zero(edge, False)
+    elif keep.sum() >= 2:
         t0 = _zero(ramp[keep], vr[keep], straight=True)
         if t0 is None:
             return Zero(edge, False)
@@ -205,7 +209,7 @@ def _zero(t: np.ndarray, v: np.ndarray, straight: bool = False,
     if len(t) < 2:
         return None
     x = t - t[0]
-    slope, icpt = line if line is not None else (float(c) for c in np.polyfit(x, v, 1))
+    slope, icpt = line if line is not None else line_fit(x, v)
     if not math.isfinite(slope) or abs(slope) < 1e-15:
         return None
     if straight and len(t) >= 4:
@@ -221,7 +225,14 @@ def _crossings(r: Rest) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     velocity interpolated to the crossing). Sampled a few times per cycle, an
     oscillation's samples can all miss its reversals; the level between them does not."""
     ratio = r.ratio
-    j = np.argmax(ratio[:-1] + ratio[1:], axis=1)
+    # Each row's first largest, column by column (as row_max finds the largest).
+    lead = ratio[:-1, 0] + ratio[1:, 0]
+    j = np.zeros(len(lead), np.intp)
+    for k in range(1, ratio.shape[1]):
+        pair = ratio[:-1, k] + ratio[1:, k]
+        ahead = pair > lead
+        j[ahead] = k
+        np.maximum(lead, pair, out=lead)
     rows = np.arange(len(j))
     va, vb = r.v[rows, j], r.v[rows + 1, j]
     idx = np.flatnonzero(va * vb < 0)
@@ -247,12 +258,22 @@ def _dips(r: Rest, taken: np.ndarray) -> list[tuple[float, float, int]]:
     cross, lead, between = _crossings(r)
     seq[2 * cross + 1] = np.minimum(between, seq[2 * cross + 1])
     joint = dict(zip(cross.tolist(), lead.tolist(), strict=True))
-    idx, prominences = maxima(-seq)
-    # Only minima outside the rests and under 30 % of the peaks beside them (in a noisy
-    # recording, a few of the tens of thousands the noise makes).
-    half = idx // 2
-    kept = ~(taken[half] | ((idx % 2 == 1) & taken[np.minimum(half + 1, n - 1)])
-             | (seq[idx] > 0.3 * (seq[idx] + prominences)))
+    # Only minima outside the rests (in a noisy recording, most of the tens of thousands
+    # the noise makes lie in them: their prominences are not looked for) and under 30 %
+    # of the peaks beside them.
+    free = np.empty(len(seq), bool)
+    free[0::2] = ~taken
+    free[1::2] = ~(taken[:-1] | taken[1:])
+    # Nor those that cannot be: the peak beside a minimum at or above the rest level
+    # lies before the level next falls under it, so within the stretch between two
+    # samples under the rest level; a minimum over 30 % of that stretch's highest
+    # (with room for rounding) is over 30 % of its peaks.
+    low = seq < 1.0
+    starts = np.flatnonzero(np.concatenate([[True], low[1:]]))
+    highest = np.repeat(np.maximum.reduceat(seq, starts), np.diff(np.append(starts, len(seq))))
+    free &= low | (seq <= 0.3 * (1.0 + 1e-6) * highest)
+    idx, prominences = maxima(-seq, free)
+    kept = ~(seq[idx] > 0.3 * (seq[idx] + prominences))
     out = []
     v = r.v if r.carried is None else r.carried[0]
     for m, prom in zip(idx[kept].tolist(), prominences[kept].tolist(), strict=True):
@@ -371,8 +392,8 @@ def _held(r: Rest, t0: float, t1: float) -> tuple[float, float]:
     band = (HELD_SIGMAS * r.noise * r.held_gain * r.sparse[k0:k1, None] + 1.01 * r.quantum
             + STILL_ANGLE)
     third = len(p) // 3
-    ref = np.median(p[third:len(p) - third], axis=0)
-    inside = np.all(np.abs(p - ref) <= band, axis=1)
+    ref = median0(p[third:len(p) - third])
+    inside = ~row_max(np.abs(p - ref) > band)  # every joint near (by columns: rows are short)
     # A brief excursion inside is noise (a logging gap); one at an end is motion.
     for a, b in runs(~inside):
         if a > 0 and b < len(inside) - 1 and b - a < r.window:

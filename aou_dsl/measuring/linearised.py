@@ -44,9 +44,11 @@ class Linearised:
             got = _expansion(self.arm, q if q0 is None else q0, exact_rows=first)
             if got is None:
                 return batch_fk(self.arm, q)
-            about = self.at[clock] = got
+            # The rotations laid out by rows, once: a product of a stack of 3x3 matrices
+            # copies each operand that is not, every time (the same numbers either way).
+            about = self.at[clock] = (*got[:2], np.ascontiguousarray(got[2]), *got[3:])
             if first:
-                return about[1], about[2]
+                return got[1], got[2]
         if about[0].shape != q.shape:
             return batch_fk(self.arm, q)
         q0, pos0, rot0, lin, ang = about

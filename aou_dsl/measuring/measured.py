@@ -56,7 +56,17 @@ from .episodes import (
 from .holds import MIN_PAUSE, REST_SPEED, Boundary, Rest, boundaries, rest_at_end, rest_signals
 from .recognisers import claimed, every_named, extra_descriptors, extra_values
 from .roll import MIN_TILT, Lobe, lobe, roll_angle, rotations, undersampled
-from .signal import Grid, JointNoise, joint_noise, short_window, smooth, to_grid, unwrap
+from .signal import (
+    Grid,
+    JointNoise,
+    joint_noise,
+    median0,
+    row_sum,
+    short_window,
+    smooth,
+    to_grid,
+    unwrap,
+)
 from .staircase import dequantised
 from .stamps import evened, judge_stamps, read_on_evened, stamped_on_arrival
 
@@ -79,7 +89,7 @@ class LineOfSight:
 
     @property
     def median(self) -> float:
-        return float(np.median(self.angle))
+        return float(median0(self.angle))
 
     @property
     def max(self) -> float:
@@ -157,8 +167,8 @@ def _checked(rec: Trajectory, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     q = np.asarray(rec.q, float)[:, cols]
     if t.ndim != 1 or len(t) < 3 or q.shape[0] != len(t):
         raise _bad(rec.path, f"a trajectory needs at least 3 samples, found {len(t)}")
-    bad = ~(np.isfinite(t) & np.isfinite(q).all(axis=1))
-    if bad.any():
+    if not (np.isfinite(t).all() and np.isfinite(q).all()):  # whole first: rows are short
+        bad = ~(np.isfinite(t) & np.isfinite(q).all(axis=1))
         i = int(np.argmax(bad))
         raise _bad(rec.path, f"sample {i} is not a finite number", sample=i)
     step = np.diff(t)
@@ -187,7 +197,7 @@ def _context(rec: Trajectory, pinned: JointNoise | None = None, fk: Kinematics |
     jn = joint_noise(t, q) if pinned is None else pinned
     q = dequantised(t, q, jn)
     noise = jn.effective
-    h0 = float(np.median(np.diff(t)))
+    h0 = float(median0(np.diff(t)))  # a checked clock: finite
     window = short_window(float(noise.max()), h0)
     grid = to_grid(t, q, window * h0)
     carried = _carried(rec, cols, grid)
@@ -299,10 +309,14 @@ def _line_of_sight(ctx: Context) -> LineOfSight | None:
     if ctx.goal is None:
         return None
     g = ctx.goal - ctx.pos_s
-    norm = np.linalg.norm(g, axis=1)
+    norm = np.sqrt(row_sum(g * g))  # np.linalg.norm's, row by row
     ok = norm > 1e-6
-    cosang = np.einsum("ij,ij->i", ctx.rot[:, :, 2][ok], g[ok]) / norm[ok]
-    return LineOfSight(ctx.rest.t[ok], np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0))))
+    # Every row (the usual) taken without a selection, laid out by rows as it lays them.
+    axis, g, norm, t = ((np.ascontiguousarray(ctx.rot[:, :, 2]), np.ascontiguousarray(g), norm,
+                         ctx.rest.t.copy()) if ok.all() else
+                        (ctx.rot[:, :, 2][ok], g[ok], norm[ok], ctx.rest.t[ok]))
+    cosang = np.einsum("ij,ij->i", axis, g) / norm
+    return LineOfSight(t, np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0))))
 
 
 def _unequal(table: Mapping[str, Descriptor], name: str, vals: list[float]) -> bool:

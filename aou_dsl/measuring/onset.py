@@ -30,7 +30,9 @@ import math
 
 import numpy as np
 
-__all__ = ["REST_SPEED", "carried_edge", "soft_edge", "soft_pause"]
+from .signal import median0
+
+__all__ = ["REST_SPEED", "carried_edge", "held_at", "soft_edge", "soft_pause"]
 
 #: Joint speed under which clean data are at rest [rad/s].
 REST_SPEED = 1e-4
@@ -60,20 +62,21 @@ RATES = (0.8, 0.9, 1.0, 1.1, 1.2)
 
 
 def soft_edge(t: np.ndarray, q: np.ndarray, noise: np.ndarray, hold: tuple[int, int],
-              step: int) -> float | None:
+              step: int, ref: np.ndarray | None = None) -> float | None:
     """The instant the motion after the hold ``hold`` (grid samples, inclusive; ``step``
     +1), or before it (``step`` -1), leaves the held position; None when no joint with
     noise moves clearly beside it, or when the fit misses.
 
     ``t`` (N,) and ``q`` (N, n) are the grid's times and joint positions; ``noise`` (n,)
-    each joint's noise std (0: a still or clean joint, not used)."""
+    each joint's noise std (0: a still or clean joint, not used); ``ref`` the held
+    position (:func:`held_at`), when the other edge's call has found it."""
     n = len(t)
     h0, h1 = hold
     if h1 - h0 < 4 or not np.any(noise > 0):
         return None
     h = float(t[1] - t[0])
-    third = (h1 - h0 + 1) // 3
-    ref = np.median(q[h0 + third:h1 - third + 1], axis=0)
+    if ref is None:
+        ref = held_at(q, hold)
     edge = h1 if step > 0 else h0
     reach = int(round(MOTION_SPAN / h))
     far = int(np.clip(edge + step * reach, 0, n - 1))
@@ -120,6 +123,14 @@ def soft_edge(t: np.ndarray, q: np.ndarray, noise: np.ndarray, hold: tuple[int, 
     if best[0] > limit:
         return None
     return float(t[edge]) + step * best[1]
+
+
+def held_at(q: np.ndarray, hold: tuple[int, int]) -> np.ndarray:
+    """The position held over ``hold`` (grid samples, inclusive): each joint's median
+    over its middle third."""
+    h0, h1 = hold
+    third = (h1 - h0 + 1) // 3
+    return median0(q[h0 + third:h1 - third + 1])
 
 
 def _best(lag: np.ndarray, y: np.ndarray, starts: np.ndarray, shapes: list[np.ndarray]
@@ -174,11 +185,13 @@ def soft_pause(t: np.ndarray, q: np.ndarray, noise: np.ndarray, span: tuple[floa
     k1 = int(np.searchsorted(t, b, "right")) - 1
     if k1 - k0 < 4:
         return a, b
+    # Both edges look from one held position: found once.
+    ref = held_at(q, (k0, k1)) if np.any(noise > 0) and (k0 > 0 or k1 < len(t) - 1) else None
     if k0 > 0:
-        edge = soft_edge(t, q, noise, (k0, k1), -1)
+        edge = soft_edge(t, q, noise, (k0, k1), -1, ref)
         a = a if edge is None else edge
     if k1 < len(t) - 1:
-        edge = soft_edge(t, q, noise, (k0, k1), +1)
+        edge = soft_edge(t, q, noise, (k0, k1), +1, ref)
         b = b if edge is None else edge
     return a, b
 

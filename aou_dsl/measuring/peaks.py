@@ -52,6 +52,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.memo import cached
+from .signal import median0, row_sum
 
 __all__ = ["PhasePeak", "curvatures", "episode_peak", "path_travel", "phase_peak"]
 
@@ -110,10 +111,10 @@ def path_travel(s: np.ndarray, q: np.ndarray, noise: np.ndarray
             continue
         slopes = np.column_stack([(degree - i) * z ** (degree - i - 1) for i in range(degree)])
         g = slopes @ coef[:-1] / extent  # d(joint)/ds along the path, (K, n)
-        weight = (g * g * w).sum(axis=1)
+        weight = row_sum(g * g * w)
         if np.any(weight <= 0):
             continue
-        return s + (miss * g * w).sum(axis=1) / weight, float(np.sqrt(1.0 / np.median(weight)))
+        return s + row_sum(miss * g * w) / weight, float(np.sqrt(1.0 / median0(weight)))
     return None
 
 

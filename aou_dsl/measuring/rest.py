@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.memo import cached
 from .onset import REST_SPEED
 from .signal import NOISE_SIGMAS, odd, row_max, sg_coefficients, slope_gain, smooth, smooth_rows
 
@@ -119,14 +120,22 @@ def _long_slope(q: np.ndarray, window: int, h: float) -> np.ndarray:
     n, half = len(q), window // 2
     if n < 2 * window or window < FFT_WINDOW:
         return smooth(q, window, 1, h, order=1)
-    weights = sg_coefficients(window, 1, 1, h)
     size = 1 << int(math.ceil(math.log2(n + window)))
     x = q - q.mean(axis=0)  # no offset: the rounding is relative to what moves
-    full = np.fft.irfft(np.fft.rfft(x, size, axis=0)
-                        * np.fft.rfft(weights[::-1], size)[:, None], size, axis=0)
+    full = np.fft.irfft(np.fft.rfft(x, size, axis=0) * _kernel(window, h, size)[:, None],
+                        size, axis=0)
     inner = full[window - 1:n]  # centred on rows half .. n - half - 1
     return np.concatenate([np.repeat(inner[:1], half, axis=0), inner,
                            np.repeat(inner[-1:], half, axis=0)])
+
+
+@cached(maxsize=16)
+def _kernel(window: int, h: float, size: int) -> np.ndarray:
+    """The slope's weights, reversed, through the FFT of ``size`` (read-only: cached;
+    the same for every recording, and every re-noised copy, on one clock)."""
+    out = np.fft.rfft(sg_coefficients(window, 1, 1, h)[::-1], size)
+    out.flags.writeable = False
+    return out
 
 
 def rest_at_end(r: Rest, last: bool) -> bool:

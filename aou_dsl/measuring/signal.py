@@ -11,7 +11,9 @@ joint by joint (docs/measure.md explains the choices).
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -24,10 +26,14 @@ __all__ = [
     "JointNoise",
     "curvature_gain",
     "filter_at",
+    "filters_at",
     "sg_coefficients",
     "joint_noise",
+    "line_fit",
+    "median0",
     "odd",
     "row_max",
+    "row_sum",
     "runs",
     "short_window",
     "slope_gain",
@@ -278,10 +284,23 @@ def filter_at(x: np.ndarray, window: int, deriv: int, h: float, at: np.ndarray,
     """:func:`smooth` of ``x`` evaluated only at the samples ``at``, each of which must
     have ``window // 2`` samples on either side: each is the weights' dot product with
     its own window of samples, whatever the other samples hold."""
+    return filters_at(x, window, (deriv,), h, at, order)[0]
+
+
+def filters_at(x: np.ndarray, window: int, derivs: tuple[int, ...], h: float,
+               at: np.ndarray, order: int = 3) -> list[np.ndarray]:
+    """:func:`filter_at` for each of ``derivs``, from one copy of the windows."""
     half = window // 2
-    c = sg_coefficients(window, order, deriv, h)
-    windows = x[np.asarray(at)[:, None] + np.arange(-half, half + 1)]  # (K, window, ...)
-    return np.moveaxis(windows, 1, -1) @ c
+    cs = [sg_coefficients(window, order, d, h) for d in derivs]
+    at = np.asarray(at)
+    if x.ndim == 2 and len(at):
+        # Each window a stretch of the rows laid out by rows (a view of rows laid out
+        # so, else a copy), as the gathered windows lie: the same product, without the
+        # gather's indices and its moved axes.
+        wins = [np.ascontiguousarray(x[k - half:k + half + 1]).T for k in at.tolist()]
+        return [np.stack([w @ c for w in wins]) for c in cs]
+    windows = np.moveaxis(x[at[:, None] + np.arange(-half, half + 1)], 1, -1)
+    return [windows @ c for c in cs]
 
 
 def slope_gain(window: int, h: float) -> float:
@@ -328,3 +347,52 @@ def row_max(a: np.ndarray) -> np.ndarray:
     for j in range(1, a.shape[1]):
         np.maximum(out, a[:, j], out=out)
     return out
+
+
+def row_sum(a: np.ndarray) -> np.ndarray:
+    """The sum of each row of the 2-D ``a``, the same bits as ``a.sum(axis=1)`` (and the
+    squares' in ``np.linalg.norm(a, axis=1)``): NumPy adds a row of fewer than eight
+    values from left to right, as this does column by column, several times faster on a
+    few joints' or coordinates' columns. A row of eight or more it adds pairwise, so
+    that is left to it."""
+    if a.shape[1] >= 8 or a.shape[1] == 0:
+        return a.sum(axis=1)
+    out = 0.0 + a[:, 0]  # NumPy's sum starts at +0.0: a row of zeros sums to +0.0
+    for j in range(1, a.shape[1]):
+        out += a[:, j]
+    return out
+
+
+def median0(a: np.ndarray) -> Any:
+    """``np.median(a, axis=0)`` of finite values, the same numbers (a zero as +0.0, as
+    its mean of the middle ones gives it): from one partition about the middle, without
+    NumPy's look for NaNs (a finite recording has none) and its general axes, which on
+    the few hundred samples of a hold cost more than the partition."""
+    n = len(a)
+    if n == 0:
+        return np.median(a, axis=0)
+    h = n // 2
+    if n % 2:
+        return 0.0 + np.partition(a, (h, n - 1), axis=0)[h]
+    part = np.partition(a, (h - 1, h), axis=0)
+    return (0.0 + part[h - 1] + part[h]) / 2.0
+
+
+def line_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float]:
+    """The slope and intercept of the least-squares line through ``(x, y)``: the
+    numbers ``np.polyfit(x, y, 1)`` gives (the same scaled design, the same solver,
+    without its checks and its general degree, which cost more than the solve on the
+    few tens of samples of a ramp; its warning on a rank-deficient fit too)."""
+    x, y = x + 0.0, y + 0.0  # as polyfit takes them (no negative zeros)
+    lhs = np.empty((len(x), 2))
+    lhs[:, 0], lhs[:, 1] = x, 1.0
+    scale = np.sqrt((lhs * lhs).sum(axis=0))
+    lhs /= scale
+    c, _, rank, _ = np.linalg.lstsq(lhs, y, len(x) * _EPS)
+    if rank != 2:
+        warnings.warn("Polyfit may be poorly conditioned", np.exceptions.RankWarning,
+                      stacklevel=2)
+    return float(c[0] / scale[0]), float(c[1] / scale[1])
+
+
+_EPS = float(np.finfo(np.float64).eps)
