@@ -22,7 +22,7 @@ The steps (docs/measure.md explains the choices):
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -33,17 +33,16 @@ from ..core.diagnostics import AouError, Diagnostic, Span, diag
 from ..core.trajectory import Trajectory
 from ..lang.cv import CVPoint, composition, infer
 from ..lang.descriptors import (
-    Descriptor,
     Descriptors,
     EpisodeValues,
     derive,
     qualify,
-    spread,
 )
 from ..lang.primitives import PAUSE
 from ..robot.batch_fk import batch_fk
 from ..robot.load import load_arm
 from .cuts import Cut, cut_motion, judge_cuts
+from .episode_spread import per_episode, unequal
 from .episodes import (
     COMPUTED_NOISE,
     STILL_TRANSLATION,
@@ -54,7 +53,7 @@ from .episodes import (
     translation,
 )
 from .holds import MIN_PAUSE, REST_SPEED, Boundary, Rest, boundaries, rest_at_end, rest_signals
-from .recognisers import claimed, every_named, extra_descriptors, extra_values
+from .recognisers import claimed, every_named, extra_values
 from .roll import MIN_TILT, Lobe, lobe, roll_angle, rotations, undersampled
 from .signal import (
     Grid,
@@ -68,7 +67,14 @@ from .signal import (
     unwrap,
 )
 from .staircase import dequantised
-from .stamps import evened, judge_stamps, read_on_evened, stamped_on_arrival
+from .stamps import (
+    STAMP_FOLLOW,
+    evened,
+    judge_stamps,
+    read_on_evened,
+    stamp_share,
+    stamped_on_arrival,
+)
 
 __all__ = ["MIN_PAUSE", "MIN_TILT", "STILL_TRANSLATION", "LineOfSight", "Measured",
            "measure"]
@@ -319,23 +325,6 @@ def _line_of_sight(ctx: Context) -> LineOfSight | None:
     return LineOfSight(t, np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0))))
 
 
-def _unequal(table: Mapping[str, Descriptor], name: str, vals: list[float]) -> bool:
-    return max(vals) - min(vals) > table[name].tolerance(float(np.median(vals)))
-
-
-def _spread(episodes: list[EpisodeValues]) -> dict[str, list[float]]:
-    """Per non-count descriptor, the eleven's and the plugins', the values of the
-    episodes it aggregates."""
-    out = spread(episodes)
-    eps = qualify(episodes)
-    for d in extra_descriptors():
-        vals = [float(e.values[d.key]) for e in eps
-                if e.kind == d.kind and e.counts and d.key in e.values]
-        if vals and not d.is_count:
-            out[d.name] = vals
-    return out
-
-
 def measure(rec: Trajectory, *, uncertainty: bool = True) -> Measured:
     """Measure the eleven descriptors of a trajectory.
 
@@ -365,12 +354,12 @@ def measure(rec: Trajectory, *, uncertainty: bool = True) -> Measured:
         # A noisy recording's own clock and joints, unless it was read on another clock
         clock = None if failed is not None or float(jn.effective.max(initial=0.0)) <= \
             COMPUTED_NOISE else _joints(rec)
-        restamp = None  # a clock stamped on arrival, evened out: the copies restamp it
-        if clock is not None and stamped_on_arrival(*clock, jn.effective):
-            restamp = evened(clock[0])
-        attach(m, rec, jn, _measure, restamp)
-        if clock is not None and m.uncertainty:  # the clock judged: read again if it moves
-            judge_stamps(m, rec.path, *clock, jn.effective,
+        share = None if clock is None else stamp_share(*clock, jn.effective)
+        arrival = share is not None and share < STAMP_FOLLOW
+        # a clock stamped on arrival, evened out: the copies restamp it
+        attach(m, rec, jn, _measure, evened(clock[0]) if clock and arrival else None)
+        if clock is not None and share is not None and arrival and m.uncertainty:
+            judge_stamps(m, rec.path, clock[0], share,  # read again on the evened clock
                          lambda even: _measure(rec.with_(t=even), jn)[0])
     if failed is not None:
         read_on_evened(m, rec.path, t, failed)
@@ -409,7 +398,7 @@ def _measure(rec: Trajectory, pinned: JointNoise | None = None, fk: Kinematics |
                    f"{', '.join(f'{v:.4g}' for v in vals)}; reporting the "
                    f"{table[name].aggregate} {values[name]:.4g}", where,
                    descriptor=name, values=vals)
-              for name, vals in _spread(episodes).items() if _unequal(table, name, vals)]
+              for name, vals in per_episode(episodes).items() if unequal(table, name, vals)]
     diags += unclaimed
     point, _ = infer(composition(episodes))
     los = _line_of_sight(ctx)

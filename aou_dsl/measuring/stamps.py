@@ -78,16 +78,15 @@ def evened(t: np.ndarray, window: int = STAMP_WINDOW) -> np.ndarray:
     return t[0] + centred_mean(t - t[0], window // 2)
 
 
-def judge_stamps(m: Any, path: str, t: np.ndarray, q: np.ndarray, noise: np.ndarray,
+def judge_stamps(m: Any, path: str, t: np.ndarray, share: float,
                  again: Callable[[np.ndarray], Any]) -> None:
-    """A recording whose stamps do not follow its samples is read again by ``again`` on
-    its clock evened out (:func:`evened`): each interval of ``m`` is widened to take in
+    """A recording whose stamps do not follow its samples (``share``, its
+    :func:`stamp_share`, under :data:`STAMP_FOLLOW`) is read again by ``again`` on its
+    clock ``t`` evened out (:func:`evened`): each interval of ``m`` is widened to take in
     that reading, and a value whose interval then reaches more than 20 % of itself from
     it (as for the noise, :mod:`.uncertainty`) is not to be trusted (R411, with both
-    readings). ``m`` is the recording's :class:`.measured.Measured`, ``t`` and ``q`` its
-    clock and unwrapped joints, ``noise`` each joint's noise."""
-    share = stamp_share(t, q, noise)
-    if share is None or share >= STAMP_FOLLOW:
+    readings). ``m`` is the recording's :class:`.measured.Measured`."""
+    if share >= STAMP_FOLLOW:
         return
     try:
         other_m = again(evened(t))
