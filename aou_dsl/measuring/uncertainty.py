@@ -35,7 +35,7 @@ from ..core.codes import R411
 from ..core.diagnostics import AouError, Span, diag
 from ..core.trajectory import Trajectory
 from ..lang.descriptors import REGISTRY
-from .episode_spread import beyond_noise
+from .episode_spread import beyond_noise, episode_noise
 from .episodes import COMPUTED_NOISE
 from .linearised import Linearised
 from .recognisers import every_named
@@ -253,6 +253,7 @@ def attach(m, rec: Trajectory, jn: JointNoise,
         step = float(np.median(np.diff(np.asarray(rec.t, float))))
         m.uncertainty = {k: _spread(k, value[k], smooth_read[k], [r[k] for r in reads],
                                     step) for k in table}
+    episode_noise(m, value)
     too_wide = [k for k, s in m.uncertainty.items() if vague(k, value[k], s)]
     # A value read from episodes the copies count differently may be read from one
     # the noise made, or miss one it hid: not to be trusted either.

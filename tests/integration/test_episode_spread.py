@@ -73,3 +73,36 @@ def test_declared_unequal_episodes_are_still_noted_through_noise(noise, rate):
     assert sorted(noted) >= ["pause_duration", "retreat_distance"]
     assert max(noted["pause_duration"]) - min(noted["pause_duration"]) > 0.4
     assert max(noted["retreat_distance"]) - min(noted["retreat_distance"]) > 0.03
+
+
+def _white(doc: dict, noise: float, seed: int):
+    """The compiled document's joints with white noise, written as a CSV logger writes
+    them (9 decimals, time to the microsecond): a recipe a new user wrote, not
+    tests/recsim.py's."""
+    import numpy as np
+
+    from aou_dsl.core.trajectory import Trajectory
+
+    rng = np.random.default_rng(seed)
+    t, q = np.asarray(doc["t"], float), np.asarray(doc["q"], float)
+    q = np.round(q + rng.normal(0.0, noise, q.shape), 9)
+    return Trajectory(np.round(t, 6), q, tuple(doc["joint_names"]), "panda", None,
+                      (0.55, 0.0, 0.25))
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_no_peak_acceleration_is_trusted_outside_what_its_episode_bears(seed):
+    """Hesitant with 1e-3 rad of white noise at 250 Hz: a value the noise moved outside
+    its interval must not be trusted. With seed 1 the first approach split off a 1 cm
+    piece that read 1.01 m/s^2 (its own std 0.45); every copy read it again, and the
+    declared 0.05 was measured as a trusted 1.01, which failed the recording."""
+    from aou_dsl.measuring.measured import measure
+
+    doc, want, _ = build((BEHAVIOURS / "hesitant.aou").read_text(), "hesitant")
+    m = measure(_white(doc, 1e-3, seed))
+    for k, d in REGISTRY.items():
+        s, w = m.uncertainty[k], want[k]
+        if d.is_count or w is None or not s.stable:
+            continue
+        tol = d.tolerance(w)
+        assert s.low - tol <= w <= s.high + tol, (k, w, m.descriptors[k], s)
