@@ -77,9 +77,9 @@ def cmd_measure_against(args: argparse.Namespace, read) -> int:
                                      for d in e.diagnostics):
                 raise
             rec = read(args.path, args, robot=lint.behaviour.settings.robot)
+        verdict = judge(rec, lint)  # its columns may not be the robot's joints (R402)
     except AouError as e:  # not a verdict: exit 2, as for a file that cannot be read
         return _unread(args, e.diagnostics, {})
-    verdict = judge(rec, lint)
     outside: list[Diagnostic] = verdict.outside() + verdict.undecided() \
         + verdict.undeclared()
     sources = {lint.path: lint.source or ""}

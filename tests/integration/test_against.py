@@ -139,3 +139,25 @@ def test_a_file_that_cannot_be_read_exits_2_in_every_format(tmp_path, capsys):
     assert main(["measure", str(bad), "--against", missing]) == 2
     err = capsys.readouterr().err
     assert "I501" in err and "nothere.aou" in err and "without its robot" not in err
+
+
+def test_columns_that_are_not_the_robots_joints_exit_2_in_every_format(tmp_path, capsys):
+    """A recording whose columns name no joint of the robot (renamed, and no --map)
+    cannot be read as that robot's: exit 2 with its R402 in every format. It exited 1,
+    a failed verdict's code, and printed nothing at all under --format json or github."""
+    import json as _json
+
+    from aou_dsl.cli.commands import main
+
+    ren = tmp_path / "renamed.csv"
+    ren.write_text("t," + ",".join(f"j{i}" for i in range(1, 8)) + "\n" + "".join(
+        f"{k * 0.004:.3f}," + ",".join(["0.1"] * 7) + "\n" for k in range(50)))
+    behaviour = str(BEHAVIOURS / "hesitant.aou")
+    args = ["measure", str(ren), "--robot", "panda", "--against", behaviour]
+    assert main(args) == 2
+    assert "R402" in capsys.readouterr().err
+    assert main([*args, "--format", "json"]) == 2
+    doc = _json.loads(capsys.readouterr().out)
+    assert doc["result"] is None and doc["diagnostics"][0]["code"] == "R402"
+    assert main([*args, "--format", "github"]) == 2
+    assert "R402" in capsys.readouterr().out
