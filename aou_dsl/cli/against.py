@@ -10,7 +10,7 @@ import sys
 
 from ..core.diagnostics import Diagnostic, Severity
 from .args import EXIT_ERRORS, EXIT_INCONCLUSIVE, EXIT_OK, EXIT_USAGE, exit_for
-from .report import about, format_github, format_json, format_text
+from .report import about, cv_text, format_github, format_json, format_text
 
 __all__ = ["cmd_measure_against", "format_verdict"]
 
@@ -45,8 +45,9 @@ def format_verdict(verdict) -> str:
             "exact" if r.tolerance == 0 else f"+-{r.tolerance:.3g}")
         lines.append(f"  {r.name:24s} {_v(r.declared):>10s} {_v(r.measured):>10s} "
                      f"{_pm(r):>17s} {tol:>11s}  {r.unit:6s} {_SHOWN[r.result]}")
-    for side, cv in (("declared", verdict.declared_cv), ("measured", verdict.measured_cv)):
-        lines.append(f"  C-V {side}: C={cv.C:+.2f} V={cv.V:+.2f} -> {cv.state.value}")
+    cv = verdict.declared_cv
+    lines.append(f"  C-V declared: C={cv.C:+.2f} V={cv.V:+.2f} -> {cv.state.value}")
+    lines.append(f"  C-V measured: {cv_text(verdict.measured)}")
     n = sum(r.ok for r in verdict.rows)
     undecided = len(verdict.inconclusive)
     lines.append(f"  {n} of {len(verdict.rows)} descriptors within tolerance"

@@ -233,6 +233,22 @@ def _around(value: float, spread) -> str:
     return "" if text == "exact" else f" {text}"
 
 
+def cv_text(m) -> str:
+    """The C-V point a measurement ``m`` infers, with its intervals, the states the
+    re-noised copies read when they differ, and the values not to be trusted it was
+    read from."""
+    inf = m.inferred
+    point = (f"C={m.cv.C:+.2f}{_around(m.cv.C, inf and inf.C)} "
+             f"V={m.cv.V:+.2f}{_around(m.cv.V, inf and inf.V)} -> {m.cv.state}")
+    if inf is not None and len(inf.states) > 1:  # the noise can flip the state
+        point += f" (the re-noised copies read {', '.join(inf.states)})"
+    untrusted = [k for k, v in (dict(m.descriptors) | m.extra).items()
+                 if v is not None and k in m.uncertainty and not m.uncertainty[k].stable]
+    if untrusted:  # a point read from a guess is a guess, however narrow its interval
+        point += f"; read from values not to be trusted ({', '.join(untrusted)})"
+    return point
+
+
 def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = ()) -> str:
     """``aouc measure``: the eleven descriptors as a table, and the C-V point; ``missing``:
     the descriptors the point could not use (:func:`aou_dsl.lang.cv.missing_descriptors`)."""
@@ -259,12 +275,7 @@ def format_measured(path: str, robot: str, measured, missing: tuple[str, ...] = 
         lines.append(f"  line of sight off the goal: median {los.median:.3g}"
                      f"{_around(los.median, inf and inf.sight_median)} deg, "
                      f"max {los.max:.3g}{_around(los.max, inf and inf.sight_max)} deg")
-    point = (f"  C-V: C={m.cv.C:+.2f}{_around(m.cv.C, inf and inf.C)} "
-             f"V={m.cv.V:+.2f}{_around(m.cv.V, inf and inf.V)} -> {m.cv.state}")
-    if inf is not None and len(inf.states) > 1:  # the noise can flip the state
-        point += f" (the re-noised copies read {', '.join(inf.states)})"
-    if untrusted:  # a point read from a guess is a guess, however narrow its interval
-        point += f"; read from values not to be trusted ({', '.join(untrusted)})"
+    point = f"  C-V: {cv_text(m)}"
     if missing:  # no state named: a point without the gazes would mislead
         point = (f"  C-V: not placed: without a goal the gaze descriptors "
                  f"{', '.join(missing)} are unknown, and the point needs them (give "

@@ -161,3 +161,26 @@ def test_columns_that_are_not_the_robots_joints_exit_2_in_every_format(tmp_path,
     assert doc["result"] is None and doc["diagnostics"][0]["code"] == "R402"
     assert main([*args, "--format", "github"]) == 2
     assert "R402" in capsys.readouterr().out
+
+
+def test_the_measured_point_reads_as_measure_prints_it(tmp_path, capsys):
+    """The verdict's measured C-V point carries what `aouc measure` prints of it: its
+    intervals, the states the re-noised copies read, the untrusted values it was read
+    from. Hesitant logged with 1e-3 rad of noise at 250 Hz; the verdict printed a bare
+    point, with no sign that the copies read another state."""
+    from tests.integration.test_episode_spread import _white
+    from tests.integration.test_recordings import build
+
+    doc, _, _ = build((BEHAVIOURS / "hesitant.aou").read_text(), "hesitant")
+    tr = _white(doc, 1e-3, 1)
+    path = tmp_path / "noisy.csv"
+    path.write_text("t," + ",".join(tr.joint_names) + "\n" + "".join(
+        f"{t:.6f}," + ",".join(f"{v:.9f}" for v in row) + "\n" for t, row in zip(tr.t, tr.q,
+                                                                                 strict=True)))
+    goal = ["--robot", "panda", "--goal", "0.55,0,0.25"]
+    main(["measure", str(path), *goal])
+    point = next(ln for ln in capsys.readouterr().out.splitlines() if "C-V:" in ln)
+    main(["measure", str(path), *goal, "--against", str(BEHAVIOURS / "hesitant.aou")])
+    verdict = next(ln for ln in capsys.readouterr().out.splitlines() if "C-V measured:" in ln)
+    assert verdict.split("C-V measured: ")[1] == point.split("C-V: ")[1]
+    assert "+-" in point and "re-noised copies read" in point
