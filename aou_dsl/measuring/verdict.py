@@ -128,10 +128,14 @@ class Verdict:
         out = []
         for r in self.failed:
             tol = "" if r.tolerance is None else f" (tolerance +-{_text(r.tolerance)})"
+            noisy = isinstance(r.measured, float) and r.low is not None and \
+                r.high is not None and r.low < r.high  # a count's copies all read it
+            within = f", 95 % interval {_text(r.low)} to {_text(r.high)}" if noisy else ""
             out.append(diag(R408, f"{r.name}: declared {_text(r.declared, r.unit)}, "
-                            f"measured {_text(r.measured, r.unit)} on `{self.path}`{tol}",
-                            r.span, descriptor=r.name, declared=r.declared,
-                            measured=r.measured, tolerance=r.tolerance))
+                            f"measured {_text(r.measured, r.unit)} on `{self.path}`"
+                            f"{within}{tol}", r.span, descriptor=r.name,
+                            declared=r.declared, measured=r.measured, tolerance=r.tolerance,
+                            low=r.low, high=r.high))
         return out
 
     def undeclared(self) -> list[Diagnostic]:

@@ -163,20 +163,42 @@ def test_columns_that_are_not_the_robots_joints_exit_2_in_every_format(tmp_path,
     assert "R402" in capsys.readouterr().out
 
 
+def _noisy_hesitant(tmp_path, seed: int):
+    """Hesitant with 1e-3 rad of white noise at 250 Hz, as a CSV."""
+    from tests.integration.test_episode_spread import _white
+    from tests.integration.test_recordings import build
+
+    doc, _, _ = build((BEHAVIOURS / "hesitant.aou").read_text(), "hesitant")
+    tr = _white(doc, 1e-3, seed)
+    path = tmp_path / "noisy.csv"
+    path.write_text("t," + ",".join(tr.joint_names) + "\n" + "".join(
+        f"{t:.6f}," + ",".join(f"{v:.9f}" for v in row) + "\n"
+        for t, row in zip(tr.t, tr.q, strict=True)))
+    return path
+
+
+def test_a_noisy_failure_gives_its_interval(tmp_path, capsys):
+    """R408 on a noisy recording says the interval that missed the tolerance, as R412
+    does: hesitant's retreats (6 cm) against a file declaring 9 cm."""
+    path = _noisy_hesitant(tmp_path, 2)
+    other = tmp_path / "far.aou"
+    other.write_text((BEHAVIOURS / "hesitant.aou").read_text().replace(
+        "retreat 0.06m", "retreat 0.09m"))
+    code = main(["measure", str(path), "--robot", "panda", "--goal", "0.55,0,0.25",
+                 "--against", str(other), "--format", "json"])
+    doc = json.loads(capsys.readouterr().out)
+    (r408,) = [d for d in doc["diagnostics"] if d["code"] == "R408"]
+    low, high = r408["fields"]["low"], r408["fields"]["high"]
+    assert code == 1 and low < r408["fields"]["measured"] < high < 0.09 - 0.001
+    assert f"95 % interval {low:.4g} to {high:.4g}" in r408["message"]
+
+
 def test_the_measured_point_reads_as_measure_prints_it(tmp_path, capsys):
     """The verdict's measured C-V point carries what `aouc measure` prints of it: its
     intervals, the states the re-noised copies read, the untrusted values it was read
     from. Hesitant logged with 1e-3 rad of noise at 250 Hz; the verdict printed a bare
     point, with no sign that the copies read another state."""
-    from tests.integration.test_episode_spread import _white
-    from tests.integration.test_recordings import build
-
-    doc, _, _ = build((BEHAVIOURS / "hesitant.aou").read_text(), "hesitant")
-    tr = _white(doc, 1e-3, 1)
-    path = tmp_path / "noisy.csv"
-    path.write_text("t," + ",".join(tr.joint_names) + "\n" + "".join(
-        f"{t:.6f}," + ",".join(f"{v:.9f}" for v in row) + "\n" for t, row in zip(tr.t, tr.q,
-                                                                                 strict=True)))
+    path = _noisy_hesitant(tmp_path, 1)
     goal = ["--robot", "panda", "--goal", "0.55,0,0.25"]
     main(["measure", str(path), *goal])
     point = next(ln for ln in capsys.readouterr().out.splitlines() if "C-V:" in ln)
