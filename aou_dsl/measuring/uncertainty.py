@@ -13,7 +13,8 @@ std, widened to take in the value less what the noise adds on average (the copie
 mean beside the smoothed recording's own reading, times :data:`BIAS`: the larger of
 noisy readings is biased up), for a duration a sampling step at each edge and the
 edges' own placement error (:data:`EDGES`), and for a peak acceleration what its
-reading cannot resolve above it (:data:`PEAK_SHAPE`). docs/measure.md gives the
+reading cannot resolve above it (:data:`PEAK_SHAPE`) and at least what the noise gives
+its own episode's reading (:func:`.episode_spread.episode_noise`). docs/measure.md gives the
 coverage measured over simulated recordings.
 
 A count or a presence that differs between the copies is a segmentation the noise can
