@@ -1,4 +1,6 @@
-"""Whether a noisy recording's episodes of one kind differ by more than its noise.
+"""What a noisy recording's episodes say of the trust its values deserve: whether
+episodes of one kind differ by more than the noise (R403, below), and how much the noise
+moves a peak acceleration's own reading (:func:`episode_noise`).
 
 R403 says that the episodes of one kind differ by more than the descriptor's tolerance.
 On a recording, each episode's value carries the noise too, so equal episodes can read
