@@ -61,7 +61,11 @@ def serve(path: str, *, robot: str | None = None, host: str = "127.0.0.1", port:
               file=sys.stderr)
     try:
         print(f"aouc studio: {studio.url} (Ctrl-C stops)", file=sys.stderr, flush=True)
-        (stop or threading.Event()).wait()
+        done = stop or threading.Event()
+        # Woken twice a second: the OS may hand Ctrl-C to another of the studio's
+        # threads, and a wait with no end would then never see it.
+        while not done.wait(0.5):
+            pass
     except KeyboardInterrupt:  # the way to stop it
         print("aouc studio: stopped", file=sys.stderr)
         return 130

@@ -107,3 +107,48 @@ def test_track_is_for_a_plan_and_draws_the_one_second_arm(capsys, tmp_path):
     assert main(["studio", str(path), "--track", "--compare", str(path)]) == 2
     assert "--track and --compare" in capsys.readouterr().err
     assert sorted(os.listdir(tmp_path)) == ["h.aou", "rec.csv"]
+
+
+def test_a_ctrl_c_the_os_hands_to_another_thread_still_stops_the_studio(tmp_path):
+    """The OS hands a process's Ctrl-C to any of its threads. When it went to one of the
+    studio's own, the main thread, waiting with no end, never saw it: one `aouc studio`
+    in twenty under load ignored Ctrl-C. Here the signal is sent to another thread on
+    purpose, once the studio serves; a studio that missed it is ended by a stop event 15 s
+    later, when the signal is finally seen."""
+    pytest.importorskip("viser")
+    import threading
+
+    from aou_dsl.studio import serve
+
+    path = tmp_path / "h.aou"
+    shutil.copy(os.path.join(ROOT, "behaviours", "hesitant.aou"), path)
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    stop = threading.Event()
+    sent: list[float] = []
+
+    def interrupt() -> None:
+        end = time.monotonic() + 60
+        while time.monotonic() < end:  # the studio serves once its port answers
+            with socket.socket() as c:
+                if c.connect_ex(("127.0.0.1", port)) == 0:
+                    break
+            time.sleep(0.1)
+        time.sleep(1.0)  # past the address it prints, into its wait
+        sent.append(time.monotonic())
+        signal.pthread_kill(threading.get_ident(), signal.SIGINT)  # to this thread
+        stop.wait(15)
+        stop.set()
+
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    helper = threading.Thread(target=interrupt, daemon=True)
+    helper.start()
+    try:
+        code = serve(str(path), port=port, stop=stop)
+        taken = time.monotonic() - sent[0]
+    finally:
+        stop.set()
+        helper.join(5)
+        signal.signal(signal.SIGINT, previous)
+    assert code == 130 and taken < 5.0, taken  # not left for the stop event at 15 s
