@@ -206,14 +206,11 @@ def _build_here(lint: FileResult, session: Session, options: BuildOptions,
     its output, to be named in input order (not when the results before it in input
     order have come back)."""
     from .builder import build_lint
-    from .delivery import _pack
+    from .delivery import delivered, pack
 
     if not _buildable(lint) or lint.source is None:
         return build_lint(lint, options)  # refused by lint (or unread): nothing to compile
     res = session.build_linted(lint)  # as --jobs 1 builds it, the lint not made again
     if outputs is None:
-        return _pack(res, encode)
-    from .delivery import stage
-
-    stage(res, outputs.dests[k], outputs)
-    return _pack(res, None if res.staged else encode)
+        return pack(res, encode)
+    return delivered(res, outputs.dests[k], outputs, encode)

@@ -2,7 +2,7 @@
 it was built.
 
 A worker's result goes back with its document's samples left behind (the arrays travel
-as raw bytes) and, when asked, its document already encoded (:func:`_pack`).
+as raw bytes) and, when asked, its document already encoded (:func:`pack`).
 
 ``aouc compile --jobs N`` knows before any work where each input's document goes
 (:class:`Outputs`). Left to this process, writing would be a serial share of the batch:
@@ -38,7 +38,7 @@ from ..core.read_set import ReadSet
 if TYPE_CHECKING:
     from .builder import BuildResult
 
-__all__ = ["Outputs", "discard", "encoded", "name", "stage"]
+__all__ = ["Outputs", "delivered", "discard", "encoded", "name", "pack", "stage"]
 
 
 @dataclass(frozen=True)
@@ -125,6 +125,14 @@ def name(dest: str, res: BuildResult, reads: ReadSet) -> None:
                 os.unlink(tmp)
 
 
+def delivered(res: BuildResult, dest: str | None, outputs: Outputs, encode: str | None
+              ) -> BuildResult:
+    """``res`` written beside ``dest`` (:func:`stage`) and ready to go back
+    (:func:`pack`): encoded too only when it could not be written here."""
+    stage(res, dest, outputs)
+    return pack(res, None if res.staged else encode)
+
+
 def discard(results: list, outputs: Outputs) -> None:
     """Remove the files staged for ``results`` that were never named, and those a
     worker that no longer runs was writing when it ended (its workers must have ended)."""
@@ -144,7 +152,7 @@ def discard(results: list, outputs: Outputs) -> None:
 _ENCODED = "_encoded"
 
 
-def _pack(res: BuildResult, encode: str | None) -> BuildResult:
+def pack(res: BuildResult, encode: str | None) -> BuildResult:
     """In the worker: the result ready to go back; its document also encoded in
     ``encode`` when asked (a byte format, from the trajectory's arrays), so that the
     parent only writes bytes. The

@@ -38,7 +38,8 @@ from ..core.codes import I505
 from ..core.diagnostics import AouError
 from ..core.options import BuildOptions
 from ..core.repeats import once_per_run
-from .pool import BuildPool, _pack, default_jobs, encoded
+from .delivery import encoded, pack
+from .pool import BuildPool, default_jobs
 from .session import Session
 
 if TYPE_CHECKING:
@@ -67,8 +68,8 @@ def build_many(paths: Iterable[str], options: BuildOptions | None = None, jobs: 
             left to this process is then copying bytes).
         outputs: where each document goes (:class:`~aou_dsl.driver.delivery.Outputs`):
             with ``jobs`` > 1 on this machine, the process that built a document writes
-            it and says so on the result (``written`` or ``unwritten``); elsewhere the
-            caller writes them.
+            it into a file beside its output and keeps that file's name on the result
+            (``staged``) for the caller to name; elsewhere the caller writes them.
     """
     yield from once_per_run(_build_many(list(paths), options or BuildOptions(), jobs,
                                         cluster, pool, encode, outputs))
@@ -97,7 +98,7 @@ def build_text(text: str, path: str, options: BuildOptions, encode: str | None =
     ``text`` (and its document encoded in ``encode``, see :func:`encoded`)."""
     from .builder import build_source
 
-    return _pack(build_source(text, path, options), encode)
+    return pack(build_source(text, path, options), encode)
 
 
 def write_result(path: str, res: BuildResult, fmt: str, *, inputs: list[str] | tuple = ()

@@ -23,7 +23,7 @@ from collections.abc import Iterable, Iterator
 from typing import TYPE_CHECKING, Any
 
 from ..core.options import BuildOptions
-from .delivery import _pack, encoded
+from .delivery import delivered, encoded, pack
 from .session import warm
 
 if TYPE_CHECKING:
@@ -106,7 +106,7 @@ def _build_linted(lint: FileResult, options: BuildOptions, encode: str | None
     """One build of a file the parent has linted (``build_lint`` of it)."""
     from .builder import build_lint
 
-    return _pack(build_lint(lint, options), encode)
+    return pack(build_lint(lint, options), encode)
 
 
 def build_group(lints: list[FileResult], options: BuildOptions, encode: str | None,
@@ -121,14 +121,8 @@ def build_group(lints: list[FileResult], options: BuildOptions, encode: str | No
 
     if outputs is None or dests is None:
         return [_build_linted(lint, options, encode) for lint in lints]
-    from .delivery import stage
-
-    out = []
-    for lint, dest in zip(lints, dests, strict=True):
-        res = build_lint(lint, options)
-        stage(res, dest, outputs)
-        out.append(_pack(res, None if res.staged else encode))
-    return out
+    return [delivered(build_lint(lint, options), dest, outputs, encode)
+            for lint, dest in zip(lints, dests, strict=True)]
 
 
 # --- the pool -----------------------------------------------------------------------------
