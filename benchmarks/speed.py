@@ -498,7 +498,8 @@ _AOUC_CPU = ("import resource, sys\n"
              "me, kids = (resource.getrusage(w) for w in (resource.RUSAGE_SELF, "
              "resource.RUSAGE_CHILDREN))\n"
              "print(me.ru_utime + me.ru_stime, kids.ru_utime + kids.ru_stime, file=sys.stderr)\n"
-             "sys.exit(code)\n")
+             "from aou_dsl.cli.endings import leave\n"
+             "leave(code)  # as the aouc command ends\n")
 
 
 def _aouc_run(args: list[str]) -> tuple[float, float, float]:

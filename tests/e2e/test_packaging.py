@@ -18,4 +18,4 @@ def test_wheel_contains_grammar_and_console_script(tmp_path):
     assert "aou_dsl/grammar/aou.lark" in names
     assert {f"aou_dsl/schemas/{n}.schema.json" for n in ("trajectory", "robot")} <= set(names)
     entry = next(n for n in names if n.endswith("entry_points.txt"))
-    assert "aouc = aou_dsl.cli:main" in zipfile.ZipFile(wheel).read(entry).decode()
+    assert "aouc = aou_dsl.cli:run" in zipfile.ZipFile(wheel).read(entry).decode()
