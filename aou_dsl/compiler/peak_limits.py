@@ -48,18 +48,17 @@ def cartesian_peak(arm: ArmModel, seg: PathSegment, samples: int = 100) -> float
     classical acceleration ``J q'' + J' q'`` from Pinocchio, at ``samples`` instants or
     :data:`PEAK_RATE`, whichever is denser.
 
-    The accelerations of all instants are computed at once with numpy
-    (:meth:`ArmModel.accelerations`), equal to Pinocchio's up to rounding; the instants
-    within rounding of the largest are then computed again by Pinocchio, so the peak is
-    Pinocchio's, to the last bit, as if every instant had been."""
+    The magnitudes of all instants are computed at once with numpy
+    (:meth:`ArmModel.acceleration_norms`), equal to Pinocchio's up to rounding; the
+    instants within rounding of the largest are then computed again by Pinocchio, so the
+    peak is Pinocchio's, to the last bit, as if every instant had been."""
     import pinocchio as pin
 
     model, data = arm.model, arm.model.createData()
     n = max(samples, int(math.ceil(seg.duration * PEAK_RATE)) + 1)
     q, qd, qdd = seg.sample(np.linspace(0.0, seg.duration, n))
-    fast = arm.accelerations(q, qd, qdd)
-    if fast is not None:
-        norms = np.sqrt(np.einsum("ij,ij->i", fast, fast))
+    norms = arm.acceleration_norms(q, qd, qdd)
+    if norms is not None:
         top = float(norms.max())
         near = np.flatnonzero(norms >= top - (1e-9 * top + 1e-12))
         q, qd, qdd = q[near], qd[near], qdd[near]
