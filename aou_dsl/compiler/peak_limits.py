@@ -95,13 +95,13 @@ def jerk_ratios(arm: ArmModel, seg: PathSegment, dense: bool = False) -> np.ndar
     (an arm turning its null space), its jerk ``q_sss s'^3`` peaks inside a piece of the
     law, not at its ends; a controller's check of the trajectory sees it there."""
     law = seg.law
-    tau = (law.probe_times() if isinstance(law, SmoothLaw)
-           else np.linspace(0.0, seg.duration, 1500))
+    jerk = (seg.path_jerk(*law.probed()) if isinstance(law, SmoothLaw)
+            else seg.jerk(np.linspace(0.0, seg.duration, 1500)))
     if dense:
         lo, hi = JERK_SAMPLES
         n = min(hi, max(lo, math.ceil(seg.duration * JERK_RATE) + 1))
-        tau = np.concatenate([tau, np.linspace(0.0, seg.duration, n)])
-    return np.abs(seg.jerk(tau)).max(axis=0) / (arm.jmax * JERK_SCALE)
+        jerk = np.concatenate([jerk, seg.jerk(np.linspace(0.0, seg.duration, n))])
+    return np.abs(jerk).max(axis=0) / (arm.jmax * JERK_SCALE)
 
 
 def jerk_ratio(arm: ArmModel, seg: PathSegment) -> float:
