@@ -114,10 +114,10 @@ class TimeLaw:
         tc = np.clip(tau, 0.0, end)
         i = np.clip(np.searchsorted(self.t, tc, side="right") - 1, 0, len(self.u) - 1)
         dt = tc - self.t[i]
-        u = self.u[i]
-        sd = self.sd[i] + u * dt
-        s = self.s[i] + self.sd[i] * dt + 0.5 * u * dt * dt
-        area = self._area[i] + self.s[i] * dt + self.sd[i] * dt**2 / 2 + u * dt**3 / 6
+        u, s0, sd0 = self.u[i], self.s[i], self.sd[i]
+        sd = sd0 + u * dt
+        s = s0 + sd0 * dt + 0.5 * u * dt * dt
+        area = self._area[i] + s0 * dt + sd0 * dt**2 / 2 + u * dt**3 / 6
         before, after = tau < 0.0, tau > end
         rest = before | after
         s = np.where(after, self.length, s)
