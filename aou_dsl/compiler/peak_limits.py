@@ -48,18 +48,17 @@ def cartesian_peak(arm: ArmModel, seg: PathSegment, samples: int = 100) -> float
     classical acceleration ``J q'' + J' q'`` from Pinocchio, at ``samples`` instants or
     :data:`PEAK_RATE`, whichever is denser.
 
-    The accelerations of all instants are computed at once with numpy
-    (:meth:`ArmModel.accelerations`), equal to Pinocchio's up to rounding; the instants
-    within rounding of the largest are then computed again by Pinocchio, so the peak is
-    Pinocchio's, to the last bit, as if every instant had been."""
+    The magnitudes of all instants are computed at once with numpy
+    (:meth:`ArmModel.acceleration_norms`), equal to Pinocchio's up to rounding; the
+    instants within rounding of the largest are then computed again by Pinocchio, so the
+    peak is Pinocchio's, to the last bit, as if every instant had been."""
     import pinocchio as pin
 
     model, data = arm.model, arm.model.createData()
     n = max(samples, int(math.ceil(seg.duration * PEAK_RATE)) + 1)
     q, qd, qdd = seg.sample(np.linspace(0.0, seg.duration, n))
-    fast = arm.accelerations(q, qd, qdd)
-    if fast is not None:
-        norms = np.sqrt(np.einsum("ij,ij->i", fast, fast))
+    norms = arm.acceleration_norms(q, qd, qdd)
+    if norms is not None:
         top = float(norms.max())
         near = np.flatnonzero(norms >= top - (1e-9 * top + 1e-12))
         q, qd, qdd = q[near], qd[near], qdd[near]
@@ -96,13 +95,13 @@ def jerk_ratios(arm: ArmModel, seg: PathSegment, dense: bool = False) -> np.ndar
     (an arm turning its null space), its jerk ``q_sss s'^3`` peaks inside a piece of the
     law, not at its ends; a controller's check of the trajectory sees it there."""
     law = seg.law
-    tau = (law.probe_times() if isinstance(law, SmoothLaw)
-           else np.linspace(0.0, seg.duration, 1500))
+    jerk = (seg.path_jerk(*law.probed()) if isinstance(law, SmoothLaw)
+            else seg.jerk(np.linspace(0.0, seg.duration, 1500)))
     if dense:
         lo, hi = JERK_SAMPLES
         n = min(hi, max(lo, math.ceil(seg.duration * JERK_RATE) + 1))
-        tau = np.concatenate([tau, np.linspace(0.0, seg.duration, n)])
-    return np.abs(seg.jerk(tau)).max(axis=0) / (arm.jmax * JERK_SCALE)
+        jerk = np.concatenate([jerk, seg.jerk(np.linspace(0.0, seg.duration, n))])
+    return np.abs(jerk).max(axis=0) / (arm.jmax * JERK_SCALE)
 
 
 def jerk_ratio(arm: ArmModel, seg: PathSegment) -> float:

@@ -60,9 +60,12 @@ class PathSegment:
         """Joint jerks at local times, shape (len(tau), n):
         ``q_sss s'^3 + 3 q_ss s' s'' + q_s s'''`` (a plain law's ``s'''`` counts as 0)."""
         if isinstance(self.law, SmoothLaw):
-            s, sd, sdd, sddd = self.law.derivatives(tau)
-        else:
-            s, sd, sdd = self.law(tau)
-            sddd = np.zeros_like(s)
+            return self.path_jerk(*self.law.derivatives(tau))
+        s, sd, sdd = self.law(tau)
+        return self.path_jerk(s, sd, sdd, np.zeros_like(s))
+
+    def path_jerk(self, s: np.ndarray, sd: np.ndarray, sdd: np.ndarray, sddd: np.ndarray
+                  ) -> np.ndarray:
+        """Joint jerks, (len(s), n), where the law is at ``s`` with these derivatives."""
         return (self.d3(s) * (sd**3)[:, None] + 3.0 * self.d2(s) * (sd * sdd)[:, None]
                 + self.d1(s) * sddd[:, None])

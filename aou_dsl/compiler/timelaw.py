@@ -114,10 +114,10 @@ class TimeLaw:
         tc = np.clip(tau, 0.0, end)
         i = np.clip(np.searchsorted(self.t, tc, side="right") - 1, 0, len(self.u) - 1)
         dt = tc - self.t[i]
-        u = self.u[i]
-        sd = self.sd[i] + u * dt
-        s = self.s[i] + self.sd[i] * dt + 0.5 * u * dt * dt
-        area = self._area[i] + self.s[i] * dt + self.sd[i] * dt**2 / 2 + u * dt**3 / 6
+        u, s0, sd0 = self.u[i], self.s[i], self.sd[i]
+        sd = sd0 + u * dt
+        s = s0 + sd0 * dt + 0.5 * u * dt * dt
+        area = self._area[i] + s0 * dt + sd0 * dt**2 / 2 + u * dt**3 / 6
         before, after = tau < 0.0, tau > end
         rest = before | after
         s = np.where(after, self.length, s)
@@ -184,7 +184,8 @@ class SmoothLaw:
 
     def peak_acceleration(self) -> float:
         """The exact peak of ``|s''|`` (a piecewise linear function: its extremes are at
-        the breakpoints); computed once per law (timing reads it twice)."""
+        the breakpoints); computed once per law (timing reads it twice), and kept on
+        the way when :meth:`probed` has computed the breakpoints' values already."""
         return self._peak
 
     @functools.cached_property
@@ -192,10 +193,24 @@ class SmoothLaw:
         return float(np.max(np.abs(self(self.breakpoints())[2])))
 
     def probe_times(self) -> np.ndarray:
-        """Times that see every piece of the law: each breakpoint, just after it, and the
-        middle of each piece."""
+        """Times that see every piece of the law: each breakpoint, just before and just
+        after it, and the middle of each piece; sorted."""
+        return np.sort(self._probe_times()[0])
+
+    def _probe_times(self) -> tuple[np.ndarray, int]:
+        """:meth:`probe_times` unsorted, the breakpoints first; and how many those are."""
         b = self.breakpoints()
         eps = 1e-9
         mid = (b[:-1] + b[1:]) / 2
-        return np.clip(np.sort(np.concatenate([b, b + eps, mid, b - eps])), 0.0,
-                       self.duration)
+        return (np.clip(np.concatenate([b, b + eps, mid, b - eps]), 0.0, self.duration),
+                len(b))
+
+    def probed(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`derivatives` at the probe times (unsorted, the breakpoints first), for
+        the jerk check; the peak acceleration is kept on the way, from the breakpoints'
+        values: :meth:`derivatives` computes each time on its own, so these are the
+        values it gives at the breakpoints alone, and the peak is the same to the bit."""
+        tau, nb = self._probe_times()
+        out = self.derivatives(tau)
+        self.__dict__.setdefault("_peak", float(np.max(np.abs(out[2][:nb]))))
+        return out

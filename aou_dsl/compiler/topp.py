@@ -249,6 +249,8 @@ def grid(s_way: np.ndarray, gridpoints: int, a: float, vmax: float) -> np.ndarra
     g = np.unique(np.concatenate(pts))
     # Points closer than a nanometre (or nanoradian) would make degenerate intervals.
     tol = 1e-9 * max(length, 1.0)
+    if len(g) >= 2 and np.all(np.diff(g[:-1]) > tol) and g[-1] - g[-2] > tol:
+        return g  # none is: the loop below would keep every point
     out = [g[0]]
     for x in g[1:-1]:
         if x - out[-1] > tol and g[-1] - x > tol:

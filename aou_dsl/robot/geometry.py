@@ -65,17 +65,29 @@ class ReachFrame:
         """``[target(start.lerp(end, f)) for f in fractions]``, the same numbers to the
         bit; the rotation is computed once per distinct angles (bit for bit: a signed
         zero is another angle), so a path that keeps its gaze and roll (an approach, a
-        retreat) turns once. The rotations are shared and read-only."""
+        retreat) turns once, and its positions are computed at once. The rotations and
+        positions are shared and read-only."""
+        f = np.fromiter(fractions, dtype=float)
+        # Pose.lerp's arithmetic for every fraction at once (elementwise: the same bits).
+        d, h, v, roll = (a + f * (b - a) for a, b in ((start.d, end.d), (start.h, end.h),
+                                                       (start.v, end.v),
+                                                       (start.roll, end.roll)))
+        angles = np.stack([h, v, roll], axis=1)
+        if len(f) and (angles.view(np.uint64) == angles[:1].view(np.uint64)).all():
+            back, r = self._turn(*angles[0].tolist())
+            r.setflags(write=False)
+            pos = self.goal + d[:, None] * back
+            pos.setflags(write=False)
+            return [(p, r) for p in pos]
         out = []
         turns: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
-        for f in fractions:
-            pose = start.lerp(end, f)
-            key = struct.pack("3d", pose.h, pose.v, pose.roll)
+        for dk, (hk, vk, rk) in zip(d.tolist(), angles.tolist(), strict=True):
+            key = struct.pack("3d", hk, vk, rk)
             turn = turns.get(key)
             if turn is None:
-                turn = turns[key] = self._turn(pose.h, pose.v, pose.roll)
+                turn = turns[key] = self._turn(hk, vk, rk)
                 turn[1].setflags(write=False)
-            out.append((self.goal + pose.d * turn[0], turn[1]))
+            out.append((self.goal + dk * turn[0], turn[1]))
         return out
 
     def _turn(self, h: float, v: float, roll: float) -> tuple[np.ndarray, np.ndarray]:

@@ -99,7 +99,7 @@ class _Solver:
         """One target from ``q0``: returns q, position error, rotation error, and the
         smallest singular value of the Jacobian at the solution."""
         q, pe, re, jac = self._newton(self.pin.SE3(r, p), q0.copy())
-        if not math.isfinite(jac.sum()):  # a NaN or an infinity in it
+        if not math.isfinite(_SUM(jac, axis=None)):  # a NaN or an infinity in it
             return q, np.inf, np.inf, 0.0  # diverged: the caller reports it unreachable
         return q, pe, re, float(self.lapack.svd(jac, signature="d->d")[-1])
 
@@ -138,6 +138,8 @@ class _Solver:
 
 _EYE6 = np.eye(6)
 _DAMPED = DAMPING * _EYE6
+#: ``a.sum()`` is this reduction, called through numpy's Python-level wrapper.
+_SUM = np.add.reduce
 
 
 @cached(maxsize=1)

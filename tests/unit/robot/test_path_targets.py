@@ -39,10 +39,12 @@ def test_a_paths_targets_are_each_poses_own_to_the_bit(start, end):
 
 def test_a_paths_shared_rotations_cannot_be_changed_by_a_user():
     frame = reach_frame(GOAL, FROM)
-    (_, r0), (_, r1) = frame.targets(Pose(0.3), Pose(0.2), [0.0, 1.0])
+    (p0, r0), (_, r1) = frame.targets(Pose(0.3), Pose(0.2), [0.0, 1.0])
     assert r0 is r1  # an approach keeps its orientation: turned once
     with pytest.raises(ValueError):
         r0[0, 0] = 1.0
+    with pytest.raises(ValueError):  # its positions, made at once, are kept as well
+        p0[0] = 1.0
 
 
 @pytest.mark.parametrize("bad", [math.nan, math.inf])
