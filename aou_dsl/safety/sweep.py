@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import heapq
 import math
-from array import array
 from bisect import bisect_left
 from dataclasses import dataclass, field
 
@@ -97,19 +96,19 @@ class Sweep:
         w = w[keep]
         self.items = items
         # The cumulative motion bound of an item is its weights (constant) times the
-        # cumulative joint travel; made for an item when it is first needed.
+        # cumulative joint travel; made for an item when it is first needed, and read
+        # through a memoryview: its items are Python floats, as the search compares them,
+        # without copying the row (an item's row is as long as the motion).
         self.weights = w
         self.travel = np.ascontiguousarray(np.vstack([
             np.zeros(q.shape[1]), np.cumsum(np.abs(np.diff(q, axis=0)), axis=0)]).T)
-        self._bounds: list[array | None] = [None] * len(items)
+        self._bounds: list[memoryview | None] = [None] * len(items)
 
-    def bound(self, p: int) -> array:
+    def bound(self, p: int) -> memoryview:
         """Item ``p``'s cumulative motion bound at every sample [m] (nondecreasing)."""
         row = self._bounds[p]
         if row is None:
-            row = array("d")
-            row.frombytes((self.weights[p] @ self.travel).tobytes())
-            self._bounds[p] = row
+            row = self._bounds[p] = memoryview(self.weights[p] @ self.travel)
         return row
 
     # --- measuring ---
