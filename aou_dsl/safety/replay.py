@@ -39,7 +39,7 @@ from ..robot.load import load_arm, robot_key
 from ..robot.scene import Scene, urdf_path
 from .limits import Check, check_limits
 from .sweep import CONTACT_MARGIN, QUERY_RANGE, Geometry, Memo, Sweep, geometry
-from .urdf_fk import rows_chain_fk, urdf_chain
+from .urdf_fk import columns_fk, urdf_chain
 
 __all__ = ["CheckReport", "check_scene", "replay"]
 
@@ -252,13 +252,13 @@ def _agreement(sweep: Sweep, arm, frame: str, t: np.ndarray, q: np.ndarray
     chain = urdf_chain(urdf_path(sweep.scene.robot, visuals=False,
                                  package_dirs=sweep.scene.options.package_dirs)[0], frame,
                        arm.joint_names)
-    pos, rot = rows_chain_fk(chain, q)
+    pos, cols = columns_fk(chain, q)
     pin_pos, pin_rot = rows_fk(arm, q)
     dp = np.linalg.norm(pos - pin_pos, axis=1)
-    dr = _angles_deg(rot, pin_rot)
+    dr = _angles_deg(cols, pin_rot)
     own_pos, own_rot = arm.fk(q[spots])  # Pinocchio's own forward kinematics
     dp[spots] = np.maximum(dp[spots], np.linalg.norm(pos[spots] - own_pos, axis=1))
-    dr[spots] = np.maximum(dr[spots], _angles_deg(rot[spots], own_rot))
+    dr[spots] = np.maximum(dr[spots], _angles_deg(cols[:, :, spots], own_rot))
     if sweep.visited:
         at = np.array(sorted(sweep.visited))
         pb = sweep.scene.pb
@@ -266,7 +266,7 @@ def _agreement(sweep: Sweep, arm, frame: str, t: np.ndarray, q: np.ndarray
         pb_rot = np.array([pb.getMatrixFromQuaternion(sweep.visited[j][1])
                            for j in at]).reshape(-1, 3, 3)
         dp[at] = np.maximum(dp[at], np.linalg.norm(pos[at] - pb_pos, axis=1))
-        dr[at] = np.maximum(dr[at], _angles_deg(rot[at], pb_rot))
+        dr[at] = np.maximum(dr[at], _angles_deg(cols[:, :, at], pb_rot))
     worst = int(np.argmax(np.maximum(dp / AGREE_POSITION, dr / AGREE_ROTATION)))
     worst_pos, worst_rot = float(dp.max()), float(dr.max())
     ok = worst_pos <= AGREE_POSITION and worst_rot <= AGREE_ROTATION
@@ -277,11 +277,12 @@ def _agreement(sweep: Sweep, arm, frame: str, t: np.ndarray, q: np.ndarray
     return check, {"position_mm": worst_pos * 1000, "rotation_deg": worst_rot}
 
 
-def _angles_deg(r1: np.ndarray, r2: np.ndarray) -> np.ndarray:
-    """The angle between rotations, row by row [deg], accurate for small angles too."""
+def _angles_deg(cols: np.ndarray, r2: np.ndarray) -> np.ndarray:
+    """The angle between rotations [deg], accurate for small angles too: ``cols`` by
+    columns (3, 3, N) as :func:`.urdf_fk.columns_fk` gives them, ``r2`` (N, 3, 3)."""
 
-    # Columns as contiguous rows: a[i, k] is r1[:, k, i] over the rows.
-    a, b = r1.transpose(2, 1, 0).copy(), r2.transpose(2, 1, 0).copy()
+    # Columns as contiguous rows: a[i, k] is the rotations' [k, i] over the samples.
+    a, b = cols, r2.transpose(2, 1, 0).copy()
 
     def rel(i: int, j: int) -> np.ndarray:  # (r1^T r2)[i, j] for every row
         return a[i, 0] * b[j, 0] + a[i, 1] * b[j, 1] + a[i, 2] * b[j, 2]
