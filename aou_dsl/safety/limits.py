@@ -21,6 +21,7 @@ limits come from :mod:`aou_dsl.core.robot_specs`, or a controller's, see
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -118,15 +119,18 @@ class Check:
                 "value": self.value, "limit": self.limit, "detail": self.detail}
 
 
-def _worst(name: str, t: np.ndarray, value: np.ndarray, limit: np.ndarray,
-           joints: tuple[str, ...], detail: str) -> Check:
+def _worst(name: str, t: np.ndarray | Callable[[int], float], value: np.ndarray,
+           limit: np.ndarray, joints: tuple[str, ...], detail: str) -> Check:
     """The sample where ``|value|`` comes nearest (or furthest past) ``|limit|``;
-    ``value`` (N, n), ``limit`` broadcastable to it."""
-    limit = np.broadcast_to(limit, value.shape)
-    ratio = np.abs(value) / np.abs(limit)
+    ``value`` (N, n), ``limit`` broadcastable to it (one per joint: its absolute value
+    is taken once, not at every sample; the quotients are the same). The sample's time is
+    ``t[i]``, or ``t(i)`` (a clock of equal steps, whose times need not be made)."""
+    ratio = np.abs(value)
+    ratio /= np.abs(limit)
     i, j = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
-    return Check(name, bool(ratio[i, j] <= 1.0 + SLACK), float(t[i]), joints[j],
-                 float(value[i, j]), float(limit[i, j]), detail)
+    at = float(t(int(i))) if callable(t) else float(t[i])
+    return Check(name, bool(ratio[i, j] <= 1.0 + SLACK), at, joints[j],
+                 float(value[i, j]), float(np.broadcast_to(limit, ratio.shape)[i, j]), detail)
 
 
 def check_limits(arm: ArmModel, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
@@ -146,7 +150,8 @@ def check_limits(arm: ArmModel, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
         t, q, qd, qdd = judged.t, judged.q, judged.qd, judged.qdd
         note = " " + judged.note
     mid = (arm.upper + arm.lower) / 2.0
-    pos = _worst("joint-position", t, q - mid, np.where(q >= mid, arm.upper, arm.lower) - mid,
+    pos = _worst("joint-position", t, q - mid,
+                 np.where(q >= mid, arm.upper - mid, arm.lower - mid),
                  names, "against the URDF position limits" + note)
     pos = Check(pos.name, pos.ok, pos.time, pos.joint,
                 pos.value + mid[names.index(pos.joint)], pos.limit + mid[names.index(pos.joint)],
@@ -181,14 +186,20 @@ def check_rates(joints: tuple[str, ...], q: np.ndarray, rate: float, *, t0: floa
     """
     checks = []
     dt = 1.0 / rate
+    diff = np.asarray(q)
     for order, name, limit, what in ((1, "joint-rate-velocity", vmax, "velocity"),
                                      (2, "joint-rate-acceleration", amax, "acceleration"),
                                      (3, "joint-jerk", jmax, "jerk")):
-        if limit is None or len(q) <= order:
+        if len(diff) < 2:
+            break
+        diff = np.diff(diff, axis=0)  # np.diff(q, order): the same differences
+        if limit is None:
             continue
-        d = np.diff(q, order, axis=0) / dt**order
-        t = t0 + (np.arange(len(d)) + order) * dt
-        checks.append(_worst(name, t, d, np.asarray(limit, dtype=float), joints,
-                             f"{what} from differences at {rate:g} Hz, against {source} "
-                             "limits"))
+
+        def newest(i: int, k: int = order) -> float:  # the time of difference i's newest tick
+            return t0 + (i + k) * dt
+
+        checks.append(_worst(name, newest, diff / dt**order, np.asarray(limit, dtype=float),
+                             joints, f"{what} from differences at {rate:g} Hz, against "
+                             f"{source} limits"))
     return checks

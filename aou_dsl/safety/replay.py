@@ -39,7 +39,7 @@ from ..robot.load import load_arm, robot_key
 from ..robot.scene import Scene, urdf_path
 from .limits import Check, check_limits
 from .sweep import CONTACT_MARGIN, QUERY_RANGE, Geometry, Memo, Sweep, geometry
-from .urdf_fk import rows_chain_fk, urdf_chain
+from .urdf_fk import Chain, columns_fk, urdf_chain
 
 __all__ = ["CheckReport", "check_scene", "replay"]
 
@@ -136,7 +136,7 @@ def replay(tr: Trajectory, *, options: SceneOptions | None = None,
     sweep = Sweep(scene, geo, q, scene.link_index.get(frame, scene.joint_index.get(frame)),
                   target=goal is not None, memo=memo)
     kin_checks, clear = _contacts(sweep, t)
-    agree_check, agree = _agreement(sweep, arm, frame, t, q)
+    agree_check, agree = _agreement(sweep, arm, frame, t, q, key)
     not_run = []
     if goal is None or scene.target is None:  # no cube at a goal: nothing to touch
         kin_checks = [c for c in kin_checks if c.name != TARGET_CONTACT]
@@ -237,7 +237,17 @@ def _contacts(sweep: Sweep, t: np.ndarray) -> tuple[list[Check], dict]:
     return checks, {k: finite(clear[k]) for k in ("target", "self", "table")}
 
 
-def _agreement(sweep: Sweep, arm, frame: str, t: np.ndarray, q: np.ndarray
+@cached(maxsize=16)
+def _chain(robot: str, package_dirs: tuple[str, ...], frame: str, joints: tuple[str, ...],
+           key: tuple) -> Chain:
+    """The chain to ``frame`` in the URDF the check scene loads, per robot files (``key``,
+    as :func:`~aou_dsl.robot.load.robot_key` gives it with the meshes): finding that URDF asks
+    for the key again, a ``stat`` of every file the robot is made from."""
+    return urdf_chain(urdf_path(robot, visuals=False, package_dirs=package_dirs)[0], frame,
+                      joints)
+
+
+def _agreement(sweep: Sweep, arm, frame: str, t: np.ndarray, q: np.ndarray, key: tuple
                ) -> tuple[Check, dict]:
     """The end-effector pose by the replay's own kinematics (the URDF, evaluated here)
     against the compiler's Pinocchio model at every sample (evaluated for all samples at
@@ -249,24 +259,23 @@ def _agreement(sweep: Sweep, arm, frame: str, t: np.ndarray, q: np.ndarray
     spots = np.unique(np.linspace(0, len(t) - 1, AGREE_SPOTS).astype(int))
     for j in spots:
         sweep.visit(int(j))
-    chain = urdf_chain(urdf_path(sweep.scene.robot, visuals=False,
-                                 package_dirs=sweep.scene.options.package_dirs)[0], frame,
-                       arm.joint_names)
-    pos, rot = rows_chain_fk(chain, q)
+    pos, cols = columns_fk(_chain(sweep.scene.robot, sweep.scene.options.package_dirs, frame,
+                                  arm.joint_names, key), q)
     pin_pos, pin_rot = rows_fk(arm, q)
     dp = np.linalg.norm(pos - pin_pos, axis=1)
-    dr = _angles_deg(rot, pin_rot)
+    dr = _angles_deg(cols, pin_rot)
     own_pos, own_rot = arm.fk(q[spots])  # Pinocchio's own forward kinematics
     dp[spots] = np.maximum(dp[spots], np.linalg.norm(pos[spots] - own_pos, axis=1))
-    dr[spots] = np.maximum(dr[spots], _angles_deg(rot[spots], own_rot))
+    dr[spots] = np.maximum(dr[spots], _angles_deg(cols[:, :, spots], own_rot))
     if sweep.visited:
-        at = np.array(sorted(sweep.visited))
+        order = sorted(sweep.visited)
+        poses = [sweep.visited[j] for j in order]
+        at = np.array(order)
         pb = sweep.scene.pb
-        pb_pos = np.array([sweep.visited[j][0] for j in at])
-        pb_rot = np.array([pb.getMatrixFromQuaternion(sweep.visited[j][1])
-                           for j in at]).reshape(-1, 3, 3)
+        pb_pos = np.array([p for p, _ in poses])
+        pb_rot = np.array([pb.getMatrixFromQuaternion(o) for _, o in poses]).reshape(-1, 3, 3)
         dp[at] = np.maximum(dp[at], np.linalg.norm(pos[at] - pb_pos, axis=1))
-        dr[at] = np.maximum(dr[at], _angles_deg(rot[at], pb_rot))
+        dr[at] = np.maximum(dr[at], _angles_deg(cols[:, :, at], pb_rot))
     worst = int(np.argmax(np.maximum(dp / AGREE_POSITION, dr / AGREE_ROTATION)))
     worst_pos, worst_rot = float(dp.max()), float(dr.max())
     ok = worst_pos <= AGREE_POSITION and worst_rot <= AGREE_ROTATION
@@ -277,11 +286,12 @@ def _agreement(sweep: Sweep, arm, frame: str, t: np.ndarray, q: np.ndarray
     return check, {"position_mm": worst_pos * 1000, "rotation_deg": worst_rot}
 
 
-def _angles_deg(r1: np.ndarray, r2: np.ndarray) -> np.ndarray:
-    """The angle between rotations, row by row [deg], accurate for small angles too."""
+def _angles_deg(cols: np.ndarray, r2: np.ndarray) -> np.ndarray:
+    """The angle between rotations [deg], accurate for small angles too: ``cols`` by
+    columns (3, 3, N) as :func:`.urdf_fk.columns_fk` gives them, ``r2`` (N, 3, 3)."""
 
-    # Columns as contiguous rows: a[i, k] is r1[:, k, i] over the rows.
-    a, b = r1.transpose(2, 1, 0).copy(), r2.transpose(2, 1, 0).copy()
+    # Columns as contiguous rows: a[i, k] is the rotations' [k, i] over the samples.
+    a, b = cols, r2.transpose(2, 1, 0).copy()
 
     def rel(i: int, j: int) -> np.ndarray:  # (r1^T r2)[i, j] for every row
         return a[i, 0] * b[j, 0] + a[i, 1] * b[j, 1] + a[i, 2] * b[j, 2]

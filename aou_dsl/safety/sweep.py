@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import heapq
 import math
-from array import array
 from bisect import bisect_left
 from dataclasses import dataclass, field
 
@@ -44,6 +43,13 @@ CONTACT_MARGIN = 1e-3
 CLEARANCE_TOL = 1e-7
 #: Distances are queried up to this [m]; beyond, only "at least this far" is known.
 QUERY_RANGE = 1.0
+#: ``getClosestPoints``' arguments between the links and the client, at their defaults
+#: (no collision shapes, whose poses PyBullet then never reads). PyBullet's calls take
+#: every argument by position here: a keyword argument has CPython look up each of the
+#: function's keyword names before it, each made a new string and hashed, which cost
+#: more than the call's own Python around a query (thousands of look-ups a replay).
+_NO_SHAPES = (-1, -1, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0),
+              (0.0, 0.0, 0.0, 1.0))
 
 
 @dataclass
@@ -97,19 +103,19 @@ class Sweep:
         w = w[keep]
         self.items = items
         # The cumulative motion bound of an item is its weights (constant) times the
-        # cumulative joint travel; made for an item when it is first needed.
+        # cumulative joint travel; made for an item when it is first needed, and read
+        # through a memoryview: its items are Python floats, as the search compares them,
+        # without copying the row (an item's row is as long as the motion).
         self.weights = w
         self.travel = np.ascontiguousarray(np.vstack([
             np.zeros(q.shape[1]), np.cumsum(np.abs(np.diff(q, axis=0)), axis=0)]).T)
-        self._bounds: list[array | None] = [None] * len(items)
+        self._bounds: list[memoryview | None] = [None] * len(items)
 
-    def bound(self, p: int) -> array:
+    def bound(self, p: int) -> memoryview:
         """Item ``p``'s cumulative motion bound at every sample [m] (nondecreasing)."""
         row = self._bounds[p]
         if row is None:
-            row = array("d")
-            row.frombytes((self.weights[p] @ self.travel).tobytes())
-            self._bounds[p] = row
+            row = self._bounds[p] = memoryview(self.weights[p] @ self.travel)
         return row
 
     # --- measuring ---
@@ -127,8 +133,8 @@ class Sweep:
         if j != self.at:
             scene = self.scene
             scene.pb.resetJointStatesMultiDof(scene.body, scene.arm,
-                                              [[v] for v in self.q[j].tolist()],
-                                              physicsClientId=scene.client)
+                                              [[v] for v in self.q[j].tolist()], [],
+                                              scene.client)  # no velocities: by position
             self.at = j
 
     def visit(self, j: int) -> None:
@@ -140,9 +146,8 @@ class Sweep:
         pose = self.memo.poses.get(key)
         if pose is None:
             self._put(j)
-            st = self.scene.pb.getLinkState(self.scene.body, self.ee_link,
-                                            computeForwardKinematics=True,
-                                            physicsClientId=self.scene.client)
+            st = self.scene.pb.getLinkState(self.scene.body, self.ee_link, 0, 1,
+                                            self.scene.client)  # forward kinematics
             pose = self.memo.poses[key] = (st[4], st[5])
         self.visited[j] = pose
 
@@ -173,13 +178,13 @@ class Sweep:
         most :data:`QUERY_RANGE`)."""
         if j != self.at:
             self._put(j)
-        scene = self.scene
+        pb, body = self.scene.pb, self.scene.body
         if it.kind == "self":
-            pts = scene.pb.getClosestPoints(scene.body, scene.body, QUERY_RANGE, it.a, it.b,
-                                            physicsClientId=scene.client)
-        else:
-            pts = scene.pb.getClosestPoints(scene.body, it.b, QUERY_RANGE, linkIndexA=it.a,
-                                            physicsClientId=scene.client)
+            pts = pb.getClosestPoints(body, body, QUERY_RANGE, it.a, it.b, *_NO_SHAPES,
+                                      self.scene.client)
+        else:  # a link and an object (-2: any of its links)
+            pts = pb.getClosestPoints(body, it.b, QUERY_RANGE, it.a, -2, *_NO_SHAPES,
+                                      self.scene.client)
         d = QUERY_RANGE
         for pt in pts:
             if pt[8] < d:

@@ -17,7 +17,7 @@ from ..core.codes import R402
 from ..core.diagnostics import AouError, Span, diag
 from ..core.memo import cached, file_digest
 
-__all__ = ["Chain", "chain_fk", "rows_chain_fk", "urdf_chain"]
+__all__ = ["Chain", "chain_fk", "columns_fk", "rows_chain_fk", "urdf_chain"]
 
 
 @dataclass(frozen=True)
@@ -113,63 +113,96 @@ def _skew(u: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
 
 
-def _rotate(rot: np.ndarray, axis: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """``rot[:, :, i] @ Rot(axis, x[i])`` for every i; ``rot`` (3, 3, N), component-major
-    so that every operation runs on contiguous rows."""
+# A stack of rotations is held by columns: ``cols[k, i, n]`` is ``R_n[i, k]``, so that
+# ``cols[k]``, column k of every rotation, is one contiguous block. The products make the
+# very BLAS calls numpy made when the stack was held by rows (``rot[i, k, n]``), on the
+# same numbers: ``R @ v`` one matrix-vector product over the 3N (column, row, sample)
+# entries (by rows, a transposed copy of the stack; by columns, the stack itself), and
+# ``R @ m`` a matrix product of N columns per row of the rotations, read with a stride.
+# BLAS rounds a product's last columns through another kernel, so these shapes are kept
+# (tests/unit/safety/test_urdf_fk_columns.py holds the two layouts equal to the bit).
+
+
+def _turn(cols: np.ndarray, axis: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``R_n @ Rot(axis, x[n])`` for every n, by columns; ``cols`` (3, 3, N) is reused
+    when the axis is a coordinate axis."""
     k = int(np.argmax(np.abs(axis)))
     if abs(axis[k]) == 1.0:  # a coordinate axis: two columns turn in their plane
         x = x * axis[k]
         c, s = np.cos(x), np.sin(x)
-        i, j = (k + 1) % 3, (k + 2) % 3
-        out = rot.copy()
-        out[:, i] = c * rot[:, i] + s * rot[:, j]
-        out[:, j] = c * rot[:, j] - s * rot[:, i]
-        return out
+        ci, cj = cols[(k + 1) % 3], cols[(k + 2) % 3]
+        new_i = c * ci
+        turn = s * cj
+        new_i += turn  # c ci + s cj
+        np.multiply(s, ci, out=turn)
+        np.multiply(c, cj, out=cj)
+        cj -= turn  # c cj - s ci
+        ci[...] = new_i
+        return cols
     # Rodrigues: R Rot(u, x) = R + sin x (R K) + (1 - cos x) (R K^2).
     kk = _skew(axis)
-    rk = _mul(rot, kk)
-    return rot + np.sin(x) * rk + (1.0 - np.cos(x)) * _mul(rk, kk)
+    rk = _times(cols, kk)
+    return cols + np.sin(x) * rk + (1.0 - np.cos(x)) * _times(rk, kk)
 
 
-def _mul(rot: np.ndarray, m: np.ndarray) -> np.ndarray:
-    """``rot @ m`` for one rotation (3, 3) or a stack (3, 3, N), ``m`` constant (3, 3) or
-    (3,); a stack gives (3, 3, N) or (3, N)."""
-    if rot.ndim == 2:
-        return rot @ m
-    if m.ndim == 2:
-        return np.matmul(m.T, rot)  # out[i, j] = sum_k m[k, j] rot[i, k]
-    return np.tensordot(m, rot, axes=([0], [1]))  # out[i] = sum_k m[k] rot[i, k]
+def _times(cols: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """``R_n @ m`` for every n, by columns, ``m`` a constant (3, 3)."""
+    out = np.empty_like(cols)
+    # out[j, i] = sum_k m[k, j] cols[k, i]: per row i, m.T @ (rows k of the columns)
+    np.matmul(m.T, cols.transpose(1, 0, 2), out=out.transpose(1, 0, 2))
+    return out
+
+
+def _apply(cols: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``R_n @ v`` for every n, (3, N), ``v`` a constant (3,)."""
+    n = cols.shape[2]
+    return np.dot(v.reshape(1, 3), cols.reshape(3, 3 * n)).reshape(3, n)
+
+
+def columns_fk(chain: Chain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Poses of the chain's link for every row of ``q`` (N, n): positions (N, 3) and the
+    rotations by columns, (3, 3, N) (``cols[k, i, n]`` is ``R_n[i, k]``), in the root
+    link's frame; each row's values those of any batch of two rows or more holding it
+    (one row alone is computed as two, as :func:`~aou_dsl.robot.rows.by_rows` does)."""
+    q = np.ascontiguousarray(np.atleast_2d(np.asarray(q, dtype=float)))
+    if len(q) == 1:
+        two = columns_fk(chain, np.vstack([q, q]))
+        return two[0][:1].copy(), two[1][:, :, :1].copy()
+    n = len(q)
+    rot = np.eye(3)  # a constant until the first moving joint
+    pos = np.zeros(3)
+    cols: np.ndarray | None = None  # then the rotations by columns (3, 3, N), pos (3, N)
+    for s in chain.steps:
+        if cols is None:
+            pos = pos + rot @ s.pos
+            rot = rot @ s.rot
+            if s.col is None:
+                continue
+            cols = np.repeat(rot.T[:, :, None], n, axis=2)
+            pos = np.repeat(pos[:, None], n, axis=1)
+        else:
+            pos = pos + _apply(cols, s.pos)
+            cols = _times(cols, s.rot)
+            if s.col is None:
+                continue
+        x = q[:, s.col]
+        if s.kind == "prismatic":
+            pos = pos + _apply(cols, s.axis) * x
+            continue
+        cols = _turn(cols, s.axis, x)
+    if cols is None:
+        return np.tile(pos, (n, 1)), np.repeat(rot.T[:, :, None], n, axis=2)
+    return pos.T.copy(), cols
 
 
 def chain_fk(chain: Chain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Poses of the chain's link for every row of ``q`` (N, n): positions (N, 3) and
     rotations (N, 3, 3) in the root link's frame."""
-    q = np.atleast_2d(np.asarray(q, dtype=float))
-    n = len(q)
-    rot = np.eye(3)  # a constant until the first moving joint, then (3, 3, N)
-    pos = np.zeros(3)  # then (3, N)
-    for s in chain.steps:
-        pos = pos + _mul(rot, s.pos)
-        rot = _mul(rot, s.rot)
-        if s.col is None:
-            continue
-        x = q[:, s.col]
-        if rot.ndim == 2:
-            rot = np.repeat(rot[:, :, None], n, axis=2)
-            pos = np.repeat(pos[:, None], n, axis=1)
-        if s.kind == "prismatic":
-            pos = pos + _mul(rot, s.axis) * x
-            continue
-        rot = _rotate(rot, s.axis, x)
-    if rot.ndim == 2:
-        return np.tile(pos, (n, 1)), np.tile(rot, (n, 1, 1))
-    return pos.T.copy(), np.ascontiguousarray(rot.transpose(2, 0, 1))
+    pos, cols = columns_fk(chain, q)
+    return pos, np.ascontiguousarray(cols.transpose(2, 1, 0))
 
 
 def rows_chain_fk(chain: Chain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """:func:`chain_fk` of the rows of ``q`` (N, n), each row's values those of any batch
     of two rows or more holding it (:func:`~aou_dsl.robot.rows.by_rows`)."""
-    from ..robot.rows import by_rows
-
-    pos, rot = by_rows(np.asarray(q, dtype=float), lambda rows: chain_fk(chain, rows))
-    return pos, rot
+    return chain_fk(chain, q)
