@@ -231,10 +231,18 @@ def peak_acceleration(c: Context, p: Piece, u: np.ndarray) -> tuple[float, float
     k1 += int(p.held1 and k1 < len(src.t) - 1)
     t, x, q = src.t[k0:k1 + 1], src.pos[k0:k1 + 1] @ u, src.q[k0:k1 + 1]
     grid = r.t[p.i0:p.i1 + 1]
+    # Read on the grid's own clock, grid sample i is read sample i + i0 - k0 (the same
+    # time): where the search finds it when the sample beside it on the search's side
+    # holds another time (the first of equal times, or the last).
+    shift = p.i0 - k0 if c.raw is None else None
 
     def own(i: int, side: int) -> int:  # grid sample i of the piece, in its own samples
         if i == (0 if side < 0 else len(grid) - 1):
             return 0 if side < 0 else len(t) - 1
+        j = -1 if shift is None else i + shift
+        if 0 <= j < len(t) and ((j == 0 or t[j - 1] < t[j]) if side < 0
+                                else (j == len(t) - 1 or t[j + 1] > t[j])):
+            return j
         at = int(np.searchsorted(t, grid[i], "left" if side < 0 else "right"))
         return at if side < 0 else at - 1
 
@@ -259,7 +267,7 @@ def peak_acceleration(c: Context, p: Piece, u: np.ndarray) -> tuple[float, float
         return 0.0, 0.0
     peak = episode_peak(found)
     if peak.value > 0:
-        at = int(np.clip(np.searchsorted(r.t, peak.at), 0, len(r.t) - 1))
+        at = min(int(np.searchsorted(r.t, peak.at)), len(r.t) - 1)  # never below 0
         window = min(odd(peak.span / h), len(r.t) - (1 - len(r.t) % 2))
         _self_check(c, peak.value, at, max(window, 3), u, sigma_x, peak.sd)
     return peak.value, peak.sd
@@ -272,8 +280,7 @@ def _self_check(c: Context, peak: float, at: int, window: int, u: np.ndarray,
     from the joints' filtered velocities and accelerations over the same window."""
     n, h = len(c.rest.t), c.rest.h
     half = window // 2
-    near = np.unique(np.clip(np.linspace(at - half, at + half, 5).round().astype(int),
-                             half, n - 1 - half))
+    near = np.array(_five(at, half, n))
     q = c.q[near]
     qd, qdd = filters_at(c.q, window, (1, 2), h, near)
     joint_side = classical_acceleration(c.arm, q, qd, qdd) @ u
@@ -285,3 +292,13 @@ def _self_check(c: Context, peak: float, at: int, window: int, u: np.ndarray,
             f"is more than the joints' motion there produces ({bound:.4g} m/s^2); this is "
             "an error of the measurement, not a value", Span.whole_file(c.path),
             measured=peak, bound=bound))
+
+
+def _five(at: int, half: int, n: int) -> list[int]:
+    """The distinct samples, in order, of five spread evenly over ``at - half`` ..
+    ``at + half``, rounded half to even and kept ``half`` from either end of ``n``: as
+    ``np.unique(np.clip(np.linspace(at - half, at + half, 5).round().astype(int), half,
+    n - 1 - half))`` gives them. The five are ``at - half + k * half / 2``: whole or half
+    numbers, exact in binary, which ``round`` rounds half to even as NumPy does."""
+    return sorted({min(max(round(at - half + k * (half / 2)), half), n - 1 - half)
+                   for k in range(5)})
