@@ -388,17 +388,22 @@ def _held(r: Rest, t0: float, t1: float) -> tuple[float, float]:
     p = r.held(k0, k1)
     if len(p) < 3:
         return t0, t0
-    # Across a logging gap fewer raw samples make each filtered value: more noise.
-    band = (HELD_SIGMAS * r.noise * r.held_gain * r.sparse[k0:k1, None] + 1.01 * r.quantum
-            + STILL_ANGLE)
+    # Across a logging gap fewer raw samples make each filtered value: more noise. A log
+    # without a gap scales every row by exactly 1: one row, the same for every sample.
+    band = HELD_SIGMAS * r.noise * r.held_gain
+    band = (band if r.gapless else band * r.sparse[k0:k1, None]) + 1.01 * r.quantum \
+        + STILL_ANGLE
     third = len(p) // 3
     ref = median0(p[third:len(p) - third])
     inside = ~row_max(np.abs(p - ref) > band)  # every joint near (by columns: rows are short)
-    # A brief excursion inside is noise (a logging gap); one at an end is motion.
-    for a, b in runs(~inside):
-        if a > 0 and b < len(inside) - 1 and b - a < r.window:
-            inside[a:b + 1] = True
-    a, b = max(runs(inside), key=lambda ab: ab[1] - ab[0], default=(0, -1))
+    if inside.all():  # the usual: one run, the whole stretch
+        a, b = 0, len(inside) - 1
+    else:
+        # A brief excursion inside is noise (a logging gap); one at an end is motion.
+        for a, b in runs(~inside):
+            if a > 0 and b < len(inside) - 1 and b - a < r.window:
+                inside[a:b + 1] = True
+        a, b = max(runs(inside), key=lambda ab: ab[1] - ab[0], default=(0, -1))
     if b < a:
         return t0, t0
     return (t0 if a == 0 else float(r.t[k0 + a]),

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -65,6 +66,11 @@ class Rest:
     held_gain: float
     sparse: np.ndarray
     carried: tuple[np.ndarray, np.ndarray] | None = None
+
+    @cached_property
+    def gapless(self) -> bool:
+        """Whether the log has no gap: ``sparse`` is exactly 1 at every sample."""
+        return bool(np.all(self.sparse == 1.0))
 
     def held(self, k0: int, k1: int) -> np.ndarray:
         """Joint positions filtered over ``window`` (raw for clean data) on samples
