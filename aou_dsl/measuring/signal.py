@@ -298,7 +298,7 @@ def filters_at(x: np.ndarray, window: int, derivs: tuple[int, ...], h: float,
         # so, else a copy), as the gathered windows lie: the same product, without the
         # gather's indices and its moved axes.
         wins = [np.ascontiguousarray(x[k - half:k + half + 1]).T for k in at.tolist()]
-        return [np.stack([w @ c for w in wins]) for c in cs]
+        return [np.array([w @ c for w in wins]) for c in cs]  # stacked: the same rows
     windows = np.moveaxis(x[at[:, None] + np.arange(-half, half + 1)], 1, -1)
     return [windows @ c for c in cs]
 
