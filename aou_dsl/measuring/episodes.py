@@ -149,6 +149,16 @@ def pieces(c: Context, bounds: list[Boundary]) -> list[Piece | Boundary]:
     first = Boundary(float(t[0]), float(t[0]), 0, 0, False)
     last = Boundary(c.rest.t_last, c.rest.t_last, n - 1, n - 1, False)
     seq = [first, *bounds, last]
+    held: dict[int, tuple[np.ndarray, float]] = {}
+
+    def anchor(b: Boundary, side: int) -> tuple[np.ndarray, float]:
+        # A pause anchors the piece before it and the one after it alike: averaged once.
+        if not b.pause:
+            return _anchor(c, b, side)
+        if id(b) not in held:
+            held[id(b)] = _anchor(c, b, side)
+        return held[id(b)]
+
     for a, b in zip(seq[:-1], seq[1:], strict=True):
         if a.pause and a is not first:
             out.append(a)
@@ -157,8 +167,8 @@ def pieces(c: Context, bounds: list[Boundary]) -> list[Piece | Boundary]:
         i1 = int(np.searchsorted(t, tb, "right")) - 1
         if tb - ta <= 0 or i1 - i0 < 1:
             continue
-        p0, r0 = _anchor(c, a, +1) if a is not first else (c.pos_s[0], float(c.roll[0]))
-        p1, r1 = _anchor(c, b, -1) if b is not last else (c.pos_s[-1], float(c.roll[-1]))
+        p0, r0 = anchor(a, +1) if a is not first else (c.pos_s[0], float(c.roll[0]))
+        p1, r1 = anchor(b, -1) if b is not last else (c.pos_s[-1], float(c.roll[-1]))
         rest0 = a is not first or c.edge_rest[0]
         rest1 = b is not last or c.edge_rest[1]
         out.append(Piece(ta, tb, i0, i1, p0, p1, r0, r1, rest0, rest1,
