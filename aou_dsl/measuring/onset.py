@@ -184,20 +184,24 @@ def _swings(d: np.ndarray, level: float) -> int:
     return int(np.count_nonzero(np.diff(side)))
 
 
-def soft_pause(t: np.ndarray, q: np.ndarray, noise: np.ndarray, span: tuple[float, float]
+def soft_pause(t: np.ndarray, q: np.ndarray, noise: np.ndarray, span: tuple[float, float],
+               known: tuple[tuple[int, int], np.ndarray] | None = None
                ) -> tuple[float, float]:
     """The hold from ``span[0]`` to ``span[1]`` [s] with each edge that borders an
     oscillation moved to where the oscillation leaves or reaches the held position
     (:func:`soft_edge`). The result may be short, or empty (its end before its start):
     then the rest was the oscillation's soft start or end, hidden under the noise, and
-    no pause."""
+    no pause. ``known``: grid samples (inclusive) and the position :func:`held_at` gives
+    for them, when the caller has found it."""
     a, b = span
     k0 = int(np.searchsorted(t, a, "left"))
     k1 = int(np.searchsorted(t, b, "right")) - 1
     if k1 - k0 < 4:
         return a, b
-    # Both edges look from one held position: found once.
-    ref = held_at(q, (k0, k1)) if np.any(noise > 0) and (k0 > 0 or k1 < len(t) - 1) else None
+    # Both edges look from one held position: found once (or known already).
+    ref = None
+    if np.any(noise > 0) and (k0 > 0 or k1 < len(t) - 1):
+        ref = known[1] if known is not None and known[0] == (k0, k1) else held_at(q, (k0, k1))
     if k0 > 0:
         edge = soft_edge(t, q, noise, (k0, k1), -1, ref)
         a = a if edge is None else edge
