@@ -220,9 +220,9 @@ def to_grid(t: np.ndarray, q: np.ndarray, window: float) -> Grid:
     """
     t = t - t[0]
     steps = np.diff(t)
-    h = float(np.median(steps))
+    h = float(median0(steps))  # np.median's number (a checked clock: finite)
     t_last = float(t[-1])
-    if np.allclose(steps[:-1], h, rtol=1e-6, atol=1e-9):
+    if _uniform(steps[:-1], h):
         ones = np.ones(len(t))
         if abs(steps[-1] - h) < 1e-9 or len(t) < 4:
             return Grid(t, q, h, ones, t_last, False)
@@ -242,6 +242,13 @@ def to_grid(t: np.ndarray, q: np.ndarray, window: float) -> Grid:
     hi = np.clip(np.arange(n) + half + 1, 0, n)
     density = (total[hi] - total[lo]) / (hi - lo)
     return Grid(tg, qg, h, np.maximum(density, 1.0 / (2 * half + 1)), t_last, True)
+
+
+def _uniform(steps: np.ndarray, h: float) -> bool:
+    """``np.allclose(steps, h, rtol=1e-6, atol=1e-9)`` of finite ``steps``: whether each
+    differs from ``h`` by at most ``1e-9 + 1e-6 * |h|`` (the same bound, in the same
+    arithmetic; a step equal to ``h`` is within it), so whether the largest does."""
+    return float(np.abs(steps - h).max()) <= 1e-9 + 1e-6 * abs(h)
 
 
 def smooth(x: np.ndarray, window: int, deriv: int, h: float, order: int = 3,
