@@ -264,8 +264,9 @@ def _edge_rest(rec: Trajectory, rest: Rest) -> tuple[bool, bool]:
     qd = rec.qd
     if qd is None or np.shape(qd) != np.shape(rec.q) or not np.isfinite(qd).all():
         return rest_at_end(rest, last=False), rest_at_end(rest, last=True)
-    speed = np.abs(np.asarray(qd, float))
-    return bool(speed[0].max() <= REST_SPEED), bool(speed[-1].max() <= REST_SPEED)
+    qd = np.asarray(qd, float)  # the first and the last row's speeds, not every row's
+    return (bool(np.abs(qd[0]).max() <= REST_SPEED),
+            bool(np.abs(qd[-1]).max() <= REST_SPEED))
 
 
 def _episodes(ctx: Context, parts: list[Piece | Boundary],
