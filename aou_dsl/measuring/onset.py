@@ -177,11 +177,10 @@ def _angular(t: np.ndarray, d: np.ndarray, first: int, back: int) -> float | Non
 
 
 def _swings(d: np.ndarray, level: float) -> int:
-    """How many times ``d`` crosses from beyond ``level`` on one side to beyond it on
-    the other."""
-    side = np.sign(d) * (np.abs(d) > level)
-    side = side[side != 0]
-    return int(np.count_nonzero(np.diff(side)))
+    """How many times ``d`` crosses from beyond ``level`` (> 0) on one side to beyond it
+    on the other: the changes of side among the samples beyond it."""
+    up = d[np.abs(d) > level] > 0
+    return int(np.count_nonzero(up[1:] != up[:-1]))
 
 
 def soft_pause(t: np.ndarray, q: np.ndarray, noise: np.ndarray, span: tuple[float, float],
