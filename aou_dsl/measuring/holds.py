@@ -233,16 +233,26 @@ def _crossings(r: Rest) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         ahead = pair > lead
         j[ahead] = k
         np.maximum(lead, pair, out=lead)
-    # Each row's leading joint, taken from the velocities in their row order (the same
-    # values as indexing rows and columns at once, without its general machinery).
-    at = np.arange(0, len(j) * r.v.shape[1], r.v.shape[1]) + j
-    va, vb = r.v.take(at), r.v.take(at + r.v.shape[1])
+    va, vb = _leading(r.v, j, 0), _leading(r.v, j, 1)
     idx = np.flatnonzero(va * vb < 0)
     j = j[idx]
     frac = (va[idx] / (va[idx] - vb[idx]))[:, None]
     v = r.v[idx] + frac * (r.v[idx + 1] - r.v[idx])
     thr = r.thr[idx] + frac * (r.thr[idx + 1] - r.thr[idx])
     return idx, j, np.max(np.abs(v) / thr, axis=1)
+
+
+def _leading(v: np.ndarray, j: np.ndarray, shift: int) -> np.ndarray:
+    """``v[np.arange(len(j)) + shift, j]``: each row's (from row ``shift`` on) joint ``j``,
+    taken from the samples in the order they lie (by rows or by columns): the same
+    values, without a look-up over both axes at once."""
+    n, cols = v.shape
+    rows = np.arange(shift, shift + len(j))
+    if v.flags.c_contiguous:
+        return v.ravel().take(rows * cols + j)
+    if v.flags.f_contiguous:
+        return v.ravel("F").take(j * n + rows)
+    return v[rows, j]
 
 
 def _dips(r: Rest, taken: np.ndarray) -> list[tuple[float, float, int]]:
