@@ -129,9 +129,13 @@ def _anchor(c: Context, b: Boundary, side: int) -> tuple[np.ndarray, float]:
         # The samples from t0 + a quarter to t1 less a quarter (the times increase).
         k0 = int(np.searchsorted(t, b.t0 + 0.25 * (b.t1 - b.t0), "left"))
         k1 = int(np.searchsorted(t, b.t1 - 0.25 * (b.t1 - b.t0), "right"))
-        idx = np.arange(k0, k1) if k1 > k0 else np.arange(b.i0, b.i1 + 1)
-        # Gathered (a copy laid out by rows), not a view: the mean sums in that order.
-        return c.pos[idx].mean(axis=0), float(c.roll[idx].mean())
+        lo, hi = (k0, k1) if k1 > k0 else (b.i0, b.i1 + 1)
+        # Laid out by rows as a gather of them lays them (a view of rows laid out so,
+        # else a copy), not a view by columns: the mean sums in that order. Each mean is
+        # NumPy's: the sum along the samples over their count.
+        rows = np.ascontiguousarray(c.pos[lo:hi])
+        return (np.add.reduce(rows, axis=0) / (hi - lo),
+                float(np.add.reduce(np.ascontiguousarray(c.roll[lo:hi]))) / (hi - lo))
     tt = b.t0 if side < 0 else b.t1
     # Interpolated between the two samples around it, as over all of them (not copying
     # a column of the whole recording for each).
