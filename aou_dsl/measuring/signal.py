@@ -303,8 +303,12 @@ def filters_at(x: np.ndarray, window: int, derivs: tuple[int, ...], h: float,
     if x.ndim == 2 and len(at):
         # Each window a stretch of the rows laid out by rows (a view of rows laid out
         # so, else a copy), as the gathered windows lie: the same product, without the
-        # gather's indices and its moved axes.
-        wins = [np.ascontiguousarray(x[k - half:k + half + 1]).T for k in at.tolist()]
+        # gather's indices and its moved axes. The few samples' windows overlap: the rows
+        # they span are laid out once, each window a stretch of them.
+        ks = at.tolist()
+        lo = min(ks) - half
+        block = np.ascontiguousarray(x[lo:max(ks) + half + 1])
+        wins = [block[k - half - lo:k + half + 1 - lo].T for k in ks]
         return [np.array([w @ c for w in wins]) for c in cs]  # stacked: the same rows
     windows = np.moveaxis(x[at[:, None] + np.arange(-half, half + 1)], 1, -1)
     return [windows @ c for c in cs]
