@@ -233,7 +233,10 @@ def _carried(rec: Trajectory, cols: np.ndarray, grid: Grid
     if qd.shape != np.shape(rec.q) or qdd.shape != qd.shape:
         return None
     n = len(grid.t)
-    qd, qdd = qd[:n, cols], qdd[:n, cols]
+    # Every column in its own place (a compiled trajectory's): the rows as they are; the
+    # rest reads single values of them and sums none, so a view reads as the copy did.
+    every = len(cols) == qd.shape[1] and bool(np.all(cols == np.arange(len(cols))))
+    qd, qdd = (qd[:n], qdd[:n]) if every else (qd[:n, cols], qdd[:n, cols])
     if not (np.isfinite(qd).all() and np.isfinite(qdd).all()):
         return None
     return qd, qdd
