@@ -17,7 +17,7 @@ import pytest
 
 from aou_dsl.measuring import holds, onset
 from aou_dsl.measuring.episode_spread import _median
-from aou_dsl.measuring.episodes import Samples, _five, pieces, translation
+from aou_dsl.measuring.episodes import Samples, _five, _length, pieces, translation
 from aou_dsl.measuring.holds import _leading
 from aou_dsl.measuring.onset import (
     CLEAR,
@@ -186,6 +186,16 @@ def test_hold_test_without_a_gap_is_the_test_of_every_row():
         assert got[:2] == want[:2]
         moved += got[:2] != (t0, t1)
     assert moved >= 20  # holds cut short by a joint beyond its band
+
+
+def test_length_is_numpys_norm_in_either_layout():
+    rng = np.random.default_rng(28)
+    for _ in range(200):
+        x = rng.normal(size=(50, 3)) * 10.0 ** rng.integers(-8, 8, size=(50, 3))
+        x[rng.random(x.shape) < 0.05] = -0.0
+        for rows in (x, np.asfortranarray(x)):  # a row of positions laid out by columns
+            for v in (rows[7], rows[7] - rows[3], rows[:, 1], rows[5, ::-1]):
+                assert _length(v) == float(np.linalg.norm(v))
 
 
 def test_five_samples_are_numpys_unique_clipped_linspace():
