@@ -28,7 +28,7 @@ import numpy as np
 
 from .extrema import maxima
 from .onset import REST_SPEED, carried_edge, soft_pause
-from .rest import CLEARLY, LONG_WINDOW, Rest, rest_at_end, rest_signals
+from .rest import CLEARLY, LONG_WINDOW, Rest, leading, rest_at_end, rest_signals
 from .signal import NOISE_SIGMAS, line_fit, median0, odd, row_max, runs
 
 __all__ = ["MIN_PAUSE", "REST_SPEED", "Boundary", "Rest", "boundaries", "rest_at_end",
@@ -233,26 +233,13 @@ def _crossings(r: Rest) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         ahead = pair > lead
         j[ahead] = k
         np.maximum(lead, pair, out=lead)
-    va, vb = _leading(r.v, j, 0), _leading(r.v, j, 1)
+    va, vb = leading(r.v, j, 0), leading(r.v, j, 1)
     idx = np.flatnonzero(va * vb < 0)
     j = j[idx]
     frac = (va[idx] / (va[idx] - vb[idx]))[:, None]
     v = r.v[idx] + frac * (r.v[idx + 1] - r.v[idx])
     thr = r.thr[idx] + frac * (r.thr[idx + 1] - r.thr[idx])
     return idx, j, np.max(np.abs(v) / thr, axis=1)
-
-
-def _leading(v: np.ndarray, j: np.ndarray, shift: int) -> np.ndarray:
-    """``v[np.arange(len(j)) + shift, j]``: each row's (from row ``shift`` on) joint ``j``,
-    taken from the samples in the order they lie (by rows or by columns): the same
-    values, without a look-up over both axes at once."""
-    n, cols = v.shape
-    rows = np.arange(shift, shift + len(j))
-    if v.flags.c_contiguous:
-        return v.ravel().take(rows * cols + j)
-    if v.flags.f_contiguous:
-        return v.ravel("F").take(j * n + rows)
-    return v[rows, j]
 
 
 def _dips(r: Rest, taken: np.ndarray) -> list[tuple[float, float, int]]:
@@ -395,30 +382,24 @@ def _held(r: Rest, t0: float, t1: float
     """The longest stretch of ``t0``..``t1`` in which the joints stay within their noise
     of one position (the one they hold in its middle third): a pause is a hold. The
     speed of a motion can hide under the noise for a while (the soft ends of two
-    shivers back to back); its positions cannot. Also, when the joints' positions are
-    tested as they are (no filter), that position and the grid samples (inclusive) it
-    was held over: :func:`.onset.held_at` of them, for :func:`.onset.soft_pause`."""
+    shivers back to back); its positions cannot. Also, for positions tested unfiltered,
+    the held one and its grid samples (inclusive), for :func:`.onset.soft_pause`."""
     k0 = int(np.searchsorted(r.t, t0, "left"))
     k1 = int(np.searchsorted(r.t, t1, "right"))
     p = r.held(k0, k1)
     if len(p) < 3:
         return t0, t0, None
-    # Across a logging gap fewer raw samples make each filtered value: more noise. A log
-    # without a gap scales every row by exactly 1: one row, the same for every sample.
+    # A gap leaves fewer raw samples per filtered value (more noise); none scales by 1.
     band = HELD_SIGMAS * r.noise * r.held_gain
-    band = (band if r.gapless else band * r.sparse[k0:k1, None]) + 1.01 * r.quantum \
-        + STILL_ANGLE
+    band = (band if r.gapless else band * r.sparse[k0:k1, None]) + 1.01 * r.quantum + STILL_ANGLE
     third = len(p) // 3
     ref = median0(p[third:len(p) - third])
     inside = ~row_max(np.abs(p - ref) > band)  # every joint near (by columns: rows are short)
-    if inside.all():  # the usual: one run, the whole stretch
-        a, b = 0, len(inside) - 1
-    else:
-        # A brief excursion inside is noise (a logging gap); one at an end is motion.
-        for a, b in runs(~inside):
-            if a > 0 and b < len(inside) - 1 and b - a < r.window:
-                inside[a:b + 1] = True
-        a, b = max(runs(inside), key=lambda ab: ab[1] - ab[0], default=(0, -1))
+    # A brief excursion inside is noise (a logging gap); one at an end is motion.
+    for a, b in runs(~inside):
+        if a > 0 and b < len(inside) - 1 and b - a < r.window:
+            inside[a:b + 1] = True
+    a, b = max(runs(inside), key=lambda ab: ab[1] - ab[0], default=(0, -1))
     if b < a:
         return t0, t0, None
     return (t0 if a == 0 else float(r.t[k0 + a]),

@@ -63,6 +63,8 @@ def runs(mask: np.ndarray) -> list[tuple[int, int]]:
     """Inclusive index ranges of the True runs of ``mask``."""
     if not mask.any():
         return []
+    if mask.all():  # one run: the whole of it (a hold held throughout)
+        return [(0, len(mask) - 1)]
     d = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
     starts = np.flatnonzero(d == 1)
     ends = np.flatnonzero(d == -1) - 1

@@ -18,7 +18,6 @@ import pytest
 from aou_dsl.measuring import holds, onset
 from aou_dsl.measuring.episode_spread import _median
 from aou_dsl.measuring.episodes import Samples, _five, _length, pieces, translation
-from aou_dsl.measuring.holds import _leading
 from aou_dsl.measuring.onset import (
     CLEAR,
     FIT_SHAPE,
@@ -37,6 +36,7 @@ from aou_dsl.measuring.onset import (
     soft_edge,
     soft_pause,
 )
+from aou_dsl.measuring.rest import leading as _leading
 from aou_dsl.measuring.signal import _uniform
 
 
