@@ -28,6 +28,7 @@ import numpy as np
 from ..core.codes import R403
 from ..lang.descriptors import REGISTRY, EpisodeValues, qualify, spread
 from .recognisers import every_named, extra_descriptors
+from .signal import median0
 
 __all__ = ["beyond_noise", "episode_noise", "per_episode", "unequal"]
 
@@ -39,8 +40,9 @@ def per_episode(episodes: list[EpisodeValues]) -> dict[str, list[float]]:
     """Per non-count descriptor, the eleven's and the plugins', the values of the
     episodes it aggregates."""
     out = spread(episodes)
-    eps = qualify(episodes)
-    for d in extra_descriptors():
+    extra = extra_descriptors()
+    eps = qualify(episodes) if extra else []  # without plugins, nothing more to read
+    for d in extra:
         vals = [float(e.values[d.key]) for e in eps
                 if e.kind == d.kind and e.counts and d.key in e.values]
         if vals and not d.is_count:
@@ -51,7 +53,15 @@ def per_episode(episodes: list[EpisodeValues]) -> dict[str, list[float]]:
 def unequal(table: Mapping, name: str, vals: list[float], margin: float = 0.0) -> bool:
     """Whether the episodes' values differ by more than the descriptor's tolerance, and
     by ``margin`` more."""
-    return max(vals) - min(vals) - margin > table[name].tolerance(float(np.median(vals)))
+    return max(vals) - min(vals) - margin > table[name].tolerance(_median(vals))
+
+
+def _median(vals: list[float]) -> float:
+    """``float(np.median(vals))``: of finite values, the middle one or the mean of the
+    middle two (as median0 takes it, NumPy's number); otherwise NumPy's own."""
+    if all(math.isfinite(v) for v in vals):
+        return float(median0(np.asarray(vals, float)))
+    return float(np.median(vals))
 
 
 def beyond_noise(m, copies: list, t95: Mapping[int, float]) -> None:

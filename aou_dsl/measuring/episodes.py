@@ -129,9 +129,13 @@ def _anchor(c: Context, b: Boundary, side: int) -> tuple[np.ndarray, float]:
         # The samples from t0 + a quarter to t1 less a quarter (the times increase).
         k0 = int(np.searchsorted(t, b.t0 + 0.25 * (b.t1 - b.t0), "left"))
         k1 = int(np.searchsorted(t, b.t1 - 0.25 * (b.t1 - b.t0), "right"))
-        idx = np.arange(k0, k1) if k1 > k0 else np.arange(b.i0, b.i1 + 1)
-        # Gathered (a copy laid out by rows), not a view: the mean sums in that order.
-        return c.pos[idx].mean(axis=0), float(c.roll[idx].mean())
+        lo, hi = (k0, k1) if k1 > k0 else (b.i0, b.i1 + 1)
+        # Laid out by rows as a gather of them lays them (a view of rows laid out so,
+        # else a copy), not a view by columns: the mean sums in that order. Each mean is
+        # NumPy's: the sum along the samples over their count.
+        rows = np.ascontiguousarray(c.pos[lo:hi])
+        return (np.add.reduce(rows, axis=0) / (hi - lo),
+                float(np.add.reduce(np.ascontiguousarray(c.roll[lo:hi]))) / (hi - lo))
     tt = b.t0 if side < 0 else b.t1
     # Interpolated between the two samples around it, as over all of them (not copying
     # a column of the whole recording for each).
@@ -149,6 +153,16 @@ def pieces(c: Context, bounds: list[Boundary]) -> list[Piece | Boundary]:
     first = Boundary(float(t[0]), float(t[0]), 0, 0, False)
     last = Boundary(c.rest.t_last, c.rest.t_last, n - 1, n - 1, False)
     seq = [first, *bounds, last]
+    held: dict[int, tuple[np.ndarray, float]] = {}
+
+    def anchor(b: Boundary, side: int) -> tuple[np.ndarray, float]:
+        # A pause anchors the piece before it and the one after it alike: averaged once.
+        if not b.pause:
+            return _anchor(c, b, side)
+        if id(b) not in held:
+            held[id(b)] = _anchor(c, b, side)
+        return held[id(b)]
+
     for a, b in zip(seq[:-1], seq[1:], strict=True):
         if a.pause and a is not first:
             out.append(a)
@@ -157,8 +171,8 @@ def pieces(c: Context, bounds: list[Boundary]) -> list[Piece | Boundary]:
         i1 = int(np.searchsorted(t, tb, "right")) - 1
         if tb - ta <= 0 or i1 - i0 < 1:
             continue
-        p0, r0 = _anchor(c, a, +1) if a is not first else (c.pos_s[0], float(c.roll[0]))
-        p1, r1 = _anchor(c, b, -1) if b is not last else (c.pos_s[-1], float(c.roll[-1]))
+        p0, r0 = anchor(a, +1) if a is not first else (c.pos_s[0], float(c.roll[0]))
+        p1, r1 = anchor(b, -1) if b is not last else (c.pos_s[-1], float(c.roll[-1]))
         rest0 = a is not first or c.edge_rest[0]
         rest1 = b is not last or c.edge_rest[1]
         out.append(Piece(ta, tb, i0, i1, p0, p1, r0, r1, rest0, rest1,
@@ -173,26 +187,35 @@ def _bearing(a: np.ndarray, b: np.ndarray, normal: np.ndarray) -> float:
     return math.degrees(math.atan2(float(np.cross(a, b) @ normal), float(a @ b)))
 
 
+def _length(v: np.ndarray) -> float:
+    """``np.linalg.norm`` of the vector ``v``, the same number: the root of its dot
+    product with itself, laid out as norm lays it (without norm's general checks, on
+    the few vectors of every piece)."""
+    x = v.ravel(order="K")
+    return math.sqrt(float(x.dot(x)))
+
+
 def translation(c: Context, p: Piece, g0: np.ndarray | None) -> EpisodeValues | None:
     """An approach, retreat or gaze; None when the hand did not translate."""
     seg = c.pos_s[p.i0:p.i1 + 1]
     off = seg - p.p0  # the largest distance is the root of the largest square
     travel = max(float(np.sqrt(row_sum(off * off).max())),
-                 float(np.linalg.norm(p.p1 - p.p0)))
+                 _length(p.p1 - p.p0))
     if travel <= STILL_TRANSLATION:
         return None
     d = p.p1 - p.p0
     if c.goal is not None:
-        along = float(np.linalg.norm(c.goal - p.p1) - np.linalg.norm(c.goal - p.p0))
+        along = _length(c.goal - p.p1) - _length(c.goal - p.p0)
         along = -along  # positive: closer to the goal
     else:
         along = float(d @ c.rot[p.i0][:, 2])  # along the forward axis
     if abs(along) >= 0.7 * travel:
         kind = moved_along(along > 0)
-        u = d / max(float(np.linalg.norm(d)), 1e-12)
+        length = _length(d)
+        u = d / max(length, 1e-12)
         peak, sd = peak_acceleration(c, p, u)
         return EpisodeValues(kind, p.t0, p.t1, {
-            "distance": float(np.linalg.norm(d)), "peak_acceleration": peak,
+            "distance": length, "peak_acceleration": peak,
             "peak_acceleration_sd": sd})
     values: dict[str, float] = {}
     if c.goal is not None and g0 is not None:
@@ -231,10 +254,18 @@ def peak_acceleration(c: Context, p: Piece, u: np.ndarray) -> tuple[float, float
     k1 += int(p.held1 and k1 < len(src.t) - 1)
     t, x, q = src.t[k0:k1 + 1], src.pos[k0:k1 + 1] @ u, src.q[k0:k1 + 1]
     grid = r.t[p.i0:p.i1 + 1]
+    # Read on the grid's own clock, grid sample i is read sample i + i0 - k0 (the same
+    # time): where the search finds it when the sample beside it on the search's side
+    # holds another time (the first of equal times, or the last).
+    shift = p.i0 - k0 if c.raw is None else None
 
     def own(i: int, side: int) -> int:  # grid sample i of the piece, in its own samples
         if i == (0 if side < 0 else len(grid) - 1):
             return 0 if side < 0 else len(t) - 1
+        j = -1 if shift is None else i + shift
+        if 0 <= j < len(t) and ((j == 0 or t[j - 1] < t[j]) if side < 0
+                                else (j == len(t) - 1 or t[j + 1] > t[j])):
+            return j
         at = int(np.searchsorted(t, grid[i], "left" if side < 0 else "right"))
         return at if side < 0 else at - 1
 
@@ -259,7 +290,7 @@ def peak_acceleration(c: Context, p: Piece, u: np.ndarray) -> tuple[float, float
         return 0.0, 0.0
     peak = episode_peak(found)
     if peak.value > 0:
-        at = int(np.clip(np.searchsorted(r.t, peak.at), 0, len(r.t) - 1))
+        at = min(int(np.searchsorted(r.t, peak.at)), len(r.t) - 1)  # never below 0
         window = min(odd(peak.span / h), len(r.t) - (1 - len(r.t) % 2))
         _self_check(c, peak.value, at, max(window, 3), u, sigma_x, peak.sd)
     return peak.value, peak.sd
@@ -272,8 +303,7 @@ def _self_check(c: Context, peak: float, at: int, window: int, u: np.ndarray,
     from the joints' filtered velocities and accelerations over the same window."""
     n, h = len(c.rest.t), c.rest.h
     half = window // 2
-    near = np.unique(np.clip(np.linspace(at - half, at + half, 5).round().astype(int),
-                             half, n - 1 - half))
+    near = np.array(_five(at, half, n))
     q = c.q[near]
     qd, qdd = filters_at(c.q, window, (1, 2), h, near)
     joint_side = classical_acceleration(c.arm, q, qd, qdd) @ u
@@ -285,3 +315,13 @@ def _self_check(c: Context, peak: float, at: int, window: int, u: np.ndarray,
             f"is more than the joints' motion there produces ({bound:.4g} m/s^2); this is "
             "an error of the measurement, not a value", Span.whole_file(c.path),
             measured=peak, bound=bound))
+
+
+def _five(at: int, half: int, n: int) -> list[int]:
+    """The distinct samples, in order, of five spread evenly over ``at - half`` ..
+    ``at + half``, rounded half to even and kept ``half`` from either end of ``n``: as
+    ``np.unique(np.clip(np.linspace(at - half, at + half, 5).round().astype(int), half,
+    n - 1 - half))`` gives them. The five are ``at - half + k * half / 2``: whole or half
+    numbers, exact in binary, which ``round`` rounds half to even as NumPy does."""
+    return sorted({min(max(round(at - half + k * (half / 2)), half), n - 1 - half)
+                   for k in range(5)})

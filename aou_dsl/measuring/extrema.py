@@ -31,9 +31,13 @@ def maxima(x: np.ndarray, among: np.ndarray | None = None
     change = np.flatnonzero(x[1:] != x[:-1]) + 1
     starts = np.concatenate([[0], change])
     ends = np.concatenate([change - 1, [n - 1]])
-    crest = ((starts == 0) | (x[np.maximum(starts - 1, 0)] < x[starts])) & (
-        (ends == n - 1) | (x[np.minimum(ends + 1, n - 1)] < x[ends]))
-    peak = crest & (starts >= 1) & (ends <= n - 2)
+    # Neighbouring runs hold different values: a run is a crest when the step into it
+    # rises (or it starts ``x``) and the step out of it falls (or it ends ``x``); a peak
+    # is a crest at neither end.
+    up = x[change] > x[change - 1]
+    crest = np.concatenate([[True], up]) & np.concatenate([~up, [True]])
+    peak = crest.copy()
+    peak[0] = peak[-1] = False
     first, last = starts[peak], ends[peak]
     if among is not None:
         asked = among[(first + last) // 2]

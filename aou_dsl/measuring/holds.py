@@ -28,7 +28,7 @@ import numpy as np
 
 from .extrema import maxima
 from .onset import REST_SPEED, carried_edge, soft_pause
-from .rest import CLEARLY, LONG_WINDOW, Rest, rest_at_end, rest_signals
+from .rest import CLEARLY, LONG_WINDOW, Rest, leading, rest_at_end, rest_signals
 from .signal import NOISE_SIGMAS, line_fit, median0, odd, row_max, runs
 
 __all__ = ["MIN_PAUSE", "REST_SPEED", "Boundary", "Rest", "boundaries", "rest_at_end",
@@ -233,8 +233,7 @@ def _crossings(r: Rest) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         ahead = pair > lead
         j[ahead] = k
         np.maximum(lead, pair, out=lead)
-    rows = np.arange(len(j))
-    va, vb = r.v[rows, j], r.v[rows + 1, j]
+    va, vb = leading(r.v, j, 0), leading(r.v, j, 1)
     idx = np.flatnonzero(va * vb < 0)
     j = j[idx]
     frac = (va[idx] / (va[idx] - vb[idx]))[:, None]
@@ -319,13 +318,13 @@ def boundaries(r: Rest) -> list[Boundary]:
         z0 = Zero(float(r.t[0]), False) if i0 == 0 else _ramp_zero(r, i0, -1, i1, i0 in slow)
         z1 = Zero(r.t_last, False) if i1 == n - 1 else _ramp_zero(r, i1, +1, i0, i1 in slow)
         t0, t1 = z0.at, z1.at
-        h0, h1 = _held(r, t0, t1) if t1 - t0 >= MIN_PAUSE else (t0, t0)
+        h0, h1, ref = _held(r, t0, t1) if t1 - t0 >= MIN_PAUSE else (t0, t0, None)
         if h1 - h0 >= max(MIN_PAUSE, 0.5 * (t1 - t0)):
             # Motion too slow to see in the speed but not in the positions (the soft
             # start of a shiver) is no part of the hold. What is left of it may be too
             # short for a pause: the whole rest was a shiver's soft end or start,
             # hidden under the noise, and it is the instant between two episodes.
-            a, b = soft_pause(r.t, r.q, r.noise, (max(t0, h0), min(t1, h1)))
+            a, b = soft_pause(r.t, r.q, r.noise, (max(t0, h0), min(t1, h1)), ref)
             if b - a >= MIN_PAUSE:
                 out.append(Boundary(a, b, i0, i1, True))
                 continue
@@ -378,19 +377,21 @@ def _passing(r: Rest, z0: Zero, z1: Zero, i0: int, i1: int) -> tuple[float, bool
     return (hi, agree) if hi < r.t[i0] - margin else None
 
 
-def _held(r: Rest, t0: float, t1: float) -> tuple[float, float]:
+def _held(r: Rest, t0: float, t1: float
+          ) -> tuple[float, float, tuple[tuple[int, int], np.ndarray] | None]:
     """The longest stretch of ``t0``..``t1`` in which the joints stay within their noise
     of one position (the one they hold in its middle third): a pause is a hold. The
     speed of a motion can hide under the noise for a while (the soft ends of two
-    shivers back to back); its positions cannot."""
+    shivers back to back); its positions cannot. Also, for positions tested unfiltered,
+    the held one and its grid samples (inclusive), for :func:`.onset.soft_pause`."""
     k0 = int(np.searchsorted(r.t, t0, "left"))
     k1 = int(np.searchsorted(r.t, t1, "right"))
     p = r.held(k0, k1)
     if len(p) < 3:
-        return t0, t0
-    # Across a logging gap fewer raw samples make each filtered value: more noise.
-    band = (HELD_SIGMAS * r.noise * r.held_gain * r.sparse[k0:k1, None] + 1.01 * r.quantum
-            + STILL_ANGLE)
+        return t0, t0, None
+    # A gap leaves fewer raw samples per filtered value (more noise); none scales by 1.
+    band = HELD_SIGMAS * r.noise * r.held_gain
+    band = (band if r.gapless else band * r.sparse[k0:k1, None]) + 1.01 * r.quantum + STILL_ANGLE
     third = len(p) // 3
     ref = median0(p[third:len(p) - third])
     inside = ~row_max(np.abs(p - ref) > band)  # every joint near (by columns: rows are short)
@@ -400,9 +401,10 @@ def _held(r: Rest, t0: float, t1: float) -> tuple[float, float]:
             inside[a:b + 1] = True
     a, b = max(runs(inside), key=lambda ab: ab[1] - ab[0], default=(0, -1))
     if b < a:
-        return t0, t0
+        return t0, t0, None
     return (t0 if a == 0 else float(r.t[k0 + a]),
-            t1 if b == len(p) - 1 else float(r.t[k0 + b]))
+            t1 if b == len(p) - 1 else float(r.t[k0 + b]),
+            ((k0, k1 - 1), ref) if r.window <= 3 else None)
 
 
 def _merged(bounds: list[Boundary]) -> list[Boundary]:

@@ -233,7 +233,10 @@ def _carried(rec: Trajectory, cols: np.ndarray, grid: Grid
     if qd.shape != np.shape(rec.q) or qdd.shape != qd.shape:
         return None
     n = len(grid.t)
-    qd, qdd = qd[:n, cols], qdd[:n, cols]
+    # Every column in its own place (a compiled trajectory's): the rows as they are; the
+    # rest reads single values of them and sums none, so a view reads as the copy did.
+    every = len(cols) == qd.shape[1] and bool(np.all(cols == np.arange(len(cols))))
+    qd, qdd = (qd[:n], qdd[:n]) if every else (qd[:n, cols], qdd[:n, cols])
     if not (np.isfinite(qd).all() and np.isfinite(qdd).all()):
         return None
     return qd, qdd
@@ -264,8 +267,9 @@ def _edge_rest(rec: Trajectory, rest: Rest) -> tuple[bool, bool]:
     qd = rec.qd
     if qd is None or np.shape(qd) != np.shape(rec.q) or not np.isfinite(qd).all():
         return rest_at_end(rest, last=False), rest_at_end(rest, last=True)
-    speed = np.abs(np.asarray(qd, float))
-    return bool(speed[0].max() <= REST_SPEED), bool(speed[-1].max() <= REST_SPEED)
+    qd = np.asarray(qd, float)  # the first and the last row's speeds, not every row's
+    return (bool(np.abs(qd[0]).max() <= REST_SPEED),
+            bool(np.abs(qd[-1]).max() <= REST_SPEED))
 
 
 def _episodes(ctx: Context, parts: list[Piece | Boundary],

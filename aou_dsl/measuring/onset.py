@@ -72,32 +72,43 @@ def soft_edge(t: np.ndarray, q: np.ndarray, noise: np.ndarray, hold: tuple[int, 
     position (:func:`held_at`), when the other edge's call has found it."""
     n = len(t)
     h0, h1 = hold
-    if h1 - h0 < 4 or not np.any(noise > 0):
+    noisy = noise > 0
+    if h1 - h0 < 4 or not noisy.any():
         return None
     h = float(t[1] - t[0])
     if ref is None:
         ref = held_at(q, hold)
     edge = h1 if step > 0 else h0
     reach = int(round(MOTION_SPAN / h))
-    far = int(np.clip(edge + step * reach, 0, n - 1))
-    side = np.arange(edge, far + step, step)
-    if len(side) < 4:
+    far = min(max(edge + step * reach, 0), n - 1)
+    if abs(far - edge) + 1 < 4:  # the samples edge, edge + step, .. far
         return None
-    # The same samples as a view (``side`` runs one way from the edge): no copies.
+    # The same samples as a view (they run one way from the edge): no copies.
     rows = slice(edge, far + step if far + step >= 0 else None, step)
-    sig = np.where(noise > 0, noise, np.inf)
-    z = np.abs(q[rows] - ref) / sig
-    j = int(np.argmax(z.max(axis=0)))
-    clear = np.flatnonzero(z[:, j] > CLEAR)
-    if not np.isfinite(sig[j]) or len(clear) == 0:
+    sig = np.where(noisy, noise, np.inf)
+    away = q[rows] - ref
+    # The joint that moves furthest in its noise. Dividing by a positive number keeps
+    # the order of what it divides, so each joint's largest deviation over its noise is
+    # its largest deviation divided by its noise: the same number, dividing n values
+    # instead of all of them; a joint without noise (inf) gives 0 as each of its would.
+    most = np.abs(away).max(axis=0)
+    j = int(np.argmax(most / sig))
+    if not noisy[j]:
         return None
-    d = (q[rows, j] - ref[j]) * np.sign(q[side[clear[0]], j] - ref[j])
+    dev = away[:, j]  # the joint's deviation from the hold, as every joint's above
+    clear = np.flatnonzero(np.abs(dev) / sig[j] > CLEAR)
+    if len(clear) == 0:
+        return None
+    first = int(clear[0])
+    d = dev * np.sign(dev[first])
     # The first lobe: up to where the deviation first swings back through the hold; the
     # onset is the part of it under ONSET_TOP of its top.
-    back = np.flatnonzero(d[clear[0]:] < 0.0)
-    top = float(d[clear[0]:clear[0] + (back[0] if len(back) else len(d))].max())
-    if top < LOBE * float(np.abs(d).max()) or _swings(d[clear[0]:], SWING * top) < 2:
+    back = np.flatnonzero(d[first:] < 0.0)
+    top = float(d[first:first + (back[0] if len(back) else len(d))].max())
+    # |d| is |dev| (a change of sign is exact): its largest is the joint's found above.
+    if top < LOBE * float(most[j]) or _swings(d[first:], SWING * top) < 2:
         return None  # no oscillation: a motion's velocity ramp gives its edge
+    side = np.arange(edge, far + step, step)
     end = clear[0] + int(np.argmax(d[clear[0]:] >= ONSET_TOP * top))
     end = max(end, clear[0])
     inside = int(min(round(HOLD_SPAN / h), h1 - h0))
@@ -166,27 +177,30 @@ def _angular(t: np.ndarray, d: np.ndarray, first: int, back: int) -> float | Non
 
 
 def _swings(d: np.ndarray, level: float) -> int:
-    """How many times ``d`` crosses from beyond ``level`` on one side to beyond it on
-    the other."""
-    side = np.sign(d) * (np.abs(d) > level)
-    side = side[side != 0]
-    return int(np.count_nonzero(np.diff(side)))
+    """How many times ``d`` crosses from beyond ``level`` (> 0) on one side to beyond it
+    on the other: the changes of side among the samples beyond it."""
+    up = d[np.abs(d) > level] > 0
+    return int(np.count_nonzero(up[1:] != up[:-1]))
 
 
-def soft_pause(t: np.ndarray, q: np.ndarray, noise: np.ndarray, span: tuple[float, float]
+def soft_pause(t: np.ndarray, q: np.ndarray, noise: np.ndarray, span: tuple[float, float],
+               known: tuple[tuple[int, int], np.ndarray] | None = None
                ) -> tuple[float, float]:
     """The hold from ``span[0]`` to ``span[1]`` [s] with each edge that borders an
     oscillation moved to where the oscillation leaves or reaches the held position
     (:func:`soft_edge`). The result may be short, or empty (its end before its start):
     then the rest was the oscillation's soft start or end, hidden under the noise, and
-    no pause."""
+    no pause. ``known``: grid samples (inclusive) and the position :func:`held_at` gives
+    for them, when the caller has found it."""
     a, b = span
     k0 = int(np.searchsorted(t, a, "left"))
     k1 = int(np.searchsorted(t, b, "right")) - 1
     if k1 - k0 < 4:
         return a, b
-    # Both edges look from one held position: found once.
-    ref = held_at(q, (k0, k1)) if np.any(noise > 0) and (k0 > 0 or k1 < len(t) - 1) else None
+    # Both edges look from one held position: found once (or known already).
+    ref = None
+    if np.any(noise > 0) and (k0 > 0 or k1 < len(t) - 1):
+        ref = known[1] if known is not None and known[0] == (k0, k1) else held_at(q, (k0, k1))
     if k0 > 0:
         edge = soft_edge(t, q, noise, (k0, k1), -1, ref)
         a = a if edge is None else edge

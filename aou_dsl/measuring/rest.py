@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -13,7 +14,7 @@ from ..core.memo import cached
 from .onset import REST_SPEED
 from .signal import NOISE_SIGMAS, odd, row_max, sg_coefficients, slope_gain, smooth, smooth_rows
 
-__all__ = ["CLEARLY", "LONG_WINDOW", "Rest", "rest_at_end", "rest_signals"]
+__all__ = ["CLEARLY", "LONG_WINDOW", "Rest", "leading", "rest_at_end", "rest_signals"]
 
 #: A joint is clearly moving at this many times its rest threshold (16 noise std).
 CLEARLY = 3.0
@@ -65,6 +66,11 @@ class Rest:
     held_gain: float
     sparse: np.ndarray
     carried: tuple[np.ndarray, np.ndarray] | None = None
+
+    @cached_property
+    def gapless(self) -> bool:
+        """Whether the log has no gap: ``sparse`` is exactly 1 at every sample."""
+        return bool(np.all(self.sparse == 1.0))
 
     def held(self, k0: int, k1: int) -> np.ndarray:
         """Joint positions filtered over ``window`` (raw for clean data) on samples
@@ -136,6 +142,19 @@ def _kernel(window: int, h: float, size: int) -> np.ndarray:
     out = np.fft.rfft(sg_coefficients(window, 1, 1, h)[::-1], size)
     out.flags.writeable = False
     return out
+
+
+def leading(v: np.ndarray, j: np.ndarray, shift: int) -> np.ndarray:
+    """``v[np.arange(len(j)) + shift, j]``: each row's (from row ``shift`` on) joint ``j``,
+    taken from the samples in the order they lie (by rows or by columns): the same
+    values, without a look-up over both axes at once."""
+    n, cols = v.shape
+    rows = np.arange(shift, shift + len(j))
+    if v.flags.c_contiguous:
+        return v.ravel().take(rows * cols + j)
+    if v.flags.f_contiguous:
+        return v.ravel("F").take(j * n + rows)
+    return v[rows, j]
 
 
 def rest_at_end(r: Rest, last: bool) -> bool:

@@ -29,6 +29,7 @@ __all__ = ["savgol", "savgol_1d", "savgol_rows", "savgol_weights"]
 _MIRROR_TOLERANCE = float(np.finfo(float).eps)
 #: Values filtered at a time (rows times columns): a few hundred kilobytes.
 _BLOCK = 1 << 15
+_EPS = float(np.finfo(np.float64).eps)
 
 
 @cached(maxsize=256)
@@ -53,7 +54,7 @@ def savgol_weights(window: int, order: int, deriv: int, delta: float,
     design = offsets ** np.arange(order + 1, dtype=np.float64).reshape(-1, 1)
     target = np.zeros(order + 1)
     target[deriv] = float(math.factorial(deriv)) / (delta ** deriv)
-    rcond = np.finfo(np.float64).eps * max(design.shape)
+    rcond = _EPS * max(design.shape)
     weights = np.linalg.lstsq(design, target, rcond=rcond)[0]
     return _frozen(weights[::-1].copy() if reverse else weights)
 
@@ -190,9 +191,8 @@ def _fit_end(x: np.ndarray, out: np.ndarray, window: slice, place: slice, order:
     seg = x[window].reshape(window.stop - window.start, -1)
     coeffs = _polyfit(seg, order)
     coeffs = _derivative(coeffs, deriv)
-    at = np.arange(place.start - window.start, place.stop - window.start,
-                   dtype=np.float64).reshape(-1, 1)
-    values = np.zeros_like(at)
+    at = _places(place.start - window.start, place.stop - window.start)
+    values = np.zeros(at.shape)
     for row in coeffs:  # Horner's scheme, highest power first
         values = values * at + row
     out[place.start - offset:place.stop - offset] = (values / (delta ** deriv)).reshape(
@@ -203,7 +203,7 @@ def _polyfit(y: np.ndarray, order: int) -> np.ndarray:
     """Coefficients (highest power first, one column per column of ``y``) of the
     least-squares polynomial through ``(k, y[k])``, ``k = 0, 1, 2, ...``."""
     lhs, scale = _edge_design(len(y), order)
-    rcond = len(y) * np.finfo(np.float64).eps
+    rcond = len(y) * _EPS
     coeffs = np.linalg.lstsq(lhs, y, rcond=rcond)[0]
     return (coeffs.T / scale).T
 
@@ -230,7 +230,21 @@ def _derivative(coeffs: np.ndarray, deriv: int) -> np.ndarray:
     if n <= deriv:
         return np.zeros_like(coeffs[:1])
     out = coeffs[:-deriv].copy()
-    for k in range(deriv):
-        powers = np.arange(n - k - 1, deriv - k - 1, -1, dtype=np.float64)
+    for powers in _powers(n, deriv):
         out *= powers.reshape((n - deriv,) + (1,) * (out.ndim - 1))
     return out
+
+
+@cached(maxsize=64)
+def _powers(n: int, deriv: int) -> tuple[np.ndarray, ...]:
+    """The factors :func:`_derivative` multiplies the top ``n - deriv`` coefficients of
+    a polynomial with ``n`` by, one array per differentiation (read-only: cached)."""
+    return tuple(_frozen(np.arange(n - k - 1, deriv - k - 1, -1, dtype=np.float64))
+                 for k in range(deriv))
+
+
+@cached(maxsize=64)
+def _places(start: int, stop: int) -> np.ndarray:
+    """The offsets ``start .. stop - 1`` into an end's window where the filter takes
+    that end's fit, as a column (read-only: cached)."""
+    return _frozen(np.arange(start, stop, dtype=np.float64).reshape(-1, 1))

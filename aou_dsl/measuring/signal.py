@@ -63,6 +63,8 @@ def runs(mask: np.ndarray) -> list[tuple[int, int]]:
     """Inclusive index ranges of the True runs of ``mask``."""
     if not mask.any():
         return []
+    if mask.all():  # one run: the whole of it (a hold held throughout)
+        return [(0, len(mask) - 1)]
     d = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
     starts = np.flatnonzero(d == 1)
     ends = np.flatnonzero(d == -1) - 1
@@ -220,9 +222,9 @@ def to_grid(t: np.ndarray, q: np.ndarray, window: float) -> Grid:
     """
     t = t - t[0]
     steps = np.diff(t)
-    h = float(np.median(steps))
+    h = float(median0(steps))  # np.median's number (a checked clock: finite)
     t_last = float(t[-1])
-    if np.allclose(steps[:-1], h, rtol=1e-6, atol=1e-9):
+    if _uniform(steps[:-1], h):
         ones = np.ones(len(t))
         if abs(steps[-1] - h) < 1e-9 or len(t) < 4:
             return Grid(t, q, h, ones, t_last, False)
@@ -242,6 +244,13 @@ def to_grid(t: np.ndarray, q: np.ndarray, window: float) -> Grid:
     hi = np.clip(np.arange(n) + half + 1, 0, n)
     density = (total[hi] - total[lo]) / (hi - lo)
     return Grid(tg, qg, h, np.maximum(density, 1.0 / (2 * half + 1)), t_last, True)
+
+
+def _uniform(steps: np.ndarray, h: float) -> bool:
+    """``np.allclose(steps, h, rtol=1e-6, atol=1e-9)`` of finite ``steps``: whether each
+    differs from ``h`` by at most ``1e-9 + 1e-6 * |h|`` (the same bound, in the same
+    arithmetic; a step equal to ``h`` is within it), so whether the largest does."""
+    return float(np.abs(steps - h).max()) <= 1e-9 + 1e-6 * abs(h)
 
 
 def smooth(x: np.ndarray, window: int, deriv: int, h: float, order: int = 3,
@@ -296,9 +305,13 @@ def filters_at(x: np.ndarray, window: int, derivs: tuple[int, ...], h: float,
     if x.ndim == 2 and len(at):
         # Each window a stretch of the rows laid out by rows (a view of rows laid out
         # so, else a copy), as the gathered windows lie: the same product, without the
-        # gather's indices and its moved axes.
-        wins = [np.ascontiguousarray(x[k - half:k + half + 1]).T for k in at.tolist()]
-        return [np.stack([w @ c for w in wins]) for c in cs]
+        # gather's indices and its moved axes. The few samples' windows overlap: the rows
+        # they span are laid out once, each window a stretch of them.
+        ks = at.tolist()
+        lo = min(ks) - half
+        block = np.ascontiguousarray(x[lo:max(ks) + half + 1])
+        wins = [block[k - half - lo:k + half + 1 - lo].T for k in ks]
+        return [np.array([w @ c for w in wins]) for c in cs]  # stacked: the same rows
     windows = np.moveaxis(x[at[:, None] + np.arange(-half, half + 1)], 1, -1)
     return [windows @ c for c in cs]
 

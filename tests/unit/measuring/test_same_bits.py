@@ -149,10 +149,13 @@ def test_filter_at_equals_the_gathered_windows_in_either_layout():
     for q in (x, np.asfortranarray(x), np.asfortranarray(x)[:-1], x[::1, :3]):
         for window in (3, 5, 61, 301, 1001):
             half = window // 2
-            at = np.sort(rng.integers(half, len(q) - half, 5))
-            gathered = np.moveaxis(q[at[:, None] + np.arange(-half, half + 1)], 1, -1)
-            want = [gathered @ sg_coefficients(window, 3, d, 0.001) for d in (1, 2)]
-            for d in (1, 2):
-                assert np.array_equal(filter_at(q, window, d, 0.001, at), want[d - 1])
-            both = filters_at(q, window, (1, 2), 0.001, at)
-            assert all(np.array_equal(g, w) for g, w in zip(both, want, strict=True))
+            spread = np.sort(rng.integers(half, len(q) - half, 5))
+            k = int(rng.integers(2 * half, len(q) - 2 * half))  # the self-check's five:
+            close = np.unique(np.linspace(k - half, k + half, 5).round().astype(int))
+            for at in (spread, close, close[::-1]):  # windows overlapping, in any order
+                gathered = np.moveaxis(q[at[:, None] + np.arange(-half, half + 1)], 1, -1)
+                want = [gathered @ sg_coefficients(window, 3, d, 0.001) for d in (1, 2)]
+                for d in (1, 2):
+                    assert np.array_equal(filter_at(q, window, d, 0.001, at), want[d - 1])
+                both = filters_at(q, window, (1, 2), 0.001, at)
+                assert all(np.array_equal(g, w) for g, w in zip(both, want, strict=True))
