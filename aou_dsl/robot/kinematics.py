@@ -113,8 +113,7 @@ class ArmModel:
         chain = self._chain
         if chain is None:
             return None
-        q, qd, qdd = (np.ascontiguousarray(np.atleast_2d(np.asarray(x, dtype=float)).T)
-                      for x in (q, qd, qdd))
+        q, qd, qdd = _samples_last(q, qd, qdd)
         n = q.shape[1]
         # Over the rows at once, samples last: vectors (3, n); rotations by their columns,
         # (3, 3, n) with cols[k, i] row i of column k. A fixed placement is then one
@@ -169,8 +168,7 @@ class ArmModel:
         turns = self._turns
         if turns is None:
             return None
-        q, qd, qdd = (np.ascontiguousarray(np.atleast_2d(np.asarray(x, dtype=float)).T)
-                      for x in (q, qd, qdd))
+        q, qd, qdd = _samples_last(q, qd, qdd)
         n = q.shape[1]
         # Per link, (3, 3, n): w, alpha and a, each (3, n) in the link's axes; None for
         # the base (at rest).
@@ -207,6 +205,13 @@ class ArmModel:
         acc = v[2] + skew @ v[1] + w * (p @ w) - np.multiply.outer(p, np.einsum(
             "ij,ij->j", w, w))
         return np.sqrt(np.einsum("ij,ij->j", acc, acc))
+
+
+def _samples_last(*rows: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Each (N, n) array of rows as (n, N), contiguous: a joint's values over the
+    samples in a row of their own."""
+    return tuple(np.ascontiguousarray(np.atleast_2d(np.asarray(x, dtype=float)).T)
+                 for x in rows)
 
 
 def _times(cols: np.ndarray, v: np.ndarray) -> np.ndarray:
