@@ -244,3 +244,58 @@ def test_an_output_onto_an_input_is_refused_under_jobs_before_any_work(tmp_path)
                  "--jobs", "2", "--rate", "100"]) != 0
     assert (src / "curious.aou").read_bytes() == before
     assert sorted(p.name for p in out.iterdir()) == ["hesitant.json"]
+
+
+class _Recorder:
+    """A pool that records what it is handed and finishes nothing by itself."""
+
+    def __init__(self):
+        from concurrent.futures import Future
+
+        self.started = [Future()]
+        self.handed: list[tuple[str, ...]] = []
+        self.futures: list = []
+        self._future = Future
+
+    def submit(self, fn, lints, *args):
+        self.handed.append(tuple(lint.path for lint in lints))
+        f = self._future()
+        self.futures.append(f)
+        return f
+
+
+def test_a_warm_worker_holds_two_groups_the_longest_first(tmp_path):
+    """The worker always has its next group waiting while it builds one: two at its
+    start, one more as each comes back, longest first; this process takes the
+    shortest."""
+    names = ("hesitant", "curious", "inactive", "confident", "fearful")
+    paths = []
+    for name in names:
+        shutil.copy(BEHAVIOURS / f"{name}.aou", tmp_path / f"{name}.aou")
+        paths.append(str(tmp_path / f"{name}.aou"))
+    lints = [lint_file(p) for p in paths]
+    groups = batch._groups(lints)
+    recorder = _Recorder()
+    queue = batch._Queue(lints, groups, OPTIONS, None, recorder)
+    queue.start()
+    assert recorder.handed == []  # not before the worker is warm
+    recorder.started[0].set_result(1234)
+    longest = [tuple(paths[k] for k in g) for g in groups]
+    assert recorder.handed == longest[:2]
+    assert queue.shortest() == groups[-1]  # this process builds from the other end
+    recorder.futures[0].set_result([])
+    assert recorder.handed == longest[:3]
+    recorder.futures[1].set_result([])
+    recorder.futures[2].set_result([])
+    assert recorder.handed == longest[:4]  # the fifth was taken here
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="pipe sizes are Linux's")
+def test_the_pool_gives_its_results_a_megabyte_of_pipe():
+    """A worker writes a result (about a megabyte for hesitant) whole before it takes its
+    next file: through a pipe of 64 KiB it waited for this process to read each part."""
+    import fcntl
+
+    with pool.BuildPool(1, robots=(), options=OPTIONS) as p:
+        writer = p._pool._result_queue._writer
+        assert fcntl.fcntl(writer.fileno(), fcntl.F_GETPIPE_SZ) >= pool._RESULT_PIPE
