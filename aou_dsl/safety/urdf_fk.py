@@ -17,7 +17,7 @@ from ..core.codes import R402
 from ..core.diagnostics import AouError, Span, diag
 from ..core.memo import cached, file_digest
 
-__all__ = ["Chain", "chain_fk", "columns_fk", "rows_chain_fk", "urdf_chain"]
+__all__ = ["Chain", "chain_fk", "columns_fk", "urdf_chain"]
 
 
 @dataclass(frozen=True)
@@ -200,9 +200,3 @@ def chain_fk(chain: Chain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     rotations (N, 3, 3) in the root link's frame."""
     pos, cols = columns_fk(chain, q)
     return pos, np.ascontiguousarray(cols.transpose(2, 1, 0))
-
-
-def rows_chain_fk(chain: Chain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`chain_fk` of the rows of ``q`` (N, n), each row's values those of any batch
-    of two rows or more holding it (:func:`~aou_dsl.robot.rows.by_rows`)."""
-    return chain_fk(chain, q)
